@@ -1,0 +1,9 @@
+//! urdf-inertia: correct `<inertial>` elements for URDF robot descriptions, computed from the collision
+//! geometry with Mirtich's polyhedral mass properties (1996).
+//!
+//! Data flows one way, each stage a module:
+//! URDF scan ([`urdf`]) → resolve and load geometry ([`mesh`]) → mass core ([`mass`]) →
+//! per-link composition ([`fill`]) → splice `<inertial>` into the original bytes ([`urdf::write`]).
+#![forbid(unsafe_code)]
+
+pub mod mass;

@@ -1,0 +1,712 @@
+//! The ten volume integrals of a closed polyhedron (Mirtich 1996, equations 18–27).
+//!
+//! Two kernels compute them in one walk over the boundary:
+//!
+//! * [`mirtich_polygons`] is the paper's algorithm (Figures 4–6): each face a planar polygon, projected
+//!   onto the coordinate plane that maximises `|n_γ|`, reduced by Green's theorem to line integrals.
+//! * [`triangle_integrals`] is the triangle-specialised path: the same divergence-theorem integrals, written
+//!   per triangle as the signed tetrahedron it spans with the reference point. It never divides, so it has
+//!   no projection choice to make. Ill-conditioned triangles (whose plane passes close to the reference
+//!   point relative to their size, as in thin plates and needles) are re-evaluated with error-free
+//!   products, so their tiny signed volume keeps its digits.
+//!
+//! Both integrate about a caller-chosen reference point `c` (vertices are shifted by `-c` on the fly), and
+//! both sum face contributions in blocks whose totals go into compensated (two-sum) accumulators.
+//! [`IntegrationOptions::paper`] reproduces the paper exactly: origin reference, plain summation.
+
+use std::ops::{Index, IndexMut};
+
+/// The ten integrals `T1, Tx, Ty, Tz, Tx², Ty², Tz², Txy, Tyz, Tzx` of a polyhedron about a reference point.
+///
+/// All are integrals of monomials of the coordinates relative to [`VolumeIntegrals::reference`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VolumeIntegrals {
+    /// ∫ 1 dV: the (signed) volume.
+    pub t1: f64,
+    /// ∫ x dV, ∫ y dV, ∫ z dV.
+    pub t: [f64; 3],
+    /// ∫ x² dV, ∫ y² dV, ∫ z² dV.
+    pub t2: [f64; 3],
+    /// ∫ xy dV, ∫ yz dV, ∫ zx dV.
+    pub tp: [f64; 3],
+    /// The point the coordinates were measured from.
+    pub reference: [f64; 3],
+    /// Low-order parts, in the order of [`VolumeIntegrals::to_array`]: each integral is the
+    /// double-double `hi + low` (all zero when summed plainly). They let the central tensor be rounded
+    /// once at the end.
+    pub low: [f64; 10],
+}
+
+/// How sums over faces are accumulated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Summation {
+    /// One running sum per integral, as in the paper.
+    Plain,
+    /// Blocks of faces summed plainly, block totals added with an error-free two-sum (Neumaier style).
+    Compensated,
+}
+
+/// Where the integrals are measured from and how they are summed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IntegrationOptions {
+    /// `None`: the centre of the vertices' bounding box (exact shifts for far-away meshes).
+    pub reference: Option<[f64; 3]>,
+    pub summation: Summation,
+    /// Re-evaluate ill-conditioned triangles with error-free products (triangle kernel only).
+    pub accurate_faces: bool,
+}
+
+impl IntegrationOptions {
+    /// The paper as published: integrals about the origin, plain running sums.
+    pub const fn paper() -> Self {
+        Self { reference: Some([0.0; 3]), summation: Summation::Plain, accurate_faces: false }
+    }
+
+    /// What urdf-inertia uses: about the bounding-box centre, compensated sums, accurate thin faces.
+    pub const fn accurate() -> Self {
+        Self { reference: None, summation: Summation::Compensated, accurate_faces: true }
+    }
+}
+
+impl Default for IntegrationOptions {
+    fn default() -> Self {
+        Self::accurate()
+    }
+}
+
+/// A face list in compressed form: face `i` is `indices[starts[i]..starts[i + 1]]`.
+///
+/// Faces are planar polygons with their vertices counter-clockwise seen from outside.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Polygons {
+    pub indices: Vec<u32>,
+    pub starts: Vec<u32>,
+}
+
+impl Polygons {
+    /// An empty face list.
+    pub fn new() -> Self {
+        Self { indices: Vec::new(), starts: vec![0] }
+    }
+
+    /// Faces all given as triangles.
+    pub fn from_triangles(tris: &[[u32; 3]]) -> Self {
+        let indices: Vec<u32> = tris.iter().flatten().copied().collect();
+        let starts = (0..=tris.len() as u32).map(|i| 3 * i).collect();
+        Self { indices, starts }
+    }
+
+    /// Appends one face.
+    pub fn push(&mut self, face: &[u32]) {
+        if self.starts.is_empty() {
+            self.starts.push(0);
+        }
+        self.indices.extend_from_slice(face);
+        self.starts.push(self.indices.len() as u32);
+    }
+
+    /// Number of faces.
+    pub fn len(&self) -> usize {
+        self.starts.len().saturating_sub(1)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The vertex indices of face `i`.
+    pub fn face(&self, i: usize) -> &[u32] {
+        &self.indices[self.starts[i] as usize..self.starts[i + 1] as usize]
+    }
+
+    /// Iterates over the faces.
+    pub fn iter(&self) -> impl Iterator<Item = &[u32]> + '_ {
+        (0..self.len()).map(move |i| self.face(i))
+    }
+
+    /// Reverses the orientation of face `i`.
+    pub fn reverse_face(&mut self, i: usize) {
+        let (a, b) = (self.starts[i] as usize, self.starts[i + 1] as usize);
+        self.indices[a..b].reverse();
+    }
+
+    /// Whether every face is a triangle.
+    pub fn all_triangles(&self) -> bool {
+        self.starts.windows(2).all(|w| w[1] - w[0] == 3)
+    }
+
+    /// Fan-triangulates every face (used by the health checks and the hull, not by the integrals).
+    pub fn triangles(&self) -> Vec<[u32; 3]> {
+        let mut out = Vec::with_capacity(self.indices.len());
+        for f in self.iter() {
+            for k in 1..f.len().saturating_sub(1) {
+                out.push([f[0], f[k], f[k + 1]]);
+            }
+        }
+        out
+    }
+}
+
+/// The centre of the axis-aligned bounding box of `vertices` (the origin for an empty slice).
+pub fn bounding_box_centre(vertices: &[[f64; 3]]) -> [f64; 3] {
+    if vertices.is_empty() {
+        return [0.0; 3];
+    }
+    let mut lo = vertices[0];
+    let mut hi = vertices[0];
+    for v in vertices {
+        for k in 0..3 {
+            lo[k] = lo[k].min(v[k]);
+            hi[k] = hi[k].max(v[k]);
+        }
+    }
+    // lo + (hi - lo)/2 stays inside [lo, hi] without overflow; the centre only has to be near the mesh.
+    [0, 1, 2].map(|k| lo[k] + 0.5 * (hi[k] - lo[k]))
+}
+
+/// Ten accumulators, summed either plainly or with compensation.
+#[derive(Debug, Clone, Copy)]
+struct Accumulator {
+    sum: [f64; 10],
+    comp: [f64; 10],
+    block: [f64; 10],
+    in_block: u32,
+    summation: Summation,
+}
+
+/// Faces per block before the block total is folded into the compensated sum.
+const BLOCK: u32 = 1;
+
+impl Accumulator {
+    fn new(summation: Summation) -> Self {
+        Self { sum: [0.0; 10], comp: [0.0; 10], block: [0.0; 10], in_block: 0, summation }
+    }
+
+    #[inline(always)]
+    fn add(&mut self, x: &[f64; 10]) {
+        match self.summation {
+            Summation::Plain => {
+                for k in 0..10 {
+                    self.sum[k] += x[k];
+                }
+            }
+            Summation::Compensated => {
+                for k in 0..10 {
+                    self.block[k] += x[k];
+                }
+                self.in_block += 1;
+                if self.in_block == BLOCK {
+                    self.flush();
+                }
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn flush(&mut self) {
+        for k in 0..10 {
+            let (s, e) = two_sum(self.sum[k], self.block[k]);
+            self.sum[k] = s;
+            self.comp[k] += e;
+            self.block[k] = 0.0;
+        }
+        self.in_block = 0;
+    }
+
+    /// The sums as double-doubles `(hi, lo)`.
+    fn total(mut self) -> ([f64; 10], [f64; 10]) {
+        self.flush();
+        let mut hi = [0.0; 10];
+        let mut lo = [0.0; 10];
+        for k in 0..10 {
+            let (h, l) = two_sum(self.sum[k], self.comp[k]);
+            hi[k] = h;
+            lo[k] = l;
+        }
+        (hi, lo)
+    }
+}
+
+/// Knuth's two-sum: `s + e == a + b` exactly, `s = fl(a + b)`.
+#[inline(always)]
+pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bb = s - a;
+    let e = (a - (s - bb)) + (b - bb);
+    (s, e)
+}
+
+/// Exact product: `p + e == a * b`.
+#[inline(always)]
+pub(crate) fn two_prod(a: f64, b: f64) -> (f64, f64) {
+    let p = a * b;
+    (p, a.mul_add(b, -p))
+}
+
+/// Error-free-transformation evaluation of `a · (b × c)`, accurate to a few ulps of the result
+/// whatever the cancellation (each triple product is expanded exactly to three terms, then summed
+/// with compensation).
+fn accurate_triple(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> f64 {
+    // a·(b×c) = Σ sign · a_i b_j c_k over the six permutations.
+    const PERMS: [(usize, usize, usize, f64); 6] = [
+        (0, 1, 2, 1.0),
+        (0, 2, 1, -1.0),
+        (1, 2, 0, 1.0),
+        (1, 0, 2, -1.0),
+        (2, 0, 1, 1.0),
+        (2, 1, 0, -1.0),
+    ];
+    let mut s = 0.0;
+    let mut comp = 0.0;
+    for &(i, j, k, sign) in &PERMS {
+        let (p, pe) = two_prod(b[j], c[k]);
+        let (q, qe) = two_prod(a[i], p);
+        let r = a[i] * pe; // error of order eps² relative to the triple product
+        for term in [q, qe, r] {
+            let (t, e) = two_sum(s, sign * term);
+            s = t;
+            comp += e;
+        }
+    }
+    s + comp
+}
+
+/// Scales raw double-double accumulations into the integrals (the divisions of Figure 4 and of the
+/// tetrahedron form), dividing the double-double by small integers without losing its low part.
+fn finish(raw: ([f64; 10], [f64; 10]), reference: [f64; 3], divisors: [f64; 4]) -> VolumeIntegrals {
+    let mut hi = [0.0; 10];
+    let mut low = [0.0; 10];
+    for k in 0..10 {
+        let div = divisors[match k {
+            0 => 0,
+            1..=3 => 1,
+            4..=6 => 2,
+            _ => 3,
+        }];
+        let q = raw.0[k] / div;
+        // The remainder of hi/div is exact (fma), so hi + lo = div · (q + low) to about eps².
+        let rem = (-q).mul_add(div, raw.0[k]);
+        let l = (rem + raw.1[k]) / div;
+        let (h, e) = two_sum(q, l);
+        hi[k] = h;
+        low[k] = e;
+    }
+    VolumeIntegrals {
+        t1: hi[0],
+        t: [hi[1], hi[2], hi[3]],
+        t2: [hi[4], hi[5], hi[6]],
+        tp: [hi[7], hi[8], hi[9]],
+        reference,
+        low,
+    }
+}
+
+#[inline(always)]
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// Triangle kernel: the integrals of the solid bounded by `triangles`, about the options' reference point.
+///
+/// Each triangle `(a, b, c)` (relative to the reference) contributes the signed tetrahedron it spans with
+/// the reference point: with `d = a · ((b − a) × (c − a))` (six times the signed volume) and `S`, `Q` the
+/// sums of the coordinates and of their pairwise products over `a, b, c`,
+/// `∫1 = d/6`, `∫x = d·Sx/24`, `∫x² = d·(Qxx + Sx²)/120`, `∫xy = d·(Qxy + Sx·Sy)/120`.
+/// Indices must be in range (the mesh layer checks them).
+pub fn triangle_integrals(
+    vertices: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    options: &IntegrationOptions,
+) -> VolumeIntegrals {
+    let reference = options.reference.unwrap_or_else(|| bounding_box_centre(vertices));
+    let mut acc = Accumulator::new(options.summation);
+    for t in triangles {
+        let a = sub(vertices[t[0] as usize], reference);
+        let b = sub(vertices[t[1] as usize], reference);
+        let c = sub(vertices[t[2] as usize], reference);
+        acc.add(&triangle_terms(&a, &b, &c, options.accurate_faces));
+    }
+    finish(acc.total(), reference, [6.0, 24.0, 120.0, 120.0])
+}
+
+/// The raw (unscaled) contributions of one triangle, relative to the reference point.
+#[inline(always)]
+fn triangle_terms(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3], accurate: bool) -> [f64; 10] {
+    let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let n = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
+    let mut d = a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
+    if accurate {
+        // The rounding error of d is about eps·|a|·|e1|·|e2|: large against d when the plane passes
+        // near the reference point (a thin plate's big faces) or when the edges are nearly parallel
+        // (its long side faces, a needle). Then d is re-evaluated from a, b, c with error-free
+        // products. 2^-12 keeps the plain evaluation within ~4096 eps of d, near-ulp for the sum;
+        // well-shaped faces of a mesh around its centre never take the slow path.
+        let aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+        let ee = (e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]) * (e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
+        if d * d * 16_777_216.0 < aa * ee {
+            d = accurate_triple(a, b, c);
+        }
+    }
+    let s = [a[0] + b[0] + c[0], a[1] + b[1] + c[1], a[2] + b[2] + c[2]];
+    let q = |i: usize, j: usize| a[i] * a[j] + b[i] * b[j] + c[i] * c[j];
+    [
+        d,
+        d * s[0],
+        d * s[1],
+        d * s[2],
+        d * (q(0, 0) + s[0] * s[0]),
+        d * (q(1, 1) + s[1] * s[1]),
+        d * (q(2, 2) + s[2] * s[2]),
+        d * (q(0, 1) + s[0] * s[1]),
+        d * (q(1, 2) + s[1] * s[2]),
+        d * (q(2, 0) + s[2] * s[0]),
+    ]
+}
+
+/// The paper's algorithm (Figures 4–6) over planar polygons, about the options' reference point.
+///
+/// For each face the projection `α-β-γ` is the right-handed permutation of `x-y-z` maximising `|n_γ|`.
+/// The face normal is Newell's (the exact area vector of the polygon's projections), so a slightly
+/// non-planar polygon gets the best-fit plane; a zero-area face contributes nothing.
+/// Indices must be in range (the mesh layer checks them).
+pub fn mirtich_polygons(
+    vertices: &[[f64; 3]],
+    faces: &Polygons,
+    options: &IntegrationOptions,
+) -> VolumeIntegrals {
+    let reference = options.reference.unwrap_or_else(|| bounding_box_centre(vertices));
+    let mut acc = Accumulator::new(options.summation);
+    let mut local: Vec<[f64; 3]> = Vec::with_capacity(8);
+    for face in faces.iter() {
+        if face.len() < 3 {
+            continue;
+        }
+        local.clear();
+        local.extend(face.iter().map(|&i| sub(vertices[i as usize], reference)));
+        if let Some(terms) = polygon_terms(&local) {
+            acc.add(&terms);
+        }
+    }
+    finish(acc.total(), reference, [1.0, 2.0, 3.0, 2.0])
+}
+
+/// One face's contribution to the (not yet halved/thirded) sums of Figure 4, or `None` for zero area.
+fn polygon_terms(p: &[[f64; 3]]) -> Option<[f64; 10]> {
+    // Newell's normal: twice the vector area.
+    let mut n = [0.0f64; 3];
+    for i in 0..p.len() {
+        let (u, v) = (p[i], p[(i + 1) % p.len()]);
+        n[0] += (u[1] - v[1]) * (u[2] + v[2]);
+        n[1] += (u[2] - v[2]) * (u[0] + v[0]);
+        n[2] += (u[0] - v[0]) * (u[1] + v[1]);
+    }
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if len == 0.0 || !len.is_finite() {
+        return None;
+    }
+    let n = [n[0] / len, n[1] / len, n[2] / len];
+    // γ = the axis of the largest normal component; α, β follow cyclically (right-handed).
+    let (ax, bx, cx) = if n[0].abs() > n[1].abs() && n[0].abs() > n[2].abs() {
+        (1, 2, 0)
+    } else if n[1].abs() > n[2].abs() {
+        (2, 0, 1)
+    } else {
+        (0, 1, 2)
+    };
+    let pr = projection_integrals(p, ax, bx);
+    // w = -n·p for a point on the face; the mean of the vertices is the best-fit choice.
+    let inv = 1.0 / p.len() as f64;
+    let mut w = 0.0;
+    for v in p {
+        w -= (n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) * inv;
+    }
+    let (na, nb, nc) = (n[ax], n[bx], n[cx]);
+    let k1 = 1.0 / nc;
+    let k2 = k1 * k1;
+    let k3 = k2 * k1;
+    let k4 = k3 * k1;
+    let [p1, pa, pb, paa, pab, pbb, paaa, paab, pabb, pbbb] = pr;
+
+    let fa = k1 * pa;
+    let fb = k1 * pb;
+    let fc = -k2 * (na * pa + nb * pb + w * p1);
+    let faa = k1 * paa;
+    let fbb = k1 * pbb;
+    let fcc = k3 * (na * na * paa + 2.0 * na * nb * pab + nb * nb * pbb + 2.0 * na * w * pa + 2.0 * nb * w * pb + w * w * p1);
+    let faaa = k1 * paaa;
+    let fbbb = k1 * pbbb;
+    let fccc = -k4
+        * (na * na * na * paaa
+            + 3.0 * na * na * nb * paab
+            + 3.0 * na * nb * nb * pabb
+            + nb * nb * nb * pbbb
+            + 3.0 * na * na * w * paa
+            + 6.0 * na * nb * w * pab
+            + 3.0 * nb * nb * w * pbb
+            + 3.0 * na * w * w * pa
+            + 3.0 * nb * w * w * pb
+            + w * w * w * p1);
+    let faab = k1 * paab;
+    let fbbc = -k2 * (na * pabb + nb * pbbb + w * pbb);
+    let fcca = k3 * (na * na * paaa + 2.0 * na * nb * paab + nb * nb * pabb + 2.0 * na * w * paa + 2.0 * nb * w * pab + w * w * pa);
+
+    let mut out = [0.0; 10];
+    // T1 from whichever of α, β, γ is x (Figure 4).
+    out[0] = if ax == 0 {
+        na * fa
+    } else if bx == 0 {
+        nb * fb
+    } else {
+        nc * fc
+    };
+    out[1 + ax] = na * faa;
+    out[1 + bx] = nb * fbb;
+    out[1 + cx] = nc * fcc;
+    out[4 + ax] = na * faaa;
+    out[4 + bx] = nb * fbbb;
+    out[4 + cx] = nc * fccc;
+    // Products: index 7 + k holds the product (k, k+1): xy, yz, zx. The cyclic choice of (α, β, γ)
+    // makes αβ, βγ, γα exactly those slots.
+    out[7 + ax] = na * faab;
+    out[7 + bx] = nb * fbbc;
+    out[7 + cx] = nc * fcca;
+    Some(out)
+}
+
+/// Figure 6: the integrals over the face's projection onto the α-β plane, as
+/// `[π1, πα, πβ, πα², παβ, πβ², πα³, πα²β, παβ², πβ³]`.
+fn projection_integrals(p: &[[f64; 3]], ax: usize, bx: usize) -> [f64; 10] {
+    let (mut p1, mut pa, mut pb, mut paa, mut pab, mut pbb) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    let (mut paaa, mut paab, mut pabb, mut pbbb) = (0.0, 0.0, 0.0, 0.0);
+    for i in 0..p.len() {
+        let a0 = p[i][ax];
+        let b0 = p[i][bx];
+        let a1 = p[(i + 1) % p.len()][ax];
+        let b1 = p[(i + 1) % p.len()][bx];
+        let da = a1 - a0;
+        let db = b1 - b0;
+        let a0_2 = a0 * a0;
+        let a0_3 = a0_2 * a0;
+        let a0_4 = a0_3 * a0;
+        let b0_2 = b0 * b0;
+        let b0_3 = b0_2 * b0;
+        let b0_4 = b0_3 * b0;
+        let a1_2 = a1 * a1;
+        let a1_3 = a1_2 * a1;
+        let b1_2 = b1 * b1;
+        let b1_3 = b1_2 * b1;
+
+        let c1 = a1 + a0;
+        let ca = a1 * c1 + a0_2;
+        let caa = a1 * ca + a0_3;
+        let caaa = a1 * caa + a0_4;
+        let cb = b1 * (b1 + b0) + b0_2;
+        let cbb = b1 * cb + b0_3;
+        let cbbb = b1 * cbb + b0_4;
+        let cab = 3.0 * a1_2 + 2.0 * a1 * a0 + a0_2;
+        let kab = a1_2 + 2.0 * a1 * a0 + 3.0 * a0_2;
+        let caab = a0 * cab + 4.0 * a1_3;
+        let kaab = a1 * kab + 4.0 * a0_3;
+        let cabb = 4.0 * b1_3 + 3.0 * b1_2 * b0 + 2.0 * b1 * b0_2 + b0_3;
+        let kabb = b1_3 + 2.0 * b1_2 * b0 + 3.0 * b1 * b0_2 + 4.0 * b0_3;
+
+        p1 += db * c1;
+        pa += db * ca;
+        paa += db * caa;
+        paaa += db * caaa;
+        pb += da * cb;
+        pbb += da * cbb;
+        pbbb += da * cbbb;
+        pab += db * (b1 * cab + b0 * kab);
+        paab += db * (b1 * caab + b0 * kaab);
+        pabb += da * (a1 * cabb + a0 * kabb);
+    }
+    [
+        p1 / 2.0,
+        pa / 6.0,
+        -pb / 6.0,
+        paa / 12.0,
+        pab / 24.0,
+        -pbb / 12.0,
+        paaa / 20.0,
+        paab / 60.0,
+        -pabb / 60.0,
+        -pbbb / 20.0,
+    ]
+}
+
+/// The integrals of a polygon mesh with any mix of face sizes: triangles through the triangle kernel,
+/// larger polygons through the paper's, both about one reference point and into one set of sums.
+pub fn volume_integrals(vertices: &[[f64; 3]], faces: &Polygons, options: &IntegrationOptions) -> VolumeIntegrals {
+    let reference = options.reference.unwrap_or_else(|| bounding_box_centre(vertices));
+    let mut tri_acc = Accumulator::new(options.summation);
+    let mut poly_acc = Accumulator::new(options.summation);
+    let mut local: Vec<[f64; 3]> = Vec::with_capacity(8);
+    for face in faces.iter() {
+        match face.len() {
+            0..=2 => {}
+            3 => {
+                let a = sub(vertices[face[0] as usize], reference);
+                let b = sub(vertices[face[1] as usize], reference);
+                let c = sub(vertices[face[2] as usize], reference);
+                tri_acc.add(&triangle_terms(&a, &b, &c, options.accurate_faces));
+            }
+            _ => {
+                local.clear();
+                local.extend(face.iter().map(|&i| sub(vertices[i as usize], reference)));
+                if let Some(terms) = polygon_terms(&local) {
+                    poly_acc.add(&terms);
+                }
+            }
+        }
+    }
+    let t = finish(tri_acc.total(), reference, [6.0, 24.0, 120.0, 120.0]);
+    let p = finish(poly_acc.total(), reference, [1.0, 2.0, 3.0, 2.0]);
+    let (ta, pa) = (t.to_array(), p.to_array());
+    let mut hi = [0.0; 10];
+    let mut low = [0.0; 10];
+    for k in 0..10 {
+        let (h, e) = two_sum(ta[k], pa[k]);
+        let (h, l) = two_sum(h, e + t.low[k] + p.low[k]);
+        hi[k] = h;
+        low[k] = l;
+    }
+    VolumeIntegrals::from_arrays(hi, low, reference)
+}
+
+impl VolumeIntegrals {
+    /// From the paper-ordered array of high parts and their low parts.
+    pub fn from_arrays(hi: [f64; 10], low: [f64; 10], reference: [f64; 3]) -> Self {
+        VolumeIntegrals {
+            t1: hi[0],
+            t: [hi[1], hi[2], hi[3]],
+            t2: [hi[4], hi[5], hi[6]],
+            tp: [hi[7], hi[8], hi[9]],
+            reference,
+            low,
+        }
+    }
+
+    /// The same integrals about another reference point `q` (exact algebra; transfer of axes).
+    pub fn about(&self, q: [f64; 3]) -> VolumeIntegrals {
+        // Coordinates relative to q are x' = x + δ with δ = c − q.
+        let d = sub(self.reference, q);
+        let hi = self.to_array();
+        let me: [f64; 10] = std::array::from_fn(|k| hi[k] + self.low[k]);
+        let this = VolumeIntegrals::from_arrays(me, [0.0; 10], self.reference);
+        let v = this.t1;
+        let t = [0, 1, 2].map(|k| this.t[k] + d[k] * v);
+        let t2 = [0, 1, 2].map(|k| this.t2[k] + 2.0 * d[k] * this.t[k] + d[k] * d[k] * v);
+        let tp = [0, 1, 2].map(|k| {
+            let j = (k + 1) % 3;
+            this.tp[k] + d[k] * this.t[j] + d[j] * this.t[k] + d[k] * d[j] * v
+        });
+        VolumeIntegrals { t1: v, t, t2, tp, reference: q, low: [0.0; 10] }
+    }
+
+    /// The integrals as an array in the paper's order `T1, Tx, Ty, Tz, Tx², Ty², Tz², Txy, Tyz, Tzx`.
+    pub fn to_array(&self) -> [f64; 10] {
+        [self.t1, self.t[0], self.t[1], self.t[2], self.t2[0], self.t2[1], self.t2[2], self.tp[0], self.tp[1], self.tp[2]]
+    }
+}
+
+impl Index<usize> for VolumeIntegrals {
+    type Output = f64;
+    fn index(&self, i: usize) -> &f64 {
+        match i {
+            0 => &self.t1,
+            1..=3 => &self.t[i - 1],
+            4..=6 => &self.t2[i - 4],
+            7..=9 => &self.tp[i - 7],
+            _ => panic!("VolumeIntegrals has ten entries, index {i}"),
+        }
+    }
+}
+
+impl IndexMut<usize> for VolumeIntegrals {
+    fn index_mut(&mut self, i: usize) -> &mut f64 {
+        match i {
+            0 => &mut self.t1,
+            1..=3 => &mut self.t[i - 1],
+            4..=6 => &mut self.t2[i - 4],
+            7..=9 => &mut self.tp[i - 7],
+            _ => panic!("VolumeIntegrals has ten entries, index {i}"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube_quads(h: f64) -> (Vec<[f64; 3]>, Polygons) {
+        let v: Vec<[f64; 3]> = (0..8)
+            .map(|i| [if i & 1 == 0 { -h } else { h }, if i & 2 == 0 { -h } else { h }, if i & 4 == 0 { -h } else { h }])
+            .collect();
+        let mut f = Polygons::new();
+        for q in [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]] {
+            f.push(&q);
+        }
+        (v, f)
+    }
+
+    #[test]
+    fn paper_table1_cube() {
+        let (v, f) = cube_quads(10.0);
+        let at_origin = IntegrationOptions { reference: Some([0.0; 3]), ..IntegrationOptions::accurate() };
+        for opts in [IntegrationOptions::paper(), at_origin] {
+            let t = mirtich_polygons(&v, &f, &opts);
+            let want = [8000.0, 0.0, 0.0, 0.0, 8e5 / 3.0, 8e5 / 3.0, 8e5 / 3.0, 0.0, 0.0, 0.0];
+            for k in 0..10 {
+                assert!((t[k] - want[k]).abs() <= 1e-15 * want[k].abs().max(1.0), "T[{k}] = {} want {}", t[k], want[k]);
+            }
+        }
+    }
+
+    #[test]
+    fn paper_table1_tetrahedron() {
+        let v = [[0.0, 0.0, 0.0], [5.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 3.0]];
+        let tris = [[0u32, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+        let want = [10.0, 12.5, 10.0, 7.5, 25.0, 16.0, 9.0, 10.0, 6.0, 7.5];
+        let polys = Polygons::from_triangles(&tris);
+        let at_origin = IntegrationOptions { reference: Some([0.0; 3]), ..IntegrationOptions::accurate() };
+        for opts in [IntegrationOptions::paper(), at_origin] {
+            let a = mirtich_polygons(&v, &polys, &opts);
+            let b = triangle_integrals(&v, &tris, &opts);
+            for k in 0..10 {
+                assert!((a[k] - want[k]).abs() <= 1e-15 * want[k], "mirtich T[{k}] = {}", a[k]);
+                assert!((b[k] - want[k]).abs() <= 1e-15 * want[k], "triangles T[{k}] = {}", b[k]);
+            }
+        }
+    }
+
+    #[test]
+    fn zero_area_faces_contribute_nothing() {
+        let v = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
+        let mut f = Polygons::new();
+        f.push(&[0, 1, 2]);
+        f.push(&[0, 0, 0, 1]);
+        let t = mirtich_polygons(&v, &f, &IntegrationOptions::paper());
+        assert_eq!(t.to_array(), [0.0; 10]);
+        let t = triangle_integrals(&v, &[[0, 1, 2], [1, 1, 1]], &IntegrationOptions::accurate());
+        assert_eq!(t.to_array(), [0.0; 10]);
+    }
+
+    #[test]
+    fn accurate_triple_matches_exact_small_case() {
+        // 2^-30 offsets: the plain formula loses ~30 bits here, the error-free one none.
+        let e = 2f64.powi(-30);
+        let a = [1.0, 1.0, 1.0 + e];
+        let b = [1.0 + e, 1.0, 1.0];
+        let c = [1.0, 1.0 + e, 1.0];
+        // det = 1·(1·1 − 1·(1+e)) − 1·((1+e)·1 − 1·1) + (1+e)·((1+e)(1+e) − 1) = e(e² + 3e + ... ) computed exactly:
+        // expand: -e - e + (1+e)(2e + e²) = -2e + 2e + e² + 2e² + e³ = 3e² + e³
+        let want = 3.0 * e * e + e * e * e;
+        assert_eq!(accurate_triple(&a, &b, &c), want);
+    }
+}
