@@ -119,23 +119,39 @@ mod tests {
     fn needle_small_moment_relative_accuracy() {
         // A needle's central inertia: moments 1e12 apart. Aligned with the axes (exactly representable),
         // Jacobi must return the small moment to full relative precision.
-        let m = [[1.0 / 12.0, 0.0, 0.0], [0.0, 1.0 / 12.0, 0.0], [0.0, 0.0, 1e-12 / 6.0]];
+        let m = [
+            [1.0 / 12.0, 0.0, 0.0],
+            [0.0, 1.0 / 12.0, 0.0],
+            [0.0, 0.0, 1e-12 / 6.0],
+        ];
         let (vals, _) = symmetric_eigen(m);
         assert_eq!(vals[0], 1e-12 / 6.0);
         // Rotated about the needle's own axis only, the small moment is untouched by any rotation.
         let c = 0.6;
         let s = 0.8;
-        let m = [[1.0 / 12.0, 0.0, 0.0], [0.0, 1.0 / 12.0 * (c * c + s * s), 0.0], [0.0, 0.0, 1e-12 / 6.0]];
+        let m = [
+            [1.0 / 12.0, 0.0, 0.0],
+            [0.0, 1.0 / 12.0 * (c * c + s * s), 0.0],
+            [0.0, 0.0, 1e-12 / 6.0],
+        ];
         let (vals, _) = symmetric_eigen(m);
         assert!((vals[0] - 1e-12 / 6.0).abs() <= 1e-15 * 1e-12);
         // A graded matrix with off-diagonal coupling scaled like the diagonal: relative accuracy holds.
-        let g = [[1.0, 1e-7, 1e-13], [1e-7, 1e-6, 1e-10], [1e-13, 1e-10, 1e-12]];
+        let g = [
+            [1.0, 1e-7, 1e-13],
+            [1e-7, 1e-6, 1e-10],
+            [1e-13, 1e-10, 1e-12],
+        ];
         let (vals, _) = symmetric_eigen(g);
         // Smallest eigenvalue by the Schur complement in exact-enough arithmetic: ≈ 1e-12 − 1e-20/1e-6·… ;
         // compare with the determinant identity λ1 λ2 λ3 = det.
-        let det = g[0][0] * (g[1][1] * g[2][2] - g[1][2] * g[2][1]) - g[0][1] * (g[1][0] * g[2][2] - g[1][2] * g[2][0])
+        let det = g[0][0] * (g[1][1] * g[2][2] - g[1][2] * g[2][1])
+            - g[0][1] * (g[1][0] * g[2][2] - g[1][2] * g[2][0])
             + g[0][2] * (g[1][0] * g[2][1] - g[1][1] * g[2][0]);
         let prod = vals[0] * vals[1] * vals[2];
-        assert!(((prod - det) / det).abs() < 1e-9, "product {prod} det {det}");
+        assert!(
+            ((prod - det) / det).abs() < 1e-9,
+            "product {prod} det {det}"
+        );
     }
 }

@@ -48,7 +48,11 @@ pub struct Principal {
 
 impl MassProperties {
     /// Nothing: the identity of `+`.
-    pub const ZERO: MassProperties = MassProperties { mass: 0.0, com: [0.0; 3], inertia: [[0.0; 3]; 3] };
+    pub const ZERO: MassProperties = MassProperties {
+        mass: 0.0,
+        com: [0.0; 3],
+        inertia: [[0.0; 3]; 3],
+    };
 
     /// From volume integrals and a uniform density.
     ///
@@ -73,7 +77,11 @@ impl MassProperties {
         let izx = -cp[2].mul(density).value();
         MassProperties {
             mass: v.mul(density).value(),
-            com: [t.reference[0] + r[0], t.reference[1] + r[1], t.reference[2] + r[2]],
+            com: [
+                t.reference[0] + r[0],
+                t.reference[1] + r[1],
+                t.reference[2] + r[2],
+            ],
             inertia: [[ixx, ixy, izx], [ixy, iyy, iyz], [izx, iyz, izz]],
         }
     }
@@ -86,19 +94,30 @@ impl MassProperties {
     }
 
     /// The same as [`MassProperties::from_mesh`] for a triangle mesh.
-    pub fn from_trimesh(vertices: &[[f64; 3]], triangles: &[[u32; 3]], density: f64) -> MassProperties {
+    pub fn from_trimesh(
+        vertices: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+        density: f64,
+    ) -> MassProperties {
         let t = integrals::triangle_integrals(vertices, triangles, &IntegrationOptions::accurate());
         MassProperties::from_integrals(&t, density)
     }
 
     /// The same body with every density multiplied by `factor` (mass and inertia scale, COM does not).
     pub fn scaled(&self, factor: f64) -> MassProperties {
-        MassProperties { mass: self.mass * factor, com: self.com, inertia: self.inertia.map(|r| r.map(|x| x * factor)) }
+        MassProperties {
+            mass: self.mass * factor,
+            com: self.com,
+            inertia: self.inertia.map(|r| r.map(|x| x * factor)),
+        }
     }
 
     /// The body moved by `t`: only the centre of mass changes.
     pub fn translated(&self, t: [f64; 3]) -> MassProperties {
-        MassProperties { com: [self.com[0] + t[0], self.com[1] + t[1], self.com[2] + t[2]], ..*self }
+        MassProperties {
+            com: [self.com[0] + t[0], self.com[1] + t[1], self.com[2] + t[2]],
+            ..*self
+        }
     }
 
     /// The body rotated by `r` about the frame origin, then moved by `t`: `c' = R c + t`, `I' = R I Rᵀ`.
@@ -159,7 +178,10 @@ impl Add for MassProperties {
 
 impl Sum for MassProperties {
     fn sum<I: Iterator<Item = MassProperties>>(iter: I) -> MassProperties {
-        iter.fold(MassProperties::ZERO, |a, b| if a.mass == 0.0 { b } else { a + b })
+        iter.fold(
+            MassProperties::ZERO,
+            |a, b| if a.mass == 0.0 { b } else { a + b },
+        )
     }
 }
 
@@ -227,7 +249,11 @@ pub fn mat_vec(a: &Mat3, v: [f64; 3]) -> [f64; 3] {
 }
 
 pub fn transpose(a: &Mat3) -> Mat3 {
-    [[a[0][0], a[1][0], a[2][0]], [a[0][1], a[1][1], a[2][1]], [a[0][2], a[1][2], a[2][2]]]
+    [
+        [a[0][0], a[1][0], a[2][0]],
+        [a[0][1], a[1][1], a[2][1]],
+        [a[0][2], a[1][2], a[2][2]],
+    ]
 }
 
 fn symmetrise(a: &Mat3) -> Mat3 {
@@ -252,9 +278,16 @@ mod tests {
     #[test]
     fn rpy_is_fixed_axis_xyz() {
         // roll 90° then yaw 90° (fixed axes): z → -y (roll) → x (yaw).
-        let r = rpy_matrix([std::f64::consts::FRAC_PI_2, 0.0, std::f64::consts::FRAC_PI_2]);
+        let r = rpy_matrix([
+            std::f64::consts::FRAC_PI_2,
+            0.0,
+            std::f64::consts::FRAC_PI_2,
+        ]);
         let z = mat_vec(&r, [0.0, 0.0, 1.0]);
-        assert!((z[0] - 1.0).abs() < 1e-15 && z[1].abs() < 1e-15 && z[2].abs() < 1e-15, "{z:?}");
+        assert!(
+            (z[0] - 1.0).abs() < 1e-15 && z[1].abs() < 1e-15 && z[2].abs() < 1e-15,
+            "{z:?}"
+        );
         let back = matrix_rpy(&rpy_matrix([0.1, -0.4, 2.5]));
         for (a, b) in back.iter().zip([0.1, -0.4, 2.5]) {
             assert!((a - b).abs() < 1e-14);
@@ -263,10 +296,21 @@ mod tests {
 
     #[test]
     fn parallel_axis_of_point_masses() {
-        let a = MassProperties { mass: 1.0, com: [1.0, 0.0, 0.0], inertia: [[0.0; 3]; 3] };
-        let b = MassProperties { mass: 1.0, com: [-1.0, 0.0, 0.0], inertia: [[0.0; 3]; 3] };
+        let a = MassProperties {
+            mass: 1.0,
+            com: [1.0, 0.0, 0.0],
+            inertia: [[0.0; 3]; 3],
+        };
+        let b = MassProperties {
+            mass: 1.0,
+            com: [-1.0, 0.0, 0.0],
+            inertia: [[0.0; 3]; 3],
+        };
         let s = a + b;
         assert_eq!(s.com, [0.0; 3]);
-        assert_eq!(s.inertia, [[0.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]]);
+        assert_eq!(
+            s.inertia,
+            [[0.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]]
+        );
     }
 }

@@ -18,7 +18,14 @@ fn diagonal(mass: f64, d: [f64; 3]) -> MassProperties {
 pub fn cuboid(size: [f64; 3], density: f64) -> MassProperties {
     let [x, y, z] = size;
     let m = density * x * y * z;
-    diagonal(m, [m * (y * y + z * z) / 12.0, m * (z * z + x * x) / 12.0, m * (x * x + y * y) / 12.0])
+    diagonal(
+        m,
+        [
+            m * (y * y + z * z) / 12.0,
+            m * (z * z + x * x) / 12.0,
+            m * (x * x + y * y) / 12.0,
+        ],
+    )
 }
 
 /// A solid cylinder of `radius` and `length` along Z.
@@ -43,7 +50,8 @@ pub fn capsule(radius: f64, length: f64, density: f64) -> MassProperties {
     let ms = density * 4.0 / 3.0 * PI * r2 * radius;
     // Each hemisphere: 2/5 m r² about an axis through its flat face, COM 3r/8 from that face, moved to
     // L/2 + 3r/8 from the centre: m (2r²/5 + L²/4 + 3Lr/8) for both together.
-    let ixx = mc * (3.0 * r2 + length * length) / 12.0 + ms * (0.4 * r2 + length * length / 4.0 + 0.375 * length * radius);
+    let ixx = mc * (3.0 * r2 + length * length) / 12.0
+        + ms * (0.4 * r2 + length * length / 4.0 + 0.375 * length * radius);
     let izz = mc * r2 / 2.0 + ms * 0.4 * r2;
     diagonal(mc + ms, [ixx, ixx, izz])
 }

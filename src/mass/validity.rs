@@ -48,7 +48,9 @@ pub const DEFAULT_TOLERANCE: f64 = 1e-9;
 /// Every violation of `mp`, each judged relative to the largest principal moment.
 pub fn check(mp: &MassProperties, rel_tol: f64) -> Vec<Violation> {
     let mut out = Vec::new();
-    let finite = mp.mass.is_finite() && mp.com.iter().all(|x| x.is_finite()) && mp.inertia.iter().flatten().all(|x| x.is_finite());
+    let finite = mp.mass.is_finite()
+        && mp.com.iter().all(|x| x.is_finite())
+        && mp.inertia.iter().flatten().all(|x| x.is_finite());
     if !finite {
         out.push(Violation::NotFinite);
         return out;
@@ -58,9 +60,14 @@ pub fn check(mp: &MassProperties, rel_tol: f64) -> Vec<Violation> {
     }
     let i = &mp.inertia;
     let scale = i.iter().flatten().fold(0.0f64, |a, x| a.max(x.abs()));
-    let asym = [(0, 1), (0, 2), (1, 2)].iter().map(|&(a, b)| (i[a][b] - i[b][a]).abs()).fold(0.0, f64::max);
+    let asym = [(0, 1), (0, 2), (1, 2)]
+        .iter()
+        .map(|&(a, b)| (i[a][b] - i[b][a]).abs())
+        .fold(0.0, f64::max);
     if scale > 0.0 && asym > rel_tol * scale {
-        out.push(Violation::NotSymmetric { asymmetry: asym / scale });
+        out.push(Violation::NotSymmetric {
+            asymmetry: asym / scale,
+        });
     }
     let (m, _) = jacobi::symmetric_eigen(*i);
     let largest = m[2].abs().max(m[0].abs());
@@ -71,7 +78,10 @@ pub fn check(mp: &MassProperties, rel_tol: f64) -> Vec<Violation> {
     }
     let excess = m[2] - (m[0] + m[1]);
     if largest > 0.0 && excess > rel_tol * largest {
-        out.push(Violation::TriangleInequality { moments: m, excess: excess / largest });
+        out.push(Violation::TriangleInequality {
+            moments: m,
+            excess: excess / largest,
+        });
     }
     out
 }
@@ -92,11 +102,18 @@ mod tests {
     fn flags_each_violation() {
         let mut mp = primitives::cuboid([1.0, 2.0, 3.0], 1.0);
         mp.inertia[2][2] = mp.inertia[0][0] + mp.inertia[1][1] + 1.0;
-        assert!(matches!(check(&mp, DEFAULT_TOLERANCE)[..], [Violation::TriangleInequality { .. }]));
+        assert!(matches!(
+            check(&mp, DEFAULT_TOLERANCE)[..],
+            [Violation::TriangleInequality { .. }]
+        ));
         mp.inertia[0][0] = -1.0;
-        assert!(check(&mp, DEFAULT_TOLERANCE).iter().any(|v| matches!(v, Violation::NotPositiveDefinite { .. })));
+        assert!(check(&mp, DEFAULT_TOLERANCE)
+            .iter()
+            .any(|v| matches!(v, Violation::NotPositiveDefinite { .. })));
         mp.mass = 0.0;
-        assert!(check(&mp, DEFAULT_TOLERANCE).iter().any(|v| matches!(v, Violation::NonPositiveMass(_))));
+        assert!(check(&mp, DEFAULT_TOLERANCE)
+            .iter()
+            .any(|v| matches!(v, Violation::NonPositiveMass(_))));
         mp.com[0] = f64::NAN;
         assert_eq!(check(&mp, DEFAULT_TOLERANCE), vec![Violation::NotFinite]);
     }

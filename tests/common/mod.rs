@@ -21,13 +21,23 @@ fn decompose(x: f64) -> (i64, i32) {
     let sign = if bits >> 63 == 0 { 1i64 } else { -1 };
     let exp = ((bits >> 52) & 0x7ff) as i32;
     let frac = (bits & ((1u64 << 52) - 1)) as i64;
-    let (m, e) = if exp == 0 { (frac, -1074) } else { (frac | (1i64 << 52), exp - 1075) };
+    let (m, e) = if exp == 0 {
+        (frac, -1074)
+    } else {
+        (frac | (1i64 << 52), exp - 1075)
+    };
     (sign * m, e)
 }
 
 /// The exact integrals `[T1, Tx, Ty, Tz, Tx², Ty², Tz², Txy, Tyz, Tzx]` of a closed triangle mesh about the origin.
 pub fn exact_integrals(v: &[[f64; 3]], tris: &[[u32; 3]]) -> [BigRational; 10] {
-    let emin = v.iter().flatten().filter(|x| **x != 0.0).map(|&x| decompose(x).1).min().unwrap_or(0);
+    let emin = v
+        .iter()
+        .flatten()
+        .filter(|x| **x != 0.0)
+        .map(|&x| decompose(x).1)
+        .min()
+        .unwrap_or(0);
     let ints: Vec<[BigInt; 3]> = v
         .iter()
         .map(|p| {
@@ -42,7 +52,11 @@ pub fn exact_integrals(v: &[[f64; 3]], tris: &[[u32; 3]]) -> [BigRational; 10] {
         let a = &ints[t[0] as usize];
         let b = &ints[t[1] as usize];
         let c = &ints[t[2] as usize];
-        let bxc = [&b[1] * &c[2] - &b[2] * &c[1], &b[2] * &c[0] - &b[0] * &c[2], &b[0] * &c[1] - &b[1] * &c[0]];
+        let bxc = [
+            &b[1] * &c[2] - &b[2] * &c[1],
+            &b[2] * &c[0] - &b[0] * &c[2],
+            &b[0] * &c[1] - &b[1] * &c[0],
+        ];
         let d = &a[0] * &bxc[0] + &a[1] * &bxc[1] + &a[2] * &bxc[2];
         let s: [BigInt; 3] = std::array::from_fn(|k| &a[k] + &b[k] + &c[k]);
         let q = |i: usize, j: usize| &a[i] * &a[j] + &b[i] * &b[j] + &c[i] * &c[j];
@@ -63,7 +77,10 @@ pub fn exact_integrals(v: &[[f64; 3]], tris: &[[u32; 3]]) -> [BigRational; 10] {
             BigRational::new(BigInt::from(1), BigInt::from(1) << ((-e) as usize))
         }
     };
-    let r = |x: &BigInt, deg: i32, div: i64| BigRational::from_integer(x.clone()) * pow2(deg) / BigRational::from_integer(BigInt::from(div));
+    let r = |x: &BigInt, deg: i32, div: i64| {
+        BigRational::from_integer(x.clone()) * pow2(deg)
+            / BigRational::from_integer(BigInt::from(div))
+    };
     [
         r(&acc[0], 3, 6),
         r(&acc[1], 4, 24),
@@ -104,7 +121,11 @@ pub fn exact_mass(t: &[BigRational; 10]) -> ExactMass {
     ExactMass {
         volume: v,
         com,
-        inertia: [[ixx, ixy.clone(), izx.clone()], [ixy, iyy, iyz.clone()], [izx, iyz, izz]],
+        inertia: [
+            [ixx, ixy.clone(), izx.clone()],
+            [ixy, iyy, iyz.clone()],
+            [izx, iyz, izz],
+        ],
     }
 }
 
@@ -217,10 +238,26 @@ pub fn icosphere(level: u32) -> Mesh {
 pub fn box_mesh(s: [f64; 3]) -> Mesh {
     let h = s.map(|x| x / 2.0);
     let v: Vec<[f64; 3]> = (0..8)
-        .map(|i| [if i & 1 == 0 { -h[0] } else { h[0] }, if i & 2 == 0 { -h[1] } else { h[1] }, if i & 4 == 0 { -h[2] } else { h[2] }])
+        .map(|i| {
+            [
+                if i & 1 == 0 { -h[0] } else { h[0] },
+                if i & 2 == 0 { -h[1] } else { h[1] },
+                if i & 4 == 0 { -h[2] } else { h[2] },
+            ]
+        })
         .collect();
-    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-    let f = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let f = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
     (v, f)
 }
 
