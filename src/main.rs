@@ -1,3 +1,5 @@
+//! The `urdf-inertia` binary: everything lives in the library's `cli` module.
+
 fn main() {
-    println!("urdf-inertia");
+    std::process::exit(urdf_inertia::cli::main());
 }

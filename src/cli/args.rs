@@ -1,0 +1,125 @@
+//! Raw command-line arguments (clap). Validation into a configuration happens in the commands.
+
+use clap::{Args as ClapArgs, Parser, Subcommand, ValueEnum};
+use std::path::PathBuf;
+
+/// Correct <inertial> elements for URDF robots, computed from their collision geometry.
+#[derive(Debug, Parser)]
+#[command(name = "urdf-inertia", version, about, long_about = None)]
+pub struct Args {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Write <inertial> for every link with collision geometry (to stdout, -o FILE or -i in place).
+    Fill(FillArgs),
+    /// Compare each link's existing <inertial> with the one computed from its collision geometry.
+    Diff(DiffArgs),
+    /// Exit 1 if an <inertial> is invalid, missing, or (with a density source) off; for pre-commit.
+    Check(CheckArgs),
+    /// Mass properties of one mesh file: volume, mass, COM, inertia, principal axes, health.
+    Mesh(MeshArgs),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
+pub enum Format {
+    #[default]
+    Text,
+    Json,
+}
+
+/// Where densities come from and where meshes are found: shared by fill, diff and check.
+#[derive(Debug, Clone, ClapArgs)]
+pub struct SourceArgs {
+    /// Density map (TOML): default, total_mass, [materials], [links], [meshes].
+    #[arg(long, value_name = "FILE", conflicts_with = "density")]
+    pub density_map: Option<PathBuf>,
+    /// One uniform density for every part, kg/m³.
+    #[arg(long, value_name = "RHO")]
+    pub density: Option<f64>,
+    /// Use each link's existing <mass> as its mass target (the robot was weighed; the inertia is unknown).
+    #[arg(long)]
+    pub keep_mass: bool,
+    /// Where a ROS package lives: `package://NAME/a/b` is DIR/a/b. Repeatable.
+    #[arg(long, value_name = "NAME=DIR")]
+    pub package_path: Vec<String>,
+    /// Treat every repaired mesh (re-wound, flipped, convex hull) as an error.
+    #[arg(long)]
+    pub strict: bool,
+    /// Only these links (glob, repeatable).
+    #[arg(long, value_name = "GLOB")]
+    pub only: Vec<String>,
+    /// Leave these links alone (glob, repeatable).
+    #[arg(long, value_name = "GLOB")]
+    pub skip: Vec<String>,
+}
+
+#[derive(Debug, Clone, ClapArgs)]
+pub struct FillArgs {
+    /// The URDF to fill.
+    pub urdf: PathBuf,
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// Write the result to this file instead of stdout.
+    #[arg(short, long, value_name = "OUT", conflicts_with = "in_place")]
+    pub output: Option<PathBuf>,
+    /// Rewrite the URDF in place (temp file beside it, then rename).
+    #[arg(short, long)]
+    pub in_place: bool,
+    /// Only links whose <inertial> is absent or invalid.
+    #[arg(long)]
+    pub missing_only: bool,
+    /// Significant digits to write (default: shortest round-trip representation).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(3..=17))]
+    pub digits: Option<u32>,
+    /// Write the principal frame's rpy and a diagonal tensor instead of the tensor in link axes.
+    #[arg(long)]
+    pub principal: bool,
+    /// Summary format on stdout when the URDF is not written there (-o or -i).
+    #[arg(long, value_enum, default_value_t)]
+    pub format: Format,
+}
+
+#[derive(Debug, Clone, ClapArgs)]
+pub struct DiffArgs {
+    /// The URDF to compare.
+    pub urdf: PathBuf,
+    #[command(flatten)]
+    pub source: SourceArgs,
+    #[arg(long, value_enum, default_value_t)]
+    pub format: Format,
+}
+
+#[derive(Debug, Clone, ClapArgs)]
+pub struct CheckArgs {
+    /// URDF files to check.
+    #[arg(required = true)]
+    pub urdf: Vec<PathBuf>,
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// Relative tolerance for existing against computed values (with a density source).
+    #[arg(long, value_name = "REL", default_value_t = 0.05)]
+    pub tolerance: f64,
+}
+
+#[derive(Debug, Clone, ClapArgs)]
+pub struct MeshArgs {
+    /// STL, OBJ or COLLADA file.
+    pub file: PathBuf,
+    /// Per-axis scale, as in the URDF's <mesh scale>.
+    #[arg(long, num_args = 3, value_names = ["SX", "SY", "SZ"], allow_negative_numbers = true)]
+    pub scale: Option<Vec<f64>>,
+    /// Density, kg/m³ (default 1: the mass equals the volume).
+    #[arg(long, conflicts_with = "mass")]
+    pub density: Option<f64>,
+    /// Total mass, kg (the density follows from the volume).
+    #[arg(long)]
+    pub mass: Option<f64>,
+    /// Treat every repaired mesh as an error.
+    #[arg(long)]
+    pub strict: bool,
+    #[arg(long, value_enum, default_value_t)]
+    pub format: Format,
+}

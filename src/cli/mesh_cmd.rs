@@ -1,0 +1,124 @@
+//! `urdf-inertia mesh FILE`: the mass properties of one mesh, with its health.
+
+use super::args::{Format, MeshArgs};
+use super::{shortest, ExitStatus};
+use crate::mesh::{self, health::HealthOptions};
+use serde_json::json;
+
+pub fn run(args: &MeshArgs) -> ExitStatus {
+    let scale = match args.scale.as_deref() {
+        Some([x, y, z]) => [*x, *y, *z],
+        _ => [1.0; 3],
+    };
+    for (name, v) in [("--density", args.density), ("--mass", args.mass)] {
+        if let Some(v) = v {
+            if !(v > 0.0 && v.is_finite()) {
+                eprintln!("error: {name} {v} must be a positive number");
+                return ExitStatus::Error;
+            }
+        }
+    }
+    let start = std::time::Instant::now();
+    let solid = match mesh::load_solid(
+        &args.file,
+        scale,
+        HealthOptions {
+            strict: args.strict,
+        },
+    ) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitStatus::Error;
+        }
+    };
+    let volume = solid.unit.mass;
+    let density = match (args.density, args.mass) {
+        (Some(d), _) => d,
+        (None, Some(m)) => m / volume,
+        (None, None) => 1.0,
+    };
+    let mp = solid.unit.scaled(density);
+    let pr = mp.principal();
+    let elapsed = start.elapsed();
+    match args.format {
+        Format::Json => {
+            let axes: Vec<Vec<f64>> = (0..3)
+                .map(|c| (0..3).map(|r| pr.axes[r][c]).collect())
+                .collect();
+            let v = json!({
+                "file": args.file.display().to_string(),
+                "scale": scale,
+                "volume": volume,
+                "density": density,
+                "mass": mp.mass,
+                "center_of_mass": mp.com,
+                "inertia": mp.inertia,
+                "principal_moments": pr.moments,
+                "principal_axes": axes,
+                "provenance": solid.rung.name(),
+                "faces": solid.faces.len(),
+                "faces_read": solid.faces_read,
+                "vertices": solid.vertices.len(),
+                "error_estimate": solid.error_estimate,
+                "warnings": solid.warnings,
+            });
+            println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        }
+        Format::Text => {
+            println!(
+                "{}  (scale {} {} {})",
+                args.file.display(),
+                scale[0],
+                scale[1],
+                scale[2]
+            );
+            println!(
+                "  health            {} ({} faces read; the solid has {} faces, {} vertices)",
+                solid.rung.name(),
+                solid.faces_read,
+                solid.faces.len(),
+                solid.vertices.len()
+            );
+            println!("  volume            {} m³", shortest(volume));
+            println!("  density           {} kg/m³", shortest(density));
+            println!("  mass              {} kg", shortest(mp.mass));
+            println!(
+                "  centre of mass    {} {} {} m",
+                shortest(mp.com[0]),
+                shortest(mp.com[1]),
+                shortest(mp.com[2])
+            );
+            println!("  inertia about the COM (kg·m², mesh axes)");
+            for row in &mp.inertia {
+                println!(
+                    "    {:>24} {:>24} {:>24}",
+                    shortest(row[0]),
+                    shortest(row[1]),
+                    shortest(row[2])
+                );
+            }
+            println!(
+                "  principal moments {} {} {}",
+                shortest(pr.moments[0]),
+                shortest(pr.moments[1]),
+                shortest(pr.moments[2])
+            );
+            for (k, name) in ["axis 1", "axis 2", "axis 3"].iter().enumerate() {
+                println!(
+                    "  principal {name}  {:.9} {:.9} {:.9}",
+                    pr.axes[0][k], pr.axes[1][k], pr.axes[2][k]
+                );
+            }
+            println!(
+                "  error estimate    {:.1e} (relative, central inertia)",
+                solid.error_estimate
+            );
+            println!("  time              {:.3} ms", elapsed.as_secs_f64() * 1e3);
+            for w in &solid.warnings {
+                println!("  warning: {w}");
+            }
+        }
+    }
+    ExitStatus::Success
+}

@@ -1,0 +1,58 @@
+//! Command line: clap parses raw arguments, they are validated into a configuration before any work
+//! starts, and each command returns an [`ExitStatus`]: 0 ok, 1 check found problems, 2 error.
+
+mod args;
+mod mesh_cmd;
+mod robot_cmd;
+
+use clap::Parser;
+
+pub use args::{Args, Command};
+
+/// The process exit code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExitStatus {
+    /// Everything done, nothing found.
+    Success = 0,
+    /// `check` (or `diff`) found problems in the robot.
+    Problems = 1,
+    /// The tool could not do its job: bad input, unreadable files, missing meshes.
+    Error = 2,
+}
+
+/// Parses the command line and runs the command; returns the exit code.
+pub fn main() -> i32 {
+    let args = match Args::try_parse() {
+        Ok(a) => a,
+        Err(e) => {
+            let code = if e.use_stderr() {
+                ExitStatus::Error as i32
+            } else {
+                0
+            };
+            let _ = e.print();
+            return code;
+        }
+    };
+    let status = match args.command {
+        Command::Mesh(m) => mesh_cmd::run(&m),
+        Command::Fill(f) => robot_cmd::fill(&f),
+        Command::Diff(d) => robot_cmd::diff(&d),
+        Command::Check(c) => robot_cmd::check(&c),
+    };
+    status as i32
+}
+
+/// Formats a number with the shortest representation that reads back to the same f64, in plain notation
+/// for ordinary magnitudes and scientific notation for very small or large ones.
+pub fn shortest(x: f64) -> String {
+    if x == 0.0 {
+        return "0".into();
+    }
+    let a = x.abs();
+    if (1e-4..1e9).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}

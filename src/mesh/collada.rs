@@ -1,0 +1,585 @@
+//! COLLADA (.dae), read with quick-xml.
+//!
+//! Convention (what ROS tools and pinocchio do with robot meshes):
+//! * every `<instance_geometry>` reachable from the scene's `<instance_visual_scene>` counts, each moved
+//!   by the product of its ancestors' node transforms (`<matrix>`, `<translate>`, `<rotate>`, `<scale>`,
+//!   in document order; `<instance_node>` follows `<library_nodes>`); without a scene, every geometry
+//!   counts once, untransformed;
+//! * `<unit meter="s">` scales all coordinates by `s` (as RViz and Gazebo do);
+//! * `<up_axis>` is **not** applied: coordinates are taken as authored in the URDF link frame, which is
+//!   what RViz, Gazebo and pinocchio (coal's assimp loader) show for `Y_UP` files; the mesh validation
+//!   on example-robot-data compares this against coal.
+//! * `<triangles>`, `<polylist>` and `<polygons>` are read (polygons stay polygons; holes in `<ph>` are
+//!   not supported and reported); `<lines>` and `<linestrips>` carry no surface and are skipped.
+
+use super::{parse_f64, MeshError, MeshErrorKind, RawMesh};
+use crate::mass::{Mat3, Polygons};
+use quick_xml::events::Event;
+use quick_xml::reader::Reader;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// A minimal element tree: enough of COLLADA for geometry and scene graphs.
+#[derive(Debug, Default)]
+struct El {
+    name: String,
+    attrs: Vec<(String, String)>,
+    children: Vec<El>,
+    text: String,
+    line: usize,
+}
+
+impl El {
+    fn attr(&self, key: &str) -> Option<&str> {
+        self.attrs
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
+    }
+    fn child(&self, name: &str) -> Option<&El> {
+        self.children.iter().find(|c| c.name == name)
+    }
+    fn children_named<'a>(&'a self, name: &'a str) -> impl Iterator<Item = &'a El> + 'a {
+        self.children.iter().filter(move |c| c.name == name)
+    }
+    fn walk<'a>(&'a self, out: &mut Vec<&'a El>) {
+        out.push(self);
+        for c in &self.children {
+            c.walk(out);
+        }
+    }
+}
+
+fn line_of(bytes: &[u8], pos: usize) -> usize {
+    1 + bytes[..pos.min(bytes.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+}
+
+/// Line numbers for increasing byte positions in one pass (elements come in document order).
+struct Lines<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+    line: usize,
+}
+
+impl Lines<'_> {
+    fn at(&mut self, pos: usize) -> usize {
+        let pos = pos.min(self.bytes.len());
+        if pos < self.pos {
+            return line_of(self.bytes, pos);
+        }
+        self.line += self.bytes[self.pos..pos]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count();
+        self.pos = pos;
+        self.line
+    }
+}
+
+fn local(name: &[u8]) -> String {
+    let s = String::from_utf8_lossy(name);
+    match s.rfind(':') {
+        Some(i) => s[i + 1..].to_string(),
+        None => s.into_owned(),
+    }
+}
+
+fn element(e: &quick_xml::events::BytesStart<'_>, line: usize) -> El {
+    let mut el = El {
+        name: local(e.name().as_ref()),
+        line,
+        ..Default::default()
+    };
+    for a in e.attributes().flatten() {
+        let v = a
+            .unescape_value()
+            .map(|v| v.into_owned())
+            .unwrap_or_default();
+        el.attrs.push((local(a.key.as_ref()), v));
+    }
+    el
+}
+
+fn parse_tree(bytes: &[u8], path: &Path) -> Result<El, MeshError> {
+    let mut reader = Reader::from_reader(bytes);
+    reader.config_mut().trim_text(false);
+    let mut stack: Vec<El> = vec![El {
+        name: "#document".into(),
+        ..Default::default()
+    }];
+    let mut lines = Lines {
+        bytes,
+        pos: 0,
+        line: 1,
+    };
+    let syntax = |pos: usize, msg: String| {
+        MeshError::new(path, Some(line_of(bytes, pos)), MeshErrorKind::Syntax(msg))
+    };
+    loop {
+        let pos = reader.buffer_position() as usize;
+        let event = reader.read_event().map_err(|e| {
+            syntax(
+                reader.error_position() as usize,
+                format!("malformed XML: {e}"),
+            )
+        })?;
+        match event {
+            Event::Start(e) => stack.push(element(&e, lines.at(pos))),
+            Event::Empty(e) => {
+                let el = element(&e, lines.at(pos));
+                if let Some(parent) = stack.last_mut() {
+                    parent.children.push(el);
+                }
+            }
+            Event::End(_) => {
+                if stack.len() < 2 {
+                    return Err(syntax(pos, "unexpected closing tag".into()));
+                }
+                let done = stack.pop().unwrap_or_default();
+                if let Some(parent) = stack.last_mut() {
+                    parent.children.push(done);
+                }
+            }
+            Event::Text(t) => {
+                if let Some(top) = stack.last_mut() {
+                    top.text.push_str(&String::from_utf8_lossy(t.as_ref()));
+                }
+            }
+            Event::Eof => break,
+            _ => {}
+        }
+    }
+    if stack.len() != 1 {
+        return Err(MeshError::new(
+            path,
+            Some(line_of(bytes, bytes.len())),
+            MeshErrorKind::Syntax("the XML ends before its elements are closed".into()),
+        ));
+    }
+    Ok(stack.pop().unwrap_or_default())
+}
+
+type Affine = (Mat3, [f64; 3]);
+
+const IDENTITY: Affine = (
+    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+    [0.0; 3],
+);
+
+fn compose(a: &Affine, b: &Affine) -> Affine {
+    let m = crate::mass::mat_mul(&a.0, &b.0);
+    let t = crate::mass::mat_vec(&a.0, b.1);
+    (m, [t[0] + a.1[0], t[1] + a.1[1], t[2] + a.1[2]])
+}
+
+fn numbers(el: &El, path: &Path) -> Result<Vec<f64>, MeshError> {
+    el.text
+        .split_ascii_whitespace()
+        .map(|w| {
+            parse_f64(w).ok_or_else(|| {
+                MeshError::new(
+                    path,
+                    Some(el.line),
+                    MeshErrorKind::Syntax(format!("`{w}` is not a number in <{}>", el.name)),
+                )
+            })
+        })
+        .collect()
+}
+
+fn node_transform(node: &El, path: &Path) -> Result<Affine, MeshError> {
+    let mut acc = IDENTITY;
+    for c in &node.children {
+        let step: Affine = match c.name.as_str() {
+            "matrix" => {
+                let m = numbers(c, path)?;
+                if m.len() != 16 {
+                    return Err(MeshError::new(
+                        path,
+                        Some(c.line),
+                        MeshErrorKind::Syntax(format!("<matrix> has {} numbers, not 16", m.len())),
+                    ));
+                }
+                (
+                    [[m[0], m[1], m[2]], [m[4], m[5], m[6]], [m[8], m[9], m[10]]],
+                    [m[3], m[7], m[11]],
+                )
+            }
+            "translate" => {
+                let t = numbers(c, path)?;
+                if t.len() != 3 {
+                    return Err(MeshError::new(
+                        path,
+                        Some(c.line),
+                        MeshErrorKind::Syntax("<translate> needs 3 numbers".into()),
+                    ));
+                }
+                (IDENTITY.0, [t[0], t[1], t[2]])
+            }
+            "scale" => {
+                let s = numbers(c, path)?;
+                if s.len() != 3 {
+                    return Err(MeshError::new(
+                        path,
+                        Some(c.line),
+                        MeshErrorKind::Syntax("<scale> needs 3 numbers".into()),
+                    ));
+                }
+                (
+                    [[s[0], 0.0, 0.0], [0.0, s[1], 0.0], [0.0, 0.0, s[2]]],
+                    [0.0; 3],
+                )
+            }
+            "rotate" => {
+                let r = numbers(c, path)?;
+                if r.len() != 4 {
+                    return Err(MeshError::new(
+                        path,
+                        Some(c.line),
+                        MeshErrorKind::Syntax("<rotate> needs 4 numbers".into()),
+                    ));
+                }
+                (axis_angle([r[0], r[1], r[2]], r[3].to_radians()), [0.0; 3])
+            }
+            _ => continue,
+        };
+        acc = compose(&acc, &step);
+    }
+    Ok(acc)
+}
+
+fn axis_angle(axis: [f64; 3], angle: f64) -> Mat3 {
+    let n = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+    if n == 0.0 {
+        return IDENTITY.0;
+    }
+    let [x, y, z] = axis.map(|a| a / n);
+    let (s, c) = angle.sin_cos();
+    let t = 1.0 - c;
+    [
+        [t * x * x + c, t * x * y - s * z, t * x * z + s * y],
+        [t * x * y + s * z, t * y * y + c, t * y * z - s * x],
+        [t * x * z - s * y, t * y * z + s * x, t * z * z + c],
+    ]
+}
+
+/// Geometry of one `<mesh>`: positions and polygons.
+fn read_geometry(
+    geom: &El,
+    path: &Path,
+    notes: &mut Vec<String>,
+) -> Result<(Vec<[f64; 3]>, Polygons), MeshError> {
+    let Some(mesh) = geom.child("mesh") else {
+        notes.push(format!(
+            "geometry `{}` is not a <mesh> (skipped)",
+            geom.attr("id").unwrap_or("?")
+        ));
+        return Ok((Vec::new(), Polygons::new()));
+    };
+    let err =
+        |line: usize, msg: String| MeshError::new(path, Some(line), MeshErrorKind::Syntax(msg));
+    // Sources by id.
+    let mut sources: HashMap<&str, (Vec<f64>, usize, usize)> = HashMap::new();
+    for src in mesh.children_named("source") {
+        let Some(id) = src.attr("id") else { continue };
+        let Some(arr) = src.child("float_array") else {
+            continue;
+        };
+        let data = numbers(arr, path)?;
+        let (stride, offset) = src
+            .child("technique_common")
+            .and_then(|t| t.child("accessor"))
+            .map(|a| {
+                (
+                    a.attr("stride")
+                        .and_then(|s| s.parse().ok())
+                        .unwrap_or(1usize),
+                    a.attr("offset")
+                        .and_then(|s| s.parse().ok())
+                        .unwrap_or(0usize),
+                )
+            })
+            .unwrap_or((3, 0));
+        sources.insert(id, (data, stride.max(1), offset));
+    }
+    let positions_of = |source_ref: &str, line: usize| -> Result<Vec<[f64; 3]>, MeshError> {
+        let id = source_ref.trim_start_matches('#');
+        // A <vertices> element forwards to its POSITION input.
+        let id = if let Some(v) = mesh
+            .children_named("vertices")
+            .find(|v| v.attr("id") == Some(id))
+        {
+            v.children_named("input")
+                .find(|i| i.attr("semantic") == Some("POSITION"))
+                .and_then(|i| i.attr("source"))
+                .map(|s| s.trim_start_matches('#'))
+                .ok_or_else(|| err(v.line, "<vertices> without a POSITION input".into()))?
+        } else {
+            id
+        };
+        let (data, stride, offset) = sources
+            .get(id)
+            .ok_or_else(|| err(line, format!("no <source id=\"{id}\">")))?;
+        if *stride < 3 {
+            return Err(err(
+                line,
+                format!("position source `{id}` has stride {stride}"),
+            ));
+        }
+        Ok(data
+            .chunks_exact(*stride)
+            .map(|c| [c[*offset], c[offset + 1], c[offset + 2]])
+            .collect())
+    };
+
+    let mut vertices: Vec<[f64; 3]> = Vec::new();
+    let mut faces = Polygons::new();
+    let mut cache: HashMap<String, u32> = HashMap::new();
+    for prim in &mesh.children {
+        let kind = prim.name.as_str();
+        match kind {
+            "triangles" | "polylist" | "polygons" => {}
+            "lines" | "linestrips" | "source" | "vertices" | "extra" => continue,
+            "tristrips" | "trifans" => {
+                return Err(err(
+                    prim.line,
+                    format!("<{kind}> is not supported; re-export the mesh with triangles"),
+                ));
+            }
+            _ => continue,
+        }
+        let inputs: Vec<&El> = prim.children_named("input").collect();
+        let stride = inputs
+            .iter()
+            .filter_map(|i| i.attr("offset").and_then(|o| o.parse::<usize>().ok()))
+            .max()
+            .unwrap_or(0)
+            + 1;
+        let vin = inputs
+            .iter()
+            .find(|i| i.attr("semantic") == Some("VERTEX"))
+            .ok_or_else(|| err(prim.line, format!("<{kind}> has no VERTEX input")))?;
+        let voff: usize = vin.attr("offset").and_then(|o| o.parse().ok()).unwrap_or(0);
+        let src = vin.attr("source").unwrap_or("");
+        // Each distinct source is appended once.
+        let base = match cache.get(src) {
+            Some(&b) => b,
+            None => {
+                let pos = positions_of(src, vin.line)?;
+                let b = vertices.len() as u32;
+                vertices.extend(pos);
+                cache.insert(src.to_string(), b);
+                b
+            }
+        };
+        let count_for_src = |_b: u32| vertices.len();
+        let nverts = count_for_src(base);
+        let index = |raw: f64, line: usize| -> Result<u32, MeshError> {
+            if raw < 0.0 || raw.fract() != 0.0 || base as f64 + raw >= nverts as f64 {
+                return Err(MeshError::new(
+                    path,
+                    Some(line),
+                    MeshErrorKind::IndexOutOfRange {
+                        index: raw as i64,
+                        vertices: nverts - base as usize,
+                    },
+                ));
+            }
+            Ok(base + raw as u32)
+        };
+        let mut face: Vec<u32> = Vec::new();
+        match kind {
+            "triangles" => {
+                let Some(p) = prim.child("p") else { continue };
+                let idx = numbers(p, path)?;
+                for tri in idx.chunks_exact(3 * stride) {
+                    face.clear();
+                    for k in 0..3 {
+                        face.push(index(tri[k * stride + voff], p.line)?);
+                    }
+                    faces.push(&face);
+                }
+            }
+            "polylist" => {
+                let Some(p) = prim.child("p") else { continue };
+                let idx = numbers(p, path)?;
+                let vcount = prim
+                    .child("vcount")
+                    .map(|v| numbers(v, path))
+                    .transpose()?
+                    .unwrap_or_default();
+                let mut at = 0usize;
+                for n in vcount {
+                    let n = n as usize;
+                    if (at + n) * stride > idx.len() {
+                        return Err(err(
+                            p.line,
+                            "<polylist> <vcount> asks for more indices than <p> holds".into(),
+                        ));
+                    }
+                    face.clear();
+                    for k in 0..n {
+                        face.push(index(idx[(at + k) * stride + voff], p.line)?);
+                    }
+                    at += n;
+                    if face.len() >= 3 {
+                        faces.push(&face);
+                    }
+                }
+            }
+            _ => {
+                // <polygons>: one <p> per polygon; <ph> (polygons with holes) are not supported.
+                if prim.child("ph").is_some() {
+                    notes.push("<polygons> with holes (<ph>) skipped".into());
+                }
+                for p in prim.children_named("p") {
+                    let idx = numbers(p, path)?;
+                    face.clear();
+                    for chunk in idx.chunks_exact(stride) {
+                        face.push(index(chunk[voff], p.line)?);
+                    }
+                    if face.len() >= 3 {
+                        faces.push(&face);
+                    }
+                }
+            }
+        }
+    }
+    Ok((vertices, faces))
+}
+
+/// Parses a COLLADA document into one mesh in the file's frame (see the module docs for the convention).
+pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
+    let doc = parse_tree(bytes, path)?;
+    let root = doc
+        .children
+        .iter()
+        .find(|c| c.name == "COLLADA")
+        .ok_or_else(|| {
+            MeshError::new(
+                path,
+                Some(1),
+                MeshErrorKind::Syntax("no <COLLADA> root element".into()),
+            )
+        })?;
+    let mut notes = Vec::new();
+    let unit = root
+        .child("asset")
+        .and_then(|a| a.child("unit"))
+        .and_then(|u| u.attr("meter"))
+        .and_then(|m| m.trim().parse::<f64>().ok())
+        .unwrap_or(1.0);
+
+    let mut all: Vec<&El> = Vec::new();
+    root.walk(&mut all);
+    let by_id: HashMap<&str, &El> = all
+        .iter()
+        .filter_map(|e| e.attr("id").map(|id| (id, *e)))
+        .collect();
+
+    let mut geom_cache: HashMap<String, (Vec<[f64; 3]>, Polygons)> = HashMap::new();
+    let mut out = RawMesh::default();
+    out.faces = Polygons::new();
+    let mut add = |geom: &El,
+                   xf: &Affine,
+                   out: &mut RawMesh,
+                   notes: &mut Vec<String>|
+     -> Result<(), MeshError> {
+        let id = geom.attr("id").unwrap_or("").to_string();
+        if !geom_cache.contains_key(&id) {
+            let g = read_geometry(geom, path, notes)?;
+            geom_cache.insert(id.clone(), g);
+        }
+        let (v, f) = &geom_cache[&id];
+        let base = out.vertices.len() as u32;
+        for p in v {
+            let q = crate::mass::mat_vec(&xf.0, *p);
+            out.vertices.push([
+                (q[0] + xf.1[0]) * unit,
+                (q[1] + xf.1[1]) * unit,
+                (q[2] + xf.1[2]) * unit,
+            ]);
+        }
+        // A mirroring node transform reverses the faces' orientation.
+        let m = &xf.0;
+        let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+        for face in f.iter() {
+            let mut g: Vec<u32> = face.iter().map(|i| i + base).collect();
+            if det < 0.0 {
+                g.reverse();
+            }
+            out.faces.push(&g);
+        }
+        Ok(())
+    };
+
+    let scene = root
+        .child("scene")
+        .and_then(|s| s.child("instance_visual_scene"))
+        .and_then(|i| i.attr("url"))
+        .and_then(|u| by_id.get(u.trim_start_matches('#')).copied())
+        .or_else(|| {
+            root.child("library_visual_scenes")
+                .and_then(|l| l.child("visual_scene"))
+        });
+    match scene {
+        Some(scene) => {
+            let mut stack: Vec<(&El, Affine, usize)> = scene
+                .children_named("node")
+                .map(|n| (n, IDENTITY, 0))
+                .collect();
+            while let Some((node, parent, depth)) = stack.pop() {
+                if depth > 64 {
+                    return Err(MeshError::new(
+                        path,
+                        Some(node.line),
+                        MeshErrorKind::Syntax(
+                            "node hierarchy deeper than 64 (a cycle of <instance_node>?)".into(),
+                        ),
+                    ));
+                }
+                let xf = compose(&parent, &node_transform(node, path)?);
+                for c in &node.children {
+                    match c.name.as_str() {
+                        "instance_geometry" => {
+                            let url = c.attr("url").unwrap_or("").trim_start_matches('#');
+                            let geom = by_id.get(url).ok_or_else(|| {
+                                MeshError::new(
+                                    path,
+                                    Some(c.line),
+                                    MeshErrorKind::Syntax(format!(
+                                        "<instance_geometry url=\"#{url}\"> names no geometry"
+                                    )),
+                                )
+                            })?;
+                            add(geom, &xf, &mut out, &mut notes)?;
+                        }
+                        "node" => stack.push((c, xf, depth + 1)),
+                        "instance_node" => {
+                            let url = c.attr("url").unwrap_or("").trim_start_matches('#');
+                            if let Some(n) = by_id.get(url) {
+                                stack.push((n, xf, depth + 1));
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        }
+        None => {
+            if let Some(lib) = root.child("library_geometries") {
+                for g in lib.children_named("geometry") {
+                    add(g, &IDENTITY, &mut out, &mut notes)?;
+                }
+            }
+            notes.push("no visual scene: every geometry counted once, untransformed".into());
+        }
+    }
+    out.notes = notes;
+    Ok(out)
+}

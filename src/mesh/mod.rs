@@ -1,0 +1,214 @@
+//! Collision meshes: reading STL, OBJ and COLLADA into vertices plus polygons, applying the URDF `scale`,
+//! and turning the result into a solid the mass core can integrate (see [`health`]).
+//!
+//! Each format is a thin module with its own parsing and a `file:line` location where the format has
+//! lines. Polygons stay polygons. Coordinates are read as f64 (binary STL's f32 values convert exactly).
+
+pub mod collada;
+pub mod health;
+pub mod hull;
+pub mod obj;
+pub mod stl;
+
+use crate::mass::Polygons;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Vertices and faces as read from a file, before any health check.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RawMesh {
+    pub vertices: Vec<[f64; 3]>,
+    pub faces: Polygons,
+    /// Things the reader tolerated (a wrong triangle count, a missing `.mtl`), for the report.
+    pub notes: Vec<String>,
+}
+
+/// The mesh formats urdf-inertia reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshFormat {
+    Stl,
+    Obj,
+    Collada,
+}
+
+impl MeshFormat {
+    /// The format of a file, by its extension (case-insensitive).
+    pub fn from_path(path: &Path) -> Option<MeshFormat> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "stl" => Some(MeshFormat::Stl),
+            "obj" => Some(MeshFormat::Obj),
+            "dae" => Some(MeshFormat::Collada),
+            _ => None,
+        }
+    }
+}
+
+/// Why a mesh file could not become a solid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshError {
+    pub path: PathBuf,
+    /// 1-based line, where the format has lines.
+    pub line: Option<usize>,
+    pub kind: MeshErrorKind,
+}
+
+/// What went wrong with a mesh.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum MeshErrorKind {
+    /// The file could not be read at all.
+    Io(String),
+    /// The extension is not one of .stl, .obj, .dae.
+    UnknownFormat(String),
+    /// The content does not follow the format.
+    Syntax(String),
+    /// A binary STL shorter than its header says, or than one triangle record.
+    Truncated(String),
+    /// A NaN or infinite coordinate.
+    NotFinite,
+    /// A face refers to a vertex that does not exist.
+    IndexOutOfRange { index: i64, vertices: usize },
+    /// No faces at all.
+    Empty,
+    /// The solid (or its convex hull) has no volume to speak of.
+    ZeroVolume { volume: f64, bbox_volume: f64 },
+    /// A rung below "exact" was needed and strict mode forbids it.
+    Strict(String),
+    /// A scale with a zero or non-finite factor.
+    BadScale([f64; 3]),
+}
+
+impl fmt::Display for MeshError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.path.display())?;
+        if let Some(line) = self.line {
+            write!(f, ":{line}")?;
+        }
+        write!(f, ": ")?;
+        match &self.kind {
+            MeshErrorKind::Io(e) => write!(f, "cannot read the file: {e}"),
+            MeshErrorKind::UnknownFormat(ext) => write!(
+                f,
+                "unsupported mesh format `{ext}`; urdf-inertia reads .stl, .obj and .dae (convert the collision mesh, e.g. with meshlab or blender)"
+            ),
+            MeshErrorKind::Syntax(msg) => write!(f, "{msg}"),
+            MeshErrorKind::Truncated(msg) => write!(f, "truncated file: {msg}; re-export the mesh"),
+            MeshErrorKind::NotFinite => write!(f, "a vertex coordinate is NaN or infinite; fix or re-export the mesh"),
+            MeshErrorKind::IndexOutOfRange { index, vertices } => {
+                write!(f, "a face refers to vertex {index}, but the file has {vertices} vertices")
+            }
+            MeshErrorKind::Empty => write!(f, "the mesh has no faces"),
+            MeshErrorKind::ZeroVolume { volume, bbox_volume } => write!(
+                f,
+                "the mesh encloses no volume ({volume:.3e} m³ against a bounding box of {bbox_volume:.3e} m³): it is flat or degenerate; give the link a primitive collision shape or a closed mesh"
+            ),
+            MeshErrorKind::Strict(msg) => write!(f, "{msg} (an error under --strict)"),
+            MeshErrorKind::BadScale(s) => {
+                write!(f, "scale \"{} {} {}\" has a zero or non-finite factor", s[0], s[1], s[2])
+            }
+        }
+    }
+}
+
+impl std::error::Error for MeshError {}
+
+impl MeshError {
+    pub fn new(path: &Path, line: Option<usize>, kind: MeshErrorKind) -> Self {
+        MeshError {
+            path: path.to_path_buf(),
+            line,
+            kind,
+        }
+    }
+}
+
+/// Reads a mesh file of any supported format (by extension).
+pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
+    let format = MeshFormat::from_path(path).ok_or_else(|| {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| format!(".{e}"))
+            .unwrap_or_else(|| "(no extension)".into());
+        MeshError::new(path, None, MeshErrorKind::UnknownFormat(ext))
+    })?;
+    let bytes = std::fs::read(path)
+        .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e.to_string())))?;
+    let mesh = match format {
+        MeshFormat::Stl => stl::parse(&bytes, path)?,
+        MeshFormat::Obj => obj::parse(&bytes, path)?,
+        MeshFormat::Collada => collada::parse(&bytes, path)?,
+    };
+    validate(&mesh, path)?;
+    Ok(mesh)
+}
+
+/// Checks what every reader must guarantee: finite coordinates, indices in range, at least one face.
+pub fn validate(mesh: &RawMesh, path: &Path) -> Result<(), MeshError> {
+    if mesh.vertices.iter().flatten().any(|x| !x.is_finite()) {
+        return Err(MeshError::new(path, None, MeshErrorKind::NotFinite));
+    }
+    let n = mesh.vertices.len();
+    if let Some(&bad) = mesh.faces.indices.iter().find(|&&i| i as usize >= n) {
+        return Err(MeshError::new(
+            path,
+            None,
+            MeshErrorKind::IndexOutOfRange {
+                index: bad as i64,
+                vertices: n,
+            },
+        ));
+    }
+    if mesh.faces.is_empty() {
+        return Err(MeshError::new(path, None, MeshErrorKind::Empty));
+    }
+    Ok(())
+}
+
+/// Applies a per-axis scale. A negative determinant mirrors the solid, so every face is reversed to keep
+/// it outward.
+pub fn apply_scale(mesh: &RawMesh, scale: [f64; 3], path: &Path) -> Result<RawMesh, MeshError> {
+    if scale.iter().any(|s| *s == 0.0 || !s.is_finite()) {
+        return Err(MeshError::new(path, None, MeshErrorKind::BadScale(scale)));
+    }
+    let mut out = mesh.clone();
+    if scale != [1.0, 1.0, 1.0] {
+        for v in out.vertices.iter_mut() {
+            *v = [v[0] * scale[0], v[1] * scale[1], v[2] * scale[2]];
+        }
+    }
+    if scale[0] * scale[1] * scale[2] < 0.0 {
+        for i in 0..out.faces.len() {
+            out.faces.reverse_face(i);
+        }
+    }
+    Ok(out)
+}
+
+/// Reads, scales and heals a mesh file: the solid the mass core integrates, with its provenance.
+pub fn load_solid(
+    path: &Path,
+    scale: [f64; 3],
+    options: health::HealthOptions,
+) -> Result<health::Solid, MeshError> {
+    let raw = read(path)?;
+    solid_from_raw(&raw, scale, path, options)
+}
+
+/// Scales and heals an already read mesh (a file used with several scales is read once).
+pub fn solid_from_raw(
+    raw: &RawMesh,
+    scale: [f64; 3],
+    path: &Path,
+    options: health::HealthOptions,
+) -> Result<health::Solid, MeshError> {
+    let scaled = apply_scale(raw, scale, path)?;
+    health::make_solid(&scaled, path, options)
+}
+
+/// Parses a float the way all three formats write them, NaN and infinities included (they are caught
+/// afterwards with a clearer message).
+pub(crate) fn parse_f64(s: &str) -> Option<f64> {
+    s.parse::<f64>().ok()
+}

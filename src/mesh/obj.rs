@@ -1,0 +1,110 @@
+//! Wavefront OBJ.
+//!
+//! Every object (`o`) and group (`g`) belongs to the mesh: a collision part exported as several objects is
+//! one solid made of all of them. Polygons stay polygons. Indices may be negative (relative to the
+//! vertices read so far); texture and normal indices (`f 1/2/3`) are ignored; `mtllib` and `usemtl` are
+//! ignored, so a missing `.mtl` file or texture is no error. Written instead of using tobj so that each
+//! error carries its line number and all objects share one vertex list (tobj splits and re-indexes them).
+
+use super::{parse_f64, MeshError, MeshErrorKind, RawMesh};
+use crate::mass::Polygons;
+use std::path::Path;
+
+/// Parses OBJ text.
+pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
+    let text = String::from_utf8_lossy(bytes);
+    let mut vertices: Vec<[f64; 3]> = Vec::new();
+    let mut faces = Polygons::new();
+    let mut face: Vec<u32> = Vec::new();
+    let mut objects = 0usize;
+    let err =
+        |line: usize, msg: String| MeshError::new(path, Some(line), MeshErrorKind::Syntax(msg));
+    let mut pending = String::new();
+    let mut start_line = 0;
+    for (lineno, raw) in text.lines().enumerate() {
+        // Backslash continues a line.
+        if let Some(stripped) = raw.strip_suffix('\\') {
+            if pending.is_empty() {
+                start_line = lineno + 1;
+            }
+            pending.push_str(stripped);
+            pending.push(' ');
+            continue;
+        }
+        let owned;
+        let (line, lineno) = if pending.is_empty() {
+            (raw, lineno + 1)
+        } else {
+            pending.push_str(raw);
+            owned = std::mem::take(&mut pending);
+            (owned.as_str(), start_line)
+        };
+        let line = line.split('#').next().unwrap_or("");
+        let mut words = line.split_ascii_whitespace();
+        let Some(keyword) = words.next() else {
+            continue;
+        };
+        match keyword {
+            "v" => {
+                let mut p = [0.0; 3];
+                for c in p.iter_mut() {
+                    let w = words
+                        .next()
+                        .ok_or_else(|| err(lineno, "`v` needs three coordinates".into()))?;
+                    *c = parse_f64(w)
+                        .ok_or_else(|| err(lineno, format!("`{w}` is not a number")))?;
+                    if !c.is_finite() {
+                        return Err(MeshError::new(path, Some(lineno), MeshErrorKind::NotFinite));
+                    }
+                }
+                vertices.push(p);
+            }
+            "f" => {
+                face.clear();
+                for w in words {
+                    let idx = w.split('/').next().unwrap_or("");
+                    let i: i64 = idx
+                        .parse()
+                        .map_err(|_| err(lineno, format!("`{w}` is not a vertex index")))?;
+                    let n = vertices.len() as i64;
+                    let resolved = if i > 0 {
+                        i - 1
+                    } else if i < 0 {
+                        n + i
+                    } else {
+                        -1
+                    };
+                    if resolved < 0 || resolved >= n {
+                        return Err(MeshError::new(
+                            path,
+                            Some(lineno),
+                            MeshErrorKind::IndexOutOfRange {
+                                index: i,
+                                vertices: vertices.len(),
+                            },
+                        ));
+                    }
+                    face.push(resolved as u32);
+                }
+                if face.len() < 3 {
+                    return Err(err(lineno, format!("a face with {} vertices", face.len())));
+                }
+                faces.push(&face);
+            }
+            "o" | "g" => objects += 1,
+            // Everything else is irrelevant to the solid: vt, vn, vp, s, l, p, usemtl, mtllib, curves.
+            _ => {}
+        }
+    }
+    let mut notes = Vec::new();
+    if objects > 1 {
+        notes.push(format!(
+            "{objects} objects/groups, all counted as one solid"
+        ));
+    }
+    Ok(RawMesh {
+        vertices,
+        faces,
+        notes,
+    })
+}

@@ -1,0 +1,223 @@
+//! STL, binary and ASCII.
+//!
+//! The format is decided by content, not by the first five bytes: a binary file whose 80-byte header
+//! begins with `solid` (common from CAD exporters) is binary when its length is `84 + 50·n`. A binary
+//! header with a wrong triangle count is tolerated when the length still holds whole records (noted);
+//! a file shorter than its records is an error. Written instead of using stl_io so that all of these
+//! cases, and line numbers for ASCII errors, are handled the same way and tested.
+
+use super::{parse_f64, MeshError, MeshErrorKind, RawMesh};
+use crate::mass::Polygons;
+use std::path::Path;
+
+/// Parses STL bytes (binary or ASCII). Vertices are not welded: each triangle has its own three.
+pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
+    let looks_ascii = {
+        let start = bytes
+            .iter()
+            .position(|b| !b.is_ascii_whitespace())
+            .unwrap_or(bytes.len());
+        bytes[start..].starts_with(b"solid")
+    };
+    if bytes.len() >= 84 {
+        let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
+        let exact_binary = 84 + 50 * n == bytes.len();
+        if exact_binary && !(looks_ascii && n == 0) {
+            return Ok(binary(bytes, n, None));
+        }
+        if looks_ascii {
+            match ascii(bytes, path) {
+                Ok(mesh) => return Ok(mesh),
+                Err(e) => {
+                    // A binary file with a `solid` header and a wrong count: whole records after the header.
+                    if (bytes.len() - 84) % 50 == 0 && bytes.len() > 84 && !is_text(bytes) {
+                        let m = (bytes.len() - 84) / 50;
+                        return Ok(binary(bytes, m, Some(n)));
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        if (bytes.len() - 84) % 50 == 0 && bytes.len() > 84 {
+            let m = (bytes.len() - 84) / 50;
+            return Ok(binary(bytes, m, Some(n)));
+        }
+        let whole = (bytes.len() - 84) / 50;
+        return Err(MeshError::new(
+            path,
+            None,
+            MeshErrorKind::Truncated(format!(
+                "binary STL header says {n} triangles ({} bytes), the file has {} bytes ({whole} whole triangles)",
+                84 + 50 * n,
+                bytes.len()
+            )),
+        ));
+    }
+    if looks_ascii {
+        return ascii(bytes, path);
+    }
+    Err(MeshError::new(
+        path,
+        None,
+        MeshErrorKind::Truncated(format!(
+            "{} bytes is shorter than a binary STL header (84 bytes)",
+            bytes.len()
+        )),
+    ))
+}
+
+fn is_text(bytes: &[u8]) -> bool {
+    bytes
+        .iter()
+        .take(4096)
+        .all(|&b| b.is_ascii_graphic() || b.is_ascii_whitespace())
+}
+
+fn binary(bytes: &[u8], n: usize, header_count: Option<usize>) -> RawMesh {
+    let mut vertices = Vec::with_capacity(3 * n);
+    let mut indices = Vec::with_capacity(3 * n);
+    let f =
+        |o: usize| f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]) as f64;
+    for t in 0..n {
+        let base = 84 + 50 * t + 12; // skip the normal
+        for k in 0..3 {
+            let o = base + 12 * k;
+            vertices.push([f(o), f(o + 4), f(o + 8)]);
+            indices.push((3 * t + k) as u32);
+        }
+    }
+    let starts = (0..=n as u32).map(|i| 3 * i).collect();
+    let mut notes = Vec::new();
+    if let Some(h) = header_count {
+        notes.push(format!(
+            "binary STL header says {h} triangles; read the {n} whole triangles the file holds"
+        ));
+    }
+    RawMesh {
+        vertices,
+        faces: Polygons { indices, starts },
+        notes,
+    }
+}
+
+fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        MeshError::new(
+            path,
+            None,
+            MeshErrorKind::Syntax(format!(
+                "ASCII STL is not valid UTF-8 at byte {}",
+                e.valid_up_to()
+            )),
+        )
+    })?;
+    let mut vertices: Vec<[f64; 3]> = Vec::new();
+    let mut faces = Polygons::new();
+    let mut current: Vec<u32> = Vec::new();
+    let mut in_loop = false;
+    for (lineno, line) in text.lines().enumerate() {
+        let lineno = lineno + 1;
+        let mut words = line.split_ascii_whitespace();
+        let Some(word) = words.next() else { continue };
+        match word {
+            "vertex" => {
+                if !in_loop {
+                    return Err(MeshError::new(
+                        path,
+                        Some(lineno),
+                        MeshErrorKind::Syntax("`vertex` outside `outer loop`".into()),
+                    ));
+                }
+                let mut p = [0.0; 3];
+                for c in p.iter_mut() {
+                    let w = words.next().ok_or_else(|| {
+                        MeshError::new(
+                            path,
+                            Some(lineno),
+                            MeshErrorKind::Syntax("`vertex` needs three coordinates".into()),
+                        )
+                    })?;
+                    *c = parse_f64(w).ok_or_else(|| {
+                        MeshError::new(
+                            path,
+                            Some(lineno),
+                            MeshErrorKind::Syntax(format!("`{w}` is not a number")),
+                        )
+                    })?;
+                    if !c.is_finite() {
+                        return Err(MeshError::new(path, Some(lineno), MeshErrorKind::NotFinite));
+                    }
+                }
+                current.push(vertices.len() as u32);
+                vertices.push(p);
+            }
+            "outer" => {
+                in_loop = true;
+                current.clear();
+            }
+            "endloop" => {
+                in_loop = false;
+                if current.len() < 3 {
+                    return Err(MeshError::new(
+                        path,
+                        Some(lineno),
+                        MeshErrorKind::Syntax(format!("a facet with {} vertices", current.len())),
+                    ));
+                }
+                faces.push(&current);
+            }
+            "solid" | "facet" | "endfacet" | "endsolid" => {}
+            other => {
+                return Err(MeshError::new(
+                    path,
+                    Some(lineno),
+                    MeshErrorKind::Syntax(format!("unexpected `{other}` in ASCII STL")),
+                ));
+            }
+        }
+    }
+    if in_loop {
+        return Err(MeshError::new(
+            path,
+            Some(text.lines().count()),
+            MeshErrorKind::Truncated("ASCII STL ends inside a facet".into()),
+        ));
+    }
+    Ok(RawMesh {
+        vertices,
+        faces,
+        notes: Vec::new(),
+    })
+}
+
+/// Writes a binary STL (used by tests and fixture generators).
+pub fn write_binary(header: &[u8], vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<u8> {
+    let mut out = vec![0u8; 80];
+    out[..header.len().min(80)].copy_from_slice(&header[..header.len().min(80)]);
+    out.extend_from_slice(&(triangles.len() as u32).to_le_bytes());
+    for t in triangles {
+        out.extend_from_slice(&[0u8; 12]);
+        for &i in t {
+            for c in vertices[i as usize] {
+                out.extend_from_slice(&(c as f32).to_le_bytes());
+            }
+        }
+        out.extend_from_slice(&[0u8; 2]);
+    }
+    out
+}
+
+/// Writes an ASCII STL (used by tests and fixture generators).
+pub fn write_ascii(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> String {
+    let mut s = String::from("solid fixture\n");
+    for t in triangles {
+        s.push_str("  facet normal 0 0 0\n    outer loop\n");
+        for &i in t {
+            let v = vertices[i as usize];
+            s.push_str(&format!("      vertex {} {} {}\n", v[0], v[1], v[2]));
+        }
+        s.push_str("    endloop\n  endfacet\n");
+    }
+    s.push_str("endsolid fixture\n");
+    s
+}
