@@ -7,5 +7,8 @@
 #![forbid(unsafe_code)]
 
 pub mod cli;
+pub mod density;
+pub mod fill;
 pub mod mass;
 pub mod mesh;
+pub mod urdf;

@@ -102,6 +102,10 @@ pub struct CheckArgs {
     /// Relative tolerance for existing against computed values (with a density source).
     #[arg(long, value_name = "REL", default_value_t = 0.05)]
     pub tolerance: f64,
+    /// Also fail on invalid <inertial> of links without collision geometry (dummy roots, sensor
+    /// frames), which fill cannot compute; by default they are reported as notes only.
+    #[arg(long)]
+    pub all_links: bool,
 }
 
 #[derive(Debug, Clone, ClapArgs)]

@@ -1,0 +1,415 @@
+//! The density map: which density (or mass) each part and link gets.
+//!
+//! ```toml
+//! default = 1000.0                  # kg/m³ for parts nothing else matches (optional)
+//! total_mass = 12.5                 # optional: scale densities so the filled links sum to this mass
+//! [materials]                       # optional names, added to the built-in table
+//! my_alloy = 2810.0
+//! [links]                           # link name or glob
+//! base_link = "aluminum"            # a material name
+//! "*_finger*" = { mass = 0.05 }     # the link's total mass; its parts share one density
+//! "wrist_*" = { density = 1200.0 }
+//! [meshes]                          # mesh file name or glob, per part
+//! "*battery*" = { density = 2500.0 }
+//! ```
+//!
+//! The most specific rule wins: for a part, a `[meshes]` entry matching its mesh file (by file name, or
+//! by the whole URI when the pattern has a `/`); else the link's rule: an exact `[links]` name, then the
+//! longest matching glob (ties: the one written first), then `default`. A value is a density (number or
+//! `{ density = … }`), a material (`"steel"` or `{ material = "steel" }`) or, for links and meshes, a
+//! mass (`{ mass = … }`: the link's total, or the part's own).
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// Built-in materials, kg/m³ (typical values; put your own in `[materials]`).
+pub const MATERIALS: &[(&str, f64)] = &[
+    ("aluminum", 2700.0),
+    ("aluminium", 2700.0),
+    ("steel", 7850.0),
+    ("stainless_steel", 8000.0),
+    ("titanium", 4430.0),
+    ("copper", 8960.0),
+    ("brass", 8500.0),
+    ("magnesium", 1740.0),
+    ("carbon_fiber", 1600.0),
+    ("pla", 1240.0),
+    ("abs", 1040.0),
+    ("petg", 1270.0),
+    ("nylon", 1150.0),
+    ("polycarbonate", 1200.0),
+    ("acrylic", 1180.0),
+    ("pom", 1410.0),
+    ("delrin", 1410.0),
+    ("rubber", 1100.0),
+    ("silicone", 1100.0),
+    ("wood", 700.0),
+    ("water", 1000.0),
+];
+
+/// What a rule gives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Spec {
+    /// kg/m³.
+    Density(f64),
+    /// kg: a link's total mass (links) or a part's own mass (meshes).
+    Mass(f64),
+}
+
+/// A density map error, with the line of the TOML it concerns.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapError {
+    pub path: PathBuf,
+    pub line: Option<usize>,
+    pub message: String,
+}
+
+impl fmt::Display for MapError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.path.display())?;
+        if let Some(l) = self.line {
+            write!(f, ":{l}")?;
+        }
+        write!(f, ": {}", self.message)
+    }
+}
+
+impl std::error::Error for MapError {}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMap {
+    default: Option<Spanned<toml::Value>>,
+    total_mass: Option<Spanned<f64>>,
+    #[serde(default)]
+    materials: BTreeMap<String, Spanned<toml::Value>>,
+    #[serde(default)]
+    links: toml::Table,
+    #[serde(default)]
+    meshes: toml::Table,
+}
+
+/// A validated density map.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct DensityMap {
+    pub default: Option<f64>,
+    pub total_mass: Option<f64>,
+    /// (pattern, spec), in file order.
+    pub links: Vec<(String, Spec)>,
+    pub meshes: Vec<(String, Spec)>,
+}
+
+impl DensityMap {
+    /// One density for everything (`--density`).
+    pub fn uniform(density: f64) -> Self {
+        DensityMap {
+            default: Some(density),
+            ..Default::default()
+        }
+    }
+
+    /// Reads and validates a density map file.
+    pub fn load(path: &Path) -> Result<Self, MapError> {
+        let text = std::fs::read_to_string(path).map_err(|e| MapError {
+            path: path.into(),
+            line: None,
+            message: format!("cannot read the density map: {e}"),
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses and validates density map text.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, MapError> {
+        let line_of = |span: std::ops::Range<usize>| {
+            Some(1 + text[..span.start.min(text.len())].matches('\n').count())
+        };
+        let err = |span: Option<std::ops::Range<usize>>, message: String| MapError {
+            path: path.into(),
+            line: span.and_then(line_of),
+            message,
+        };
+        let raw: RawMap =
+            toml::from_str(text).map_err(|e| err(e.span(), format!("{}", e.message())))?;
+
+        let mut materials: BTreeMap<String, f64> =
+            MATERIALS.iter().map(|(k, v)| (k.to_string(), *v)).collect();
+        for (name, v) in &raw.materials {
+            let d = v
+                .get_ref()
+                .as_float()
+                .or_else(|| v.get_ref().as_integer().map(|i| i as f64))
+                .ok_or_else(|| {
+                    err(
+                        Some(v.span()),
+                        format!("material `{name}` must be a density in kg/m³"),
+                    )
+                })?;
+            check_positive(d, &format!("material `{name}`")).map_err(|m| err(Some(v.span()), m))?;
+            materials.insert(name.to_ascii_lowercase(), d);
+        }
+        let spec = |v: &toml::Value, allow_mass: bool, what: &str| -> Result<Spec, String> {
+            let material = |name: &str| -> Result<Spec, String> {
+                materials.get(&name.to_ascii_lowercase()).map(|d| Spec::Density(*d)).ok_or_else(|| {
+                    format!("{what}: unknown material `{name}`; add it under [materials] (built in: {})", MATERIALS.iter().map(|m| m.0).collect::<Vec<_>>().join(", "))
+                })
+            };
+            match v {
+                toml::Value::Float(d) => check_positive(*d, what).map(|_| Spec::Density(*d)),
+                toml::Value::Integer(i) => {
+                    check_positive(*i as f64, what).map(|_| Spec::Density(*i as f64))
+                }
+                toml::Value::String(s) => material(s),
+                toml::Value::Table(t) => {
+                    if t.len() != 1 {
+                        return Err(format!(
+                            "{what}: give exactly one of density, mass or material"
+                        ));
+                    }
+                    let (k, val) = t
+                        .iter()
+                        .next()
+                        .ok_or_else(|| format!("{what}: empty table"))?;
+                    let num = || {
+                        val.as_float()
+                            .or_else(|| val.as_integer().map(|i| i as f64))
+                            .ok_or_else(|| format!("{what}: `{k}` must be a number"))
+                    };
+                    match k.as_str() {
+                        "density" => {
+                            let d = num()?;
+                            check_positive(d, what).map(|_| Spec::Density(d))
+                        }
+                        "mass" if allow_mass => {
+                            let m = num()?;
+                            check_positive(m, what).map(|_| Spec::Mass(m))
+                        }
+                        "material" => material(
+                            val.as_str()
+                                .ok_or_else(|| format!("{what}: material must be a name"))?,
+                        ),
+                        other => Err(format!(
+                            "{what}: unknown key `{other}` (expected density, mass or material)"
+                        )),
+                    }
+                }
+                _ => Err(format!(
+                    "{what}: expected a density, a material name or a table"
+                )),
+            }
+        };
+        let default = match &raw.default {
+            None => None,
+            Some(v) => {
+                match spec(v.get_ref(), false, "default").map_err(|m| err(Some(v.span()), m))? {
+                    Spec::Density(d) => Some(d),
+                    Spec::Mass(_) => None,
+                }
+            }
+        };
+        if let Some(t) = &raw.total_mass {
+            check_positive(*t.get_ref(), "total_mass").map_err(|m| err(Some(t.span()), m))?;
+        }
+        // Spans of individual entries: toml's Table does not keep them, so find each key's line in the text.
+        let key_line = |section: &str, key: &str| -> Option<usize> {
+            let mut in_section = false;
+            for (i, line) in text.lines().enumerate() {
+                let t = line.trim();
+                if t.starts_with('[') {
+                    in_section = t.trim_start_matches('[').trim_end_matches(']').trim() == section;
+                    continue;
+                }
+                let k = t
+                    .split('=')
+                    .next()
+                    .unwrap_or("")
+                    .trim()
+                    .trim_matches('"')
+                    .trim_matches('\'');
+                if in_section && k == key {
+                    return Some(i + 1);
+                }
+            }
+            None
+        };
+        let mut links = Vec::new();
+        for (k, v) in &raw.links {
+            let s = spec(v, true, &format!("[links] `{k}`")).map_err(|m| MapError {
+                path: path.into(),
+                line: key_line("links", k),
+                message: m,
+            })?;
+            links.push((k.clone(), s));
+        }
+        let mut meshes = Vec::new();
+        for (k, v) in &raw.meshes {
+            let s = spec(v, true, &format!("[meshes] `{k}`")).map_err(|m| MapError {
+                path: path.into(),
+                line: key_line("meshes", k),
+                message: m,
+            })?;
+            meshes.push((k.clone(), s));
+        }
+        // File order for tie-breaking.
+        links.sort_by_key(|(k, _)| key_line("links", k).unwrap_or(usize::MAX));
+        meshes.sort_by_key(|(k, _)| key_line("meshes", k).unwrap_or(usize::MAX));
+        Ok(DensityMap {
+            default,
+            total_mass: raw.total_mass.map(|t| *t.get_ref()),
+            links,
+            meshes,
+        })
+    }
+
+    /// The rule for a link: exact name, then the longest matching glob, then `None` (the default applies).
+    pub fn link_rule(&self, link: &str) -> Option<(&str, Spec)> {
+        if let Some((k, s)) = self.links.iter().find(|(k, _)| k == link) {
+            return Some((k, *s));
+        }
+        best_glob(&self.links, |_| link)
+    }
+
+    /// The rule for a part's mesh, if any: `uri` is the URDF's filename attribute. A pattern with a `/`
+    /// is matched against the whole URI, any other against the file name.
+    pub fn mesh_rule(&self, uri: &str) -> Option<(&str, Spec)> {
+        let file = uri.rsplit('/').next().unwrap_or(uri);
+        let target = |k: &str| if k.contains('/') { uri } else { file };
+        if let Some((k, s)) = self.meshes.iter().find(|(k, _)| k == target(k)) {
+            return Some((k, *s));
+        }
+        best_glob(&self.meshes, target)
+    }
+}
+
+/// The longest pattern that matches (the first written on ties).
+fn best_glob<'a, 'b>(
+    rules: &'a [(String, Spec)],
+    target: impl Fn(&str) -> &'b str,
+) -> Option<(&'a str, Spec)> {
+    let mut best: Option<&(String, Spec)> = None;
+    for r in rules {
+        if glob_match(&r.0, target(&r.0)) && best.is_none_or(|b| r.0.len() > b.0.len()) {
+            best = Some(r);
+        }
+    }
+    best.map(|(k, s)| (k.as_str(), *s))
+}
+
+fn check_positive(x: f64, what: &str) -> Result<(), String> {
+    if x > 0.0 && x.is_finite() {
+        Ok(())
+    } else {
+        Err(format!("{what}: {x} must be a positive number"))
+    }
+}
+
+/// Glob matching with `*` (any run, including empty) and `?` (one character).
+pub fn glob_match(pattern: &str, name: &str) -> bool {
+    let p: Vec<char> = pattern.chars().collect();
+    let n: Vec<char> = name.chars().collect();
+    let (mut pi, mut ni) = (0usize, 0usize);
+    let (mut star, mut mark) = (None, 0usize);
+    while ni < n.len() {
+        if pi < p.len() && (p[pi] == '?' || p[pi] == n[ni]) {
+            pi += 1;
+            ni += 1;
+        } else if pi < p.len() && p[pi] == '*' {
+            star = Some(pi);
+            mark = ni;
+            pi += 1;
+        } else if let Some(s) = star {
+            pi = s + 1;
+            mark += 1;
+            ni = mark;
+        } else {
+            return false;
+        }
+    }
+    while pi < p.len() && p[pi] == '*' {
+        pi += 1;
+    }
+    pi == p.len()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MAP: &str = r#"
+default = 1000.0
+total_mass = 12.5
+[materials]
+my_alloy = 2810.0
+[links]
+base_link = "aluminum"
+"*_finger*" = { mass = 0.05 }
+"wrist_*" = { density = 1200.0 }
+"wrist_roll*" = "my_alloy"
+"*" = "pla"
+[meshes]
+"*battery*" = { density = 2500.0 }
+"#;
+
+    #[test]
+    fn most_specific_rule_wins() {
+        let m = DensityMap::parse(MAP, Path::new("d.toml")).expect("parse");
+        assert_eq!(m.default, Some(1000.0));
+        assert_eq!(m.total_mass, Some(12.5));
+        assert_eq!(
+            m.link_rule("base_link"),
+            Some(("base_link", Spec::Density(2700.0)))
+        );
+        assert_eq!(
+            m.link_rule("left_finger_1"),
+            Some(("*_finger*", Spec::Mass(0.05)))
+        );
+        assert_eq!(
+            m.link_rule("wrist_pitch"),
+            Some(("wrist_*", Spec::Density(1200.0)))
+        );
+        // Longer glob beats shorter.
+        assert_eq!(
+            m.link_rule("wrist_roll_link"),
+            Some(("wrist_roll*", Spec::Density(2810.0)))
+        );
+        assert_eq!(m.link_rule("elbow"), Some(("*", Spec::Density(1240.0))));
+        assert_eq!(m.mesh_rule("package://r/meshes/Battery_pack.stl"), None);
+        assert_eq!(
+            m.mesh_rule("package://r/meshes/big_battery.stl"),
+            Some(("*battery*", Spec::Density(2500.0)))
+        );
+    }
+
+    #[test]
+    fn errors_name_the_line() {
+        let e = DensityMap::parse("[links]\nbase = \"unobtainium\"\n", Path::new("d.toml"))
+            .unwrap_err();
+        assert_eq!(e.line, Some(2), "{e}");
+        assert!(e.message.contains("unknown material `unobtainium`"), "{e}");
+        let e = DensityMap::parse("default = 1000\ncolour = 3\n", Path::new("d.toml")).unwrap_err();
+        assert_eq!(e.line, Some(2), "{e}");
+        assert!(e.message.contains("colour"), "{e}");
+        let e = DensityMap::parse("default = -5.0\n", Path::new("d.toml")).unwrap_err();
+        assert!(e.message.contains("positive"), "{e}");
+        let e = DensityMap::parse(
+            "[links]\n\"a*\" = { mass = 1, density = 2 }\n",
+            Path::new("d.toml"),
+        )
+        .unwrap_err();
+        assert_eq!(e.line, Some(2), "{e}");
+        let e = DensityMap::parse("[meshes]\n\"a\" = { weight = 1 }\n", Path::new("d.toml"))
+            .unwrap_err();
+        assert!(e.message.contains("unknown key `weight`"), "{e}");
+    }
+
+    #[test]
+    fn globs() {
+        assert!(glob_match("*_finger*", "l_finger_tip"));
+        assert!(glob_match("a?c", "abc"));
+        assert!(!glob_match("a?c", "ac"));
+        assert!(glob_match("*", ""));
+        assert!(!glob_match("wrist_*", "base"));
+    }
+}

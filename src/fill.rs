@@ -1,0 +1,584 @@
+//! Per-link composition (the paper's Problem 1): each link's collision parts, each with a density or a
+//! mass, as one body in the link frame.
+//!
+//! Work a robot does not need is left out: only links with collision geometry (and selected by
+//! `--only/--skip/--missing-only`) are computed, visual meshes are never read, each mesh file is read
+//! once and each (file, scale) healed and integrated once.
+
+use crate::density::{DensityMap, Spec};
+use crate::mass::{mat_vec, primitives, rpy_matrix, validity, MassProperties};
+use crate::mesh::health::{HealthOptions, Solid};
+use crate::mesh::{self, MeshError, RawMesh};
+use crate::urdf::resolve::PackageResolver;
+use crate::urdf::{Geometry, Inertial, Link, Robot};
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// What to compute.
+#[derive(Debug, Clone, Default)]
+pub struct FillOptions {
+    pub strict: bool,
+    pub only: Vec<String>,
+    pub skip: Vec<String>,
+    /// Only links whose inertial is absent or invalid.
+    pub missing_only: bool,
+    /// Each link's existing `<mass>` is its mass target.
+    pub keep_mass: bool,
+}
+
+/// One collision element's contribution.
+#[derive(Debug, Clone)]
+pub struct PartReport {
+    /// 1-based collision index in the link.
+    pub collision: usize,
+    /// `box 0.1 0.2 0.3`, or the mesh URI.
+    pub what: String,
+    pub file: Option<PathBuf>,
+    /// "primitive" or the mesh rung's name.
+    pub provenance: String,
+    pub warnings: Vec<String>,
+    pub faces: usize,
+    pub volume: f64,
+    pub mass: f64,
+    pub density: f64,
+    /// Where the density came from (`[meshes] "*battery*"`, `[links] base_link`, `default`, …).
+    pub density_source: String,
+    pub error_estimate: f64,
+}
+
+/// A link whose inertial was computed.
+#[derive(Debug, Clone)]
+pub struct LinkReport {
+    /// Index into `Robot::links`.
+    pub index: usize,
+    pub name: String,
+    pub line: usize,
+    pub computed: MassProperties,
+    pub parts: Vec<PartReport>,
+    /// Upper estimate of the volume counted twice by overlapping parts, m³.
+    pub overlap: Option<(f64, String)>,
+    /// Diagonal of the link's collision geometry's bounding box (link frame), m.
+    pub size: f64,
+    pub warnings: Vec<String>,
+}
+
+/// A link that could not be computed.
+#[derive(Debug, Clone)]
+pub struct LinkFailure {
+    pub name: String,
+    pub line: usize,
+    pub message: String,
+}
+
+/// Wall time per stage.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Timing {
+    pub load: Duration,
+    pub integrate: Duration,
+}
+
+/// Everything `fill`, `diff` and `check` need to report.
+#[derive(Debug, Clone, Default)]
+pub struct FillReport {
+    pub links: Vec<LinkReport>,
+    pub failures: Vec<LinkFailure>,
+    /// Links with no collision geometry (left as they are).
+    pub without_geometry: usize,
+    /// Links not selected (--only/--skip/--missing-only).
+    pub not_selected: usize,
+    pub mesh_files: usize,
+    pub faces: usize,
+    pub timing: Timing,
+}
+
+/// Reads each file once and heals each (file, scale) once.
+#[derive(Debug, Default)]
+pub struct MeshCache {
+    raw: HashMap<PathBuf, Result<Arc<RawMesh>, MeshError>>,
+    solids: HashMap<(PathBuf, [u64; 3]), Result<Arc<Solid>, MeshError>>,
+    pub load_time: Duration,
+    pub integrate_time: Duration,
+}
+
+impl MeshCache {
+    pub fn solid(
+        &mut self,
+        path: &PathBuf,
+        scale: [f64; 3],
+        options: HealthOptions,
+    ) -> Result<Arc<Solid>, MeshError> {
+        let key = (path.clone(), scale.map(f64::to_bits));
+        if let Some(r) = self.solids.get(&key) {
+            return r.clone();
+        }
+        let t0 = Instant::now();
+        let raw = match self.raw.get(path) {
+            Some(r) => r.clone(),
+            None => {
+                let r = mesh::read(path).map(Arc::new);
+                self.raw.insert(path.clone(), r.clone());
+                r
+            }
+        };
+        let t1 = Instant::now();
+        self.load_time += t1 - t0;
+        let solid = raw
+            .and_then(|raw| mesh::solid_from_raw(&raw, scale, path, options))
+            .map(Arc::new);
+        self.integrate_time += t1.elapsed();
+        self.solids.insert(key, solid.clone());
+        solid
+    }
+
+    /// Number of distinct files read.
+    pub fn files(&self) -> usize {
+        self.raw.len()
+    }
+}
+
+/// Whether a link is selected by `--only` / `--skip` globs.
+pub fn selected(name: &str, opts: &FillOptions) -> bool {
+    let only = opts.only.is_empty()
+        || opts
+            .only
+            .iter()
+            .any(|g| crate::density::glob_match(g, name));
+    only && !opts
+        .skip
+        .iter()
+        .any(|g| crate::density::glob_match(g, name))
+}
+
+/// An existing inertial as mass properties in link coordinates (tensor rotated out of its origin frame).
+pub fn existing_props(inertial: &Inertial) -> Option<MassProperties> {
+    let mass = inertial.mass?;
+    let i = inertial.inertia?;
+    let local = [[i[0], i[1], i[2]], [i[1], i[3], i[4]], [i[2], i[4], i[5]]];
+    let r = rpy_matrix(inertial.origin.rpy);
+    let mp = MassProperties {
+        mass,
+        com: [0.0; 3],
+        inertia: local,
+    };
+    Some(mp.transformed(&r, inertial.origin.xyz))
+}
+
+/// Problems of a link's existing `<inertial>` (missing parts, unreadable numbers, physical validity).
+///
+/// One exception: an all-zero inertial (mass 0, zero tensor) on a link *without* collision geometry is
+/// the usual way to write a massless frame (IMU, tool or sensor frames on fixed joints) and is accepted.
+pub fn existing_problems(link: &Link) -> Vec<String> {
+    let Some(span) = &link.inertial else {
+        return vec!["no <inertial>".into()];
+    };
+    if link.collisions.is_empty()
+        && span.problem.is_none()
+        && span.value.mass == Some(0.0)
+        && span
+            .value
+            .inertia
+            .is_none_or(|i| i.iter().all(|x| *x == 0.0))
+    {
+        return Vec::new();
+    }
+    if let Some(p) = &span.problem {
+        return vec![format!("<inertial> cannot be read: {p}")];
+    }
+    let mut out = Vec::new();
+    if span.value.mass.is_none() {
+        out.push("<inertial> has no <mass>".into());
+    }
+    if span.value.inertia.is_none() {
+        out.push("<inertial> has no <inertia>".into());
+    }
+    if let Some(mp) = existing_props(&span.value) {
+        for v in validity::check(&mp, validity::DEFAULT_TOLERANCE) {
+            out.push(v.to_string());
+        }
+    }
+    out
+}
+
+struct Part {
+    collision: usize,
+    what: String,
+    file: Option<PathBuf>,
+    uri: Option<String>,
+    unit: MassProperties,
+    provenance: String,
+    warnings: Vec<String>,
+    faces: usize,
+    error_estimate: f64,
+    bbox: ([f64; 3], [f64; 3]),
+}
+
+fn transformed_bbox(
+    points: impl Iterator<Item = [f64; 3]>,
+    r: &crate::mass::Mat3,
+    t: [f64; 3],
+) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        let q = mat_vec(r, p);
+        for k in 0..3 {
+            lo[k] = lo[k].min(q[k] + t[k]);
+            hi[k] = hi[k].max(q[k] + t[k]);
+        }
+    }
+    (lo, hi)
+}
+
+fn box_corners(h: [f64; 3]) -> impl Iterator<Item = [f64; 3]> {
+    (0..8).map(move |i| {
+        [
+            if i & 1 == 0 { -h[0] } else { h[0] },
+            if i & 2 == 0 { -h[1] } else { h[1] },
+            if i & 4 == 0 { -h[2] } else { h[2] },
+        ]
+    })
+}
+
+fn geometry_part(
+    c: &crate::urdf::Collision,
+    robot: &Robot,
+    resolver: &PackageResolver,
+    cache: &mut MeshCache,
+    opts: &FillOptions,
+) -> Result<Part, String> {
+    let r = rpy_matrix(c.origin.rpy);
+    let t = c.origin.xyz;
+    let fmt3 = |v: [f64; 3]| format!("{} {} {}", v[0], v[1], v[2]);
+    let primitive = |unit: MassProperties, what: String, half: [f64; 3]| Part {
+        collision: c.index,
+        what,
+        file: None,
+        uri: None,
+        unit: unit.transformed(&r, t),
+        provenance: "primitive".into(),
+        warnings: Vec::new(),
+        faces: 0,
+        error_estimate: 0.0,
+        bbox: transformed_bbox(box_corners(half), &r, t),
+    };
+    Ok(match &c.geometry {
+        Geometry::Box { size } => primitive(
+            primitives::cuboid(*size, 1.0),
+            format!("box {}", fmt3(*size)),
+            size.map(|s| s / 2.0),
+        ),
+        Geometry::Cylinder { radius, length } => primitive(
+            primitives::cylinder(*radius, *length, 1.0),
+            format!("cylinder r={radius} l={length}"),
+            [*radius, *radius, length / 2.0],
+        ),
+        Geometry::Capsule { radius, length } => primitive(
+            primitives::capsule(*radius, *length, 1.0),
+            format!("capsule r={radius} l={length}"),
+            [*radius, *radius, length / 2.0 + radius],
+        ),
+        Geometry::Sphere { radius } => primitive(
+            primitives::sphere(*radius, 1.0),
+            format!("sphere r={radius}"),
+            [*radius; 3],
+        ),
+        Geometry::Mesh { filename, scale } => {
+            let path = resolver.resolve(filename, &robot.path).map_err(|nf| {
+                let searched: Vec<String> = nf
+                    .searched
+                    .iter()
+                    .map(|p| format!("    {}", p.display()))
+                    .collect();
+                format!(
+                    "collision {} (line {}): mesh `{}` not found; searched:\n{}\n  {}",
+                    c.index,
+                    c.line,
+                    nf.uri,
+                    if searched.is_empty() {
+                        "    (nothing)".to_string()
+                    } else {
+                        searched.join("\n")
+                    },
+                    nf.hint
+                )
+            })?;
+            let solid = cache
+                .solid(
+                    &path,
+                    *scale,
+                    HealthOptions {
+                        strict: opts.strict,
+                    },
+                )
+                .map_err(|e| format!("collision {} (line {}): {e}", c.index, c.line))?;
+            Part {
+                collision: c.index,
+                what: filename.clone(),
+                file: Some(path),
+                uri: Some(filename.clone()),
+                unit: solid.unit.transformed(&r, t),
+                provenance: solid.rung.name().into(),
+                warnings: solid.warnings.clone(),
+                faces: solid.faces_read,
+                error_estimate: solid.error_estimate,
+                bbox: transformed_bbox(solid.vertices.iter().copied(), &r, t),
+            }
+        }
+    })
+}
+
+/// Computes every selected link with collision geometry.
+pub fn compute(
+    robot: &Robot,
+    map: &DensityMap,
+    resolver: &PackageResolver,
+    opts: &FillOptions,
+) -> FillReport {
+    let mut cache = MeshCache::default();
+    let mut report = FillReport::default();
+    let mut missing_density: Vec<(String, usize)> = Vec::new();
+    // Links whose mass follows from densities (scaled by total_mass), as indices into report.links.
+    let mut density_links: Vec<usize> = Vec::new();
+    for (li, link) in robot.links.iter().enumerate() {
+        if link.collisions.is_empty() {
+            report.without_geometry += 1;
+            continue;
+        }
+        if !selected(&link.name, opts) || (opts.missing_only && existing_problems(link).is_empty())
+        {
+            report.not_selected += 1;
+            continue;
+        }
+        let mut parts = Vec::new();
+        let mut failed = None;
+        for c in &link.collisions {
+            match geometry_part(c, robot, resolver, &mut cache, opts) {
+                Ok(p) => parts.push(p),
+                Err(m) => {
+                    failed = Some(m);
+                    break;
+                }
+            }
+        }
+        if let Some(message) = failed {
+            report.failures.push(LinkFailure {
+                name: link.name.clone(),
+                line: link.line,
+                message,
+            });
+            continue;
+        }
+        // Densities: a part's own [meshes] rule, else the link's rule (keep-mass, [links], default).
+        let own: Vec<Option<(String, Spec)>> = parts
+            .iter()
+            .map(|p| {
+                p.uri
+                    .as_deref()
+                    .and_then(|u| map.mesh_rule(u))
+                    .map(|(k, s)| (format!("[meshes] \"{k}\""), s))
+            })
+            .collect();
+        let kept = if opts.keep_mass {
+            link.inertial
+                .as_ref()
+                .and_then(|s| s.value.mass)
+                .filter(|m| *m > 0.0 && m.is_finite())
+        } else {
+            None
+        };
+        let link_spec: Option<(String, Spec)> = match kept {
+            Some(m) => Some(("existing <mass> (--keep-mass)".into(), Spec::Mass(m))),
+            None => map
+                .link_rule(&link.name)
+                .map(|(k, s)| (format!("[links] \"{k}\""), s))
+                .or_else(|| map.default.map(|d| ("default".into(), Spec::Density(d)))),
+        };
+        let others_need = own.iter().any(|o| o.is_none());
+        let link_spec = match link_spec {
+            Some(s) => Some(s),
+            None if others_need => {
+                missing_density.push((link.name.clone(), link.line));
+                continue;
+            }
+            None => None,
+        };
+        let mut warnings = Vec::new();
+        let own_mass: f64 = parts
+            .iter()
+            .zip(&own)
+            .map(|(p, o)| match o {
+                Some((_, Spec::Density(d))) => p.unit.mass * d,
+                Some((_, Spec::Mass(m))) => *m,
+                None => 0.0,
+            })
+            .sum();
+        let other_volume: f64 = parts
+            .iter()
+            .zip(&own)
+            .filter(|(_, o)| o.is_none())
+            .map(|(p, _)| p.unit.mass)
+            .sum();
+        let shared_density = match &link_spec {
+            Some((_, Spec::Density(d))) => *d,
+            Some((src, Spec::Mass(m))) => {
+                if other_volume > 0.0 {
+                    let d = (m - own_mass) / other_volume;
+                    if !(d > 0.0) {
+                        report.failures.push(LinkFailure {
+                            name: link.name.clone(),
+                            line: link.line,
+                            message: format!("{src} gives the link {m} kg, but its parts with their own [meshes] rule already weigh {own_mass} kg"),
+                        });
+                        continue;
+                    }
+                    d
+                } else {
+                    if (m - own_mass).abs() > 1e-9 * m {
+                        warnings.push(format!("{src} asks for {m} kg, but every part has its own rule ({own_mass} kg); the parts' rules win"));
+                    }
+                    0.0
+                }
+            }
+            None => 0.0,
+        };
+        let mut part_reports = Vec::new();
+        let mut bodies = Vec::new();
+        for (p, o) in parts.iter().zip(&own) {
+            let (density, source) = match o {
+                Some((src, Spec::Density(d))) => (*d, src.clone()),
+                Some((src, Spec::Mass(m))) => (m / p.unit.mass, src.clone()),
+                None => (
+                    shared_density,
+                    link_spec.as_ref().map(|l| l.0.clone()).unwrap_or_default(),
+                ),
+            };
+            let body = p.unit.scaled(density);
+            bodies.push(body);
+            part_reports.push(PartReport {
+                collision: p.collision,
+                what: p.what.clone(),
+                file: p.file.clone(),
+                provenance: p.provenance.clone(),
+                warnings: p.warnings.clone(),
+                faces: p.faces,
+                volume: p.unit.mass,
+                mass: body.mass,
+                density,
+                density_source: source,
+                error_estimate: p.error_estimate,
+            });
+        }
+        let computed: MassProperties = bodies.into_iter().sum();
+        let (lo, hi) = parts.iter().fold(
+            ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+            |(lo, hi), p| {
+                (
+                    [0, 1, 2].map(|k| lo[k].min(p.bbox.0[k])),
+                    [0, 1, 2].map(|k| hi[k].max(p.bbox.1[k])),
+                )
+            },
+        );
+        let size =
+            ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
+        let overlap = overlap_estimate(&parts);
+        if let Some((v, pair)) = &overlap {
+            let total: f64 = parts.iter().map(|p| p.unit.mass).sum();
+            warnings.push(format!(
+                "parts {pair} overlap: up to {v:.3e} m³ ({:.1}% of the link's volume) is counted twice (bounding-box estimate)",
+                100.0 * v / total
+            ));
+        }
+        if matches!(link_spec, Some((_, Spec::Density(_)))) && own.iter().all(|o| o.is_none()) {
+            density_links.push(report.links.len());
+        }
+        report.faces += parts.iter().map(|p| p.faces).sum::<usize>();
+        report.links.push(LinkReport {
+            index: li,
+            name: link.name.clone(),
+            line: link.line,
+            computed,
+            parts: part_reports,
+            overlap,
+            size,
+            warnings,
+        });
+    }
+    if !missing_density.is_empty() {
+        let list: Vec<String> = missing_density
+            .iter()
+            .map(|(n, l)| format!("`{n}` (line {l})"))
+            .collect();
+        report.failures.push(LinkFailure {
+            name: String::new(),
+            line: missing_density[0].1,
+            message: format!(
+                "no density for {} link(s) with collision geometry: {}; give --density RHO, a `default` in the density map, or a [links] rule",
+                missing_density.len(),
+                list.join(", ")
+            ),
+        });
+    }
+    if let Some(total) = map.total_mass {
+        let variable: f64 = density_links
+            .iter()
+            .map(|&i| report.links[i].computed.mass)
+            .sum();
+        let fixed: f64 = report.links.iter().map(|l| l.computed.mass).sum::<f64>() - variable;
+        if variable > 0.0 && total > fixed {
+            let factor = (total - fixed) / variable;
+            for &i in &density_links {
+                let l = &mut report.links[i];
+                l.computed = l.computed.scaled(factor);
+                for p in l.parts.iter_mut() {
+                    p.mass *= factor;
+                    p.density *= factor;
+                    p.density_source =
+                        format!("{} × {factor:.6} (total_mass {total} kg)", p.density_source);
+                }
+            }
+        } else {
+            report.failures.push(LinkFailure {
+                name: String::new(),
+                line: 0,
+                message: format!("total_mass {total} kg cannot be met: links with fixed masses already weigh {fixed} kg and density-based links {variable} kg"),
+            });
+        }
+    }
+    report.mesh_files = cache.files();
+    report.timing = Timing {
+        load: cache.load_time,
+        integrate: cache.integrate_time,
+    };
+    report
+}
+
+/// The largest pairwise overlap of the parts' bounding boxes, capped by the smaller part's volume, when it
+/// exceeds 1% of that volume: an upper estimate of the volume counted twice.
+fn overlap_estimate(parts: &[Part]) -> Option<(f64, String)> {
+    let mut best: Option<(f64, String)> = None;
+    for i in 0..parts.len() {
+        for j in i + 1..parts.len() {
+            let (a, b) = (&parts[i].bbox, &parts[j].bbox);
+            let mut v = 1.0;
+            for k in 0..3 {
+                v *= (a.1[k].min(b.1[k]) - a.0[k].max(b.0[k])).max(0.0);
+            }
+            let smaller = parts[i].unit.mass.min(parts[j].unit.mass);
+            let v = v.min(smaller);
+            if v > 0.01 * smaller && best.as_ref().is_none_or(|b| v > b.0) {
+                best = Some((
+                    v,
+                    format!("{} and {}", parts[i].collision, parts[j].collision),
+                ));
+            }
+        }
+    }
+    best
+}
+
+/// Whether a mesh rung is below "exact".
+pub fn repaired(provenance: &str) -> bool {
+    provenance != "exact" && provenance != "primitive"
+}

@@ -1,0 +1,229 @@
+//! Mesh URIs to files: `package://NAME/rest` (also `package:///NAME/rest`), `file://`, and plain paths
+//! relative to the URDF.
+//!
+//! A package is looked up, in order: `--package-path NAME=DIR` (DIR is the package's own directory),
+//! then each entry of `ROS_PACKAGE_PATH` (a package directory itself, or a tree containing it), then each
+//! `AMENT_PREFIX_PATH` prefix's `share/NAME`, then walking up from the URDF's directory to a directory
+//! that is the package (holds a `package.xml` naming it, or is named like it) or that contains one.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// How to find packages.
+#[derive(Debug, Clone, Default)]
+pub struct PackageResolver {
+    explicit: HashMap<String, PathBuf>,
+    ros_package_path: Vec<PathBuf>,
+    ament_prefix_path: Vec<PathBuf>,
+    cache: std::cell::RefCell<HashMap<(String, PathBuf), Option<PathBuf>>>,
+}
+
+/// A mesh URI that names no existing file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NotFound {
+    pub uri: String,
+    /// Every place looked at, in order.
+    pub searched: Vec<PathBuf>,
+    pub hint: String,
+}
+
+impl PackageResolver {
+    /// From `NAME=DIR` arguments and the environment.
+    pub fn new(package_paths: &[(String, PathBuf)]) -> Self {
+        let split = |var: &str| -> Vec<PathBuf> {
+            std::env::var_os(var)
+                .map(|v| {
+                    std::env::split_paths(&v)
+                        .filter(|p| !p.as_os_str().is_empty())
+                        .collect()
+                })
+                .unwrap_or_default()
+        };
+        PackageResolver {
+            explicit: package_paths.iter().cloned().collect(),
+            ros_package_path: split("ROS_PACKAGE_PATH"),
+            ament_prefix_path: split("AMENT_PREFIX_PATH"),
+            cache: Default::default(),
+        }
+    }
+
+    /// Parses `NAME=DIR`.
+    pub fn parse_package_arg(arg: &str) -> Result<(String, PathBuf), String> {
+        match arg.split_once('=') {
+            Some((name, dir)) if !name.is_empty() && !dir.is_empty() => {
+                Ok((name.to_string(), PathBuf::from(dir)))
+            }
+            _ => Err(format!("--package-path `{arg}` should be NAME=DIR")),
+        }
+    }
+
+    /// The file a mesh URI names, relative to the URDF at `urdf`.
+    pub fn resolve(&self, uri: &str, urdf: &Path) -> Result<PathBuf, NotFound> {
+        let base = urdf.parent().map(Path::to_path_buf).unwrap_or_default();
+        if let Some(rest) = uri.strip_prefix("package://") {
+            let rest = rest.trim_start_matches('/');
+            let (pkg, inner) = rest.split_once('/').unwrap_or((rest, ""));
+            let mut searched = Vec::new();
+            for dir in self.package_dirs(pkg, &base, &mut searched) {
+                let p = dir.join(inner);
+                if p.is_file() {
+                    return Ok(p);
+                }
+                searched.push(p);
+            }
+            return Err(NotFound {
+                uri: uri.to_string(),
+                searched,
+                hint: format!("pass --package-path {pkg}=DIR (DIR is the package's directory), or set ROS_PACKAGE_PATH"),
+            });
+        }
+        let path = if let Some(rest) = uri.strip_prefix("file://") {
+            let p = PathBuf::from(rest);
+            if p.is_absolute() {
+                p
+            } else {
+                base.join(p)
+            }
+        } else if uri.contains("://") {
+            return Err(NotFound {
+                uri: uri.to_string(),
+                searched: Vec::new(),
+                hint: "only package:// and file:// URIs and plain paths are supported".into(),
+            });
+        } else {
+            let p = PathBuf::from(uri);
+            if p.is_absolute() {
+                p
+            } else {
+                base.join(p)
+            }
+        };
+        if path.is_file() {
+            Ok(path)
+        } else {
+            Err(NotFound {
+                uri: uri.to_string(),
+                searched: vec![path],
+                hint: "check the path (relative paths are relative to the URDF's directory)".into(),
+            })
+        }
+    }
+
+    /// Candidate directories for package `pkg`, in search order (recording what was looked at).
+    fn package_dirs(&self, pkg: &str, base: &Path, searched: &mut Vec<PathBuf>) -> Vec<PathBuf> {
+        let mut out = Vec::new();
+        if let Some(d) = self.explicit.get(pkg) {
+            out.push(d.clone());
+        }
+        for root in &self.ros_package_path {
+            if is_package(root, pkg) {
+                out.push(root.clone());
+            } else {
+                let cand = root.join(pkg);
+                if cand.is_dir() {
+                    out.push(cand);
+                } else {
+                    searched.push(cand);
+                }
+            }
+        }
+        for prefix in &self.ament_prefix_path {
+            let cand = prefix.join("share").join(pkg);
+            if cand.is_dir() {
+                out.push(cand);
+            } else {
+                searched.push(cand);
+            }
+        }
+        let key = (pkg.to_string(), base.to_path_buf());
+        let found = self.cache.borrow().get(&key).cloned();
+        let found = match found {
+            Some(f) => f,
+            None => {
+                let f = walk_up(base, pkg);
+                self.cache.borrow_mut().insert(key, f.clone());
+                f
+            }
+        };
+        match found {
+            Some(d) => out.push(d),
+            None => searched.push(base.join(format!("..(each parent)/{pkg}"))),
+        }
+        out
+    }
+}
+
+/// Whether `dir` is package `pkg`: its `package.xml` names it, or the directory has the package's name.
+fn is_package(dir: &Path, pkg: &str) -> bool {
+    let xml = dir.join("package.xml");
+    if let Ok(text) = std::fs::read_to_string(&xml) {
+        if let (Some(a), Some(b)) = (text.find("<name>"), text.find("</name>")) {
+            if a < b && text[a + 6..b].trim() == pkg {
+                return true;
+            }
+        }
+    }
+    dir.file_name().and_then(|n| n.to_str()) == Some(pkg)
+}
+
+fn walk_up(base: &Path, pkg: &str) -> Option<PathBuf> {
+    let start = std::fs::canonicalize(base).unwrap_or_else(|_| base.to_path_buf());
+    let mut dir = Some(start.as_path());
+    while let Some(d) = dir {
+        if is_package(d, pkg) {
+            return Some(d.to_path_buf());
+        }
+        let child = d.join(pkg);
+        if child.is_dir() {
+            return Some(child);
+        }
+        dir = d.parent();
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resolves_package_uris_three_ways() {
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let pkg = tmp.path().join("src").join("my_robot_description");
+        std::fs::create_dir_all(pkg.join("meshes")).expect("mkdir");
+        std::fs::create_dir_all(pkg.join("urdf")).expect("mkdir");
+        std::fs::write(
+            pkg.join("package.xml"),
+            "<package><name>my_robot_description</name></package>",
+        )
+        .expect("write");
+        std::fs::write(pkg.join("meshes/a.stl"), "solid x\nendsolid x\n").expect("write");
+        let urdf = pkg.join("urdf/robot.urdf");
+        let r = PackageResolver::new(&[]);
+        // Walking up from the URDF finds the package.
+        assert!(r
+            .resolve("package://my_robot_description/meshes/a.stl", &urdf)
+            .is_ok());
+        assert!(r
+            .resolve("package:///my_robot_description/meshes/a.stl", &urdf)
+            .is_ok());
+        // Explicit path.
+        let elsewhere = tmp.path().join("robot.urdf");
+        let r2 = PackageResolver::new(&[("other".into(), pkg.clone())]);
+        assert_eq!(
+            r2.resolve("package://other/meshes/a.stl", &elsewhere)
+                .expect("explicit"),
+            pkg.join("meshes/a.stl")
+        );
+        // Relative and file://.
+        assert!(r.resolve("../meshes/a.stl", &urdf).is_ok());
+        assert!(r
+            .resolve(
+                &format!("file://{}", pkg.join("meshes/a.stl").display()),
+                &urdf
+            )
+            .is_ok());
+        let nf = r.resolve("package://nope/meshes/a.stl", &urdf).unwrap_err();
+        assert!(nf.hint.contains("--package-path nope=DIR"));
+    }
+}
