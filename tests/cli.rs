@@ -1,0 +1,332 @@
+//! The real binary on URDFs made by this project: analytic values, lossless output, exit codes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const PI: f64 = std::f64::consts::PI;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("run urdf-inertia")
+}
+
+fn demo() -> (PathBuf, PathBuf) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("robots/demo_arm_description");
+    (root.join("urdf/demo_arm.urdf"), root.join("densities.toml"))
+}
+
+/// A copy of the demo package in a temp dir (so tests may write next to it).
+fn demo_copy() -> (tempfile::TempDir, PathBuf, PathBuf) {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let (urdf, map) = demo();
+    let src = urdf.parent().and_then(Path::parent).expect("package dir").to_path_buf();
+    let dst = tmp.path().join("demo_arm_description");
+    for sub in ["urdf", "meshes"] {
+        std::fs::create_dir_all(dst.join(sub)).expect("mkdir");
+        for e in std::fs::read_dir(src.join(sub)).expect("read_dir") {
+            let e = e.expect("entry");
+            std::fs::copy(e.path(), dst.join(sub).join(e.file_name())).expect("copy");
+        }
+    }
+    std::fs::copy(src.join("package.xml"), dst.join("package.xml")).expect("copy");
+    std::fs::copy(&map, dst.join("densities.toml")).expect("copy");
+    let urdf = dst.join("urdf/demo_arm.urdf");
+    let map = dst.join("densities.toml");
+    (tmp, urdf, map)
+}
+
+/// Parsed `<inertial>` of one link from URDF text: (mass, com, [ixx, ixy, ixz, iyy, iyz, izz]).
+fn inertial_of(text: &str, link: &str) -> Option<(f64, [f64; 3], [f64; 6])> {
+    let start = text.find(&format!("<link name=\"{link}\""))?;
+    let end = start + text[start..].find("</link>")?;
+    let body = &text[start..end];
+    let i = body.find("<inertial>")?;
+    let body = &body[i..];
+    let attr = |tag: &str, key: &str| -> f64 {
+        let t = body.find(&format!("<{tag} ")).expect("tag");
+        let s = &body[t..];
+        let k = s.find(&format!(" {key}=\"")).expect("key") + key.len() + 3;
+        let v = &s[k..];
+        v[..v.find('"').expect("quote")].parse().expect("number")
+    };
+    let xyz = {
+        let t = body.find("<origin ").expect("origin");
+        let s = &body[t..];
+        let k = s.find("xyz=\"").expect("xyz") + 5;
+        let v: Vec<f64> = s[k..k + s[k..].find('"').expect("q")].split_whitespace().map(|x| x.parse().expect("n")).collect();
+        [v[0], v[1], v[2]]
+    };
+    Some((attr("mass", "value"), xyz, [attr("inertia", "ixx"), attr("inertia", "ixy"), attr("inertia", "ixz"), attr("inertia", "iyy"), attr("inertia", "iyz"), attr("inertia", "izz")]))
+}
+
+fn close(got: f64, want: f64, rel: f64, scale: f64, what: &str) {
+    assert!((got - want).abs() <= rel * scale, "{what}: got {got}, want {want}");
+}
+
+fn assert_inertial(text: &str, link: &str, mass: f64, com: [f64; 3], inertia: [f64; 6], rel: f64) {
+    let (m, c, i) = inertial_of(text, link).unwrap_or_else(|| panic!("no inertial for {link}"));
+    close(m, mass, rel, mass, &format!("{link} mass"));
+    let size = com.iter().fold(0.1f64, |a, x| a.max(x.abs()));
+    for k in 0..3 {
+        close(c[k], com[k], rel, size, &format!("{link} com[{k}]"));
+    }
+    let norm = inertia.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    for k in 0..6 {
+        close(i[k], inertia[k], rel, norm, &format!("{link} inertia[{k}]"));
+    }
+}
+
+/// Box inertia about its centre: [ixx, 0, 0, iyy, 0, izz].
+fn box_i(m: f64, s: [f64; 3]) -> [f64; 6] {
+    [m * (s[1] * s[1] + s[2] * s[2]) / 12.0, 0.0, 0.0, m * (s[0] * s[0] + s[2] * s[2]) / 12.0, 0.0, m * (s[0] * s[0] + s[1] * s[1]) / 12.0]
+}
+
+/// Adds a body (mass, com, central inertia) to an accumulation about the origin (second moments).
+fn combine(parts: &[(f64, [f64; 3], [f64; 6])]) -> (f64, [f64; 3], [f64; 6]) {
+    let m: f64 = parts.iter().map(|p| p.0).sum();
+    let c = [0, 1, 2].map(|k| parts.iter().map(|p| p.0 * p.1[k]).sum::<f64>() / m);
+    let mut i = [0.0; 6];
+    for (pm, pc, pi) in parts {
+        let d = [pc[0] - c[0], pc[1] - c[1], pc[2] - c[2]];
+        i[0] += pi[0] + pm * (d[1] * d[1] + d[2] * d[2]);
+        i[3] += pi[3] + pm * (d[0] * d[0] + d[2] * d[2]);
+        i[5] += pi[5] + pm * (d[0] * d[0] + d[1] * d[1]);
+        i[1] += pi[1] - pm * d[0] * d[1];
+        i[2] += pi[2] - pm * d[0] * d[2];
+        i[4] += pi[4] - pm * d[1] * d[2];
+    }
+    (m, c, i)
+}
+
+#[test]
+fn fill_demo_robot_gives_analytic_values() {
+    let (urdf, map) = demo();
+    let out = run(&["fill", urdf.to_str().unwrap(), "--density-map", map.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).expect("utf8");
+
+    // base_link: aluminium plate 0.3 × 0.3 × 0.05 at z 0.025, battery box 0.12 × 0.08 × 0.04 at z 0.07 (2500).
+    let plate = (2700.0 * 0.3 * 0.3 * 0.05, [0.0, 0.0, 0.025], box_i(2700.0 * 0.3 * 0.3 * 0.05, [0.3, 0.3, 0.05]));
+    let batt = (2500.0 * 0.12 * 0.08 * 0.04, [0.0, 0.0, 0.07], box_i(2500.0 * 0.12 * 0.08 * 0.04, [0.12, 0.08, 0.04]));
+    let (m, c, i) = combine(&[plate, batt]);
+    assert_inertial(&text, "base_link", m, c, i, 1e-12);
+
+    // shoulder: 80 × 80 × 200 mm box (binary STL in mm, scale 0.001), from z 0 to 0.2.
+    let m = 2700.0 * 0.08 * 0.08 * 0.2;
+    assert_inertial(&text, "shoulder_link", m, [0.0, 0.0, 0.1], box_i(m, [0.08, 0.08, 0.2]), 1e-12);
+
+    // upper arm: regular hexagonal prism, circumradius R = 0.04, length 0.3 (OBJ quads and hexagons).
+    let (r, l) = (0.04f64, 0.3f64);
+    let area = 1.5 * 3f64.sqrt() * r * r;
+    let m = 2700.0 * area * l;
+    let polar = 5.0 * 3f64.sqrt() / 8.0 * r.powi(4); // ∫(x²+y²) dA of the hexagon
+    let izz = 2700.0 * l * polar;
+    let ixx = 2700.0 * (l * polar / 2.0 + area * l.powi(3) / 12.0);
+    assert_inertial(&text, "upper_arm_link", m, [0.0, 0.0, 0.15], [ixx, 0.0, 0.0, ixx, 0.0, izz], 1e-12);
+
+    // forearm: 60 × 60 × 250 mm box (COLLADA in mm, node matrix lifts it by 125 mm), yawed 45°.
+    let m = 2700.0 * 0.06 * 0.06 * 0.25;
+    assert_inertial(&text, "forearm_link", m, [0.0, 0.0, 0.125], box_i(m, [0.06, 0.06, 0.25]), 1e-12);
+
+    // wrist: right-triangle prism (legs a = 0.06, b = 0.04, height h = 0.05), mirrored in y, mass 0.15.
+    let (a, b, h, m) = (0.06f64, 0.04f64, 0.05f64, 0.15f64);
+    let want = [m * (b * b / 18.0 + h * h / 12.0), -m * a * b / 36.0, 0.0, m * (a * a / 18.0 + h * h / 12.0), 0.0, m * (a * a + b * b) / 18.0];
+    // Binary STL stores f32 coordinates: 1e-7 relative.
+    assert_inertial(&text, "wrist_link", m, [a / 3.0, -b / 3.0, h / 2.0], want, 1e-7);
+
+    // gripper (PLA 1240): capsule r 0.02 l 0.06 at z 0.05; cylinder r 0.01 l 0.04 along x at (0.04, 0, 0.04);
+    // sphere r 0.015 at z 0.12.
+    let rho = 1240.0;
+    let (rc, lc) = (0.02f64, 0.06f64);
+    let mcyl = rho * PI * rc * rc * lc;
+    let mhemi = rho * 2.0 / 3.0 * PI * rc.powi(3);
+    // Hemisphere: COM 3r/8 from its flat face, central Ixx = (83/320) m r².
+    let d = lc / 2.0 + 3.0 * rc / 8.0;
+    let cap_ixx = mcyl * (3.0 * rc * rc + lc * lc) / 12.0 + 2.0 * (83.0 / 320.0 * mhemi * rc * rc + mhemi * d * d);
+    let cap_izz = mcyl * rc * rc / 2.0 + 2.0 * 0.4 * mhemi * rc * rc;
+    let capsule = (mcyl + 2.0 * mhemi, [0.0, 0.0, 0.05], [cap_ixx, 0.0, 0.0, cap_ixx, 0.0, cap_izz]);
+    let (rr, lr) = (0.01f64, 0.04f64);
+    let mr = rho * PI * rr * rr * lr;
+    let along = mr * rr * rr / 2.0;
+    let across = mr * (3.0 * rr * rr + lr * lr) / 12.0;
+    let rod = (mr, [0.04, 0.0, 0.04], [along, 0.0, 0.0, across, 0.0, across]);
+    let ms = rho * 4.0 / 3.0 * PI * 0.015f64.powi(3);
+    let is = 0.4 * ms * 0.015 * 0.015;
+    let ball = (ms, [0.0, 0.0, 0.12], [is, 0.0, 0.0, is, 0.0, is]);
+    let (m, c, i) = combine(&[capsule, rod, ball]);
+    assert_inertial(&text, "gripper_link", m, c, i, 1e-12);
+
+    // tool0 is a frame: untouched.
+    assert!(text.contains("  <link name=\"tool0\"/>\n"));
+    assert!(inertial_of(&text, "tool0").is_none());
+}
+
+/// Removes every `<inertial>…</inertial>` block together with the line it stands on.
+fn strip_inertials(text: &str) -> String {
+    let mut out = String::new();
+    let mut rest = text;
+    while let Some(s) = rest.find("<inertial>") {
+        let line_start = rest[..s].rfind('\n').map(|i| i + 1).unwrap_or(0);
+        out.push_str(&rest[..line_start]);
+        let e = s + rest[s..].find("</inertial>").expect("closing") + "</inertial>".len();
+        rest = &rest[e..];
+        // Drop the newline that ended the block's last line.
+        rest = rest.strip_prefix("\r\n").or_else(|| rest.strip_prefix('\n')).unwrap_or(rest);
+    }
+    out.push_str(rest);
+    out
+}
+
+#[test]
+fn only_inertials_change_and_fill_is_idempotent() {
+    let (_tmp, urdf, map) = demo_copy();
+    let original = std::fs::read_to_string(&urdf).expect("read");
+    let out = run(&["fill", urdf.to_str().unwrap(), "--density-map", map.to_str().unwrap(), "-i"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let once = std::fs::read_to_string(&urdf).expect("read");
+    // Outside <inertial>, every byte is the same (the original's one stale block is removed on both sides).
+    assert_eq!(strip_inertials(&once), strip_inertials(&original));
+    // New blocks follow the link's indentation: tabs for forearm_link.
+    assert!(once.contains("\t<link name=\"forearm_link\">\n\t\t<inertial>\n\t\t\t<origin "), "{once}");
+    let out = run(&["fill", urdf.to_str().unwrap(), "--density-map", map.to_str().unwrap(), "-i"]);
+    assert!(out.status.success());
+    assert_eq!(std::fs::read_to_string(&urdf).expect("read"), once, "second fill changed the file");
+    // No temp files left beside it.
+    let leftovers: Vec<_> = std::fs::read_dir(urdf.parent().unwrap()).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().contains(".tmp")).collect();
+    assert!(leftovers.is_empty());
+    // And the filled file passes check.
+    let out = run(&["check", urdf.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stdout));
+}
+
+#[test]
+fn crlf_comments_and_unknown_tags_survive() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let text = "<?xml version=\"1.0\"?>\r\n<!-- keep me -->\r\n<robot name=\"r\" xmlns:xacro=\"http://ros.org/wiki/xacro\">\r\n   <link name=\"a\"   >\r\n      <collision><geometry><box size=\"1 2 3\"/></geometry></collision>\r\n   </link>\r\n   <xacro:property name=\"x\" value=\"1\"/>\r\n   <mujoco><compiler meshdir=\"m\"/></mujoco>\r\n   <ros2_control name=\"c\" type=\"system\"/>\r\n</robot>\r\n";
+    let path = tmp.path().join("r.urdf");
+    std::fs::write(&path, text).expect("write");
+    let out = run(&["fill", path.to_str().unwrap(), "--density", "1000"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let filled = String::from_utf8(out.stdout).expect("utf8");
+    assert_eq!(strip_inertials(&filled), text);
+    assert!(filled.contains("   <link name=\"a\"   >\r\n      <inertial>\r\n         <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\r\n"), "{filled:?}");
+    assert!(!filled.replace("\r\n", "").contains('\n'), "a bare LF was written into a CRLF file");
+    // 1 × 2 × 3 box of 1000 kg/m³.
+    assert_inertial(&filled, "a", 6000.0, [0.0; 3], [6500.0, 0.0, 0.0, 5000.0, 0.0, 2500.0], 1e-15);
+}
+
+#[test]
+fn package_paths_resolve_through_the_option_and_walking_up() {
+    let (_tmp, urdf, map) = demo_copy();
+    // Move the URDF out of the package: walking up no longer finds it, --package-path does.
+    let outside = urdf.parent().unwrap().parent().unwrap().parent().unwrap().join("robot.urdf");
+    let text = std::fs::read_to_string(&urdf).unwrap().replace("../meshes/upper_arm.obj", "package://demo_arm_description/meshes/upper_arm.obj");
+    std::fs::write(&outside, text).unwrap();
+    let pkg = urdf.parent().unwrap().parent().unwrap().to_path_buf();
+    let out = run(&["fill", outside.to_str().unwrap(), "--density-map", map.to_str().unwrap(), "--package-path", &format!("demo_arm_description={}", pkg.display())]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // Without it, the sibling-directory walk finds demo_arm_description next to robot.urdf.
+    let out = run(&["fill", outside.to_str().unwrap(), "--density-map", map.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+#[test]
+fn check_exit_codes() {
+    let (urdf, map) = demo();
+    // The demo ships links without <inertial> and one stale value: problems, exit 1.
+    let out = run(&["check", urdf.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("demo_arm.urdf:5: link `base_link`: has collision geometry but no <inertial>"), "{stdout}");
+    // With a density source, the stale upper arm is reported with its line.
+    let out = run(&["check", urdf.to_str().unwrap(), "--density-map", map.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("demo_arm.urdf:41: link `upper_arm_link`: mass 1.2 kg"), "{stdout}");
+    // A missing file: exit 2.
+    let out = run(&["check", "/nonexistent/robot.urdf"]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn diff_names_unit_slips() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    // Mass written in grams: 1000 × the computed 6000 kg → off by 1e3.
+    let text = "<robot name=\"r\"><link name=\"a\"><inertial><mass value=\"6000000\"/><inertia ixx=\"6500\" ixy=\"0\" ixz=\"0\" iyy=\"5000\" iyz=\"0\" izz=\"2500\"/></inertial><collision><geometry><box size=\"1 2 3\"/></geometry></collision></link></robot>";
+    let path = tmp.path().join("r.urdf");
+    std::fs::write(&path, text).unwrap();
+    let out = run(&["diff", path.to_str().unwrap(), "--density", "1000"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("mass off by 1e3"), "{stdout}");
+    let out = run(&["diff", path.to_str().unwrap(), "--density", "1000", "--format", "json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert_eq!(v[0]["mass_ratio"].as_f64(), Some(1000.0));
+}
+
+#[test]
+fn bad_input_is_reported_and_files_are_never_damaged() {
+    let (_tmp, urdf, map) = demo_copy();
+    let dir = urdf.parent().unwrap().to_path_buf();
+    let cases: Vec<(&str, String, &[&str], &str)> = vec![
+        ("malformed.urdf", "<robot name=\"r\">\n  <link name=\"a\">\n  </lnk>\n</robot>\n".into(), &[], "malformed.urdf:3:"),
+        ("norobot.urdf", "<sdf version=\"1.6\"/>\n".into(), &[], "not a URDF"),
+        ("dup.urdf", "<robot name=\"r\">\n<link name=\"a\"/>\n<link name=\"a\"/>\n</robot>\n".into(), &[], "duplicate link name `a`"),
+        ("scale.urdf", "<robot name=\"r\"><link name=\"a\"><collision><geometry><mesh filename=\"../meshes/battery.stl\" scale=\"1 0 1\"/></geometry></collision></link></robot>".into(), &[], "zero factor"),
+        ("rpy.urdf", "<robot name=\"r\"><link name=\"a\"><collision><origin rpy=\"0 x 0\"/><geometry><box size=\"1 1 1\"/></geometry></collision></link></robot>".into(), &[], "rpy"),
+        ("missing.urdf", "<robot name=\"r\">\n<link name=\"arm\"><collision><geometry><mesh filename=\"package://nope_description/meshes/arm.stl\"/></geometry></collision></link></robot>".into(), &[], "link `arm`: collision 1 (line 2): mesh `package://nope_description/meshes/arm.stl` not found"),
+        ("format.urdf", "<robot name=\"r\"><link name=\"a\"><collision><geometry><mesh filename=\"../meshes/part.glb\"/></geometry></collision></link></robot>".into(), &[], "unsupported mesh format `.glb`"),
+    ];
+    std::fs::write(dir.parent().unwrap().join("meshes/part.glb"), b"glTF").unwrap();
+    for (name, text, extra, expect) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, &text).unwrap();
+        let mut args = vec!["fill", path.to_str().unwrap(), "--density", "1000", "-i"];
+        args.extend_from_slice(extra);
+        let out = run(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {stderr}");
+        assert!(stderr.contains(expect), "{name}: expected `{expect}` in: {stderr}");
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), text, "{name} was modified");
+    }
+    // Bad densities: negative, and a density map with an unknown material (line named).
+    let out = run(&["fill", urdf.to_str().unwrap(), "--density", "-3"]);
+    assert_eq!(out.status.code(), Some(2));
+    let bad_map = dir.join("bad.toml");
+    std::fs::write(&bad_map, "default = 1000\n[links]\nbase_link = \"unobtainium\"\n").unwrap();
+    let out = run(&["fill", urdf.to_str().unwrap(), "--density-map", bad_map.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr.contains("bad.toml:3: [links] `base_link`: unknown material `unobtainium`"), "{stderr}");
+    // No density at all for some links: every such link listed.
+    let partial = dir.join("partial.toml");
+    std::fs::write(&partial, "[links]\nbase_link = \"steel\"\n").unwrap();
+    let out = run(&["fill", urdf.to_str().unwrap(), "--density-map", partial.to_str().unwrap(), "-o", dir.join("out.urdf").to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr.contains("no density for 5 link(s)") && stderr.contains("`shoulder_link` (line 25)"), "{stderr}");
+    // An unwritable output path: exit 2, input untouched.
+    let before = std::fs::read(&urdf).unwrap();
+    let out = run(&["fill", urdf.to_str().unwrap(), "--density-map", map.to_str().unwrap(), "-o", "/nonexistent/dir/out.urdf"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(std::fs::read(&urdf).unwrap(), before);
+}
+
+#[test]
+fn mesh_command_json() {
+    let (urdf, _) = demo();
+    let stl = urdf.parent().unwrap().parent().unwrap().join("meshes/shoulder.STL");
+    let out = run(&["mesh", stl.to_str().unwrap(), "--scale", "0.001", "0.001", "0.001", "--mass", "2", "--format", "json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    for key in ["volume", "mass", "center_of_mass", "inertia", "principal_moments", "principal_axes", "provenance", "warnings"] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    assert!((v["volume"].as_f64().unwrap() - 0.08 * 0.08 * 0.2).abs() < 1e-15);
+    assert_eq!(v["mass"].as_f64(), Some(2.0));
+    assert_eq!(v["provenance"], "exact");
+    let izz = v["inertia"][2][2].as_f64().unwrap();
+    assert!((izz - 2.0 * (0.08f64 * 0.08 + 0.08 * 0.08) / 12.0).abs() < 1e-15);
+}
