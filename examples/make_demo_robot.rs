@@ -12,10 +12,29 @@ use urdf_inertia::mesh::stl::{write_ascii, write_binary};
 fn box_mesh(s: [f64; 3]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
     let h = s.map(|x| x / 2.0);
     let v: Vec<[f64; 3]> = (0..8)
-        .map(|i| [if i & 1 == 0 { -h[0] } else { h[0] }, if i & 2 == 0 { -h[1] } else { h[1] }, if i & 4 == 0 { -h[2] } else { h[2] }])
+        .map(|i| {
+            [
+                if i & 1 == 0 { -h[0] } else { h[0] },
+                if i & 2 == 0 { -h[1] } else { h[1] },
+                if i & 4 == 0 { -h[2] } else { h[2] },
+            ]
+        })
         .collect();
-    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-    (v, quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect())
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    (
+        v,
+        quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect(),
+    )
 }
 
 fn main() -> std::io::Result<()> {
@@ -25,7 +44,10 @@ fn main() -> std::io::Result<()> {
     // Shoulder: an 80 × 80 × 200 mm box, binary STL whose header starts with "solid".
     let (v, f) = box_mesh([80.0, 80.0, 200.0]);
     let v: Vec<[f64; 3]> = v.iter().map(|p| [p[0], p[1], p[2] + 100.0]).collect();
-    std::fs::write(dir.join("shoulder.STL"), write_binary(b"solid shoulder exported by a CAD tool", &v, &f))?;
+    std::fs::write(
+        dir.join("shoulder.STL"),
+        write_binary(b"solid shoulder exported by a CAD tool", &v, &f),
+    )?;
 
     // Battery in the base: ASCII STL, 0.12 × 0.08 × 0.04 m.
     let (v, f) = box_mesh([0.12, 0.08, 0.04]);
@@ -52,8 +74,14 @@ fn main() -> std::io::Result<()> {
 
     // Forearm: a 60 × 60 × 250 mm box in COLLADA, millimetre units, moved by a node matrix.
     let (v, f) = box_mesh([60.0, 60.0, 250.0]);
-    let positions: Vec<String> = v.iter().map(|p| format!("{} {} {}", p[0], p[1], p[2])).collect();
-    let indices: Vec<String> = f.iter().map(|t| format!("{} {} {}", t[0], t[1], t[2])).collect();
+    let positions: Vec<String> = v
+        .iter()
+        .map(|p| format!("{} {} {}", p[0], p[1], p[2]))
+        .collect();
+    let indices: Vec<String> = f
+        .iter()
+        .map(|t| format!("{} {} {}", t[0], t[1], t[2]))
+        .collect();
     let dae = format!(
         r##"<?xml version="1.0" encoding="utf-8"?>
 <COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
@@ -94,8 +122,24 @@ fn main() -> std::io::Result<()> {
     std::fs::write(dir.join("forearm.dae"), dae)?;
 
     // Wrist: an asymmetric wedge (right triangle 0.06 × 0.04 extruded 0.05 along z), used mirrored.
-    let v = vec![[0.0, 0.0, 0.0], [0.06, 0.0, 0.0], [0.0, 0.04, 0.0], [0.0, 0.0, 0.05], [0.06, 0.0, 0.05], [0.0, 0.04, 0.05]];
-    let f: Vec<[u32; 3]> = vec![[0, 2, 1], [3, 4, 5], [0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4], [2, 0, 3], [2, 3, 5]];
+    let v = vec![
+        [0.0, 0.0, 0.0],
+        [0.06, 0.0, 0.0],
+        [0.0, 0.04, 0.0],
+        [0.0, 0.0, 0.05],
+        [0.06, 0.0, 0.05],
+        [0.0, 0.04, 0.05],
+    ];
+    let f: Vec<[u32; 3]> = vec![
+        [0, 2, 1],
+        [3, 4, 5],
+        [0, 1, 4],
+        [0, 4, 3],
+        [1, 2, 5],
+        [1, 5, 4],
+        [2, 0, 3],
+        [2, 3, 5],
+    ];
     std::fs::write(dir.join("wrist_wedge.stl"), write_binary(b"wedge", &v, &f))?;
     println!("wrote the demo meshes under {}", dir.display());
     Ok(())

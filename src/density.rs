@@ -132,7 +132,7 @@ impl DensityMap {
             message,
         };
         let raw: RawMap =
-            toml::from_str(text).map_err(|e| err(e.span(), format!("{}", e.message())))?;
+            toml::from_str(text).map_err(|e| err(e.span(), e.message().to_string()))?;
 
         let mut materials: BTreeMap<String, f64> =
             MATERIALS.iter().map(|(k, v)| (k.to_string(), *v)).collect();

@@ -425,7 +425,7 @@ pub fn compute(
             Some((src, Spec::Mass(m))) => {
                 if other_volume > 0.0 {
                     let d = (m - own_mass) / other_volume;
-                    if !(d > 0.0) {
+                    if d.is_nan() || d <= 0.0 {
                         report.failures.push(LinkFailure {
                             name: link.name.clone(),
                             line: link.line,

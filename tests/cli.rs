@@ -22,7 +22,11 @@ fn demo() -> (PathBuf, PathBuf) {
 fn demo_copy() -> (tempfile::TempDir, PathBuf, PathBuf) {
     let tmp = tempfile::tempdir().expect("tempdir");
     let (urdf, map) = demo();
-    let src = urdf.parent().and_then(Path::parent).expect("package dir").to_path_buf();
+    let src = urdf
+        .parent()
+        .and_then(Path::parent)
+        .expect("package dir")
+        .to_path_buf();
     let dst = tmp.path().join("demo_arm_description");
     for sub in ["urdf", "meshes"] {
         std::fs::create_dir_all(dst.join(sub)).expect("mkdir");
@@ -56,14 +60,31 @@ fn inertial_of(text: &str, link: &str) -> Option<(f64, [f64; 3], [f64; 6])> {
         let t = body.find("<origin ").expect("origin");
         let s = &body[t..];
         let k = s.find("xyz=\"").expect("xyz") + 5;
-        let v: Vec<f64> = s[k..k + s[k..].find('"').expect("q")].split_whitespace().map(|x| x.parse().expect("n")).collect();
+        let v: Vec<f64> = s[k..k + s[k..].find('"').expect("q")]
+            .split_whitespace()
+            .map(|x| x.parse().expect("n"))
+            .collect();
         [v[0], v[1], v[2]]
     };
-    Some((attr("mass", "value"), xyz, [attr("inertia", "ixx"), attr("inertia", "ixy"), attr("inertia", "ixz"), attr("inertia", "iyy"), attr("inertia", "iyz"), attr("inertia", "izz")]))
+    Some((
+        attr("mass", "value"),
+        xyz,
+        [
+            attr("inertia", "ixx"),
+            attr("inertia", "ixy"),
+            attr("inertia", "ixz"),
+            attr("inertia", "iyy"),
+            attr("inertia", "iyz"),
+            attr("inertia", "izz"),
+        ],
+    ))
 }
 
 fn close(got: f64, want: f64, rel: f64, scale: f64, what: &str) {
-    assert!((got - want).abs() <= rel * scale, "{what}: got {got}, want {want}");
+    assert!(
+        (got - want).abs() <= rel * scale,
+        "{what}: got {got}, want {want}"
+    );
 }
 
 fn assert_inertial(text: &str, link: &str, mass: f64, com: [f64; 3], inertia: [f64; 6], rel: f64) {
@@ -81,7 +102,14 @@ fn assert_inertial(text: &str, link: &str, mass: f64, com: [f64; 3], inertia: [f
 
 /// Box inertia about its centre: [ixx, 0, 0, iyy, 0, izz].
 fn box_i(m: f64, s: [f64; 3]) -> [f64; 6] {
-    [m * (s[1] * s[1] + s[2] * s[2]) / 12.0, 0.0, 0.0, m * (s[0] * s[0] + s[2] * s[2]) / 12.0, 0.0, m * (s[0] * s[0] + s[1] * s[1]) / 12.0]
+    [
+        m * (s[1] * s[1] + s[2] * s[2]) / 12.0,
+        0.0,
+        0.0,
+        m * (s[0] * s[0] + s[2] * s[2]) / 12.0,
+        0.0,
+        m * (s[0] * s[0] + s[1] * s[1]) / 12.0,
+    ]
 }
 
 /// Adds a body (mass, com, central inertia) to an accumulation about the origin (second moments).
@@ -104,19 +132,43 @@ fn combine(parts: &[(f64, [f64; 3], [f64; 6])]) -> (f64, [f64; 3], [f64; 6]) {
 #[test]
 fn fill_demo_robot_gives_analytic_values() {
     let (urdf, map) = demo();
-    let out = run(&["fill", urdf.to_str().unwrap(), "--density-map", map.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = run(&[
+        "fill",
+        urdf.to_str().unwrap(),
+        "--density-map",
+        map.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8(out.stdout).expect("utf8");
 
     // base_link: aluminium plate 0.3 × 0.3 × 0.05 at z 0.025, battery box 0.12 × 0.08 × 0.04 at z 0.07 (2500).
-    let plate = (2700.0 * 0.3 * 0.3 * 0.05, [0.0, 0.0, 0.025], box_i(2700.0 * 0.3 * 0.3 * 0.05, [0.3, 0.3, 0.05]));
-    let batt = (2500.0 * 0.12 * 0.08 * 0.04, [0.0, 0.0, 0.07], box_i(2500.0 * 0.12 * 0.08 * 0.04, [0.12, 0.08, 0.04]));
+    let plate = (
+        2700.0 * 0.3 * 0.3 * 0.05,
+        [0.0, 0.0, 0.025],
+        box_i(2700.0 * 0.3 * 0.3 * 0.05, [0.3, 0.3, 0.05]),
+    );
+    let batt = (
+        2500.0 * 0.12 * 0.08 * 0.04,
+        [0.0, 0.0, 0.07],
+        box_i(2500.0 * 0.12 * 0.08 * 0.04, [0.12, 0.08, 0.04]),
+    );
     let (m, c, i) = combine(&[plate, batt]);
     assert_inertial(&text, "base_link", m, c, i, 1e-12);
 
     // shoulder: 80 × 80 × 200 mm box (binary STL in mm, scale 0.001), from z 0 to 0.2.
     let m = 2700.0 * 0.08 * 0.08 * 0.2;
-    assert_inertial(&text, "shoulder_link", m, [0.0, 0.0, 0.1], box_i(m, [0.08, 0.08, 0.2]), 1e-12);
+    assert_inertial(
+        &text,
+        "shoulder_link",
+        m,
+        [0.0, 0.0, 0.1],
+        box_i(m, [0.08, 0.08, 0.2]),
+        1e-12,
+    );
 
     // upper arm: regular hexagonal prism, circumradius R = 0.04, length 0.3 (OBJ quads and hexagons).
     let (r, l) = (0.04f64, 0.3f64);
@@ -125,17 +177,45 @@ fn fill_demo_robot_gives_analytic_values() {
     let polar = 5.0 * 3f64.sqrt() / 8.0 * r.powi(4); // ∫(x²+y²) dA of the hexagon
     let izz = 2700.0 * l * polar;
     let ixx = 2700.0 * (l * polar / 2.0 + area * l.powi(3) / 12.0);
-    assert_inertial(&text, "upper_arm_link", m, [0.0, 0.0, 0.15], [ixx, 0.0, 0.0, ixx, 0.0, izz], 1e-12);
+    assert_inertial(
+        &text,
+        "upper_arm_link",
+        m,
+        [0.0, 0.0, 0.15],
+        [ixx, 0.0, 0.0, ixx, 0.0, izz],
+        1e-12,
+    );
 
     // forearm: 60 × 60 × 250 mm box (COLLADA in mm, node matrix lifts it by 125 mm), yawed 45°.
     let m = 2700.0 * 0.06 * 0.06 * 0.25;
-    assert_inertial(&text, "forearm_link", m, [0.0, 0.0, 0.125], box_i(m, [0.06, 0.06, 0.25]), 1e-12);
+    assert_inertial(
+        &text,
+        "forearm_link",
+        m,
+        [0.0, 0.0, 0.125],
+        box_i(m, [0.06, 0.06, 0.25]),
+        1e-12,
+    );
 
     // wrist: right-triangle prism (legs a = 0.06, b = 0.04, height h = 0.05), mirrored in y, mass 0.15.
     let (a, b, h, m) = (0.06f64, 0.04f64, 0.05f64, 0.15f64);
-    let want = [m * (b * b / 18.0 + h * h / 12.0), -m * a * b / 36.0, 0.0, m * (a * a / 18.0 + h * h / 12.0), 0.0, m * (a * a + b * b) / 18.0];
+    let want = [
+        m * (b * b / 18.0 + h * h / 12.0),
+        -m * a * b / 36.0,
+        0.0,
+        m * (a * a / 18.0 + h * h / 12.0),
+        0.0,
+        m * (a * a + b * b) / 18.0,
+    ];
     // Binary STL stores f32 coordinates: 1e-7 relative.
-    assert_inertial(&text, "wrist_link", m, [a / 3.0, -b / 3.0, h / 2.0], want, 1e-7);
+    assert_inertial(
+        &text,
+        "wrist_link",
+        m,
+        [a / 3.0, -b / 3.0, h / 2.0],
+        want,
+        1e-7,
+    );
 
     // gripper (PLA 1240): capsule r 0.02 l 0.06 at z 0.05; cylinder r 0.01 l 0.04 along x at (0.04, 0, 0.04);
     // sphere r 0.015 at z 0.12.
@@ -145,14 +225,23 @@ fn fill_demo_robot_gives_analytic_values() {
     let mhemi = rho * 2.0 / 3.0 * PI * rc.powi(3);
     // Hemisphere: COM 3r/8 from its flat face, central Ixx = (83/320) m r².
     let d = lc / 2.0 + 3.0 * rc / 8.0;
-    let cap_ixx = mcyl * (3.0 * rc * rc + lc * lc) / 12.0 + 2.0 * (83.0 / 320.0 * mhemi * rc * rc + mhemi * d * d);
+    let cap_ixx = mcyl * (3.0 * rc * rc + lc * lc) / 12.0
+        + 2.0 * (83.0 / 320.0 * mhemi * rc * rc + mhemi * d * d);
     let cap_izz = mcyl * rc * rc / 2.0 + 2.0 * 0.4 * mhemi * rc * rc;
-    let capsule = (mcyl + 2.0 * mhemi, [0.0, 0.0, 0.05], [cap_ixx, 0.0, 0.0, cap_ixx, 0.0, cap_izz]);
+    let capsule = (
+        mcyl + 2.0 * mhemi,
+        [0.0, 0.0, 0.05],
+        [cap_ixx, 0.0, 0.0, cap_ixx, 0.0, cap_izz],
+    );
     let (rr, lr) = (0.01f64, 0.04f64);
     let mr = rho * PI * rr * rr * lr;
     let along = mr * rr * rr / 2.0;
     let across = mr * (3.0 * rr * rr + lr * lr) / 12.0;
-    let rod = (mr, [0.04, 0.0, 0.04], [along, 0.0, 0.0, across, 0.0, across]);
+    let rod = (
+        mr,
+        [0.04, 0.0, 0.04],
+        [along, 0.0, 0.0, across, 0.0, across],
+    );
     let ms = rho * 4.0 / 3.0 * PI * 0.015f64.powi(3);
     let is = 0.4 * ms * 0.015 * 0.015;
     let ball = (ms, [0.0, 0.0, 0.12], [is, 0.0, 0.0, is, 0.0, is]);
@@ -174,7 +263,10 @@ fn strip_inertials(text: &str) -> String {
         let e = s + rest[s..].find("</inertial>").expect("closing") + "</inertial>".len();
         rest = &rest[e..];
         // Drop the newline that ended the block's last line.
-        rest = rest.strip_prefix("\r\n").or_else(|| rest.strip_prefix('\n')).unwrap_or(rest);
+        rest = rest
+            .strip_prefix("\r\n")
+            .or_else(|| rest.strip_prefix('\n'))
+            .unwrap_or(rest);
     }
     out.push_str(rest);
     out
@@ -184,22 +276,54 @@ fn strip_inertials(text: &str) -> String {
 fn only_inertials_change_and_fill_is_idempotent() {
     let (_tmp, urdf, map) = demo_copy();
     let original = std::fs::read_to_string(&urdf).expect("read");
-    let out = run(&["fill", urdf.to_str().unwrap(), "--density-map", map.to_str().unwrap(), "-i"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = run(&[
+        "fill",
+        urdf.to_str().unwrap(),
+        "--density-map",
+        map.to_str().unwrap(),
+        "-i",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let once = std::fs::read_to_string(&urdf).expect("read");
     // Outside <inertial>, every byte is the same (the original's one stale block is removed on both sides).
     assert_eq!(strip_inertials(&once), strip_inertials(&original));
     // New blocks follow the link's indentation: tabs for forearm_link.
-    assert!(once.contains("\t<link name=\"forearm_link\">\n\t\t<inertial>\n\t\t\t<origin "), "{once}");
-    let out = run(&["fill", urdf.to_str().unwrap(), "--density-map", map.to_str().unwrap(), "-i"]);
+    assert!(
+        once.contains("\t<link name=\"forearm_link\">\n\t\t<inertial>\n\t\t\t<origin "),
+        "{once}"
+    );
+    let out = run(&[
+        "fill",
+        urdf.to_str().unwrap(),
+        "--density-map",
+        map.to_str().unwrap(),
+        "-i",
+    ]);
     assert!(out.status.success());
-    assert_eq!(std::fs::read_to_string(&urdf).expect("read"), once, "second fill changed the file");
+    assert_eq!(
+        std::fs::read_to_string(&urdf).expect("read"),
+        once,
+        "second fill changed the file"
+    );
     // No temp files left beside it.
-    let leftovers: Vec<_> = std::fs::read_dir(urdf.parent().unwrap()).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().contains(".tmp")).collect();
+    let leftovers: Vec<_> = std::fs::read_dir(urdf.parent().unwrap())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
+        .collect();
     assert!(leftovers.is_empty());
     // And the filled file passes check.
     let out = run(&["check", urdf.to_str().unwrap()]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stdout));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
 }
 
 #[test]
@@ -209,28 +333,72 @@ fn crlf_comments_and_unknown_tags_survive() {
     let path = tmp.path().join("r.urdf");
     std::fs::write(&path, text).expect("write");
     let out = run(&["fill", path.to_str().unwrap(), "--density", "1000"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let filled = String::from_utf8(out.stdout).expect("utf8");
     assert_eq!(strip_inertials(&filled), text);
     assert!(filled.contains("   <link name=\"a\"   >\r\n      <inertial>\r\n         <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\r\n"), "{filled:?}");
-    assert!(!filled.replace("\r\n", "").contains('\n'), "a bare LF was written into a CRLF file");
+    assert!(
+        !filled.replace("\r\n", "").contains('\n'),
+        "a bare LF was written into a CRLF file"
+    );
     // 1 × 2 × 3 box of 1000 kg/m³.
-    assert_inertial(&filled, "a", 6000.0, [0.0; 3], [6500.0, 0.0, 0.0, 5000.0, 0.0, 2500.0], 1e-15);
+    assert_inertial(
+        &filled,
+        "a",
+        6000.0,
+        [0.0; 3],
+        [6500.0, 0.0, 0.0, 5000.0, 0.0, 2500.0],
+        1e-15,
+    );
 }
 
 #[test]
 fn package_paths_resolve_through_the_option_and_walking_up() {
     let (_tmp, urdf, map) = demo_copy();
     // Move the URDF out of the package: walking up no longer finds it, --package-path does.
-    let outside = urdf.parent().unwrap().parent().unwrap().parent().unwrap().join("robot.urdf");
-    let text = std::fs::read_to_string(&urdf).unwrap().replace("../meshes/upper_arm.obj", "package://demo_arm_description/meshes/upper_arm.obj");
+    let outside = urdf
+        .parent()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .join("robot.urdf");
+    let text = std::fs::read_to_string(&urdf).unwrap().replace(
+        "../meshes/upper_arm.obj",
+        "package://demo_arm_description/meshes/upper_arm.obj",
+    );
     std::fs::write(&outside, text).unwrap();
     let pkg = urdf.parent().unwrap().parent().unwrap().to_path_buf();
-    let out = run(&["fill", outside.to_str().unwrap(), "--density-map", map.to_str().unwrap(), "--package-path", &format!("demo_arm_description={}", pkg.display())]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = run(&[
+        "fill",
+        outside.to_str().unwrap(),
+        "--density-map",
+        map.to_str().unwrap(),
+        "--package-path",
+        &format!("demo_arm_description={}", pkg.display()),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     // Without it, the sibling-directory walk finds demo_arm_description next to robot.urdf.
-    let out = run(&["fill", outside.to_str().unwrap(), "--density-map", map.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = run(&[
+        "fill",
+        outside.to_str().unwrap(),
+        "--density-map",
+        map.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]
@@ -240,11 +408,24 @@ fn check_exit_codes() {
     let out = run(&["check", urdf.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1));
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("demo_arm.urdf:5: link `base_link`: has collision geometry but no <inertial>"), "{stdout}");
+    assert!(
+        stdout.contains(
+            "demo_arm.urdf:5: link `base_link`: has collision geometry but no <inertial>"
+        ),
+        "{stdout}"
+    );
     // With a density source, the stale upper arm is reported with its line.
-    let out = run(&["check", urdf.to_str().unwrap(), "--density-map", map.to_str().unwrap()]);
+    let out = run(&[
+        "check",
+        urdf.to_str().unwrap(),
+        "--density-map",
+        map.to_str().unwrap(),
+    ]);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("demo_arm.urdf:41: link `upper_arm_link`: mass 1.2 kg"), "{stdout}");
+    assert!(
+        stdout.contains("demo_arm.urdf:41: link `upper_arm_link`: mass 1.2 kg"),
+        "{stdout}"
+    );
     // A missing file: exit 2.
     let out = run(&["check", "/nonexistent/robot.urdf"]);
     assert_eq!(out.status.code(), Some(2));
@@ -258,10 +439,21 @@ fn diff_names_unit_slips() {
     let path = tmp.path().join("r.urdf");
     std::fs::write(&path, text).unwrap();
     let out = run(&["diff", path.to_str().unwrap(), "--density", "1000"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("mass off by 1e3"), "{stdout}");
-    let out = run(&["diff", path.to_str().unwrap(), "--density", "1000", "--format", "json"]);
+    let out = run(&[
+        "diff",
+        path.to_str().unwrap(),
+        "--density",
+        "1000",
+        "--format",
+        "json",
+    ]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
     assert_eq!(v[0]["mass_ratio"].as_f64(), Some(1000.0));
 }
@@ -288,28 +480,64 @@ fn bad_input_is_reported_and_files_are_never_damaged() {
         let out = run(&args);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{name}: {stderr}");
-        assert!(stderr.contains(expect), "{name}: expected `{expect}` in: {stderr}");
-        assert_eq!(std::fs::read_to_string(&path).unwrap(), text, "{name} was modified");
+        assert!(
+            stderr.contains(expect),
+            "{name}: expected `{expect}` in: {stderr}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            text,
+            "{name} was modified"
+        );
     }
     // Bad densities: negative, and a density map with an unknown material (line named).
     let out = run(&["fill", urdf.to_str().unwrap(), "--density", "-3"]);
     assert_eq!(out.status.code(), Some(2));
     let bad_map = dir.join("bad.toml");
-    std::fs::write(&bad_map, "default = 1000\n[links]\nbase_link = \"unobtainium\"\n").unwrap();
-    let out = run(&["fill", urdf.to_str().unwrap(), "--density-map", bad_map.to_str().unwrap()]);
+    std::fs::write(
+        &bad_map,
+        "default = 1000\n[links]\nbase_link = \"unobtainium\"\n",
+    )
+    .unwrap();
+    let out = run(&[
+        "fill",
+        urdf.to_str().unwrap(),
+        "--density-map",
+        bad_map.to_str().unwrap(),
+    ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr.contains("bad.toml:3: [links] `base_link`: unknown material `unobtainium`"), "{stderr}");
+    assert!(
+        stderr.contains("bad.toml:3: [links] `base_link`: unknown material `unobtainium`"),
+        "{stderr}"
+    );
     // No density at all for some links: every such link listed.
     let partial = dir.join("partial.toml");
     std::fs::write(&partial, "[links]\nbase_link = \"steel\"\n").unwrap();
-    let out = run(&["fill", urdf.to_str().unwrap(), "--density-map", partial.to_str().unwrap(), "-o", dir.join("out.urdf").to_str().unwrap()]);
+    let out = run(&[
+        "fill",
+        urdf.to_str().unwrap(),
+        "--density-map",
+        partial.to_str().unwrap(),
+        "-o",
+        dir.join("out.urdf").to_str().unwrap(),
+    ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr.contains("no density for 5 link(s)") && stderr.contains("`shoulder_link` (line 25)"), "{stderr}");
+    assert!(
+        stderr.contains("no density for 5 link(s)") && stderr.contains("`shoulder_link` (line 25)"),
+        "{stderr}"
+    );
     // An unwritable output path: exit 2, input untouched.
     let before = std::fs::read(&urdf).unwrap();
-    let out = run(&["fill", urdf.to_str().unwrap(), "--density-map", map.to_str().unwrap(), "-o", "/nonexistent/dir/out.urdf"]);
+    let out = run(&[
+        "fill",
+        urdf.to_str().unwrap(),
+        "--density-map",
+        map.to_str().unwrap(),
+        "-o",
+        "/nonexistent/dir/out.urdf",
+    ]);
     assert_eq!(out.status.code(), Some(2));
     assert_eq!(std::fs::read(&urdf).unwrap(), before);
 }
@@ -317,11 +545,40 @@ fn bad_input_is_reported_and_files_are_never_damaged() {
 #[test]
 fn mesh_command_json() {
     let (urdf, _) = demo();
-    let stl = urdf.parent().unwrap().parent().unwrap().join("meshes/shoulder.STL");
-    let out = run(&["mesh", stl.to_str().unwrap(), "--scale", "0.001", "0.001", "0.001", "--mass", "2", "--format", "json"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stl = urdf
+        .parent()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .join("meshes/shoulder.STL");
+    let out = run(&[
+        "mesh",
+        stl.to_str().unwrap(),
+        "--scale",
+        "0.001",
+        "0.001",
+        "0.001",
+        "--mass",
+        "2",
+        "--format",
+        "json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
-    for key in ["volume", "mass", "center_of_mass", "inertia", "principal_moments", "principal_axes", "provenance", "warnings"] {
+    for key in [
+        "volume",
+        "mass",
+        "center_of_mass",
+        "inertia",
+        "principal_moments",
+        "principal_axes",
+        "provenance",
+        "warnings",
+    ] {
         assert!(v.get(key).is_some(), "missing {key}");
     }
     assert!((v["volume"].as_f64().unwrap() - 0.08 * 0.08 * 0.2).abs() < 1e-15);

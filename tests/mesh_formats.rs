@@ -15,7 +15,12 @@ const CENTRE: [f64; 3] = [1.0, 2.0, 3.0];
 
 fn solid() -> common::Mesh {
     let (v, f) = box_mesh(SIZE);
-    (v.iter().map(|p| [p[0] + CENTRE[0], p[1] + CENTRE[1], p[2] + CENTRE[2]]).collect(), f)
+    (
+        v.iter()
+            .map(|p| [p[0] + CENTRE[0], p[1] + CENTRE[1], p[2] + CENTRE[2]])
+            .collect(),
+        f,
+    )
 }
 
 fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
@@ -26,15 +31,36 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
 
 /// Checks volume, COM and central inertia against the box's exact values (all representable here).
 fn assert_box(path: &Path, scale: [f64; 3], size: [f64; 3], centre: [f64; 3]) {
-    let s = mesh::load_solid(path, scale, HealthOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let s =
+        mesh::load_solid(path, scale, HealthOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let v = size[0] * size[1] * size[2];
-    assert!((s.unit.mass - v).abs() <= 1e-15 * v, "{}: volume {} want {v}", path.display(), s.unit.mass);
+    assert!(
+        (s.unit.mass - v).abs() <= 1e-15 * v,
+        "{}: volume {} want {v}",
+        path.display(),
+        s.unit.mass
+    );
     for k in 0..3 {
-        assert!((s.unit.com[k] - centre[k]).abs() <= 1e-15 * centre[k].abs().max(1.0), "{}: com {:?}", path.display(), s.unit.com);
+        assert!(
+            (s.unit.com[k] - centre[k]).abs() <= 1e-15 * centre[k].abs().max(1.0),
+            "{}: com {:?}",
+            path.display(),
+            s.unit.com
+        );
     }
-    let want = [v * (size[1] * size[1] + size[2] * size[2]) / 12.0, v * (size[0] * size[0] + size[2] * size[2]) / 12.0, v * (size[0] * size[0] + size[1] * size[1]) / 12.0];
+    let want = [
+        v * (size[1] * size[1] + size[2] * size[2]) / 12.0,
+        v * (size[0] * size[0] + size[2] * size[2]) / 12.0,
+        v * (size[0] * size[0] + size[1] * size[1]) / 12.0,
+    ];
     for k in 0..3 {
-        assert!((s.unit.inertia[k][k] - want[k]).abs() <= 1e-14 * want[k], "{}: I[{k}] {} want {}", path.display(), s.unit.inertia[k][k], want[k]);
+        assert!(
+            (s.unit.inertia[k][k] - want[k]).abs() <= 1e-14 * want[k],
+            "{}: I[{k}] {} want {}",
+            path.display(),
+            s.unit.inertia[k][k],
+            want[k]
+        );
     }
     assert_eq!(s.rung, Rung::Exact, "{}", path.display());
 }
@@ -52,8 +78,14 @@ fn obj_text(v: &[[f64; 3]]) -> String {
 }
 
 fn dae_text(v: &[[f64; 3]], f: &[[u32; 3]], unit: f64, up: &str, matrix: &str) -> String {
-    let pos: Vec<String> = v.iter().map(|p| format!("{} {} {}", p[0], p[1], p[2])).collect();
-    let idx: Vec<String> = f.iter().map(|t| format!("{} 0 {} 0 {} 0", t[0], t[1], t[2])).collect();
+    let pos: Vec<String> = v
+        .iter()
+        .map(|p| format!("{} {} {}", p[0], p[1], p[2]))
+        .collect();
+    let idx: Vec<String> = f
+        .iter()
+        .map(|t| format!("{} 0 {} 0 {} 0", t[0], t[1], t[2]))
+        .collect();
     format!(
         r##"<?xml version="1.0"?>
 <COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
@@ -87,28 +119,95 @@ fn same_solid_through_every_reader() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let d = tmp.path();
     let (v, f) = solid();
-    assert_box(&write(d, "bin.stl", &write_binary(b"binary", &v, &f)), [1.0; 3], SIZE, CENTRE);
-    assert_box(&write(d, "solidheader.STL", &write_binary(b"solid but binary", &v, &f)), [1.0; 3], SIZE, CENTRE);
-    assert_box(&write(d, "ascii.stl", write_ascii(&v, &f).as_bytes()), [1.0; 3], SIZE, CENTRE);
+    assert_box(
+        &write(d, "bin.stl", &write_binary(b"binary", &v, &f)),
+        [1.0; 3],
+        SIZE,
+        CENTRE,
+    );
+    assert_box(
+        &write(
+            d,
+            "solidheader.STL",
+            &write_binary(b"solid but binary", &v, &f),
+        ),
+        [1.0; 3],
+        SIZE,
+        CENTRE,
+    );
+    assert_box(
+        &write(d, "ascii.stl", write_ascii(&v, &f).as_bytes()),
+        [1.0; 3],
+        SIZE,
+        CENTRE,
+    );
     // Header count wrong (0) but whole records: read, with a note.
     let mut bad_count = write_binary(b"x", &v, &f);
     bad_count[80..84].copy_from_slice(&0u32.to_le_bytes());
     let p = write(d, "count.stl", &bad_count);
     assert_box(&p, [1.0; 3], SIZE, CENTRE);
     let s = mesh::load_solid(&p, [1.0; 3], HealthOptions::default()).unwrap();
-    assert!(s.warnings.iter().any(|w| w.contains("header says 0 triangles")), "{:?}", s.warnings);
-    assert_box(&write(d, "quads.obj", obj_text(&v).as_bytes()), [1.0; 3], SIZE, CENTRE);
-    assert_box(&write(d, "plain.dae", dae_text(&v, &f, 1.0, "Z_UP", IDENTITY).as_bytes()), [1.0; 3], SIZE, CENTRE);
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("header says 0 triangles")),
+        "{:?}",
+        s.warnings
+    );
+    assert_box(
+        &write(d, "quads.obj", obj_text(&v).as_bytes()),
+        [1.0; 3],
+        SIZE,
+        CENTRE,
+    );
+    assert_box(
+        &write(
+            d,
+            "plain.dae",
+            dae_text(&v, &f, 1.0, "Z_UP", IDENTITY).as_bytes(),
+        ),
+        [1.0; 3],
+        SIZE,
+        CENTRE,
+    );
     // Y_UP is not applied (see the COLLADA module docs): same result.
-    assert_box(&write(d, "yup.dae", dae_text(&v, &f, 1.0, "Y_UP", IDENTITY).as_bytes()), [1.0; 3], SIZE, CENTRE);
+    assert_box(
+        &write(
+            d,
+            "yup.dae",
+            dae_text(&v, &f, 1.0, "Y_UP", IDENTITY).as_bytes(),
+        ),
+        [1.0; 3],
+        SIZE,
+        CENTRE,
+    );
     // Millimetre units: the same box written in mm.
     let mm: Vec<[f64; 3]> = v.iter().map(|p| p.map(|c| c * 1000.0)).collect();
-    assert_box(&write(d, "mm.dae", dae_text(&mm, &f, 0.001, "Z_UP", IDENTITY).as_bytes()), [1.0; 3], SIZE, CENTRE);
+    assert_box(
+        &write(
+            d,
+            "mm.dae",
+            dae_text(&mm, &f, 0.001, "Z_UP", IDENTITY).as_bytes(),
+        ),
+        [1.0; 3],
+        SIZE,
+        CENTRE,
+    );
     // A node matrix: rotate 90° about z and move by (10, 0, 0): the box becomes 0.25 × 0.5 × 0.125 at (8, 1, 3).
     let m = "0 -1 0 10 1 0 0 0 0 0 1 0 0 0 0 1";
-    assert_box(&write(d, "matrix.dae", dae_text(&v, &f, 1.0, "Z_UP", m).as_bytes()), [1.0; 3], [SIZE[1], SIZE[0], SIZE[2]], [8.0, 1.0, 3.0]);
+    assert_box(
+        &write(d, "matrix.dae", dae_text(&v, &f, 1.0, "Z_UP", m).as_bytes()),
+        [1.0; 3],
+        [SIZE[1], SIZE[0], SIZE[2]],
+        [8.0, 1.0, 3.0],
+    );
     // Scale (mm file with URDF scale 0.001): same solid.
-    assert_box(&write(d, "mm.stl", &write_binary(b"mm", &mm, &f)), [0.001; 3], SIZE, CENTRE);
+    assert_box(
+        &write(d, "mm.stl", &write_binary(b"mm", &mm, &f)),
+        [0.001; 3],
+        SIZE,
+        CENTRE,
+    );
     // Mirrored scale: the solid is mirrored, its volume stays positive.
     let p = write(d, "mirror.stl", &write_binary(b"m", &v, &f));
     assert_box(&p, [1.0, -1.0, 1.0], SIZE, [1.0, -2.0, 3.0]);
@@ -120,18 +219,30 @@ fn broken_meshes_take_the_documented_rung() {
     let d = tmp.path();
     let (v, f) = solid();
     // Open box: the top face (two triangles) missing → convex hull, with the numbers.
-    let open: Vec<[u32; 3]> = f.iter().copied().filter(|t| !(t.iter().all(|&i| i & 4 != 0))).collect();
+    let open: Vec<[u32; 3]> = f
+        .iter()
+        .copied()
+        .filter(|t| !(t.iter().all(|&i| i & 4 != 0)))
+        .collect();
     assert_eq!(open.len(), 10);
     let p = write(d, "open.stl", &write_binary(b"open", &v, &open));
     let s = mesh::load_solid(&p, [1.0; 3], HealthOptions::default()).unwrap();
     match &s.rung {
-        Rung::ConvexHull { boundary_edges, hull_volume, .. } => {
+        Rung::ConvexHull {
+            boundary_edges,
+            hull_volume,
+            ..
+        } => {
             assert_eq!(*boundary_edges, 4);
             assert!((hull_volume - 0.5 * 0.25 * 0.125).abs() < 1e-15);
         }
         other => panic!("open box gave {other:?}"),
     }
-    assert!(s.warnings[0].contains("open (4 boundary edges)"), "{:?}", s.warnings);
+    assert!(
+        s.warnings[0].contains("open (4 boundary edges)"),
+        "{:?}",
+        s.warnings
+    );
     assert!(mesh::load_solid(&p, [1.0; 3], HealthOptions { strict: true }).is_err());
     // Two flipped faces → reoriented, exact numbers.
     let mut flipped = f.clone();
@@ -139,9 +250,20 @@ fn broken_meshes_take_the_documented_rung() {
     flipped[7].swap(1, 2);
     let p = write(d, "flipped.stl", &write_binary(b"flip", &v, &flipped));
     let s = mesh::load_solid(&p, [1.0; 3], HealthOptions::default()).unwrap();
-    assert_eq!(s.rung, Rung::Reoriented { faces_flipped: 2, components: 1 });
+    assert_eq!(
+        s.rung,
+        Rung::Reoriented {
+            faces_flipped: 2,
+            components: 1
+        }
+    );
     assert!((s.unit.mass - 0.5 * 0.25 * 0.125).abs() < 1e-15);
-    assert!(matches!(mesh::load_solid(&p, [1.0; 3], HealthOptions { strict: true }).unwrap_err().kind, MeshErrorKind::Strict(_)));
+    assert!(matches!(
+        mesh::load_solid(&p, [1.0; 3], HealthOptions { strict: true })
+            .unwrap_err()
+            .kind,
+        MeshErrorKind::Strict(_)
+    ));
     // Inside-out box → inverted, exact numbers.
     let inside: Vec<[u32; 3]> = f.iter().map(|t| [t[0], t[2], t[1]]).collect();
     let p = write(d, "inside.stl", &write_binary(b"in", &v, &inside));
@@ -156,30 +278,76 @@ fn broken_meshes_take_the_documented_rung() {
     assert!(e.to_string().contains("header says 12 triangles"), "{e}");
     // NaN vertices (ASCII STL: with the line) and OBJ.
     let ascii = write_ascii(&v, &f).replacen("vertex 0.75", "vertex nan", 1);
-    let e = mesh::load_solid(&write(d, "nan.stl", ascii.as_bytes()), [1.0; 3], HealthOptions::default()).unwrap_err();
+    let e = mesh::load_solid(
+        &write(d, "nan.stl", ascii.as_bytes()),
+        [1.0; 3],
+        HealthOptions::default(),
+    )
+    .unwrap_err();
     assert_eq!(e.kind, MeshErrorKind::NotFinite);
     assert_eq!(e.line, Some(4), "{e}");
-    let e = mesh::load_solid(&write(d, "nan.obj", b"v 0 0 0\nv 1 0 0\nv 0 NaN 0\nf 1 2 3\n"), [1.0; 3], HealthOptions::default()).unwrap_err();
+    let e = mesh::load_solid(
+        &write(d, "nan.obj", b"v 0 0 0\nv 1 0 0\nv 0 NaN 0\nf 1 2 3\n"),
+        [1.0; 3],
+        HealthOptions::default(),
+    )
+    .unwrap_err();
     assert_eq!((e.kind, e.line), (MeshErrorKind::NotFinite, Some(3)));
     // Empty OBJ.
-    let e = mesh::load_solid(&write(d, "empty.obj", b"# nothing\n"), [1.0; 3], HealthOptions::default()).unwrap_err();
+    let e = mesh::load_solid(
+        &write(d, "empty.obj", b"# nothing\n"),
+        [1.0; 3],
+        HealthOptions::default(),
+    )
+    .unwrap_err();
     assert_eq!(e.kind, MeshErrorKind::Empty);
     // Out-of-range index.
-    let e = mesh::load_solid(&write(d, "index.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), [1.0; 3], HealthOptions::default()).unwrap_err();
+    let e = mesh::load_solid(
+        &write(d, "index.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"),
+        [1.0; 3],
+        HealthOptions::default(),
+    )
+    .unwrap_err();
     assert_eq!(e.line, Some(4));
-    assert!(matches!(e.kind, MeshErrorKind::IndexOutOfRange { index: 9, vertices: 3 }));
+    assert!(matches!(
+        e.kind,
+        MeshErrorKind::IndexOutOfRange {
+            index: 9,
+            vertices: 3
+        }
+    ));
     // .glb and .ply: unsupported format, named.
     for name in ["part.glb", "part.ply"] {
-        let e = mesh::load_solid(&write(d, name, b"data"), [1.0; 3], HealthOptions::default()).unwrap_err();
+        let e = mesh::load_solid(&write(d, name, b"data"), [1.0; 3], HealthOptions::default())
+            .unwrap_err();
         assert!(matches!(e.kind, MeshErrorKind::UnknownFormat(_)), "{e}");
     }
     // A flat mesh (a single square, both sides) has no volume.
-    let flat = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+    let flat = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
     let ft = [[0u32, 1, 2], [0, 2, 3], [0, 2, 1], [0, 3, 2]];
-    let e = mesh::load_solid(&write(d, "flat.stl", &write_binary(b"f", &flat, &ft)), [1.0; 3], HealthOptions::default()).unwrap_err();
+    let e = mesh::load_solid(
+        &write(d, "flat.stl", &write_binary(b"f", &flat, &ft)),
+        [1.0; 3],
+        HealthOptions::default(),
+    )
+    .unwrap_err();
     assert!(matches!(e.kind, MeshErrorKind::ZeroVolume { .. }), "{e}");
     // Malformed COLLADA: line named.
-    let e = mesh::load_solid(&write(d, "bad.dae", b"<?xml version=\"1.0\"?>\n<COLLADA>\n<asset>\n</COLLADA>\n"), [1.0; 3], HealthOptions::default()).unwrap_err();
+    let e = mesh::load_solid(
+        &write(
+            d,
+            "bad.dae",
+            b"<?xml version=\"1.0\"?>\n<COLLADA>\n<asset>\n</COLLADA>\n",
+        ),
+        [1.0; 3],
+        HealthOptions::default(),
+    )
+    .unwrap_err();
     assert!(e.line.is_some(), "{e}");
 }
 
@@ -226,7 +394,11 @@ fn nearly_closed_mesh_is_used_as_it_is() {
     let p = write(tmp.path(), "crack.stl", &write_binary(b"c", &v, &f));
     let s = mesh::load_solid(&p, [1.0; 3], HealthOptions::default()).unwrap();
     match s.rung {
-        Rung::NearlyClosed { boundary_edges: 3, relative_uncertainty, .. } => assert!(relative_uncertainty < 1e-3 && relative_uncertainty > 0.0),
+        Rung::NearlyClosed {
+            boundary_edges: 3,
+            relative_uncertainty,
+            ..
+        } => assert!(relative_uncertainty < 1e-3 && relative_uncertainty > 0.0),
         ref other => panic!("{other:?}"),
     }
 }

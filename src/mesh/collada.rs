@@ -481,8 +481,10 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         .collect();
 
     let mut geom_cache: HashMap<String, (Vec<[f64; 3]>, Polygons)> = HashMap::new();
-    let mut out = RawMesh::default();
-    out.faces = Polygons::new();
+    let mut out = RawMesh {
+        faces: Polygons::new(),
+        ..Default::default()
+    };
     let mut add = |geom: &El,
                    xf: &Affine,
                    out: &mut RawMesh,

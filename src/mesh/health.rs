@@ -481,7 +481,7 @@ pub fn make_solid(mesh: &RawMesh, path: &Path, options: HealthOptions) -> Result
 }
 
 fn check_volume(volume: f64, diag: f64, bbox_volume: f64, path: &Path) -> Result<(), MeshError> {
-    if !(volume > ZERO_VOLUME * diag.powi(3)) {
+    if volume.is_nan() || volume <= ZERO_VOLUME * diag.powi(3) {
         return Err(MeshError::new(
             path,
             None,

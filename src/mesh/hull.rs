@@ -10,6 +10,9 @@ use parry3d_f64::math::Vector3;
 use parry3d_f64::transformation::{try_convex_hull, ConvexHullError};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
+/// Vertices and outward triangles.
+pub type TriangleMesh = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
 /// Why no hull could be built.
 #[derive(Debug, Clone, PartialEq)]
 pub enum HullError {
@@ -20,7 +23,7 @@ pub enum HullError {
 }
 
 /// The convex hull of `points` as (hull vertices, outward triangles).
-pub fn convex_hull(points: &[[f64; 3]]) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), HullError> {
+pub fn convex_hull(points: &[[f64; 3]]) -> Result<TriangleMesh, HullError> {
     if points.len() < 4 {
         return Err(HullError::Degenerate);
     }

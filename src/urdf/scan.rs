@@ -187,7 +187,7 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
     let mut robot_name: Option<String> = None;
     let mut links: Vec<Link> = Vec::new();
     let mut current: Option<Link> = None;
-    let mut collision: Option<(usize, usize, Option<String>, Pose, Option<Geometry>)> = None;
+    let mut collision: CollisionInProgress = None;
     let mut inertial: Option<InertialSpan> = None;
     let mut seen: HashMap<String, usize> = HashMap::new();
 
@@ -215,7 +215,7 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
                             links.push(link);
                         }
                     }
-                    (2, "collision") => finish_collision(&mut collision, &mut current, path, &err)?,
+                    (2, "collision") => finish_collision(&mut collision, &mut current),
                     (2, "inertial") => {
                         if let (Some(mut span), Some(link)) = (inertial.take(), current.as_mut()) {
                             span.end = end;
@@ -269,7 +269,7 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
                         let index = current.as_ref().map(|l| l.collisions.len() + 1).unwrap_or(1);
                         collision = Some((index, lines.at(pos), a.get("name").cloned(), Pose::default(), None));
                         if empty {
-                            finish_collision(&mut collision, &mut current, path, &err)?;
+                            finish_collision(&mut collision, &mut current);
                         }
                     }
                     "inertial" => {
@@ -345,27 +345,20 @@ fn link_name(link: &Option<Link>) -> String {
 
 type CollisionInProgress = Option<(usize, usize, Option<String>, Pose, Option<Geometry>)>;
 
-fn finish_collision(
-    collision: &mut CollisionInProgress,
-    current: &mut Option<Link>,
-    _path: &Path,
-    _err: &dyn Fn(usize, String) -> UrdfError,
-) -> Result<(), UrdfError> {
-    if let (Some((index, line, name, origin, geometry)), Some(link)) =
+/// Ends the `<collision>` being read. One without geometry (urdfdom rejects it; some generators emit
+/// it) contributes nothing.
+fn finish_collision(collision: &mut CollisionInProgress, current: &mut Option<Link>) {
+    if let (Some((index, line, name, origin, Some(geometry))), Some(link)) =
         (collision.take(), current.as_mut())
     {
-        // A collision without geometry (urdfdom rejects it; some generators emit it) contributes nothing.
-        if let Some(geometry) = geometry {
-            link.collisions.push(Collision {
-                index,
-                name,
-                line,
-                origin,
-                geometry,
-            });
-        }
+        link.collisions.push(Collision {
+            index,
+            name,
+            line,
+            origin,
+            geometry,
+        });
     }
-    Ok(())
 }
 
 fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
@@ -440,7 +433,7 @@ fn geometry(kind: &str, a: &HashMap<String, String>) -> Result<Geometry, String>
                     }
                 }
             };
-            if scale.iter().any(|x| *x == 0.0) {
+            if scale.contains(&0.0) {
                 return Err(format!(
                     "mesh scale \"{} {} {}\" has a zero factor",
                     scale[0], scale[1], scale[2]
