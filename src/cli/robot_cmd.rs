@@ -254,6 +254,9 @@ pub fn fill(a: &FillArgs) -> ExitStatus {
             report.timing.integrate.as_secs_f64(),
             write_time.as_secs_f64()
         );
+        if robot.name.is_empty() {
+            eprintln!("  warning: <robot> has no name attribute: urdfdom (ROS, pinocchio) refuses such a file");
+        }
         if report.without_geometry + report.not_selected > 0 {
             eprintln!(
                 "  left as they are: {} link(s) without collision geometry, {} not selected",
