@@ -218,7 +218,7 @@ fn broken_meshes_take_the_documented_rung() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let d = tmp.path();
     let (v, f) = solid();
-    // Open box: the top face (two triangles) missing → convex hull, with the numbers.
+    // Open box: the top face (two triangles) missing → a flat hole, capped: exact numbers.
     let open: Vec<[u32; 3]> = f
         .iter()
         .copied()
@@ -227,23 +227,50 @@ fn broken_meshes_take_the_documented_rung() {
     assert_eq!(open.len(), 10);
     let p = write(d, "open.stl", &write_binary(b"open", &v, &open));
     let s = mesh::load_solid(&p, [1.0; 3], HealthOptions::default()).unwrap();
+    assert!(
+        matches!(
+            s.rung,
+            Rung::Capped {
+                holes: 1,
+                boundary_edges: 4,
+                ..
+            }
+        ),
+        "{:?}",
+        s.rung
+    );
+    assert!((s.unit.mass - 0.5 * 0.25 * 0.125).abs() < 1e-15);
+    assert!(
+        s.warnings[0].contains("open (4 boundary edges): closed its 1 hole(s) with flat caps"),
+        "{:?}",
+        s.warnings
+    );
+    assert!(mesh::load_solid(&p, [1.0; 3], HealthOptions { strict: true }).is_err());
+    // Top and one side missing: an L-shaped, far from flat hole → convex hull, with the numbers.
+    let open2: Vec<[u32; 3]> = open
+        .iter()
+        .copied()
+        .filter(|t| !(t.iter().all(|&i| i & 1 != 0)))
+        .collect();
+    assert_eq!(open2.len(), 8);
+    let p = write(d, "open2.stl", &write_binary(b"open", &v, &open2));
+    let s = mesh::load_solid(&p, [1.0; 3], HealthOptions::default()).unwrap();
     match &s.rung {
         Rung::ConvexHull {
             boundary_edges,
             hull_volume,
             ..
         } => {
-            assert_eq!(*boundary_edges, 4);
+            assert_eq!(*boundary_edges, 6);
             assert!((hull_volume - 0.5 * 0.25 * 0.125).abs() < 1e-15);
         }
         other => panic!("open box gave {other:?}"),
     }
     assert!(
-        s.warnings[0].contains("open (4 boundary edges)"),
+        s.warnings[0].contains("open (6 boundary edges); used its convex hull"),
         "{:?}",
         s.warnings
     );
-    assert!(mesh::load_solid(&p, [1.0; 3], HealthOptions { strict: true }).is_err());
     // Two flipped faces → reoriented, exact numbers.
     let mut flipped = f.clone();
     flipped[0].swap(1, 2);
@@ -352,9 +379,8 @@ fn broken_meshes_take_the_documented_rung() {
 }
 
 #[test]
-fn nearly_closed_mesh_is_used_as_it_is() {
-    // A closed 1 × 1 × 1 box of 16 × 16 quads per side minus one triangle (area 1/512): the hole's vector
-    // area bounds the volume uncertainty far below 1e-3, so the mesh itself is used.
+fn small_hole_is_capped_exactly() {
+    // A closed 1 × 1 × 1 box of 16 × 16 quads per side minus one triangle: one flat hole, capped exactly.
     let n = 16;
     let mut v = Vec::new();
     let mut idx = std::collections::HashMap::new();
@@ -393,12 +419,41 @@ fn nearly_closed_mesh_is_used_as_it_is() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let p = write(tmp.path(), "crack.stl", &write_binary(b"c", &v, &f));
     let s = mesh::load_solid(&p, [1.0; 3], HealthOptions::default()).unwrap();
-    match s.rung {
-        Rung::NearlyClosed {
-            boundary_edges: 3,
-            relative_uncertainty,
-            ..
-        } => assert!(relative_uncertainty < 1e-3 && relative_uncertainty > 0.0),
-        ref other => panic!("{other:?}"),
-    }
+    assert!(
+        matches!(
+            s.rung,
+            Rung::Capped {
+                holes: 1,
+                boundary_edges: 3,
+                ..
+            }
+        ),
+        "{:?}",
+        s.rung
+    );
+    assert!((s.unit.mass - 1.0).abs() < 1e-15, "{}", s.unit.mass);
+}
+
+/// Regression (validation on alex UJointLink.obj): holes whose vector areas cancel, as at the two ends of
+/// an open tube, leave the signed volume origin-independent but a third too small; they must be capped.
+#[test]
+fn open_tube_is_capped_not_trusted() {
+    let (v, f) = common::cylinder_mesh(0.5, 2.0, 64);
+    // cylinder_mesh's faces come in fours per segment: bottom cap, top cap, two side triangles.
+    let sides: Vec<[u32; 3]> = f.chunks(4).flat_map(|c| [c[2], c[3]]).collect();
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let p = write(tmp.path(), "tube.stl", &write_binary(b"tube", &v, &sides));
+    let s = mesh::load_solid(&p, [1.0; 3], HealthOptions::default()).unwrap();
+    assert!(
+        matches!(s.rung, Rung::Capped { holes: 2, .. }),
+        "{:?}",
+        s.rung
+    );
+    let closed = urdf_inertia::mass::MassProperties::from_trimesh(&v, &f, 1.0);
+    assert!(
+        (s.unit.mass - closed.mass).abs() < 1e-7 * closed.mass,
+        "{} vs {}",
+        s.unit.mass,
+        closed.mass
+    );
 }

@@ -95,8 +95,10 @@ def reason_for(parts, urdf_text):
         prov = p["provenance"]
         if prov == "convex-hull":
             reasons.append(f"{Path(p['geometry']).name}: open mesh replaced by its convex hull (coal integrates the open surface)")
-        elif prov == "nearly-closed":
-            reasons.append(f"{Path(p['geometry']).name}: mesh with negligible holes, integrated about its bounding-box centre (coal: about the origin)")
+        elif prov == "capped":
+            reasons.append(f"{Path(p['geometry']).name}: open mesh, holes closed with flat caps (coal integrates the open surface about the origin)")
+        elif prov == "non-manifold":
+            reasons.append(f"{Path(p['geometry']).name}: non-manifold closed mesh, integrated about its bounding-box centre (coal: about the origin)")
         elif prov in ("reoriented", "inverted"):
             reasons.append(f"{Path(p['geometry']).name}: {prov} winding fixed (coal integrates it as wound)")
     return reasons

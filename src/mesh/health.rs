@@ -7,12 +7,14 @@
 //! 2. [`Rung::Reoriented`]: closed, but some faces wound against their neighbours: each connected
 //!    component is made consistent, then turned outward by its signed volume.
 //! 3. [`Rung::Inverted`]: closed and consistent but wound inward (negative volume): flipped.
-//! 4. Open (boundary edges) or non-manifold:
-//!    * [`Rung::NearlyClosed`] when its holes are negligible: an open surface's signed volume depends on
-//!      the reference point `o` only through its vector area `A` (`V(o) = V(0) − o·A/3`), so with `o` at
-//!      the bounding-box centre the result is uncertain by at most `|A|·diag/6`. Below 1e-3 of the
-//!      volume the mesh itself (oriented as consistently as its manifold edges allow) is used, with that
-//!      bound as its error estimate: for a CAD mesh with a few cracks this is far closer than a hull.
+//! 4. Open (boundary edges) or non-manifold, after orienting what the manifold edges allow:
+//!    * [`Rung::Capped`]: each boundary loop is closed by a fan from its centroid. For a planar hole that
+//!      cap is exact; for a non-planar one, any cap spanning the loop differs from it by at most about
+//!      (the loop's largest distance from its mean plane) × (the cap's area). When that bound, summed over
+//!      the holes, is below 1e-3 of the volume, the capped mesh is used and the bound reported.
+//!    * [`Rung::NonManifold`]: no boundary edges but edges shared by three or more faces (solids touching
+//!      along an edge, or overlapping shells): the surface still bounds a region, integrated as it is
+//!      (a region enclosed twice counts twice: a warning says so).
 //!    * [`Rung::ConvexHull`] otherwise: the convex hull of its vertices, with the numbers that say how far
 //!      that is from the mesh.
 //! 5. Zero or near-zero volume: an error.
@@ -35,11 +37,16 @@ pub enum Rung {
         components: usize,
     },
     Inverted,
-    NearlyClosed {
+    Capped {
+        holes: usize,
         boundary_edges: usize,
         nonmanifold_edges: usize,
         faces_flipped: usize,
         relative_uncertainty: f64,
+    },
+    NonManifold {
+        nonmanifold_edges: usize,
+        faces_flipped: usize,
     },
     ConvexHull {
         boundary_edges: usize,
@@ -57,7 +64,8 @@ impl Rung {
             Rung::Exact => "exact",
             Rung::Reoriented { .. } => "reoriented",
             Rung::Inverted => "inverted",
-            Rung::NearlyClosed { .. } => "nearly-closed",
+            Rung::Capped { .. } => "capped",
+            Rung::NonManifold { .. } => "non-manifold",
             Rung::ConvexHull { .. } => "convex-hull",
         }
     }
@@ -95,8 +103,8 @@ pub struct HealthOptions {
 /// Relative volume below which a solid counts as empty (against the bounding-box diagonal cubed).
 const ZERO_VOLUME: f64 = 1e-12;
 
-/// Largest relative volume uncertainty (`|A|·diag/6 / V`) for which an open mesh is used as it is.
-const NEARLY_CLOSED: f64 = 1e-3;
+/// Largest relative volume uncertainty of the caps for which a capped mesh is used.
+const CAPPED: f64 = 1e-3;
 
 /// Welds bit-identical vertices and drops faces that collapse to fewer than three distinct vertices.
 pub fn weld(mesh: &RawMesh) -> (Vec<[f64; 3]>, Polygons, usize) {
@@ -152,6 +160,8 @@ struct Edges {
     /// Pairs of faces sharing a manifold edge, and whether they traverse it the same way (inconsistent).
     pairs: Vec<(u32, u32, bool)>,
     inconsistent: usize,
+    /// Boundary edges as directed in their face.
+    boundary_half_edges: Vec<(u32, u32)>,
 }
 
 fn edges(faces: &Polygons) -> Edges {
@@ -163,6 +173,14 @@ fn edges(faces: &Polygons) -> Edges {
             rec.push((key, fi as u32, u < v));
         }
     }
+    let key_edge = |key: u64, forward: bool| {
+        let (a, b) = ((key >> 32) as u32, key as u32);
+        if forward {
+            (a, b)
+        } else {
+            (b, a)
+        }
+    };
     rec.sort_unstable_by_key(|r| r.0);
     let mut e = Edges::default();
     let mut i = 0;
@@ -172,7 +190,10 @@ fn edges(faces: &Polygons) -> Edges {
             j += 1;
         }
         match j - i {
-            1 => e.boundary += 1,
+            1 => {
+                e.boundary += 1;
+                e.boundary_half_edges.push(key_edge(rec[i].0, rec[i].2));
+            }
             2 => {
                 let same = rec[i].2 == rec[i + 1].2;
                 if same {
@@ -358,7 +379,8 @@ pub fn make_solid(mesh: &RawMesh, path: &Path, options: HealthOptions) -> Result
             "closed but not orientable".to_string()
         };
         // Orient what the manifold edges allow, each component outward; failing that (contradicting
-        // edges, or open sheets whose sign is meaningless), the winding as the file gives it. Then see whether the holes matter.
+        // edges, or open sheets whose sign is meaningless), the winding as the file gives it. Then close
+        // the holes, if they are small enough for flat caps to be trusted.
         let mut candidates: Vec<(Polygons, usize)> = Vec::new();
         if let Some((flip, comp, ncomp)) = orient(faces.len(), &e.pairs) {
             let mut trial = faces.clone();
@@ -383,31 +405,75 @@ pub fn make_solid(mesh: &RawMesh, path: &Path, options: HealthOptions) -> Result
         }
         candidates.push((faces.clone(), 0));
         for (trial, flipped) in candidates {
-            let area = vector_area(&vertices, &trial);
-            let unit = unit_props(&vertices, &trial, None);
-            let uncertainty = area * diag / 6.0 / unit.mass.abs();
-            if unit.mass > 0.0 && uncertainty <= NEARLY_CLOSED {
+            let flips = if flipped > 0 {
+                format!(", {flipped} faces re-oriented")
+            } else {
+                String::new()
+            };
+            if e.boundary == 0 {
+                let unit = unit_props(&vertices, &trial, None);
+                if unit.mass > 0.0 {
+                    strict(format!("mesh is {what}"))?;
+                    warnings.push(format!("mesh is {what} but has no holes: integrated as it is{flips} (a region enclosed by two overlapping shells would count twice)"));
+                    check_volume(unit.mass, diag, bbox_volume, path)?;
+                    let error_estimate = estimate(&vertices, &trial, &unit);
+                    let rung = Rung::NonManifold {
+                        nonmanifold_edges: e.nonmanifold,
+                        faces_flipped: flipped,
+                    };
+                    return Ok(Solid {
+                        vertices,
+                        faces: trial,
+                        rung,
+                        warnings,
+                        unit,
+                        error_estimate,
+                        faces_read,
+                    });
+                }
+                continue;
+            }
+            let Some(Capping {
+                vertices: cv,
+                faces: cf,
+                holes,
+                cracks,
+                bound,
+            }) = cap_holes(&vertices, &trial)
+            else {
+                continue;
+            };
+            let unit = unit_props(&cv, &cf, None);
+            let uncertainty = bound / unit.mass.abs();
+            if unit.mass > 0.0 && uncertainty <= CAPPED {
                 strict(format!("mesh is {what}"))?;
-                let flips = if flipped > 0 {
-                    format!(", {flipped} faces re-oriented")
-                } else {
-                    String::new()
-                };
+                let mut done = Vec::new();
+                if holes > 0 {
+                    done.push(format!("closed its {holes} hole(s) with flat caps"));
+                }
+                if cracks > 0 {
+                    done.push(format!(
+                        "left {cracks} edge(s) of cracks or T-junctions open"
+                    ));
+                }
                 warnings.push(format!(
-                    "mesh is {what}, but its holes are negligible: used the mesh itself{flips}; its volume {:.6e} m³ is uncertain by at most {:.1e} (relative) because of the holes",
-                    unit.mass, uncertainty
+                    "mesh is {what}: {}{flips}; its volume {:.6e} m³ is uncertain by at most {:.1e} (relative) because of them",
+                    done.join(", "),
+                    unit.mass,
+                    uncertainty
                 ));
                 check_volume(unit.mass, diag, bbox_volume, path)?;
-                let rung = Rung::NearlyClosed {
+                let rung = Rung::Capped {
+                    holes,
                     boundary_edges: e.boundary,
                     nonmanifold_edges: e.nonmanifold,
                     faces_flipped: flipped,
                     relative_uncertainty: uncertainty,
                 };
-                let error_estimate = uncertainty.max(estimate(&vertices, &trial, &unit));
+                let error_estimate = uncertainty.max(estimate(&cv, &cf, &unit));
                 return Ok(Solid {
-                    vertices,
-                    faces: trial,
+                    vertices: cv,
+                    faces: cf,
                     rung,
                     warnings,
                     unit,
@@ -516,6 +582,108 @@ fn component_volumes(
     vol
 }
 
+/// Closes every boundary loop of `faces` with a fan from the loop's centroid, wound against the loop's
+/// edges so the result is consistently oriented. Returns the new vertices and faces, the number of holes,
+/// and the volume uncertainty bound Σ (largest distance of a loop vertex from the loop's mean plane) ×
+/// (cap area). `None` when the boundary edges do not chain into loops (inconsistent winding at a hole).
+fn cap_holes(vertices: &[[f64; 3]], faces: &Polygons) -> Option<Capping> {
+    let half = edges(faces).boundary_half_edges;
+    // Walk boundary edges as undirected (cracks and slivers often have both sides in one direction),
+    // preferring the mesh's own direction; each cap triangle is wound against its own edge.
+    let mut out_of: HashMap<u32, Vec<(u32, usize, bool)>> = HashMap::new();
+    for (i, &(u, v)) in half.iter().enumerate() {
+        out_of.entry(u).or_default().push((v, i, true));
+    }
+    for (i, &(u, v)) in half.iter().enumerate() {
+        out_of.entry(v).or_default().push((u, i, false));
+    }
+    let mut used = vec![false; half.len()];
+    let mut v_out = vertices.to_vec();
+    let mut f_out = faces.clone();
+    let mut holes = 0;
+    let mut cracks = 0;
+    let mut bound = 0.0;
+    for start in 0..half.len() {
+        if used[start] {
+            continue;
+        }
+        used[start] = true;
+        // (vertex, edge into the next vertex as directed in the mesh)
+        let mut steps: Vec<(u32, u32, u32)> = vec![(half[start].0, half[start].0, half[start].1)];
+        let mut at = half[start].1;
+        let mut closed = true;
+        while at != half[start].0 {
+            let Some((next, i, forward)) = out_of
+                .get(&at)
+                .and_then(|o| o.iter().find(|(_, i, _)| !used[*i]).copied())
+            else {
+                closed = false;
+                break;
+            };
+            used[i] = true;
+            let (mu, mv) = if forward { (at, next) } else { (next, at) };
+            steps.push((at, mu, mv));
+            at = next;
+        }
+        if !closed {
+            // A chain that does not close is a crack or a T-junction, not a hole: left open, and
+            // accounted for below by the vector area that remains.
+            cracks += steps.len();
+            continue;
+        }
+        let lp: Vec<u32> = steps.iter().map(|s| s.0).collect();
+        holes += 1;
+        let n = lp.len() as f64;
+        let c = [0, 1, 2].map(|k| lp.iter().map(|&i| vertices[i as usize][k]).sum::<f64>() / n);
+        let ci = v_out.len() as u32;
+        v_out.push(c);
+        let mut area = [0.0f64; 3];
+        for &(_, a, b) in &steps {
+            // The mesh has a → b on its boundary; the cap runs b → a.
+            f_out.push(&[ci, b, a]);
+            let p = sub(vertices[b as usize], c);
+            let q = sub(vertices[a as usize], c);
+            area[0] += 0.5 * (p[1] * q[2] - p[2] * q[1]);
+            area[1] += 0.5 * (p[2] * q[0] - p[0] * q[2]);
+            area[2] += 0.5 * (p[0] * q[1] - p[1] * q[0]);
+        }
+        let len = (area[0] * area[0] + area[1] * area[1] + area[2] * area[2]).sqrt();
+        if len > 0.0 {
+            let nrm = area.map(|x| x / len);
+            let dev = lp.iter().map(|&i| {
+                let d = sub(vertices[i as usize], c);
+                (d[0] * nrm[0] + d[1] * nrm[1] + d[2] * nrm[2]).abs()
+            });
+            bound += dev.fold(0.0, f64::max) * len;
+        }
+    }
+    if cracks > 0 {
+        // What is left open makes the result depend on the reference point by at most |A|·diag/6.
+        let (lo, hi) = bbox(vertices);
+        let diag =
+            ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
+        bound += vector_area(&v_out, &f_out) * diag / 6.0;
+    }
+    Some(Capping {
+        vertices: v_out,
+        faces: f_out,
+        holes,
+        cracks,
+        bound,
+    })
+}
+
+/// A mesh with its holes capped.
+struct Capping {
+    vertices: Vec<[f64; 3]>,
+    faces: Polygons,
+    holes: usize,
+    /// Boundary edges left open (cracks, T-junctions).
+    cracks: usize,
+    /// Bound on the volume uncertainty the caps and cracks leave, m³.
+    bound: f64,
+}
+
 /// The length of the surface's vector area `Σ N/2` (zero for a closed surface).
 fn vector_area(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
     let centre = bounding_box_centre(vertices);
@@ -523,10 +691,8 @@ fn vector_area(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
     for face in faces.iter() {
         let p = sub(vertices[face[0] as usize], centre);
         for k in 1..face.len() - 1 {
-            let q = sub(vertices[face[k] as usize], centre);
-            let r = sub(vertices[face[k + 1] as usize], centre);
-            let e1 = sub(q, p);
-            let e2 = sub(r, p);
+            let e1 = sub(sub(vertices[face[k] as usize], centre), p);
+            let e2 = sub(sub(vertices[face[k + 1] as usize], centre), p);
             a[0] += 0.5 * (e1[1] * e2[2] - e1[2] * e2[1]);
             a[1] += 0.5 * (e1[2] * e2[0] - e1[0] * e2[2]);
             a[2] += 0.5 * (e1[0] * e2[1] - e1[1] * e2[0]);
