@@ -12,7 +12,7 @@ use urdf_inertia::mass::{IntegrationOptions, Polygons};
 
 fn kernel(c: &mut Criterion) {
     let mut group = c.benchmark_group("kernel");
-    for level in [4u32, 5, 6, 7, 8] {
+    for level in [4u32, 5, 6, 7, 8, 9] {
         let (v, f) = common::icosphere(level);
         // Moved away from the origin, as real parts are.
         let v: Vec<[f64; 3]> = v

@@ -330,13 +330,14 @@ fn geometry_part(
 }
 
 /// Computes every selected link with collision geometry.
-pub fn compute(
-    robot: &Robot,
-    map: &DensityMap,
-    resolver: &PackageResolver,
-    opts: &FillOptions,
-) -> FillReport {
-    let mut cache = MeshCache::default();
+pub fn compute(robot: &Robot, map: &DensityMap, resolver: &PackageResolver, opts: &FillOptions) -> FillReport {
+    compute_with(robot, map, resolver, opts, &mut MeshCache::default())
+}
+
+/// [`compute`] with a mesh cache shared across calls (several URDFs of one robot, or a whole corpus).
+/// The report's timing and file counts are this call's share.
+pub fn compute_with(robot: &Robot, map: &DensityMap, resolver: &PackageResolver, opts: &FillOptions, cache: &mut MeshCache) -> FillReport {
+    let (load0, integrate0, files0) = (cache.load_time, cache.integrate_time, cache.files());
     let mut report = FillReport::default();
     let mut missing_density: Vec<(String, usize)> = Vec::new();
     // Links whose mass follows from densities (scaled by total_mass), as indices into report.links.
@@ -354,7 +355,7 @@ pub fn compute(
         let mut parts = Vec::new();
         let mut failed = None;
         for c in &link.collisions {
-            match geometry_part(c, robot, resolver, &mut cache, opts) {
+            match geometry_part(c, robot, resolver, cache, opts) {
                 Ok(p) => parts.push(p),
                 Err(m) => {
                     failed = Some(m);
@@ -546,11 +547,8 @@ pub fn compute(
             });
         }
     }
-    report.mesh_files = cache.files();
-    report.timing = Timing {
-        load: cache.load_time,
-        integrate: cache.integrate_time,
-    };
+    report.mesh_files = cache.files() - files0;
+    report.timing = Timing { load: cache.load_time - load0, integrate: cache.integrate_time - integrate0 };
     report
 }
 

@@ -14,7 +14,7 @@ const PI: f64 = std::f64::consts::PI;
 /// integrals that vanish by symmetry are below 1e-15, for 20 to 1,310,720 faces.
 #[test]
 fn paper_table2_sphere_series() {
-    for level in 1..=8u32 {
+    for level in 1..=9u32 {
         let (v, f) = icosphere(level);
         assert_eq!(f.len(), 20 * 4usize.pow(level - 1));
         // Inscribed radius: the smallest distance from the centre to a face plane.
@@ -57,10 +57,10 @@ fn paper_table2_sphere_series() {
                 t.t2[0]
             );
             // The paper reports |Tx|, |Tyz| < 1e-15 up to 20,480 faces. About the origin, each face's
-            // Green's-theorem sums cancel terms ~100× the face's share, so the paper-faithful variant
-            // lands near 2e-15 on some levels of our series; the recentred, compensated kernel keeps
-            // the paper's bound on all of them, to 1.3 M faces.
-            let bound = if name == "paper" { 1e-14 } else { 1e-15 };
+            // Green's-theorem sums cancel terms ~100× the face's share, and plain sums drift with the
+            // face count: the paper-faithful variant lands near 2e-15 at 20,480 faces and 2.3e-14 at
+            // 1.3 M. The recentred, compensated kernel keeps the paper's bound on every level.
+            let bound = if name == "paper" { 1e-13 } else { 1e-15 };
             for (k, x) in t.t.iter().chain(t.tp.iter()).enumerate() {
                 assert!(
                     x.abs() < bound,
@@ -332,7 +332,7 @@ fn stiff_and_extreme_cases_against_exact() {
 /// The 1.3 M-face sphere against exact rationals (bar: 6.6e-17, trimesh).
 #[test]
 fn sphere_1_3m_faces_against_exact() {
-    let (v, f) = icosphere(8);
+    let (v, f) = icosphere(9);
     let exact = exact_mass(&exact_integrals(&v, &f));
     let ours = MassProperties::from_trimesh(&v, &f, 1.0);
     let err = inertia_error(&ours.inertia, &exact.inertia);

@@ -89,7 +89,7 @@ fn primitives_against_their_tessellations_moved_and_rotated() {
         dm < 1e-6 && dc < 1e-12 && di < 1e-6,
         "cylinder {dm:e} {dc:e} {di:e}"
     );
-    // Sphere: an icosphere of 1.3 M faces.
+    // Sphere: an icosphere of 327,680 faces (level 8).
     let prim = primitives::sphere(1.0, 1.0).transformed(&r, t);
     let (v, f) = transform(&icosphere(8), 1.0, &r, t);
     let (dm, _, di) = rel_diff(&MassProperties::from_trimesh(&v, &f, 1.0), &prim);

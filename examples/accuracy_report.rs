@@ -1,0 +1,378 @@
+//! Error against run time: writes `docs/accuracy.md` and `docs/accuracy.svg`.
+//!
+//! `cargo run --release --example accuracy_report` (a few minutes). With `EXAMPLE_ROBOT_DATA_SHARE` set to
+//! the `cmeel.prefix/share` directory of example-robot-data (as `validation/run.sh` installs it), it also
+//! times filling every URDF of the corpus and loading every collision mesh once.
+//!
+//! Every error is against exact rational arithmetic on the stored mesh (tests/common's reference).
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use common::*;
+use num_rational::BigRational;
+use num_traits::ToPrimitive;
+use std::fmt::Write as _;
+use std::time::Instant;
+use urdf_inertia::mass::integrals::{mirtich_polygons, triangle_integrals, volume_integrals};
+use urdf_inertia::mass::{IntegrationOptions, MassProperties, Polygons, Summation, VolumeIntegrals};
+
+/// The kernel variants compared.
+#[derive(Clone, Copy)]
+enum Variant {
+    /// Mirtich's Figures 4–6 about the origin, plain sums.
+    Paper,
+    /// Triangle kernel about the bounding-box centre, plain sums, no accurate faces.
+    Recentred,
+    /// ... with compensated sums.
+    RecentredCompensated,
+    /// urdf-inertia's kernel: recentred, compensated, accurate ill-conditioned faces, one final rounding.
+    Ours,
+    /// urdf-inertia's kernel on vertices rounded to f32 first (what float32 loaders such as assimp feed).
+    OursF32Input,
+}
+
+const VARIANTS: [(Variant, &str); 5] = [
+    (Variant::Paper, "paper (origin, plain sums)"),
+    (Variant::Recentred, "recentred, plain sums"),
+    (Variant::RecentredCompensated, "recentred, compensated"),
+    (Variant::Ours, "ours (recentred, compensated, accurate faces)"),
+    (Variant::OursF32Input, "ours on f32-rounded input"),
+];
+
+fn integrate(variant: Variant, v: &[[f64; 3]], f: &[[u32; 3]], polys: &Polygons) -> VolumeIntegrals {
+    match variant {
+        Variant::Paper => mirtich_polygons(v, polys, &IntegrationOptions::paper()),
+        Variant::Recentred => triangle_integrals(v, f, &IntegrationOptions { reference: None, summation: Summation::Plain, accurate_faces: false }),
+        Variant::RecentredCompensated => triangle_integrals(v, f, &IntegrationOptions { reference: None, summation: Summation::Compensated, accurate_faces: false }),
+        Variant::Ours => triangle_integrals(v, f, &IntegrationOptions::accurate()),
+        Variant::OursF32Input => {
+            let v32: Vec<[f64; 3]> = v.iter().map(|p| p.map(|c| c as f32 as f64)).collect();
+            triangle_integrals(&v32, f, &IntegrationOptions::accurate())
+        }
+    }
+}
+
+/// Median time of `f` in seconds, repeated until about `budget` seconds are spent.
+fn time<T>(budget: f64, mut f: impl FnMut() -> T) -> f64 {
+    let mut samples = Vec::new();
+    let start = Instant::now();
+    while samples.len() < 3 || (start.elapsed().as_secs_f64() < budget && samples.len() < 2000) {
+        let t = Instant::now();
+        std::hint::black_box(f());
+        samples.push(t.elapsed().as_secs_f64());
+    }
+    samples.sort_by(f64::total_cmp);
+    samples[samples.len() / 2]
+}
+
+struct Errors {
+    mass: f64,
+    com: f64,
+    inertia: f64,
+    smallest: f64,
+}
+
+fn smallest_exact(exact: &ExactMass) -> f64 {
+    // The Rayleigh quotient of the exact tensor at the eigenvector of its f64 rounding: second-order
+    // accurate in the eigenvector's error, so exact to far below f64 for the smallest moment.
+    let rounded = [0, 1, 2].map(|i| [0, 1, 2].map(|j| exact.inertia[i][j].to_f64().unwrap()));
+    let (_, axes) = urdf_inertia::mass::jacobi::symmetric_eigen(rounded);
+    let n: Vec<BigRational> = (0..3).map(|r| rat(axes[r][0])).collect();
+    let mut num = BigRational::from_integer(0.into());
+    for i in 0..3 {
+        for j in 0..3 {
+            num += &n[i] * &exact.inertia[i][j] * &n[j];
+        }
+    }
+    let den: BigRational = n.iter().map(|x| x * x).fold(BigRational::from_integer(0.into()), |a, b| a + b);
+    (num / den).to_f64().unwrap()
+}
+
+fn errors(mp: &MassProperties, exact: &ExactMass, size: f64, small: f64) -> Errors {
+    let finite = mp.inertia.iter().flatten().all(|x| x.is_finite()) && mp.mass.is_finite();
+    if !finite {
+        return Errors { mass: f64::INFINITY, com: f64::INFINITY, inertia: f64::INFINITY, smallest: f64::INFINITY };
+    }
+    Errors {
+        mass: rel_error(mp.mass, &exact.volume),
+        com: com_error(mp.com, &exact.com, size),
+        inertia: inertia_error(&mp.inertia, &exact.inertia),
+        smallest: ((mp.principal().moments[0] - small) / small).abs(),
+    }
+}
+
+fn e(x: f64) -> String {
+    if x == 0.0 {
+        "0".into()
+    } else if x.is_finite() {
+        format!("{x:.1e}")
+    } else {
+        "inf".into()
+    }
+}
+
+fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string()))
+        .unwrap_or_else(|| "unknown CPU".into());
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    format!("{cpu}, {cores} cores visible, one core used; {} {}", std::env::consts::OS, std::env::consts::ARCH)
+}
+
+fn main() -> std::io::Result<()> {
+    let mut md = String::new();
+    writeln!(md, "# Accuracy against run time\n").ok();
+    writeln!(md, "Generated by `cargo run --release --example accuracy_report` on {}. Errors are against exact rational arithmetic on the stored meshes (every f64 is a rational); times are medians of repeated runs on one core.\n", machine()).ok();
+
+    // 1. Table 1.
+    writeln!(md, "## 1. The paper's Table 1\n").ok();
+    writeln!(md, "Integrals about the origin. Paper: 15 significant digits, 64 µs (tetrahedron) and 110 µs (cube) on an R4400.\n").ok();
+    writeln!(md, "| object | integral | ours | exact | relative error |\n|---|---|---|---|---|").ok();
+    let names = ["T1", "Tx", "Ty", "Tz", "Tx²", "Ty²", "Tz²", "Txy", "Tyz", "Tzx"];
+    let tet_v = vec![[0.0, 0.0, 0.0], [5.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 3.0]];
+    let tet_f = vec![[0u32, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+    let cube = box_mesh([20.0, 20.0, 20.0]);
+    let mut cube_quads = Polygons::new();
+    for q in [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]] {
+        cube_quads.push(&q);
+    }
+    let mut times = Vec::new();
+    for (name, v, polys, tris) in [("cube (quads)", cube.0.clone(), cube_quads.clone(), cube.1.clone()), ("tetrahedron", tet_v.clone(), Polygons::from_triangles(&tet_f), tet_f.clone())] {
+        let ours = volume_integrals(&v, &polys, &IntegrationOptions::accurate()).about([0.0; 3]);
+        let exact = exact_integrals(&v, &tris);
+        for k in 0..10 {
+            let ex = exact[k].to_f64().unwrap();
+            writeln!(md, "| {name} | {} | {} | {} | {} |", names[k], ours[k], ex, e(rel_error(ours[k], &exact[k]))).ok();
+        }
+        times.push((name, time(0.3, || volume_integrals(&v, &polys, &IntegrationOptions::accurate())), time(0.3, || mirtich_polygons(&v, &polys, &IntegrationOptions::paper()))));
+    }
+    writeln!(md).ok();
+    for (name, t_ours, t_paper) in &times {
+        writeln!(md, "Time for all ten integrals of the {name}: ours {:.2} µs, paper-faithful {:.2} µs.", t_ours * 1e6, t_paper * 1e6).ok();
+    }
+
+    // 2. Table 2.
+    writeln!(md, "\n## 2. The paper's Table 2: the sphere series\n").ok();
+    writeln!(md, "Icosahedron refined by projecting edge midpoints onto the unit sphere. Error: relative Frobenius error of the central inertia against the exact value for that polyhedron. Paper times on an R4400.\n").ok();
+    writeln!(md, "| approx. | verts | edges | faces | T1 | Tx | Tx² | Tyz | error (ours) | error (paper variant) | time (ours) | ns/face | growth | paper time |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|").ok();
+    let paper_times = ["500 µs", "1.2 ms", "4.9 ms", "21 ms", "82 ms", "350 ms", "-", "-", "-"];
+    let mut last = None;
+    let mut plot: Vec<(usize, f64, f64)> = Vec::new(); // (variant, ns/face, error)
+    let mut plot_faces: Vec<usize> = Vec::new();
+    for level in 1..=9u32 {
+        let (v, f) = icosphere(level);
+        let polys = Polygons::from_triangles(&f);
+        let t = integrate(Variant::Ours, &v, &f, &polys).about([0.0; 3]);
+        let exact = exact_mass(&exact_integrals(&v, &f));
+        let ours = MassProperties::from_integrals(&integrate(Variant::Ours, &v, &f, &polys), 1.0);
+        let paper = MassProperties::from_integrals(&integrate(Variant::Paper, &v, &f, &polys), 1.0);
+        let secs = time(if level > 6 { 2.0 } else { 0.5 }, || integrate(Variant::Ours, &v, &f, &polys));
+        let growth = last.map(|l: f64| format!("{:.2}", secs / l)).unwrap_or_else(|| "-".into());
+        last = Some(secs);
+        writeln!(
+            md,
+            "| {level} | {} | {} | {} | {:.4} | {:+.1e} | {:.4} | {:+.1e} | {} | {} | {:.3} ms | {:.1} | {growth} | {} |",
+            v.len(),
+            3 * f.len() / 2,
+            f.len(),
+            t.t1,
+            t.t[0],
+            t.t2[0],
+            t.tp[1],
+            e(inertia_error(&ours.inertia, &exact.inertia)),
+            e(inertia_error(&paper.inertia, &exact.inertia)),
+            secs * 1e3,
+            secs * 1e9 / f.len() as f64,
+            paper_times[level as usize - 1]
+        )
+        .ok();
+        eprintln!("sphere level {level} done");
+    }
+    writeln!(md, "\nLinear time means a growth of 4 per refinement.").ok();
+
+    // 3. Stiff and extreme cases, every variant.
+    writeln!(md, "\n## 3. Stiff and extreme cases\n").ok();
+    writeln!(md, "Relative errors against exact rationals: mass, COM (distance over the body's size), central inertia (Frobenius), smallest principal moment (against the exact tensor's Rayleigh quotient). The floor is the exact central tensor rounded to f64.\n").ok();
+    let sphere = icosphere(6);
+    let cubem = box_mesh([1.0, 1.0, 1.0]);
+    let plate = box_mesh([1.0, 1.0, 1e-6]);
+    let needle = box_mesh([1e-6, 1e-6, 1.0]);
+    let id = rotation([0.0; 3]);
+    let rot = rotation([0.7, -1.3, 2.9]);
+    let far = [1e4, -2e4, 3e4];
+    let cases: Vec<(&str, Mesh, f64)> = vec![
+        ("cube 1e3 away", transform(&cubem, 1.0, &id, [1e3; 3]), 1.0),
+        ("cube 1e6 away", transform(&cubem, 1.0, &id, [1e6, -1e6, 1e6]), 1.0),
+        ("cube 1e8 away", transform(&cubem, 1.0, &id, [1e8, 1e8, -1e8]), 1.0),
+        ("sphere 1e8 away", transform(&sphere, 1.0, &id, [1e8; 3]), 2.0),
+        ("sphere scaled 1e-6", transform(&sphere, 1e-6, &id, [0.0; 3]), 2e-6),
+        ("sphere scaled 1e6", transform(&sphere, 1e6, &id, [0.0; 3]), 2e6),
+        ("sphere rotated, 1e4 away", transform(&sphere, 1.0, &rot, far), 2.0),
+        ("plate 1×1×1e-6 rotated, 1e4 away", transform(&plate, 1.0, &rot, far), 1.4),
+        ("needle 1e-6×1e-6×1 rotated, 1e4 away", transform(&needle, 1.0, &rot, far), 1.0),
+        ("cube mirrored (x → −x), wound outward", ((cubem.0.iter().map(|p| [-p[0], p[1], p[2]]).collect()), cubem.1.iter().map(|t| [t[0], t[2], t[1]]).collect()), 1.0),
+        ("cube inside-out (after the health ladder's flip)", cubem.clone(), 1.0),
+    ];
+    writeln!(md, "| case | variant | mass | COM | inertia | smallest moment | floor |\n|---|---|---|---|---|---|---|").ok();
+    for (name, (v, f), size) in &cases {
+        let exact = exact_mass(&exact_integrals(v, f));
+        let small = smallest_exact(&exact);
+        let rounded = [0, 1, 2].map(|i| [0, 1, 2].map(|j| exact.inertia[i][j].to_f64().unwrap()));
+        let floor = inertia_error(&rounded, &exact.inertia);
+        let polys = Polygons::from_triangles(f);
+        for (variant, vname) in VARIANTS {
+            let mp = MassProperties::from_integrals(&integrate(variant, v, f, &polys), 1.0);
+            let er = errors(&mp, &exact, *size, small);
+            writeln!(md, "| {name} | {vname} | {} | {} | {} | {} | {} |", e(er.mass), e(er.com), e(er.inertia), e(er.smallest), e(floor)).ok();
+        }
+        eprintln!("{name} done");
+    }
+
+    // 4. Error against run time, on a sphere moved 100 radii away, every variant and size.
+    for level in 3..=9u32 {
+        let (v, f) = transform(&icosphere(level), 1.0, &id, [100.0, -50.0, 30.0]);
+        let polys = Polygons::from_triangles(&f);
+        let exact = exact_mass(&exact_integrals(&v, &f));
+        for (vi, (variant, _)) in VARIANTS.iter().enumerate() {
+            let secs = time(if level > 6 { 1.0 } else { 0.3 }, || integrate(*variant, &v, &f, &polys));
+            let mp = MassProperties::from_integrals(&integrate(*variant, &v, &f, &polys), 1.0);
+            plot.push((vi, secs * 1e9 / f.len() as f64, inertia_error(&mp.inertia, &exact.inertia)));
+            plot_faces.push(f.len());
+        }
+        eprintln!("plot level {level} done");
+    }
+    writeln!(md, "\n## 4. Error against run time\n").ok();
+    writeln!(md, "![error against time](accuracy.svg)\n").ok();
+    writeln!(md, "Sphere series (levels 3–9, 320 to 1.3 M faces) moved 100 radii away from the origin. x: ns per face; y: relative Frobenius error of the central inertia. The dashed line is the f64 round-off of the result (2⁻⁵³); points at zero error are drawn on the bottom edge.\n").ok();
+    writeln!(md, "| variant | faces | ns/face | error |\n|---|---|---|---|").ok();
+    for ((vi, ns, err), faces) in plot.iter().zip(&plot_faces) {
+        writeln!(md, "| {} | {faces} | {:.1} | {} |", VARIANTS[*vi].1, ns, e(*err)).ok();
+    }
+    std::fs::create_dir_all("docs")?;
+    std::fs::write("docs/accuracy.svg", svg(&plot))?;
+
+    // 5. Loading, and the corpus end to end.
+    writeln!(md, "\n## 5. Loading\n").ok();
+    let (v, f) = icosphere(9);
+    let bytes = urdf_inertia::mesh::stl::write_binary(b"bench", &v, &f);
+    let secs = time(3.0, || urdf_inertia::mesh::stl::parse(&bytes, std::path::Path::new("bench.stl")).map(|m| m.faces.len()).unwrap_or(0));
+    writeln!(md, "Binary STL, {} faces ({:.1} MB) from memory: {:.1} ms, {:.0} MB/s, {:.1} M faces/s.", f.len(), bytes.len() as f64 / 1e6, secs * 1e3, bytes.len() as f64 / 1e6 / secs, f.len() as f64 / 1e6 / secs).ok();
+    let raw = urdf_inertia::mesh::stl::parse(&bytes, std::path::Path::new("bench.stl")).expect("parse");
+    let secs = time(3.0, || urdf_inertia::mesh::health::make_solid(&raw, std::path::Path::new("bench.stl"), Default::default()).map(|s| s.faces.len()).unwrap_or(0));
+    writeln!(md, "Welding, edge analysis and integration of the same mesh: {:.1} ms ({:.0} ns/face).", secs * 1e3, secs * 1e9 / f.len() as f64).ok();
+    match std::env::var("EXAMPLE_ROBOT_DATA_SHARE") {
+        Ok(share) => corpus(&mut md, std::path::Path::new(&share)),
+        Err(_) => {
+            writeln!(md, "\nSet `EXAMPLE_ROBOT_DATA_SHARE` to time the example-robot-data corpus end to end.").ok();
+        }
+    }
+    std::fs::write("docs/accuracy.md", md)?;
+    println!("wrote docs/accuracy.md and docs/accuracy.svg");
+    Ok(())
+}
+
+fn corpus(md: &mut String, share: &std::path::Path) {
+    use urdf_inertia::density::DensityMap;
+    use urdf_inertia::fill::{compute_with, FillOptions, MeshCache};
+    use urdf_inertia::urdf::resolve::PackageResolver;
+    let robots = share.join("example-robot-data/robots");
+    let mut urdfs = Vec::new();
+    let mut stack = vec![robots.clone()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).into_iter().flatten().flatten() {
+            let p = entry.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().and_then(|e| e.to_str()) == Some("urdf") {
+                urdfs.push(p);
+            }
+        }
+    }
+    urdfs.sort();
+    let resolver = PackageResolver::new(&[("example-robot-data".into(), share.join("example-robot-data"))]);
+    let map = DensityMap::uniform(1000.0);
+    writeln!(md, "\n## 6. End to end on example-robot-data\n").ok();
+    writeln!(md, "Each URDF filled with a fresh cache (as the command does): parse, mesh loading, healing and integration, writing.\n").ok();
+    writeln!(md, "| URDF | links | faces | parse ms | load ms | heal+integrate ms | write ms | total ms | M faces/s |\n|---|---|---|---|---|---|---|---|---|").ok();
+    let mut shared = MeshCache::default();
+    let mut shared_faces = 0usize;
+    for u in &urdfs {
+        let t0 = Instant::now();
+        let text = std::fs::read_to_string(u).unwrap_or_default();
+        let Ok(robot) = urdf_inertia::urdf::scan(text, u) else { continue };
+        let parse = t0.elapsed().as_secs_f64();
+        let mut cache = MeshCache::default();
+        let report = compute_with(&robot, &map, &resolver, &FillOptions::default(), &mut cache);
+        let t1 = Instant::now();
+        let updates: Vec<_> = report.links.iter().map(|l| (l.index, l.computed)).collect();
+        let out = urdf_inertia::urdf::write::splice(&robot, &updates, &Default::default());
+        std::hint::black_box(out.len());
+        let write = t1.elapsed().as_secs_f64();
+        let total = t0.elapsed().as_secs_f64();
+        let rel = u.strip_prefix(&robots).unwrap_or(u).display().to_string();
+        writeln!(
+            md,
+            "| {rel} | {} | {} | {:.2} | {:.1} | {:.1} | {:.2} | {:.1} | {:.1} |",
+            report.links.len(),
+            report.faces,
+            parse * 1e3,
+            report.timing.load.as_secs_f64() * 1e3,
+            report.timing.integrate.as_secs_f64() * 1e3,
+            write * 1e3,
+            total * 1e3,
+            report.faces as f64 / total / 1e6
+        )
+        .ok();
+        let r2 = compute_with(&robot, &map, &resolver, &FillOptions::default(), &mut shared);
+        shared_faces += r2.faces;
+    }
+    writeln!(
+        md,
+        "\nEvery collision mesh of the corpus loaded once (one cache across all {} URDFs): {} files, loading {:.2} s, healing and integration {:.2} s.",
+        urdfs.len(),
+        shared.files(),
+        shared.load_time.as_secs_f64(),
+        shared.integrate_time.as_secs_f64()
+    )
+    .ok();
+    let _ = shared_faces;
+}
+
+/// A log-log scatter plot, one colour per variant, with the f64 floor as a dashed line.
+fn svg(points: &[(usize, f64, f64)]) -> String {
+    let (w, h, l, b, t, r) = (760.0, 460.0, 70.0, 50.0, 20.0, 250.0);
+    let xs: Vec<f64> = points.iter().map(|p| p.1.log10()).collect();
+    let (x0, x1) = (xs.iter().cloned().fold(f64::INFINITY, f64::min).floor(), xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max).ceil());
+    let (y0, y1) = (-18.0f64, 0.0f64);
+    let px = |x: f64| l + (x.log10() - x0) / (x1 - x0) * (w - l - r);
+    let py = |y: f64| {
+        let ly = if y > 0.0 { y.log10().clamp(y0, y1) } else { y0 };
+        t + (y1 - ly) / (y1 - y0) * (h - t - b)
+    };
+    let colours = ["#d62728", "#ff7f0e", "#2ca02c", "#1f77b4", "#9467bd"];
+    let mut s = format!("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n");
+    for k in (y0 as i32)..=(y1 as i32) {
+        let y = py(10f64.powi(k));
+        if k % 2 == 0 {
+            s += &format!("<line x1=\"{l}\" x2=\"{}\" y1=\"{y}\" y2=\"{y}\" stroke=\"#eee\"/><text x=\"{}\" y=\"{}\" text-anchor=\"end\">1e{k}</text>\n", w - r, l - 5.0, y + 4.0);
+        }
+    }
+    for k in (x0 as i32)..=(x1 as i32) {
+        let x = px(10f64.powi(k));
+        s += &format!("<line x1=\"{x}\" x2=\"{x}\" y1=\"{t}\" y2=\"{}\" stroke=\"#eee\"/><text x=\"{x}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n", h - b, h - b + 16.0, 10f64.powi(k));
+    }
+    let floor = py(2f64.powi(-53));
+    s += &format!("<line x1=\"{l}\" x2=\"{}\" y1=\"{floor}\" y2=\"{floor}\" stroke=\"black\" stroke-dasharray=\"5,4\"/><text x=\"{}\" y=\"{}\">f64 round-off 2^-53</text>\n", w - r, w - r + 5.0, floor + 4.0);
+    for (vi, ns, err) in points {
+        s += &format!("<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"4\" fill=\"{}\" fill-opacity=\"0.8\"/>\n", px(*ns), py(*err), colours[*vi]);
+    }
+    for (vi, (_, name)) in VARIANTS.iter().enumerate() {
+        let y = t + 20.0 + 20.0 * vi as f64;
+        s += &format!("<circle cx=\"{}\" cy=\"{y}\" r=\"5\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}</text>\n", w - r + 15.0, colours[vi], w - r + 25.0, y + 4.0, name.replace('&', "and"));
+    }
+    s += &format!("<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">ns per face</text>\n", (l + w - r) / 2.0, h - 10.0);
+    s += &format!("<text x=\"15\" y=\"{}\" transform=\"rotate(-90 15 {})\" text-anchor=\"middle\">relative error, central inertia</text>\n</svg>\n", (t + h - b) / 2.0, (t + h - b) / 2.0);
+    s
+}
