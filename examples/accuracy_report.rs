@@ -15,7 +15,9 @@ use num_traits::ToPrimitive;
 use std::fmt::Write as _;
 use std::time::Instant;
 use urdf_inertia::mass::integrals::{mirtich_polygons, triangle_integrals, volume_integrals};
-use urdf_inertia::mass::{IntegrationOptions, MassProperties, Polygons, Summation, VolumeIntegrals};
+use urdf_inertia::mass::{
+    IntegrationOptions, MassProperties, Polygons, Summation, VolumeIntegrals,
+};
 
 /// The kernel variants compared.
 #[derive(Clone, Copy)]
@@ -36,15 +38,39 @@ const VARIANTS: [(Variant, &str); 5] = [
     (Variant::Paper, "paper (origin, plain sums)"),
     (Variant::Recentred, "recentred, plain sums"),
     (Variant::RecentredCompensated, "recentred, compensated"),
-    (Variant::Ours, "ours (recentred, compensated, accurate faces)"),
+    (
+        Variant::Ours,
+        "ours (recentred, compensated, accurate faces)",
+    ),
     (Variant::OursF32Input, "ours on f32-rounded input"),
 ];
 
-fn integrate(variant: Variant, v: &[[f64; 3]], f: &[[u32; 3]], polys: &Polygons) -> VolumeIntegrals {
+fn integrate(
+    variant: Variant,
+    v: &[[f64; 3]],
+    f: &[[u32; 3]],
+    polys: &Polygons,
+) -> VolumeIntegrals {
     match variant {
         Variant::Paper => mirtich_polygons(v, polys, &IntegrationOptions::paper()),
-        Variant::Recentred => triangle_integrals(v, f, &IntegrationOptions { reference: None, summation: Summation::Plain, accurate_faces: false }),
-        Variant::RecentredCompensated => triangle_integrals(v, f, &IntegrationOptions { reference: None, summation: Summation::Compensated, accurate_faces: false }),
+        Variant::Recentred => triangle_integrals(
+            v,
+            f,
+            &IntegrationOptions {
+                reference: None,
+                summation: Summation::Plain,
+                accurate_faces: false,
+            },
+        ),
+        Variant::RecentredCompensated => triangle_integrals(
+            v,
+            f,
+            &IntegrationOptions {
+                reference: None,
+                summation: Summation::Compensated,
+                accurate_faces: false,
+            },
+        ),
         Variant::Ours => triangle_integrals(v, f, &IntegrationOptions::accurate()),
         Variant::OursF32Input => {
             let v32: Vec<[f64; 3]> = v.iter().map(|p| p.map(|c| c as f32 as f64)).collect();
@@ -85,14 +111,22 @@ fn smallest_exact(exact: &ExactMass) -> f64 {
             num += &n[i] * &exact.inertia[i][j] * &n[j];
         }
     }
-    let den: BigRational = n.iter().map(|x| x * x).fold(BigRational::from_integer(0.into()), |a, b| a + b);
+    let den: BigRational = n
+        .iter()
+        .map(|x| x * x)
+        .fold(BigRational::from_integer(0.into()), |a, b| a + b);
     (num / den).to_f64().unwrap()
 }
 
 fn errors(mp: &MassProperties, exact: &ExactMass, size: f64, small: f64) -> Errors {
     let finite = mp.inertia.iter().flatten().all(|x| x.is_finite()) && mp.mass.is_finite();
     if !finite {
-        return Errors { mass: f64::INFINITY, com: f64::INFINITY, inertia: f64::INFINITY, smallest: f64::INFINITY };
+        return Errors {
+            mass: f64::INFINITY,
+            com: f64::INFINITY,
+            inertia: f64::INFINITY,
+            smallest: f64::INFINITY,
+        };
     }
     Errors {
         mass: rel_error(mp.mass, &exact.volume),
@@ -115,10 +149,20 @@ fn e(x: f64) -> String {
 fn machine() -> String {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string()))
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
         .unwrap_or_else(|| "unknown CPU".into());
-    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
-    format!("{cpu}, {cores} cores visible, one core used; {} {}", std::env::consts::OS, std::env::consts::ARCH)
+    let cores = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
+    format!(
+        "{cpu}, {cores} cores visible, one core used; {} {}",
+        std::env::consts::OS,
+        std::env::consts::ARCH
+    )
 }
 
 fn main() -> std::io::Result<()> {
@@ -129,35 +173,90 @@ fn main() -> std::io::Result<()> {
     // 1. Table 1.
     writeln!(md, "## 1. The paper's Table 1\n").ok();
     writeln!(md, "Integrals about the origin. Paper: 15 significant digits, 64 µs (tetrahedron) and 110 µs (cube) on an R4400.\n").ok();
-    writeln!(md, "| object | integral | ours | exact | relative error |\n|---|---|---|---|---|").ok();
-    let names = ["T1", "Tx", "Ty", "Tz", "Tx²", "Ty²", "Tz²", "Txy", "Tyz", "Tzx"];
-    let tet_v = vec![[0.0, 0.0, 0.0], [5.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 3.0]];
+    writeln!(
+        md,
+        "| object | integral | ours | exact | relative error |\n|---|---|---|---|---|"
+    )
+    .ok();
+    let names = [
+        "T1", "Tx", "Ty", "Tz", "Tx²", "Ty²", "Tz²", "Txy", "Tyz", "Tzx",
+    ];
+    let tet_v = vec![
+        [0.0, 0.0, 0.0],
+        [5.0, 0.0, 0.0],
+        [0.0, 4.0, 0.0],
+        [0.0, 0.0, 3.0],
+    ];
     let tet_f = vec![[0u32, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
     let cube = box_mesh([20.0, 20.0, 20.0]);
     let mut cube_quads = Polygons::new();
-    for q in [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]] {
+    for q in [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ] {
         cube_quads.push(&q);
     }
     let mut times = Vec::new();
-    for (name, v, polys, tris) in [("cube (quads)", cube.0.clone(), cube_quads.clone(), cube.1.clone()), ("tetrahedron", tet_v.clone(), Polygons::from_triangles(&tet_f), tet_f.clone())] {
+    for (name, v, polys, tris) in [
+        (
+            "cube (quads)",
+            cube.0.clone(),
+            cube_quads.clone(),
+            cube.1.clone(),
+        ),
+        (
+            "tetrahedron",
+            tet_v.clone(),
+            Polygons::from_triangles(&tet_f),
+            tet_f.clone(),
+        ),
+    ] {
         let ours = volume_integrals(&v, &polys, &IntegrationOptions::accurate()).about([0.0; 3]);
         let exact = exact_integrals(&v, &tris);
         for k in 0..10 {
             let ex = exact[k].to_f64().unwrap();
-            writeln!(md, "| {name} | {} | {} | {} | {} |", names[k], ours[k], ex, e(rel_error(ours[k], &exact[k]))).ok();
+            writeln!(
+                md,
+                "| {name} | {} | {} | {} | {} |",
+                names[k],
+                ours[k],
+                ex,
+                e(rel_error(ours[k], &exact[k]))
+            )
+            .ok();
         }
-        times.push((name, time(0.3, || volume_integrals(&v, &polys, &IntegrationOptions::accurate())), time(0.3, || mirtich_polygons(&v, &polys, &IntegrationOptions::paper()))));
+        times.push((
+            name,
+            time(0.3, || {
+                volume_integrals(&v, &polys, &IntegrationOptions::accurate())
+            }),
+            time(0.3, || {
+                mirtich_polygons(&v, &polys, &IntegrationOptions::paper())
+            }),
+        ));
     }
     writeln!(md).ok();
     for (name, t_ours, t_paper) in &times {
-        writeln!(md, "Time for all ten integrals of the {name}: ours {:.2} µs, paper-faithful {:.2} µs.", t_ours * 1e6, t_paper * 1e6).ok();
+        writeln!(
+            md,
+            "Time for all ten integrals of the {name}: ours {:.2} µs, paper-faithful {:.2} µs.",
+            t_ours * 1e6,
+            t_paper * 1e6
+        )
+        .ok();
     }
 
     // 2. Table 2.
     writeln!(md, "\n## 2. The paper's Table 2: the sphere series\n").ok();
     writeln!(md, "Icosahedron refined by projecting edge midpoints onto the unit sphere. Error: relative Frobenius error of the central inertia against the exact value for that polyhedron. Paper times on an R4400.\n").ok();
     writeln!(md, "| approx. | verts | edges | faces | T1 | Tx | Tx² | Tyz | error (ours) | error (paper variant) | time (ours) | ns/face | growth | paper time |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|").ok();
-    let paper_times = ["500 µs", "1.2 ms", "4.9 ms", "21 ms", "82 ms", "350 ms", "-", "-", "-"];
+    let paper_times = [
+        "500 µs", "1.2 ms", "4.9 ms", "21 ms", "82 ms", "350 ms", "-", "-", "-",
+    ];
     let mut last = None;
     let mut plot: Vec<(usize, f64, f64)> = Vec::new(); // (variant, ns/face, error)
     let mut plot_faces: Vec<usize> = Vec::new();
@@ -168,8 +267,12 @@ fn main() -> std::io::Result<()> {
         let exact = exact_mass(&exact_integrals(&v, &f));
         let ours = MassProperties::from_integrals(&integrate(Variant::Ours, &v, &f, &polys), 1.0);
         let paper = MassProperties::from_integrals(&integrate(Variant::Paper, &v, &f, &polys), 1.0);
-        let secs = time(if level > 6 { 2.0 } else { 0.5 }, || integrate(Variant::Ours, &v, &f, &polys));
-        let growth = last.map(|l: f64| format!("{:.2}", secs / l)).unwrap_or_else(|| "-".into());
+        let secs = time(if level > 6 { 2.0 } else { 0.5 }, || {
+            integrate(Variant::Ours, &v, &f, &polys)
+        });
+        let growth = last
+            .map(|l: f64| format!("{:.2}", secs / l))
+            .unwrap_or_else(|| "-".into());
         last = Some(secs);
         writeln!(
             md,
@@ -204,16 +307,59 @@ fn main() -> std::io::Result<()> {
     let far = [1e4, -2e4, 3e4];
     let cases: Vec<(&str, Mesh, f64)> = vec![
         ("cube 1e3 away", transform(&cubem, 1.0, &id, [1e3; 3]), 1.0),
-        ("cube 1e6 away", transform(&cubem, 1.0, &id, [1e6, -1e6, 1e6]), 1.0),
-        ("cube 1e8 away", transform(&cubem, 1.0, &id, [1e8, 1e8, -1e8]), 1.0),
-        ("sphere 1e8 away", transform(&sphere, 1.0, &id, [1e8; 3]), 2.0),
-        ("sphere scaled 1e-6", transform(&sphere, 1e-6, &id, [0.0; 3]), 2e-6),
-        ("sphere scaled 1e6", transform(&sphere, 1e6, &id, [0.0; 3]), 2e6),
-        ("sphere rotated, 1e4 away", transform(&sphere, 1.0, &rot, far), 2.0),
-        ("plate 1×1×1e-6 rotated, 1e4 away", transform(&plate, 1.0, &rot, far), 1.4),
-        ("needle 1e-6×1e-6×1 rotated, 1e4 away", transform(&needle, 1.0, &rot, far), 1.0),
-        ("cube mirrored (x → −x), wound outward", ((cubem.0.iter().map(|p| [-p[0], p[1], p[2]]).collect()), cubem.1.iter().map(|t| [t[0], t[2], t[1]]).collect()), 1.0),
-        ("cube inside-out (after the health ladder's flip)", cubem.clone(), 1.0),
+        (
+            "cube 1e6 away",
+            transform(&cubem, 1.0, &id, [1e6, -1e6, 1e6]),
+            1.0,
+        ),
+        (
+            "cube 1e8 away",
+            transform(&cubem, 1.0, &id, [1e8, 1e8, -1e8]),
+            1.0,
+        ),
+        (
+            "sphere 1e8 away",
+            transform(&sphere, 1.0, &id, [1e8; 3]),
+            2.0,
+        ),
+        (
+            "sphere scaled 1e-6",
+            transform(&sphere, 1e-6, &id, [0.0; 3]),
+            2e-6,
+        ),
+        (
+            "sphere scaled 1e6",
+            transform(&sphere, 1e6, &id, [0.0; 3]),
+            2e6,
+        ),
+        (
+            "sphere rotated, 1e4 away",
+            transform(&sphere, 1.0, &rot, far),
+            2.0,
+        ),
+        (
+            "plate 1×1×1e-6 rotated, 1e4 away",
+            transform(&plate, 1.0, &rot, far),
+            1.4,
+        ),
+        (
+            "needle 1e-6×1e-6×1 rotated, 1e4 away",
+            transform(&needle, 1.0, &rot, far),
+            1.0,
+        ),
+        (
+            "cube mirrored (x → −x), wound outward",
+            (
+                (cubem.0.iter().map(|p| [-p[0], p[1], p[2]]).collect()),
+                cubem.1.iter().map(|t| [t[0], t[2], t[1]]).collect(),
+            ),
+            1.0,
+        ),
+        (
+            "cube inside-out (after the health ladder's flip)",
+            cubem.clone(),
+            1.0,
+        ),
     ];
     writeln!(md, "| case | variant | mass | COM | inertia | smallest moment | floor |\n|---|---|---|---|---|---|---|").ok();
     for (name, (v, f), size) in &cases {
@@ -225,7 +371,16 @@ fn main() -> std::io::Result<()> {
         for (variant, vname) in VARIANTS {
             let mp = MassProperties::from_integrals(&integrate(variant, v, f, &polys), 1.0);
             let er = errors(&mp, &exact, *size, small);
-            writeln!(md, "| {name} | {vname} | {} | {} | {} | {} | {} |", e(er.mass), e(er.com), e(er.inertia), e(er.smallest), e(floor)).ok();
+            writeln!(
+                md,
+                "| {name} | {vname} | {} | {} | {} | {} | {} |",
+                e(er.mass),
+                e(er.com),
+                e(er.inertia),
+                e(er.smallest),
+                e(floor)
+            )
+            .ok();
         }
         eprintln!("{name} done");
     }
@@ -236,9 +391,15 @@ fn main() -> std::io::Result<()> {
         let polys = Polygons::from_triangles(&f);
         let exact = exact_mass(&exact_integrals(&v, &f));
         for (vi, (variant, _)) in VARIANTS.iter().enumerate() {
-            let secs = time(if level > 6 { 1.0 } else { 0.3 }, || integrate(*variant, &v, &f, &polys));
+            let secs = time(if level > 6 { 1.0 } else { 0.3 }, || {
+                integrate(*variant, &v, &f, &polys)
+            });
             let mp = MassProperties::from_integrals(&integrate(*variant, &v, &f, &polys), 1.0);
-            plot.push((vi, secs * 1e9 / f.len() as f64, inertia_error(&mp.inertia, &exact.inertia)));
+            plot.push((
+                vi,
+                secs * 1e9 / f.len() as f64,
+                inertia_error(&mp.inertia, &exact.inertia),
+            ));
             plot_faces.push(f.len());
         }
         eprintln!("plot level {level} done");
@@ -246,9 +407,20 @@ fn main() -> std::io::Result<()> {
     writeln!(md, "\n## 4. Error against run time\n").ok();
     writeln!(md, "![error against time](accuracy.svg)\n").ok();
     writeln!(md, "Sphere series (levels 3–9, 320 to 1.3 M faces) moved 100 radii away from the origin. x: ns per face; y: relative Frobenius error of the central inertia. The dashed line is the f64 round-off of the result (2⁻⁵³); points at zero error are drawn on the bottom edge.\n").ok();
-    writeln!(md, "| variant | faces | ns/face | error |\n|---|---|---|---|").ok();
+    writeln!(
+        md,
+        "| variant | faces | ns/face | error |\n|---|---|---|---|"
+    )
+    .ok();
     for ((vi, ns, err), faces) in plot.iter().zip(&plot_faces) {
-        writeln!(md, "| {} | {faces} | {:.1} | {} |", VARIANTS[*vi].1, ns, e(*err)).ok();
+        writeln!(
+            md,
+            "| {} | {faces} | {:.1} | {} |",
+            VARIANTS[*vi].1,
+            ns,
+            e(*err)
+        )
+        .ok();
     }
     std::fs::create_dir_all("docs")?;
     std::fs::write("docs/accuracy.svg", svg(&plot))?;
@@ -257,11 +429,39 @@ fn main() -> std::io::Result<()> {
     writeln!(md, "\n## 5. Loading\n").ok();
     let (v, f) = icosphere(9);
     let bytes = urdf_inertia::mesh::stl::write_binary(b"bench", &v, &f);
-    let secs = time(3.0, || urdf_inertia::mesh::stl::parse(&bytes, std::path::Path::new("bench.stl")).map(|m| m.faces.len()).unwrap_or(0));
-    writeln!(md, "Binary STL, {} faces ({:.1} MB) from memory: {:.1} ms, {:.0} MB/s, {:.1} M faces/s.", f.len(), bytes.len() as f64 / 1e6, secs * 1e3, bytes.len() as f64 / 1e6 / secs, f.len() as f64 / 1e6 / secs).ok();
-    let raw = urdf_inertia::mesh::stl::parse(&bytes, std::path::Path::new("bench.stl")).expect("parse");
-    let secs = time(3.0, || urdf_inertia::mesh::health::make_solid(&raw, std::path::Path::new("bench.stl"), Default::default()).map(|s| s.faces.len()).unwrap_or(0));
-    writeln!(md, "Welding, edge analysis and integration of the same mesh: {:.1} ms ({:.0} ns/face).", secs * 1e3, secs * 1e9 / f.len() as f64).ok();
+    let secs = time(3.0, || {
+        urdf_inertia::mesh::stl::parse(&bytes, std::path::Path::new("bench.stl"))
+            .map(|m| m.faces.len())
+            .unwrap_or(0)
+    });
+    writeln!(
+        md,
+        "Binary STL, {} faces ({:.1} MB) from memory: {:.1} ms, {:.0} MB/s, {:.1} M faces/s.",
+        f.len(),
+        bytes.len() as f64 / 1e6,
+        secs * 1e3,
+        bytes.len() as f64 / 1e6 / secs,
+        f.len() as f64 / 1e6 / secs
+    )
+    .ok();
+    let raw =
+        urdf_inertia::mesh::stl::parse(&bytes, std::path::Path::new("bench.stl")).expect("parse");
+    let secs = time(3.0, || {
+        urdf_inertia::mesh::health::make_solid(
+            &raw,
+            std::path::Path::new("bench.stl"),
+            Default::default(),
+        )
+        .map(|s| s.faces.len())
+        .unwrap_or(0)
+    });
+    writeln!(
+        md,
+        "Welding, edge analysis and integration of the same mesh: {:.1} ms ({:.0} ns/face).",
+        secs * 1e3,
+        secs * 1e9 / f.len() as f64
+    )
+    .ok();
     match std::env::var("EXAMPLE_ROBOT_DATA_SHARE") {
         Ok(share) => corpus(&mut md, std::path::Path::new(&share)),
         Err(_) => {
@@ -291,7 +491,10 @@ fn corpus(md: &mut String, share: &std::path::Path) {
         }
     }
     urdfs.sort();
-    let resolver = PackageResolver::new(&[("example-robot-data".into(), share.join("example-robot-data"))]);
+    let resolver = PackageResolver::new(&[(
+        "example-robot-data".into(),
+        share.join("example-robot-data"),
+    )]);
     let map = DensityMap::uniform(1000.0);
     writeln!(md, "\n## 6. End to end on example-robot-data\n").ok();
     writeln!(md, "Each URDF filled with a fresh cache (as the command does): parse, mesh loading, healing and integration, writing.\n").ok();
@@ -301,7 +504,9 @@ fn corpus(md: &mut String, share: &std::path::Path) {
     for u in &urdfs {
         let t0 = Instant::now();
         let text = std::fs::read_to_string(u).unwrap_or_default();
-        let Ok(robot) = urdf_inertia::urdf::scan(text, u) else { continue };
+        let Ok(robot) = urdf_inertia::urdf::scan(text, u) else {
+            continue;
+        };
         let parse = t0.elapsed().as_secs_f64();
         let mut cache = MeshCache::default();
         let report = compute_with(&robot, &map, &resolver, &FillOptions::default(), &mut cache);
@@ -325,7 +530,13 @@ fn corpus(md: &mut String, share: &std::path::Path) {
             report.faces as f64 / total / 1e6
         )
         .ok();
-        let r2 = compute_with(&robot, &map, &resolver, &FillOptions::default(), &mut shared);
+        let r2 = compute_with(
+            &robot,
+            &map,
+            &resolver,
+            &FillOptions::default(),
+            &mut shared,
+        );
         shared_faces += r2.faces;
     }
     writeln!(
@@ -344,7 +555,10 @@ fn corpus(md: &mut String, share: &std::path::Path) {
 fn svg(points: &[(usize, f64, f64)]) -> String {
     let (w, h, l, b, t, r) = (760.0, 460.0, 70.0, 50.0, 20.0, 250.0);
     let xs: Vec<f64> = points.iter().map(|p| p.1.log10()).collect();
-    let (x0, x1) = (xs.iter().cloned().fold(f64::INFINITY, f64::min).floor(), xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max).ceil());
+    let (x0, x1) = (
+        xs.iter().cloned().fold(f64::INFINITY, f64::min).floor(),
+        xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max).ceil(),
+    );
     let (y0, y1) = (-18.0f64, 0.0f64);
     let px = |x: f64| l + (x.log10() - x0) / (x1 - x0) * (w - l - r);
     let py = |y: f64| {
@@ -366,13 +580,29 @@ fn svg(points: &[(usize, f64, f64)]) -> String {
     let floor = py(2f64.powi(-53));
     s += &format!("<line x1=\"{l}\" x2=\"{}\" y1=\"{floor}\" y2=\"{floor}\" stroke=\"black\" stroke-dasharray=\"5,4\"/><text x=\"{}\" y=\"{}\">f64 round-off 2^-53</text>\n", w - r, w - r + 5.0, floor + 4.0);
     for (vi, ns, err) in points {
-        s += &format!("<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"4\" fill=\"{}\" fill-opacity=\"0.8\"/>\n", px(*ns), py(*err), colours[*vi]);
+        s += &format!(
+            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"4\" fill=\"{}\" fill-opacity=\"0.8\"/>\n",
+            px(*ns),
+            py(*err),
+            colours[*vi]
+        );
     }
     for (vi, (_, name)) in VARIANTS.iter().enumerate() {
         let y = t + 20.0 + 20.0 * vi as f64;
-        s += &format!("<circle cx=\"{}\" cy=\"{y}\" r=\"5\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}</text>\n", w - r + 15.0, colours[vi], w - r + 25.0, y + 4.0, name.replace('&', "and"));
+        s += &format!(
+            "<circle cx=\"{}\" cy=\"{y}\" r=\"5\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}</text>\n",
+            w - r + 15.0,
+            colours[vi],
+            w - r + 25.0,
+            y + 4.0,
+            name.replace('&', "and")
+        );
     }
-    s += &format!("<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">ns per face</text>\n", (l + w - r) / 2.0, h - 10.0);
+    s += &format!(
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">ns per face</text>\n",
+        (l + w - r) / 2.0,
+        h - 10.0
+    );
     s += &format!("<text x=\"15\" y=\"{}\" transform=\"rotate(-90 15 {})\" text-anchor=\"middle\">relative error, central inertia</text>\n</svg>\n", (t + h - b) / 2.0, (t + h - b) / 2.0);
     s
 }

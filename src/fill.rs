@@ -330,13 +330,24 @@ fn geometry_part(
 }
 
 /// Computes every selected link with collision geometry.
-pub fn compute(robot: &Robot, map: &DensityMap, resolver: &PackageResolver, opts: &FillOptions) -> FillReport {
+pub fn compute(
+    robot: &Robot,
+    map: &DensityMap,
+    resolver: &PackageResolver,
+    opts: &FillOptions,
+) -> FillReport {
     compute_with(robot, map, resolver, opts, &mut MeshCache::default())
 }
 
 /// [`compute`] with a mesh cache shared across calls (several URDFs of one robot, or a whole corpus).
 /// The report's timing and file counts are this call's share.
-pub fn compute_with(robot: &Robot, map: &DensityMap, resolver: &PackageResolver, opts: &FillOptions, cache: &mut MeshCache) -> FillReport {
+pub fn compute_with(
+    robot: &Robot,
+    map: &DensityMap,
+    resolver: &PackageResolver,
+    opts: &FillOptions,
+    cache: &mut MeshCache,
+) -> FillReport {
     let (load0, integrate0, files0) = (cache.load_time, cache.integrate_time, cache.files());
     let mut report = FillReport::default();
     let mut missing_density: Vec<(String, usize)> = Vec::new();
@@ -548,7 +559,10 @@ pub fn compute_with(robot: &Robot, map: &DensityMap, resolver: &PackageResolver,
         }
     }
     report.mesh_files = cache.files() - files0;
-    report.timing = Timing { load: cache.load_time - load0, integrate: cache.integrate_time - integrate0 };
+    report.timing = Timing {
+        load: cache.load_time - load0,
+        integrate: cache.integrate_time - integrate0,
+    };
     report
 }
 

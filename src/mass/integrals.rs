@@ -642,6 +642,18 @@ impl VolumeIntegrals {
         }
     }
 
+    /// The integrals of the same surface wound the other way (every integral changes sign).
+    pub fn negated(&self) -> VolumeIntegrals {
+        VolumeIntegrals {
+            t1: -self.t1,
+            t: self.t.map(|x| -x),
+            t2: self.t2.map(|x| -x),
+            tp: self.tp.map(|x| -x),
+            reference: self.reference,
+            low: self.low.map(|x| -x),
+        }
+    }
+
     /// The integrals as an array in the paper's order `T1, Tx, Ty, Tz, Tx², Ty², Tz², Txy, Tyz, Tzx`.
     pub fn to_array(&self) -> [f64; 10] {
         [

@@ -106,9 +106,42 @@ const ZERO_VOLUME: f64 = 1e-12;
 /// Largest relative volume uncertainty of the caps for which a capped mesh is used.
 const CAPPED: f64 = 1e-3;
 
+/// A multiply-rotate hasher (rustc's Fx hash, with a finalising mix) for integer keys: welding 4 M
+/// vertices with the default SipHash took 390 ns per face, most of the healing time.
+#[derive(Debug, Default, Clone, Copy)]
+struct FxHasher(u64);
+
+impl std::hash::Hasher for FxHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut b = [0u8; 8];
+            b[..chunk.len()].copy_from_slice(chunk);
+            self.write_u64(u64::from_le_bytes(b));
+        }
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_u32(&mut self, x: u32) {
+        self.write_u64(x as u64);
+    }
+    fn write_usize(&mut self, x: usize) {
+        self.write_u64(x as u64);
+    }
+    fn finish(&self) -> u64 {
+        // Coordinates read from f32 have 29 zero low bits, which a plain multiply keeps in the low bits
+        // the table indexes by: fold the high half down (MurmurHash3's finaliser step).
+        let h = self.0 ^ (self.0 >> 33);
+        h.wrapping_mul(0xff51_afd7_ed55_8ccd) ^ (h >> 29)
+    }
+}
+
+type FxMap<K, V> = HashMap<K, V, std::hash::BuildHasherDefault<FxHasher>>;
+
 /// Welds bit-identical vertices and drops faces that collapse to fewer than three distinct vertices.
 pub fn weld(mesh: &RawMesh) -> (Vec<[f64; 3]>, Polygons, usize) {
-    let mut map: HashMap<[u64; 3], u32> = HashMap::with_capacity(mesh.vertices.len());
+    let mut map: FxMap<[u64; 3], u32> =
+        FxMap::with_capacity_and_hasher(mesh.vertices.len() / 2, Default::default());
     let mut vertices = Vec::new();
     let remap: Vec<u32> = mesh
         .vertices
@@ -310,30 +343,35 @@ pub fn make_solid(mesh: &RawMesh, path: &Path, options: HealthOptions) -> Result
         }
     };
     let e = edges(&faces);
-    let oriented = if e.boundary == 0 && e.nonmanifold == 0 {
+    let closed = e.boundary == 0 && e.nonmanifold == 0;
+    // Orientation is only worked out when some edge says it is needed.
+    let oriented = if closed && e.inconsistent > 0 {
         orient(faces.len(), &e.pairs)
     } else {
         None
     };
 
     let rung;
-    if let Some((flip, comp, ncomp)) = oriented {
-        if e.inconsistent == 0 {
-            let total = unit_props(&vertices, &faces, None).mass;
-            if total < 0.0 {
-                strict("closed mesh wound inward".into())?;
-                for i in 0..faces.len() {
-                    faces.reverse_face(i);
-                }
-                warnings.push(format!(
-                    "all {} faces wound inward (negative volume); flipped",
-                    faces.len()
-                ));
-                rung = Rung::Inverted;
-            } else {
-                rung = Rung::Exact;
+    let mut integrals = None;
+    if closed && e.inconsistent == 0 {
+        let t = volume_integrals(&vertices, &faces, &IntegrationOptions::accurate());
+        if t.t1 < 0.0 {
+            strict("closed mesh wound inward".into())?;
+            for i in 0..faces.len() {
+                faces.reverse_face(i);
             }
+            warnings.push(format!(
+                "all {} faces wound inward (negative volume); flipped",
+                faces.len()
+            ));
+            integrals = Some(t.negated());
+            rung = Rung::Inverted;
         } else {
+            integrals = Some(t);
+            rung = Rung::Exact;
+        }
+    } else if let Some((flip, comp, ncomp)) = oriented {
+        {
             for (i, f) in flip.iter().enumerate() {
                 if *f {
                     faces.reverse_face(i);
@@ -532,7 +570,10 @@ pub fn make_solid(mesh: &RawMesh, path: &Path, options: HealthOptions) -> Result
             faces_read,
         });
     }
-    let unit = unit_props(&vertices, &faces, None);
+    let unit = match integrals {
+        Some(t) => MassProperties::from_integrals(&t, 1.0),
+        None => unit_props(&vertices, &faces, None),
+    };
     check_volume(unit.mass, diag, bbox_volume, path)?;
     let error_estimate = estimate(&vertices, &faces, &unit);
     Ok(Solid {
