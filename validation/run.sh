@@ -11,4 +11,5 @@ fi
 "$venv/bin/python" -m pip install --quiet --disable-pip-version-check pin==4.1.0 example-robot-data==6.0.0
 share="$("$venv/bin/python" -c 'import sysconfig, pathlib; print(pathlib.Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share")')"
 cargo build --release --quiet
+"$venv/bin/python" validation/meshes.py --binary target/release/urdf-inertia --share "$share" --out "$(dirname "$out")/MESHES.md"
 "$venv/bin/python" validation/validate.py --binary target/release/urdf-inertia --share "$share" --out "$out" --work validation/work
