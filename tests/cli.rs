@@ -587,3 +587,261 @@ fn mesh_command_json() {
     let izz = v["inertia"][2][2].as_f64().unwrap();
     assert!((izz - 2.0 * (0.08f64 * 0.08 + 0.08 * 0.08) / 12.0).abs() < 1e-15);
 }
+
+fn rpy_of(text: &str, link: &str) -> [f64; 3] {
+    let start = text.find(&format!("<link name=\"{link}\"")).expect("link");
+    let body = &text[start..];
+    let o = body.find("<inertial>").expect("inertial");
+    let s = &body[o..];
+    let k = s.find("rpy=\"").expect("rpy") + 5;
+    let v: Vec<f64> = s[k..k + s[k..].find('"').unwrap()]
+        .split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect();
+    [v[0], v[1], v[2]]
+}
+
+#[test]
+fn principal_frame_reproduces_the_tensor() {
+    let (urdf, map) = demo();
+    let plain = String::from_utf8(
+        run(&[
+            "fill",
+            urdf.to_str().unwrap(),
+            "--density-map",
+            map.to_str().unwrap(),
+        ])
+        .stdout,
+    )
+    .unwrap();
+    let out = run(&[
+        "fill",
+        urdf.to_str().unwrap(),
+        "--density-map",
+        map.to_str().unwrap(),
+        "--principal",
+    ]);
+    assert!(out.status.success());
+    let principal = String::from_utf8(out.stdout).unwrap();
+    for link in ["wrist_link", "gripper_link", "base_link"] {
+        let (m, c, i) = inertial_of(&plain, link).unwrap();
+        let (pm, pc, d) = inertial_of(&principal, link).unwrap();
+        assert_eq!((m, c), (pm, pc));
+        assert_eq!(
+            (d[1], d[2], d[4]),
+            (0.0, 0.0, 0.0),
+            "{link}: principal tensor must be diagonal"
+        );
+        // R diag(d) Rᵀ with URDF's fixed-axis rpy gives back the tensor in link axes.
+        let r = urdf_inertia::mass::rpy_matrix(rpy_of(&principal, link));
+        let dd = [d[0], d[3], d[5]];
+        let full = [[i[0], i[1], i[2]], [i[1], i[3], i[4]], [i[2], i[4], i[5]]];
+        let norm = i.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        for a in 0..3 {
+            for b in 0..3 {
+                let got: f64 = (0..3).map(|k| r[a][k] * dd[k] * r[b][k]).sum();
+                assert!(
+                    (got - full[a][b]).abs() < 1e-12 * norm,
+                    "{link}[{a}][{b}]: {got} vs {}",
+                    full[a][b]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn digits_round_and_stay_valid() {
+    let (_tmp, urdf, map) = demo_copy();
+    let out = run(&[
+        "fill",
+        urdf.to_str().unwrap(),
+        "--density-map",
+        map.to_str().unwrap(),
+        "--digits",
+        "4",
+        "-i",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&urdf).unwrap();
+    let (m, _, _) = inertial_of(&text, "shoulder_link").unwrap();
+    assert_eq!(m, 3.456);
+    assert!(text.contains("<mass value=\"13.11\"/>"), "{text}");
+    let out = run(&["check", urdf.to_str().unwrap()]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    // Idempotent with --digits too.
+    let before = text.clone();
+    run(&[
+        "fill",
+        urdf.to_str().unwrap(),
+        "--density-map",
+        map.to_str().unwrap(),
+        "--digits",
+        "4",
+        "-i",
+    ]);
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), before);
+}
+
+#[test]
+fn selection_options() {
+    let (urdf, map) = demo();
+    let u = urdf.to_str().unwrap();
+    let m = map.to_str().unwrap();
+    let only = String::from_utf8(
+        run(&[
+            "fill",
+            u,
+            "--density-map",
+            m,
+            "--only",
+            "*arm*",
+            "--skip",
+            "forearm_link",
+        ])
+        .stdout,
+    )
+    .unwrap();
+    assert!(inertial_of(&only, "upper_arm_link").is_some());
+    assert!(inertial_of(&only, "forearm_link").is_none());
+    assert!(inertial_of(&only, "base_link").is_none());
+    // --missing-only: a valid existing inertial (even a stale one) stays; missing ones are filled.
+    let (_tmp, copy, map2) = demo_copy();
+    let text = std::fs::read_to_string(&copy).unwrap().replace(
+        "<inertia ixx=\"0.1\" ixy=\"0\" ixz=\"0\" iyy=\"0.1\" iyz=\"0\" izz=\"0.3\"/>",
+        "<inertia ixx=\"0.2\" ixy=\"0\" ixz=\"0\" iyy=\"0.2\" iyz=\"0\" izz=\"0.3\"/>",
+    );
+    std::fs::write(&copy, &text).unwrap();
+    let out = run(&[
+        "fill",
+        copy.to_str().unwrap(),
+        "--density-map",
+        map2.to_str().unwrap(),
+        "--missing-only",
+    ]);
+    let filled = String::from_utf8(out.stdout).unwrap();
+    let (mass, _, _) = inertial_of(&filled, "upper_arm_link").unwrap();
+    assert_eq!(
+        mass, 1.2,
+        "a valid existing inertial is kept with --missing-only"
+    );
+    assert!(inertial_of(&filled, "base_link").is_some());
+}
+
+#[test]
+fn keep_mass_and_total_mass() {
+    let (urdf, _) = demo();
+    let u = urdf.to_str().unwrap();
+    // --keep-mass: upper_arm keeps its weighed 1.2 kg; links without a mass need a density (none: error).
+    let out = run(&["fill", u, "--keep-mass"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no density for 5 link(s)"));
+    let out = run(&["fill", u, "--keep-mass", "--density", "1000"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    let (m, c, i) = inertial_of(&text, "upper_arm_link").unwrap();
+    assert_eq!(m, 1.2);
+    assert!((c[2] - 0.15).abs() < 1e-15);
+    // Same shape as at 2700 kg/m³, scaled to 1.2 kg.
+    let full = String::from_utf8(run(&["fill", u, "--density", "2700"]).stdout).unwrap();
+    let (m2, _, i2) = inertial_of(&full, "upper_arm_link").unwrap();
+    assert!((i[5] - i2[5] * 1.2 / m2).abs() < 1e-15 * i2[5]);
+    // total_mass: the links sum to it.
+    let tmp = tempfile::tempdir().unwrap();
+    let map = tmp.path().join("total.toml");
+    std::fs::write(&map, "default = 1000\ntotal_mass = 20.0\n").unwrap();
+    let out = run(&["fill", u, "--density-map", map.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let sum: f64 = [
+        "base_link",
+        "shoulder_link",
+        "upper_arm_link",
+        "forearm_link",
+        "wrist_link",
+        "gripper_link",
+    ]
+    .iter()
+    .map(|l| inertial_of(&text, l).unwrap().0)
+    .sum();
+    assert!((sum - 20.0).abs() < 1e-12, "{sum}");
+}
+
+#[test]
+fn json_summary_names_repairs() {
+    let tmp = tempfile::tempdir().unwrap();
+    // An inside-out box mesh: the summary must say it was flipped.
+    let v: Vec<[f64; 3]> = (0..8)
+        .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+        .collect();
+    let quads = [
+        [0u32, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let tris: Vec<[u32; 3]> = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[2], q[1]], [q[0], q[3], q[2]]])
+        .collect();
+    std::fs::write(
+        tmp.path().join("inside.stl"),
+        urdf_inertia::mesh::stl::write_binary(b"in", &v, &tris),
+    )
+    .unwrap();
+    let urdf = tmp.path().join("r.urdf");
+    std::fs::write(&urdf, "<robot name=\"r\">\n  <link name=\"box\">\n    <collision><geometry><mesh filename=\"inside.stl\"/></geometry></collision>\n  </link>\n</robot>\n").unwrap();
+    let out = run(&[
+        "fill",
+        urdf.to_str().unwrap(),
+        "--density",
+        "1000",
+        "-o",
+        tmp.path().join("out.urdf").to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert_eq!(v["links_filled"], 1);
+    assert_eq!(v["links"][0]["parts"][0]["provenance"], "inverted");
+    assert_eq!(v["links"][0]["mass"].as_f64(), Some(1000.0));
+    // Under --strict the same mesh is an error naming link, collision and file.
+    let out = run(&[
+        "fill",
+        urdf.to_str().unwrap(),
+        "--density",
+        "1000",
+        "--strict",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr.contains("link `box`: collision 1 (line 3)")
+            && stderr.contains("inside.stl: closed mesh wound inward (an error under --strict)"),
+        "{stderr}"
+    );
+    // The text summary names the repair too.
+    let out = run(&["fill", urdf.to_str().unwrap(), "--density", "1000"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(
+            "warning: link `box`, collision 1, inside.stl: inverted: all 12 faces wound inward"
+        ),
+        "{stderr}"
+    );
+}
