@@ -5,37 +5,13 @@
 //! starts with `solid`, an ASCII STL, an OBJ of quads and hexagons in two objects, a COLLADA file with
 //! `<unit meter="0.001">` and a node `<matrix>`, and an asymmetric wedge used with a mirroring scale.
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use common::box_mesh;
 use std::fmt::Write as _;
 use std::path::Path;
 use urdf_inertia::mesh::stl::{write_ascii, write_binary};
-
-fn box_mesh(s: [f64; 3]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let h = s.map(|x| x / 2.0);
-    let v: Vec<[f64; 3]> = (0..8)
-        .map(|i| {
-            [
-                if i & 1 == 0 { -h[0] } else { h[0] },
-                if i & 2 == 0 { -h[1] } else { h[1] },
-                if i & 4 == 0 { -h[2] } else { h[2] },
-            ]
-        })
-        .collect();
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    (
-        v,
-        quads
-            .iter()
-            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-            .collect(),
-    )
-}
 
 fn main() -> std::io::Result<()> {
     let dir = Path::new("robots/demo_arm_description/meshes");

@@ -11,4 +11,5 @@ pub mod density;
 pub mod fill;
 pub mod mass;
 pub mod mesh;
+mod text;
 pub mod urdf;

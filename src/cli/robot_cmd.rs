@@ -49,6 +49,25 @@ fn sources(s: &SourceArgs) -> Result<Sources, String> {
     })
 }
 
+/// Sources, a density map (required by `command`) and the scanned URDF, or the error status already reported.
+fn prepare(
+    source: &SourceArgs,
+    urdf: &Path,
+    command: &str,
+) -> Result<(Sources, DensityMap, Robot), ExitStatus> {
+    let report = |e: String| {
+        eprintln!("error: {e}");
+        ExitStatus::Error
+    };
+    let mut src = sources(source).map_err(report)?;
+    let map = src
+        .map
+        .take()
+        .ok_or_else(|| report(format!("{command} needs densities: pass --density RHO (kg/m³), --density-map FILE, or --keep-mass")))?;
+    let robot = read_robot(urdf).map_err(report)?;
+    Ok((src, map, robot))
+}
+
 fn read_robot(path: &Path) -> Result<Robot, String> {
     let bytes = std::fs::read(path)
         .map_err(|e| format!("{}: cannot read the URDF: {e}", path.display()))?;
@@ -177,25 +196,11 @@ fn summary_json(robot: &Robot, report: &FillReport, seconds: f64) -> serde_json:
 
 pub fn fill(a: &FillArgs) -> ExitStatus {
     let start = Instant::now();
-    let mut src = match sources(&a.source) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitStatus::Error;
-        }
-    };
-    let Some(map) = src.map.take() else {
-        eprintln!("error: fill needs densities: pass --density RHO (kg/m³), --density-map FILE, or --keep-mass");
-        return ExitStatus::Error;
+    let (mut src, map, robot) = match prepare(&a.source, &a.urdf, "fill") {
+        Ok(p) => p,
+        Err(status) => return status,
     };
     src.options.missing_only = a.missing_only;
-    let robot = match read_robot(&a.urdf) {
-        Ok(r) => r,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitStatus::Error;
-        }
-    };
     let report = fill::compute(&robot, &map, &src.resolver, &src.options);
     print_failures(&robot, &report);
     let t_write = Instant::now();
@@ -368,23 +373,9 @@ fn compare(existing: &MassProperties, computed: &MassProperties, size: f64) -> C
 }
 
 pub fn diff(a: &DiffArgs) -> ExitStatus {
-    let src = match sources(&a.source) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitStatus::Error;
-        }
-    };
-    let Some(map) = src.map else {
-        eprintln!("error: diff needs densities to compute masses: pass --density RHO, --density-map FILE, or --keep-mass");
-        return ExitStatus::Error;
-    };
-    let robot = match read_robot(&a.urdf) {
-        Ok(r) => r,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitStatus::Error;
-        }
+    let (src, map, robot) = match prepare(&a.source, &a.urdf, "diff") {
+        Ok(p) => p,
+        Err(status) => return status,
     };
     let report = fill::compute(&robot, &map, &src.resolver, &src.options);
     print_failures(&robot, &report);

@@ -66,6 +66,12 @@ impl IntegrationOptions {
         }
     }
 
+    /// The reference point for `vertices`: the given one, or the bounding-box centre.
+    pub fn reference_for(&self, vertices: &[[f64; 3]]) -> [f64; 3] {
+        self.reference
+            .unwrap_or_else(|| bounding_box_centre(vertices))
+    }
+
     /// What urdf-inertia uses: about the bounding-box centre, compensated sums, accurate thin faces.
     pub const fn accurate() -> Self {
         Self {
@@ -335,9 +341,7 @@ pub fn triangle_integrals(
     triangles: &[[u32; 3]],
     options: &IntegrationOptions,
 ) -> VolumeIntegrals {
-    let reference = options
-        .reference
-        .unwrap_or_else(|| bounding_box_centre(vertices));
+    let reference = options.reference_for(vertices);
     // Shift every vertex once (a vertex is shared by about six triangles).
     let shifted: Vec<[f64; 3]> = vertices.iter().map(|&v| sub(v, reference)).collect();
     let mut acc = Accumulator::new(options.summation);
@@ -401,9 +405,7 @@ pub fn mirtich_polygons(
     faces: &Polygons,
     options: &IntegrationOptions,
 ) -> VolumeIntegrals {
-    let reference = options
-        .reference
-        .unwrap_or_else(|| bounding_box_centre(vertices));
+    let reference = options.reference_for(vertices);
     let mut acc = Accumulator::new(options.summation);
     let mut local: Vec<[f64; 3]> = Vec::with_capacity(8);
     for face in faces.iter() {
@@ -587,9 +589,7 @@ pub fn volume_integrals(
     faces: &Polygons,
     options: &IntegrationOptions,
 ) -> VolumeIntegrals {
-    let reference = options
-        .reference
-        .unwrap_or_else(|| bounding_box_centre(vertices));
+    let reference = options.reference_for(vertices);
     let mut acc = Accumulator::new(options.summation);
     for face in faces.iter() {
         if face.len() < 3 {

@@ -14,6 +14,7 @@
 
 use super::{parse_f64, MeshError, MeshErrorKind, RawMesh};
 use crate::mass::{Mat3, Polygons};
+use crate::text::{line_of, LineCounter};
 use quick_xml::events::Event;
 use quick_xml::reader::Reader;
 use std::collections::HashMap;
@@ -50,35 +51,6 @@ impl El {
     }
 }
 
-fn line_of(bytes: &[u8], pos: usize) -> usize {
-    1 + bytes[..pos.min(bytes.len())]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-}
-
-/// Line numbers for increasing byte positions in one pass (elements come in document order).
-struct Lines<'a> {
-    bytes: &'a [u8],
-    pos: usize,
-    line: usize,
-}
-
-impl Lines<'_> {
-    fn at(&mut self, pos: usize) -> usize {
-        let pos = pos.min(self.bytes.len());
-        if pos < self.pos {
-            return line_of(self.bytes, pos);
-        }
-        self.line += self.bytes[self.pos..pos]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count();
-        self.pos = pos;
-        self.line
-    }
-}
-
 fn local(name: &[u8]) -> String {
     let s = String::from_utf8_lossy(name);
     match s.rfind(':') {
@@ -110,11 +82,7 @@ fn parse_tree(bytes: &[u8], path: &Path) -> Result<El, MeshError> {
         name: "#document".into(),
         ..Default::default()
     }];
-    let mut lines = Lines {
-        bytes,
-        pos: 0,
-        line: 1,
-    };
+    let mut lines = LineCounter::new(bytes);
     let syntax = |pos: usize, msg: String| {
         MeshError::new(path, Some(line_of(bytes, pos)), MeshErrorKind::Syntax(msg))
     };

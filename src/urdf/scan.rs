@@ -1,6 +1,7 @@
 //! A one-pass scan of a URDF: links, their collisions, their existing `<inertial>` and the byte spans
 //! the writer needs.
 
+use crate::text::LineCounter;
 use quick_xml::events::{BytesStart, Event};
 use quick_xml::reader::Reader;
 use std::collections::HashMap;
@@ -122,26 +123,6 @@ pub fn line_col(text: &str, pos: usize) -> (usize, usize) {
     (line, col)
 }
 
-struct Lines<'a> {
-    text: &'a [u8],
-    pos: usize,
-    line: usize,
-}
-
-impl Lines<'_> {
-    fn at(&mut self, pos: usize) -> usize {
-        if pos < self.pos {
-            return 1 + self.text[..pos].iter().filter(|&&b| b == b'\n').count();
-        }
-        self.line += self.text[self.pos..pos]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count();
-        self.pos = pos;
-        self.line
-    }
-}
-
 fn attrs(e: &BytesStart<'_>) -> HashMap<String, String> {
     let mut m = HashMap::new();
     for a in e.attributes().with_checks(false).flatten() {
@@ -178,11 +159,7 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
     };
     let mut reader = Reader::from_str(&text);
     reader.config_mut().check_end_names = true;
-    let mut lines = Lines {
-        text: text.as_bytes(),
-        pos: 0,
-        line: 1,
-    };
+    let mut lines = LineCounter::new(text.as_bytes());
     let mut stack: Vec<String> = Vec::new();
     let mut robot_name: Option<String> = None;
     let mut links: Vec<Link> = Vec::new();
