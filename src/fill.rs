@@ -16,6 +16,9 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+/// A collision mesh larger than this (bounding-box diagonal, m) is almost surely in millimetres.
+const MILLIMETRE_SLIP: f64 = 10.0;
+
 /// What to compute.
 #[derive(Debug, Clone, Default)]
 pub struct FillOptions {
@@ -313,6 +316,29 @@ fn geometry_part(
                     },
                 )
                 .map_err(|e| format!("collision {} (line {}): {e}", c.index, c.line))?;
+            let mut warnings = solid.warnings.clone();
+            let (lo, hi) = solid.vertices.iter().fold(
+                ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+                |(lo, hi), p| {
+                    (
+                        [0, 1, 2].map(|k| lo[k].min(p[k])),
+                        [0, 1, 2].map(|k| hi[k].max(p[k])),
+                    )
+                },
+            );
+            let extent =
+                ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2))
+                    .sqrt();
+            if extent > MILLIMETRE_SLIP {
+                let s = if *scale == [1.0; 3] {
+                    String::new()
+                } else {
+                    format!(" (after scale {} {} {})", scale[0], scale[1], scale[2])
+                };
+                warnings.push(format!(
+                    "the mesh is {extent:.1} m across{s}: if it was exported in millimetres, give it scale=\"0.001 0.001 0.001\""
+                ));
+            }
             Part {
                 collision: c.index,
                 what: filename.clone(),
@@ -320,7 +346,7 @@ fn geometry_part(
                 uri: Some(filename.clone()),
                 unit: solid.unit.transformed(&r, t),
                 provenance: solid.rung.name().into(),
-                warnings: solid.warnings.clone(),
+                warnings,
                 faces: solid.faces_read,
                 error_estimate: solid.error_estimate,
                 bbox: transformed_bbox(solid.vertices.iter().copied(), &r, t),

@@ -845,3 +845,16 @@ fn json_summary_names_repairs() {
         "{stderr}"
     );
 }
+
+#[test]
+fn millimetre_meshes_without_scale_are_flagged() {
+    let (_tmp, urdf, _) = demo_copy();
+    let text = std::fs::read_to_string(&urdf)
+        .unwrap()
+        .replace(" scale=\"0.001 0.001 0.001\"", "");
+    std::fs::write(&urdf, text).unwrap();
+    let out = run(&["fill", urdf.to_str().unwrap(), "--density", "1000"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("link `shoulder_link`, collision 1, package://demo_arm_description/meshes/shoulder.STL: exact: the mesh is 229.8 m across: if it was exported in millimetres, give it scale=\"0.001 0.001 0.001\""), "{stderr}");
+}

@@ -196,6 +196,10 @@ fn summary_json(robot: &Robot, report: &FillReport, seconds: f64) -> serde_json:
 
 pub fn fill(a: &FillArgs) -> ExitStatus {
     let start = Instant::now();
+    if a.format == Format::Json && !a.in_place && a.output.is_none() {
+        eprintln!("error: --format json prints the summary on stdout, where the URDF goes without -o OUT or -i");
+        return ExitStatus::Error;
+    }
     let (mut src, map, robot) = match prepare(&a.source, &a.urdf, "fill") {
         Ok(p) => p,
         Err(status) => return status,
