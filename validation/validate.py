@@ -26,6 +26,14 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+try:  # optional: the filled URDFs must also load in MuJoCo and Drake (validation/run.sh installs both)
+    import mujoco
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+    SIMULATORS = True
+except ImportError:  # pragma: no cover
+    SIMULATORS = False
+
 DENSITY = 1000.0
 TOL_STL = 1e-9
 TOL_FLOAT32 = 1e-6
@@ -77,6 +85,59 @@ def reference_inertias(model, urdf, package_dirs):
         j = go.parentJoint
         per_joint[j] = per_joint[j] + moved if j in per_joint else moved
     return per_joint
+
+
+def without_geometry(text):
+    """The URDF with <visual> and <collision> removed: simulators then judge only the inertials."""
+    return re.sub(r"<(visual|collision)\b.*?</\1>|<(visual|collision)\b[^>]*/>", "", text, flags=re.S)
+
+
+def _load(which, path):
+    if which == "mujoco":
+        mujoco.MjModel.from_xml_path(str(path))
+    else:
+        _drake_load(path)
+
+
+def _error(which, path):
+    """The loader's message (paths and line numbers removed), or None if it loads."""
+    try:
+        _load(which, path)
+        return None
+    except Exception as e:  # noqa: BLE001 - each loader has its own exception types
+        msg = " ".join(str(e).split())
+        return re.sub(r"\S*\.urdf(:\d+)?:?", "", msg).strip()
+
+
+def simulator_checks(filled_text, original_text, filled_links, work, stem):
+    """Loads the filled robot (without geometry) in MuJoCo and Drake. Returns (mujoco, drake) verdicts:
+    "ok"; "explained: …" when the shipped file fails the same way (a structural problem, not an inertial),
+    or the message names only links urdf-inertia does not fill (no collision geometry, their inertials
+    stripped by this validation); otherwise "FAILED: …"."""
+    filled = work / f"{stem}.geomless.urdf"
+    filled.write_text(without_geometry(filled_text), encoding="utf-8")
+    original = work / f"{stem}.original.geomless.urdf"
+    original.write_text(without_geometry(original_text), encoding="utf-8")
+    verdicts = []
+    for which in ("mujoco", "drake"):
+        msg = _error(which, filled)
+        if msg is None:
+            verdicts.append("ok")
+            continue
+        named = re.findall(r"(?:Element name|[Bb]ody|[Ll]ink)\s*'?\"?([A-Za-z0-9_.\-]+)", msg)
+        if msg == _error(which, original):
+            verdicts.append(f"explained: the shipped file fails the same way: {msg[:200]}")
+        elif named and not any(n in filled_links for n in named):
+            verdicts.append(f"explained: {msg[:160]} (a link without collision geometry, which urdf-inertia leaves as it is; this validation stripped its shipped <inertial>)")
+        else:
+            verdicts.append(f"FAILED: {msg[:300]}")
+    return verdicts
+
+
+def _drake_load(path):
+    plant = MultibodyPlant(0.0)
+    Parser(plant).AddModels(str(path))
+    plant.Finalize()
 
 
 def link_joints(model):
@@ -140,7 +201,7 @@ def main():
         (work / (str(rel).replace("/", "__") + ".log")).write_text(proc.stderr)
         if proc.returncode != 0:
             failures.append(f"{rel}: fill exited {proc.returncode}: {proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else ''}")
-            rows.append((robot, str(rel), "FAILED", 0, "-", "-", f"{seconds:.2f}"))
+            rows.append((robot, str(rel), "FAILED", 0, "-", "-", f"{seconds:.2f}", "-", "-"))
             continue
         summary = json.loads(proc.stdout)
         try:
@@ -149,7 +210,7 @@ def main():
             first = str(e).strip().splitlines()
             why = next((l.strip() for l in first if "Error" in l), first[0] if first else "")
             explained.append(f"| {rel} | - | - | the shipped file does not load in pinocchio either ({why}); urdf-inertia fills it (nothing to fill) and warns |")
-            rows.append((robot, str(rel), summary["links_filled"], 0, "original not loadable", "-", f"{seconds:.2f}"))
+            rows.append((robot, str(rel), summary["links_filled"], 0, "original not loadable", "-", f"{seconds:.2f}", "-", "-"))
             for p in (stripped, filled):
                 p.unlink(missing_ok=True)
             continue
@@ -157,8 +218,17 @@ def main():
             filled_model = pin.buildModelFromUrdf(str(filled))
         except Exception as e:  # noqa: BLE001 - any loader failure is a validation failure
             failures.append(f"{rel}: pinocchio cannot load the filled URDF: {e}")
-            rows.append((robot, str(rel), summary["links_filled"], 0, "load FAILED", "-", f"{seconds:.2f}"))
+            rows.append((robot, str(rel), summary["links_filled"], 0, "load FAILED", "-", f"{seconds:.2f}", "-", "-"))
             continue
+        sim = ("-", "-")
+        if SIMULATORS:
+            filled_links = {l["link"] for l in summary["links"]}
+            sim = simulator_checks(filled.read_text(encoding="utf-8"), text, filled_links, work, str(rel).replace("/", "__"))
+            for which, verdict in zip(("MuJoCo", "Drake"), sim):
+                if verdict.startswith("FAILED"):
+                    failures.append(f"{rel}: {which} cannot load the filled URDF: {verdict}")
+                elif verdict.startswith("explained"):
+                    explained.append(f"| {rel} | - | - | {which}: {verdict[len('explained: '):]} |")
         ref = reference_inertias(original_model, urdf, [str(share)])
         joints_of = link_joints(filled_model)
         parts_by_joint = {}
@@ -214,9 +284,27 @@ def main():
             rng = f"{min(ratios):.3g}–{max(ratios):.3g}" if ratios else "-"
             shipped_notes.append(f"| {rel} | {rng} | {bad} |")
         rung_text = ", ".join(f"{k} {v}" for k, v in sorted(rungs.items()))
-        rows.append((robot, str(rel), summary["links_filled"], compared, f"{worst:.1e}", rung_text, f"{seconds:.2f}"))
+        short = lambda v: v if v in ("ok", "-") else v.split(":")[0]
+        rows.append((robot, str(rel), summary["links_filled"], compared, f"{worst:.1e}", rung_text, f"{seconds:.2f}", short(sim[0]), short(sim[1])))
         for p in (stripped, filled):
             p.unlink(missing_ok=True)
+    # The demo robot of this repository, filled with its density map, in all three.
+    demo = Path(__file__).resolve().parent.parent / "robots" / "demo_arm_description"
+    demo_filled = work / "demo_arm.filled.urdf"
+    proc = subprocess.run([args.binary, "fill", str(demo / "urdf" / "demo_arm.urdf"), "--density-map", str(demo / "densities.toml"), "-o", str(demo_filled)], capture_output=True, text=True)
+    demo_line = "demo robot: fill failed"
+    if proc.returncode != 0:
+        failures.append(f"robots/demo_arm_description: fill exited {proc.returncode}: {proc.stderr.strip()}")
+    else:
+        try:
+            m = pin.buildModelFromUrdf(str(demo_filled))
+            verdicts = simulator_checks(demo_filled.read_text(encoding="utf-8"), (demo / "urdf" / "demo_arm.urdf").read_text(encoding="utf-8"), set(), work, "demo_arm") if SIMULATORS else ["-", "-"]
+            demo_line = f"demo robot (robots/demo_arm_description, {m.nbodies} bodies): pinocchio ok, MuJoCo {verdicts[0]}, Drake {verdicts[1]}"
+            for which, v in zip(("MuJoCo", "Drake"), verdicts):
+                if v != "ok" and v != "-":
+                    failures.append(f"demo robot: {which}: {v}")
+        except Exception as e:  # noqa: BLE001
+            failures.append(f"demo robot: pinocchio cannot load it: {e}")
     total = time.time() - t_all
 
     lines = [
@@ -227,15 +315,21 @@ def main():
         "loaded with `pinocchio.buildModelFromUrdf`, and each joint's inertia is compared with pinocchio's "
         "own collision model of the original URDF (coal volume, COM and inertia per geometry, moved by its "
         "placement and summed per joint). The difference is the largest of the relative mass, COM "
-        "(against the radius of gyration) and central-inertia (Frobenius) differences.",
+        "(against the radius of gyration) and central-inertia (Frobenius) differences. The filled URDF, "
+        "with its geometry removed so that only the inertials are judged, is also loaded in MuJoCo "
+        f"{mujoco.__version__ if SIMULATORS else '(not installed)'} (`MjModel.from_xml_path`: mass above "
+        "mjMINVAL, strict triangle inequality) and Drake (`Parser.AddModels`, `Finalize`: physically valid "
+        "spatial inertias).",
         "",
         f"URDFs: {len(urdfs)}; failures: {len(failures)}; total time {total:.1f} s. "
         f"Parts by provenance over all URDFs: {', '.join(f'{k} {v}' for k, v in sorted(all_rungs.items()))}.",
         "",
-        "| robot | URDF | links filled | joints compared | worst diff, closed-mesh joints | parts by provenance | fill time (s) |",
-        "|---|---|---|---|---|---|---|",
+        demo_line + ".",
+        "",
+        "| robot | URDF | links filled | joints compared | worst diff, closed-mesh joints | parts by provenance | fill time (s) | MuJoCo | Drake |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
-    lines += [f"| {r[0]} | {r[1]} | {r[2]} | {r[3]} | {r[4]} | {r[5]} | {r[6]} |" for r in rows]
+    lines += [f"| {' | '.join(str(x) for x in r)} |" for r in rows]
     lines += [
         "",
         "Tolerances for closed-mesh joints: 1e-9 relative for STL meshes and primitives, 1e-6 where OBJ or "
