@@ -77,6 +77,13 @@ impl PackageResolver {
                 hint: format!("pass --package-path {pkg}=DIR (DIR is the package's directory), or set ROS_PACKAGE_PATH"),
             });
         }
+        if uri.contains("$(") || uri.contains("${") {
+            return Err(NotFound {
+                uri: uri.to_string(),
+                searched: Vec::new(),
+                hint: "this is an unexpanded xacro expression: run `xacro FILE.urdf.xacro > FILE.urdf` first".into(),
+            });
+        }
         let path = if let Some(rest) = uri.strip_prefix("file://") {
             let p = PathBuf::from(rest);
             if p.is_absolute() {
@@ -223,6 +230,11 @@ mod tests {
                 &urdf
             )
             .is_ok());
+        assert!(r
+            .resolve("$(find my_robot_description)/meshes/a.stl", &urdf)
+            .unwrap_err()
+            .hint
+            .contains("xacro"));
         let nf = r.resolve("package://nope/meshes/a.stl", &urdf).unwrap_err();
         assert!(nf.hint.contains("--package-path nope=DIR"));
     }

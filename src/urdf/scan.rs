@@ -150,6 +150,11 @@ fn indent_before(text: &str, pos: usize) -> Option<String> {
 pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
     let err = |pos: usize, message: String| {
         let (line, column) = line_col(&text, pos);
+        let message = if message.contains("${") || message.contains("$(") {
+            format!("{message} (an unexpanded xacro expression: run `xacro FILE.urdf.xacro > FILE.urdf` first)")
+        } else {
+            message
+        };
         UrdfError {
             path: path.to_path_buf(),
             line,
@@ -488,6 +493,8 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.message.contains("duplicate link name `a`"), "{e}");
+        let e = scan("<robot name=\"r\"><link name=\"a\"><collision><origin xyz=\"${x} 0 0\"/><geometry><box size=\"1 1 1\"/></geometry></collision></link></robot>".into(), Path::new("x.urdf")).unwrap_err();
+        assert!(e.message.contains("unexpanded xacro"), "{e}");
         let e = scan("<sdf/>".into(), Path::new("x.urdf")).unwrap_err();
         assert!(e.message.contains("not a URDF"), "{e}");
         let e = scan("<robot name=\"r\"><link name=\"a\"><collision><geometry><mesh filename=\"m.stl\" scale=\"1 x 1\"/></geometry></collision></link></robot>".into(), Path::new("x.urdf")).unwrap_err();
