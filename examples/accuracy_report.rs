@@ -2,7 +2,9 @@
 //!
 //! `cargo run --release --example accuracy_report` (a few minutes). With `EXAMPLE_ROBOT_DATA_SHARE` set to
 //! the `cmeel.prefix/share` directory of example-robot-data (as `validation/run.sh` installs it), it also
-//! times filling every URDF of the corpus and loading every collision mesh once.
+//! times filling every URDF of the corpus and loading every collision mesh once. With `PEERS_PYTHON` set to
+//! a Python that has coal and trimesh (e.g. `validation/.venv/bin/python` plus `pip install trimesh`), it
+//! runs them on the same meshes through `validation/peers.py`.
 //!
 //! Every error is against exact rational arithmetic on the stored mesh (tests/common's reference).
 
@@ -450,9 +452,28 @@ fn main() -> std::io::Result<()> {
 
     // Peers in the same run: parry3d-f64 (a dependency already, for convex hulls).
     writeln!(md, "\n### Peers in the same run\n").ok();
-    writeln!(md, "parry3d-f64 0.31 (`MassProperties::from_trimesh`) on the same stored meshes, timed the same way. coal and trimesh are not in this run (Python); issue #2 lists their figures measured on this kind of machine.\n").ok();
-    writeln!(md, "| case | parry3d-f64 inertia error | ours | parry3d-f64 ns/face | ours ns/face |\n|---|---|---|---|---|").ok();
-    for (name, (v, f), _) in &cases {
+    let peers = python_peers(&cases);
+    let peer_names: Vec<String> = peers.as_ref().map(|p| p.0.clone()).unwrap_or_default();
+    writeln!(
+        md,
+        "parry3d-f64 0.31 (`MassProperties::from_trimesh`), and {} on the same stored meshes, each timed for one computation of the mass properties (median). Relative Frobenius error of the central inertia against exact rationals; time in ns per face.\n",
+        if peer_names.is_empty() { "no Python peers (set `PEERS_PYTHON` to an interpreter with coal and trimesh)".to_string() } else { peer_names.join(" and ") }
+    )
+    .ok();
+    let mut header = String::from("| case | ours | parry3d-f64 |");
+    let mut rule = String::from("|---|---|---|");
+    for p in &peer_names {
+        header += &format!(" {p} |");
+        rule += "---|";
+    }
+    header += " ours ns/face | parry3d-f64 ns/face |";
+    rule += "---|---|";
+    for p in &peer_names {
+        header += &format!(" {p} ns/face |");
+        rule += "---|";
+    }
+    writeln!(md, "{header}\n{rule}").ok();
+    for (ci, (name, (v, f), _)) in cases.iter().enumerate() {
         let exact = exact_mass(&exact_integrals(v, f));
         let pv: Vec<parry3d_f64::math::Vector> = v
             .iter()
@@ -473,15 +494,48 @@ fn main() -> std::io::Result<()> {
         } else {
             f64::INFINITY
         };
-        writeln!(
-            md,
-            "| {name} | {} | {} | {:.1} | {:.1} |",
-            e(pe),
+        let per_face = |t: f64| t * 1e9 / f.len() as f64;
+        let mut row = format!(
+            "| {name} | {} | {} |",
             e(inertia_error(&ours.inertia, &exact.inertia)),
-            t_parry * 1e9 / f.len() as f64,
-            t_ours * 1e9 / f.len() as f64
-        )
-        .ok();
+            e(pe)
+        );
+        let mut times = format!(" {:.1} | {:.1} |", per_face(t_ours), per_face(t_parry));
+        if let Some((tools, results)) = &peers {
+            for tool in tools {
+                match results.get(&(ci, tool.clone())) {
+                    Some(Ok((inertia, secs))) => {
+                        let finite = inertia.iter().flatten().all(|x| x.is_finite());
+                        row += &format!(
+                            " {} |",
+                            if finite {
+                                e(inertia_error(inertia, &exact.inertia))
+                            } else {
+                                "inf".into()
+                            }
+                        );
+                        times += &format!(" {:.1} |", per_face(*secs));
+                    }
+                    Some(Err(msg)) => {
+                        row += &format!(
+                            " fails: {} |",
+                            msg.split_whitespace()
+                                .collect::<Vec<_>>()
+                                .join(" ")
+                                .chars()
+                                .take(40)
+                                .collect::<String>()
+                        );
+                        times += " - |";
+                    }
+                    None => {
+                        row += " - |";
+                        times += " - |";
+                    }
+                }
+            }
+        }
+        writeln!(md, "{row}{times}").ok();
     }
 
     // 4. Error against run time, on a sphere moved 100 radii away, every variant and size.
@@ -642,6 +696,63 @@ fn corpus(md: &mut String, share: &std::path::Path) {
     )
     .ok();
     let _ = shared_faces;
+}
+
+type PeerResults = std::collections::HashMap<(usize, String), Result<([[f64; 3]; 3], f64), String>>;
+
+/// Runs validation/peers.py (coal, trimesh) on the cases with the interpreter in `PEERS_PYTHON`.
+fn python_peers(cases: &[(&str, Mesh, f64)]) -> Option<(Vec<String>, PeerResults)> {
+    let python = std::env::var("PEERS_PYTHON").ok()?;
+    let dir = std::env::temp_dir().join(format!("urdf-inertia-peers-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).ok()?;
+    for (i, (_, (v, f), _)) in cases.iter().enumerate() {
+        let vb: Vec<u8> = v.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
+        let fb: Vec<u8> = f.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
+        std::fs::write(dir.join(format!("case{i:02}.v")), vb).ok()?;
+        std::fs::write(dir.join(format!("case{i:02}.f")), fb).ok()?;
+    }
+    let out = std::process::Command::new(python)
+        .arg("validation/peers.py")
+        .arg(&dir)
+        .output()
+        .ok()?;
+    let _ = std::fs::remove_dir_all(&dir);
+    if !out.status.success() {
+        eprintln!("peers.py failed: {}", String::from_utf8_lossy(&out.stderr));
+        return None;
+    }
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).ok()?;
+    let mut tools: Vec<String> = Vec::new();
+    let mut results = PeerResults::new();
+    for r in v["results"].as_array()? {
+        let case: usize = r["case"]
+            .as_str()?
+            .trim_start_matches("case")
+            .parse()
+            .ok()?;
+        let version = v["versions"][r["tool"].as_str()?].as_str().unwrap_or("");
+        let tool = format!("{} {version}", r["tool"].as_str()?)
+            .trim()
+            .to_string();
+        if !tools.contains(&tool) {
+            tools.push(tool.clone());
+        }
+        let entry = match (r.get("error"), r.get("inertia")) {
+            (Some(err), _) => Err(err.as_str().unwrap_or("error").to_string()),
+            (None, Some(m)) => {
+                let mut i = [[0.0; 3]; 3];
+                for (a, row) in m.as_array()?.iter().enumerate() {
+                    for (b, x) in row.as_array()?.iter().enumerate() {
+                        i[a][b] = x.as_f64().unwrap_or(f64::NAN);
+                    }
+                }
+                Ok((i, r["seconds"].as_f64().unwrap_or(f64::NAN)))
+            }
+            _ => continue,
+        };
+        results.insert((case, tool), entry);
+    }
+    Some((tools, results))
 }
 
 /// A log-log scatter plot, one colour per variant, with the f64 floor as a dashed line.
