@@ -858,3 +858,101 @@ fn millimetre_meshes_without_scale_are_flagged() {
     assert!(out.status.success(), "{stderr}");
     assert!(stderr.contains("link `shoulder_link`, collision 1, package://demo_arm_description/meshes/shoulder.STL: exact: the mesh is 229.8 m across: if it was exported in millimetres, give it scale=\"0.001 0.001 0.001\""), "{stderr}");
 }
+
+#[test]
+fn ros_package_path_and_ament_prefix_path() {
+    let (tmp, urdf, _) = demo_copy();
+    // The URDF moved far from its package, so walking up cannot find it.
+    let far = tempfile::tempdir().unwrap();
+    let moved = far.path().join("robot.urdf");
+    let text = std::fs::read_to_string(&urdf).unwrap().replace(
+        "../meshes/upper_arm.obj",
+        "package://demo_arm_description/meshes/upper_arm.obj",
+    );
+    std::fs::write(&moved, text).unwrap();
+    let m = moved.to_str().unwrap();
+    let out = bin()
+        .args(["fill", m, "--density", "1000"])
+        .env_remove("ROS_PACKAGE_PATH")
+        .env_remove("AMENT_PREFIX_PATH")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("pass --package-path demo_arm_description=DIR"),
+        "{stderr}"
+    );
+    // ROS 1: a directory holding the package.
+    let out = bin()
+        .args(["fill", m, "--density", "1000"])
+        .env("ROS_PACKAGE_PATH", tmp.path())
+        .env_remove("AMENT_PREFIX_PATH")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // ROS 2: PREFIX/share/NAME.
+    let prefix = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(prefix.path().join("share")).unwrap();
+    std::fs::rename(
+        tmp.path().join("demo_arm_description"),
+        prefix.path().join("share/demo_arm_description"),
+    )
+    .unwrap();
+    let out = bin()
+        .args(["fill", m, "--density", "1000"])
+        .env_remove("ROS_PACKAGE_PATH")
+        .env("AMENT_PREFIX_PATH", prefix.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn diff_names_origin_and_mirror_mistakes() {
+    let tmp = tempfile::tempdir().unwrap();
+    // A 1 × 2 × 3 box of 1000 kg/m³ centred at (1, 0, 0): central tensor diag(6500, 5000, 2500) with mass 6000.
+    let body = |inertial: &str| {
+        format!("<robot name=\"r\"><link name=\"a\"><inertial>{inertial}</inertial><collision><origin xyz=\"1 0 0\"/><geometry><box size=\"1 2 3\"/></geometry></collision></link></robot>")
+    };
+    // About the link origin instead of the COM: Iyy and Izz grow by m·1².
+    let origin = body("<origin xyz=\"1 0 0\"/><mass value=\"6000\"/><inertia ixx=\"6500\" ixy=\"0\" ixz=\"0\" iyy=\"11000\" iyz=\"0\" izz=\"8500\"/>");
+    let path = tmp.path().join("origin.urdf");
+    std::fs::write(&path, origin).unwrap();
+    let out = run(&["diff", path.to_str().unwrap(), "--density", "1000"]);
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("about the link origin, not the COM"),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    // Products of inertia with mirrored signs: a rotated box whose ixy sign was flipped.
+    let text = "<robot name=\"r\"><link name=\"a\"><collision><origin rpy=\"0 0 0.5\"/><geometry><box size=\"1 2 3\"/></geometry></collision></link></robot>";
+    let path = tmp.path().join("rot.urdf");
+    std::fs::write(&path, text).unwrap();
+    let filled =
+        String::from_utf8(run(&["fill", path.to_str().unwrap(), "--density", "1000"]).stdout)
+            .unwrap();
+    let (_, _, i) = inertial_of(&filled, "a").unwrap();
+    assert!(i[1].abs() > 1.0);
+    let mirrored = filled.replacen(
+        &format!("ixy=\"{}\"", urdf_inertia::cli::shortest(i[1])),
+        &format!("ixy=\"{}\"", urdf_inertia::cli::shortest(-i[1])),
+        1,
+    );
+    assert_ne!(mirrored, filled);
+    std::fs::write(&path, mirrored).unwrap();
+    let out = run(&["diff", path.to_str().unwrap(), "--density", "1000"]);
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("products of inertia look mirrored"),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+}
