@@ -364,6 +364,30 @@ fn broken_meshes_take_the_documented_rung() {
     )
     .unwrap_err();
     assert!(matches!(e.kind, MeshErrorKind::ZeroVolume { .. }), "{e}");
+    // A COLLADA index past its source's vertices: an error naming the line, never another vertex.
+    let mut bad_f = f.clone();
+    bad_f[3][1] = 8;
+    let e = mesh::load_solid(
+        &write(
+            d,
+            "index.dae",
+            dae_text(&v, &bad_f, 1.0, "Z_UP", IDENTITY).as_bytes(),
+        ),
+        [1.0; 3],
+        HealthOptions::default(),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(
+            e.kind,
+            MeshErrorKind::IndexOutOfRange {
+                index: 8,
+                vertices: 8
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.line.is_some());
     // Malformed COLLADA: line named.
     let e = mesh::load_solid(
         &write(

@@ -305,7 +305,7 @@ fn read_geometry(
 
     let mut vertices: Vec<[f64; 3]> = Vec::new();
     let mut faces = Polygons::new();
-    let mut cache: HashMap<String, u32> = HashMap::new();
+    let mut cache: HashMap<String, (u32, usize)> = HashMap::new();
     for prim in &mesh.children {
         let kind = prim.name.as_str();
         match kind {
@@ -332,27 +332,25 @@ fn read_geometry(
             .ok_or_else(|| err(prim.line, format!("<{kind}> has no VERTEX input")))?;
         let voff: usize = vin.attr("offset").and_then(|o| o.parse().ok()).unwrap_or(0);
         let src = vin.attr("source").unwrap_or("");
-        // Each distinct source is appended once.
-        let base = match cache.get(src) {
-            Some(&b) => b,
+        // Each distinct source is appended once; its indices may only reach its own vertices.
+        let (base, count) = match cache.get(src) {
+            Some(&bc) => bc,
             None => {
                 let pos = positions_of(src, vin.line)?;
-                let b = vertices.len() as u32;
+                let bc = (vertices.len() as u32, pos.len());
                 vertices.extend(pos);
-                cache.insert(src.to_string(), b);
-                b
+                cache.insert(src.to_string(), bc);
+                bc
             }
         };
-        let count_for_src = |_b: u32| vertices.len();
-        let nverts = count_for_src(base);
         let index = |raw: f64, line: usize| -> Result<u32, MeshError> {
-            if raw < 0.0 || raw.fract() != 0.0 || base as f64 + raw >= nverts as f64 {
+            if raw < 0.0 || raw.fract() != 0.0 || raw >= count as f64 {
                 return Err(MeshError::new(
                     path,
                     Some(line),
                     MeshErrorKind::IndexOutOfRange {
                         index: raw as i64,
-                        vertices: nverts - base as usize,
+                        vertices: count,
                     },
                 ));
             }
