@@ -956,3 +956,29 @@ fn diff_names_origin_and_mirror_mistakes() {
         String::from_utf8_lossy(&out.stdout)
     );
 }
+
+/// Regression: `-i` on a symlinked URDF once replaced the link with a regular file.
+#[cfg(unix)]
+#[test]
+fn in_place_through_a_symlink_keeps_the_link() {
+    let (_tmp, urdf, map) = demo_copy();
+    let link = urdf.with_file_name("linked.urdf");
+    std::os::unix::fs::symlink(&urdf, &link).unwrap();
+    let out = run(&[
+        "fill",
+        link.to_str().unwrap(),
+        "--density-map",
+        map.to_str().unwrap(),
+        "-i",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert!(inertial_of(&std::fs::read_to_string(&urdf).unwrap(), "base_link").is_some());
+}

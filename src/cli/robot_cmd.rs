@@ -100,6 +100,13 @@ fn print_failures(robot: &Robot, report: &FillReport) {
 /// Writes `text` to `path` through a temporary file in the same directory and a rename, so the target is
 /// never left half-written.
 fn write_atomically(path: &Path, text: &str) -> Result<(), String> {
+    // Through a symlink, replace its target: renaming onto the link would turn it into a plain file.
+    let resolved = if path.is_symlink() {
+        std::fs::canonicalize(path).ok()
+    } else {
+        None
+    };
+    let path = resolved.as_deref().unwrap_or(path);
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())

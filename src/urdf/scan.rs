@@ -162,7 +162,13 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
             message,
         }
     };
-    let mut reader = Reader::from_str(&text);
+    // quick-xml does not count a UTF-8 byte-order mark in its positions: read after it and add it back.
+    let bom = if text.starts_with('\u{feff}') {
+        '\u{feff}'.len_utf8()
+    } else {
+        0
+    };
+    let mut reader = Reader::from_str(&text[bom..]);
     reader.config_mut().check_end_names = true;
     let mut lines = LineCounter::new(text.as_bytes());
     let mut stack: Vec<String> = Vec::new();
@@ -174,12 +180,12 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
     let mut seen: HashMap<String, usize> = HashMap::new();
 
     loop {
-        let pos = reader.buffer_position() as usize;
+        let pos = bom + reader.buffer_position() as usize;
         let event = match reader.read_event() {
             Ok(e) => e,
             Err(e) => {
                 return Err(err(
-                    reader.error_position() as usize,
+                    bom + reader.error_position() as usize,
                     format!("malformed XML: {e}"),
                 ))
             }
@@ -189,7 +195,7 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
             Event::Empty(e) => (e, true),
             Event::End(_) => {
                 let name = stack.pop().unwrap_or_default();
-                let end = reader.buffer_position() as usize;
+                let end = bom + reader.buffer_position() as usize;
                 match (stack.len(), name.as_str()) {
                     (1, "link") => {
                         if let Some(mut link) = current.take() {
@@ -227,7 +233,7 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
                     name: lname,
                     line,
                     start: pos,
-                    open_end: reader.buffer_position() as usize,
+                    open_end: bom + reader.buffer_position() as usize,
                     self_closing: empty,
                     indent: indent_before(&text, pos).unwrap_or_default(),
                     child_indent: None,
@@ -256,7 +262,7 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
                     }
                     "inertial" => {
                         let line = lines.at(pos);
-                        let span = InertialSpan { start: pos, end: reader.buffer_position() as usize, line, value: Inertial::default(), problem: None };
+                        let span = InertialSpan { start: pos, end: bom + reader.buffer_position() as usize, line, value: Inertial::default(), problem: None };
                         if empty {
                             if let Some(link) = current.as_mut() {
                                 link.inertial = Some(span);
@@ -477,6 +483,19 @@ mod tests {
             }
         );
         assert!(r.links[1].self_closing);
+    }
+
+    #[test]
+    fn byte_order_mark_keeps_spans_right() {
+        let text = "\u{feff}<robot name=\"r\">\n  <link name=\"a\">\n    <inertial><mass value=\"1\"/></inertial>\n  </link>\n</robot>\n";
+        let r = scan(text.to_string(), Path::new("r.urdf")).expect("scan");
+        let l = &r.links[0];
+        assert_eq!(&text[l.start..l.open_end], "<link name=\"a\">");
+        let span = l.inertial.as_ref().expect("inertial");
+        assert_eq!(
+            &text[span.start..span.end],
+            "<inertial><mass value=\"1\"/></inertial>"
+        );
     }
 
     #[test]
