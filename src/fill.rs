@@ -9,6 +9,7 @@ use crate::density::{DensityMap, Spec};
 use crate::mass::{mat_vec, primitives, rpy_matrix, validity, MassProperties};
 use crate::mesh::health::{HealthOptions, Solid};
 use crate::mesh::{self, MeshError, RawMesh};
+use crate::overlap::{overlap_volume, PartShape, PlacedPart};
 use crate::urdf::resolve::PackageResolver;
 use crate::urdf::{Geometry, Inertial, Link, Robot};
 use std::collections::HashMap;
@@ -60,8 +61,8 @@ pub struct LinkReport {
     pub line: usize,
     pub computed: MassProperties,
     pub parts: Vec<PartReport>,
-    /// Upper estimate of the volume counted twice by overlapping parts, m³.
-    pub overlap: Option<(f64, String)>,
+    /// Estimated volume counted twice by overlapping parts (m³), which parts, and the sampling grid size.
+    pub overlap: Option<(f64, String, usize)>,
     /// Diagonal of the link's collision geometry's bounding box (link frame), m.
     pub size: f64,
     pub warnings: Vec<String>,
@@ -214,7 +215,8 @@ struct Part {
     warnings: Vec<String>,
     faces: usize,
     error_estimate: f64,
-    bbox: ([f64; 3], [f64; 3]),
+    /// The solid in the link frame (for bounding boxes and the overlap estimate).
+    placed: PlacedPart,
 }
 
 fn transformed_bbox(
@@ -254,7 +256,7 @@ fn geometry_part(
     let r = rpy_matrix(c.origin.rpy);
     let t = c.origin.xyz;
     let fmt3 = |v: [f64; 3]| format!("{} {} {}", v[0], v[1], v[2]);
-    let primitive = |unit: MassProperties, what: String, half: [f64; 3]| Part {
+    let primitive = |unit: MassProperties, what: String, half: [f64; 3], shape: PartShape| Part {
         collision: c.index,
         what,
         file: None,
@@ -264,28 +266,40 @@ fn geometry_part(
         warnings: Vec::new(),
         faces: 0,
         error_estimate: 0.0,
-        bbox: transformed_bbox(box_corners(half), &r, t),
+        placed: PlacedPart {
+            shape,
+            rotation: r,
+            translation: t,
+            bbox: transformed_bbox(box_corners(half), &r, t),
+            volume: unit.mass,
+            locator: None,
+        },
     };
+
     Ok(match &c.geometry {
         Geometry::Box { size } => primitive(
             primitives::cuboid(*size, 1.0),
             format!("box {}", fmt3(*size)),
             size.map(|s| s / 2.0),
+            PartShape::Box(size.map(|s| s / 2.0)),
         ),
         Geometry::Cylinder { radius, length } => primitive(
             primitives::cylinder(*radius, *length, 1.0),
             format!("cylinder r={radius} l={length}"),
             [*radius, *radius, length / 2.0],
+            PartShape::Cylinder(*radius, length / 2.0),
         ),
         Geometry::Capsule { radius, length } => primitive(
             primitives::capsule(*radius, *length, 1.0),
             format!("capsule r={radius} l={length}"),
             [*radius, *radius, length / 2.0 + radius],
+            PartShape::Capsule(*radius, length / 2.0),
         ),
         Geometry::Sphere { radius } => primitive(
             primitives::sphere(*radius, 1.0),
             format!("sphere r={radius}"),
             [*radius; 3],
+            PartShape::Sphere(*radius),
         ),
         Geometry::Mesh { filename, scale } => {
             let path = resolver.resolve(filename, &robot.path).map_err(|nf| {
@@ -349,7 +363,14 @@ fn geometry_part(
                 warnings,
                 faces: solid.faces_read,
                 error_estimate: solid.error_estimate,
-                bbox: transformed_bbox(solid.vertices.iter().copied(), &r, t),
+                placed: PlacedPart {
+                    shape: PartShape::Mesh(solid.clone()),
+                    rotation: r,
+                    translation: t,
+                    bbox: transformed_bbox(solid.vertices.iter().copied(), &r, t),
+                    volume: solid.unit.mass,
+                    locator: None,
+                },
             }
         }
     })
@@ -513,18 +534,18 @@ pub fn compute_with(
             ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
             |(lo, hi), p| {
                 (
-                    [0, 1, 2].map(|k| lo[k].min(p.bbox.0[k])),
-                    [0, 1, 2].map(|k| hi[k].max(p.bbox.1[k])),
+                    [0, 1, 2].map(|k| lo[k].min(p.placed.bbox.0[k])),
+                    [0, 1, 2].map(|k| hi[k].max(p.placed.bbox.1[k])),
                 )
             },
         );
         let size =
             ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
-        let overlap = overlap_estimate(&parts);
-        if let Some((v, pair)) = &overlap {
+        let overlap = overlap_estimate(&mut parts);
+        if let Some((v, pair, n)) = &overlap {
             let total: f64 = parts.iter().map(|p| p.unit.mass).sum();
             warnings.push(format!(
-                "parts {pair} overlap: up to {v:.3e} m³ ({:.1}% of the link's volume) is counted twice (bounding-box estimate)",
+                "parts {pair} overlap: about {v:.3e} m³ ({:.1}% of the link's volume) is counted twice (estimated on a {n}³ grid)",
                 100.0 * v / total
             ));
         }
@@ -594,21 +615,29 @@ pub fn compute_with(
 
 /// The largest pairwise overlap of the parts' bounding boxes, capped by the smaller part's volume, when it
 /// exceeds 1% of that volume: an upper estimate of the volume counted twice.
-fn overlap_estimate(parts: &[Part]) -> Option<(f64, String)> {
-    let mut best: Option<(f64, String)> = None;
+fn overlap_estimate(parts: &mut [Part]) -> Option<(f64, String, usize)> {
+    let mut best: Option<(f64, String, usize)> = None;
     for i in 0..parts.len() {
         for j in i + 1..parts.len() {
-            let (a, b) = (&parts[i].bbox, &parts[j].bbox);
-            let mut v = 1.0;
-            for k in 0..3 {
-                v *= (a.1[k].min(b.1[k]) - a.0[k].max(b.0[k])).max(0.0);
+            let (a, b) = (&parts[i].placed, &parts[j].placed);
+            let smaller = a.volume.min(b.volume);
+            // Bounding boxes first: no sampling where they cannot hold 1% of the smaller part.
+            let boxes: f64 = (0..3)
+                .map(|k| (a.bbox.1[k].min(b.bbox.1[k]) - a.bbox.0[k].max(b.bbox.0[k])).max(0.0))
+                .product();
+            if boxes <= 0.01 * smaller {
+                continue;
             }
-            let smaller = parts[i].unit.mass.min(parts[j].unit.mass);
-            let v = v.min(smaller);
+            parts[i].placed.prepare();
+            parts[j].placed.prepare();
+            let Some((v, n)) = overlap_volume(&parts[i].placed, &parts[j].placed) else {
+                continue;
+            };
             if v > 0.01 * smaller && best.as_ref().is_none_or(|b| v > b.0) {
                 best = Some((
                     v,
                     format!("{} and {}", parts[i].collision, parts[j].collision),
+                    n,
                 ));
             }
         }

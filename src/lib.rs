@@ -11,5 +11,6 @@ pub mod density;
 pub mod fill;
 pub mod mass;
 pub mod mesh;
+pub mod overlap;
 mod text;
 pub mod urdf;

@@ -982,3 +982,17 @@ fn in_place_through_a_symlink_keeps_the_link() {
         .is_symlink());
     assert!(inertial_of(&std::fs::read_to_string(&urdf).unwrap(), "base_link").is_some());
 }
+
+#[test]
+fn overlapping_parts_are_reported_with_the_doubly_counted_volume() {
+    let tmp = tempfile::tempdir().unwrap();
+    // Two unit cubes overlapping by half (0.5 m³), and a sphere with a small box in its bounding box's
+    // corner but outside the sphere (no overlap).
+    let text = "<robot name=\"r\">\n<link name=\"cubes\">\n<collision><geometry><box size=\"1 1 1\"/></geometry></collision>\n<collision><origin xyz=\"0.5 0 0\"/><geometry><box size=\"1 1 1\"/></geometry></collision>\n</link>\n<link name=\"ball\">\n<collision><geometry><sphere radius=\"1\"/></geometry></collision>\n<collision><origin xyz=\"0.9 0.9 0.9\"/><geometry><box size=\"0.2 0.2 0.2\"/></geometry></collision>\n</link>\n</robot>\n";
+    let path = tmp.path().join("r.urdf");
+    std::fs::write(&path, text).unwrap();
+    let out = run(&["fill", path.to_str().unwrap(), "--density", "1000"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("link `cubes`: parts 1 and 2 overlap: about 5.000e-1 m³ (25.0% of the link's volume) is counted twice"), "{stderr}");
+    assert!(!stderr.contains("link `ball`: parts"), "{stderr}");
+}
