@@ -136,10 +136,74 @@ impl MeshCache {
         solid
     }
 
+    /// Reads and heals every not yet cached (file, scale) pair on all cores: each file once, then each
+    /// of its scales. Times are summed over threads (CPU time).
+    pub fn preload(&mut self, items: &[(PathBuf, [f64; 3])], options: HealthOptions) {
+        use rayon::prelude::*;
+        let mut by_file: HashMap<&PathBuf, Vec<[f64; 3]>> = HashMap::new();
+        for (path, scale) in items {
+            if !self
+                .solids
+                .contains_key(&(path.clone(), scale.map(f64::to_bits)))
+            {
+                let scales = by_file.entry(path).or_default();
+                if !scales
+                    .iter()
+                    .any(|s| s.map(f64::to_bits) == scale.map(f64::to_bits))
+                {
+                    scales.push(*scale);
+                }
+            }
+        }
+        type Loaded = (
+            PathBuf,
+            Result<Arc<RawMesh>, MeshError>,
+            Vec<([f64; 3], Result<Arc<Solid>, MeshError>)>,
+            Duration,
+            Duration,
+        );
+        let work: Vec<(&PathBuf, Vec<[f64; 3]>)> = by_file.into_iter().collect();
+        let loaded: Vec<Loaded> = work
+            .into_par_iter()
+            .map(|(path, scales)| {
+                let t0 = Instant::now();
+                let raw = mesh::read(path).map(Arc::new);
+                let t1 = Instant::now();
+                let solids = scales
+                    .into_iter()
+                    .map(|scale| {
+                        (
+                            scale,
+                            raw.clone()
+                                .and_then(|r| mesh::solid_from_raw(&r, scale, path, options))
+                                .map(Arc::new),
+                        )
+                    })
+                    .collect();
+                (path.clone(), raw, solids, t1 - t0, t1.elapsed())
+            })
+            .collect();
+        for (path, raw, solids, load, integrate) in loaded {
+            self.load_time += load;
+            self.integrate_time += integrate;
+            for (scale, solid) in solids {
+                self.solids
+                    .insert((path.clone(), scale.map(f64::to_bits)), solid);
+            }
+            self.raw.insert(path, raw);
+        }
+    }
+
     /// Number of distinct files read.
     pub fn files(&self) -> usize {
         self.raw.len()
     }
+}
+
+/// Whether `fill` computes this link (it must also have collision geometry): selected by the globs and,
+/// with `--missing-only`, lacking a valid inertial.
+fn is_target(link: &Link, opts: &FillOptions) -> bool {
+    selected(&link.name, opts) && !(opts.missing_only && existing_problems(link).is_empty())
 }
 
 /// Whether a link is selected by `--only` / `--skip` globs.
@@ -396,6 +460,27 @@ pub fn compute_with(
     cache: &mut MeshCache,
 ) -> FillReport {
     let (load0, integrate0, files0) = (cache.load_time, cache.integrate_time, cache.files());
+    // Every mesh the selected links need, read and healed in parallel up front (a path that does not
+    // resolve is reported by the per-link pass below).
+    let wanted: Vec<(PathBuf, [f64; 3])> = robot
+        .links
+        .iter()
+        .filter(|l| !l.collisions.is_empty() && is_target(l, opts))
+        .flat_map(|l| l.collisions.iter())
+        .filter_map(|c| match &c.geometry {
+            Geometry::Mesh { filename, scale } => resolver
+                .resolve(filename, &robot.path)
+                .ok()
+                .map(|p| (p, *scale)),
+            _ => None,
+        })
+        .collect();
+    cache.preload(
+        &wanted,
+        HealthOptions {
+            strict: opts.strict,
+        },
+    );
     let mut report = FillReport::default();
     let mut missing_density: Vec<(String, usize)> = Vec::new();
     // Links whose mass follows from densities (scaled by total_mass), as indices into report.links.
@@ -405,8 +490,7 @@ pub fn compute_with(
             report.without_geometry += 1;
             continue;
         }
-        if !selected(&link.name, opts) || (opts.missing_only && existing_problems(link).is_empty())
-        {
+        if !is_target(link, opts) {
             report.not_selected += 1;
             continue;
         }

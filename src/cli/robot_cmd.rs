@@ -259,7 +259,7 @@ pub fn fill(a: &FillArgs) -> ExitStatus {
     } else {
         let parts: usize = report.links.iter().map(|l| l.parts.len()).sum();
         eprintln!(
-            "urdf-inertia: robot `{}`: filled {} link(s) ({} parts, {} mesh files, {} faces) in {:.3} s (mesh loading {:.3} s, healing and integration {:.3} s, writing {:.3} s)",
+            "urdf-inertia: robot `{}`: filled {} link(s) ({} parts, {} mesh files, {} faces) in {:.3} s (CPU time over all cores: mesh loading {:.3} s, healing and integration {:.3} s; writing {:.3} s)",
             robot.name,
             report.links.len(),
             parts,
