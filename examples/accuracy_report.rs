@@ -644,7 +644,7 @@ fn corpus(md: &mut String, share: &std::path::Path) {
     )]);
     let map = DensityMap::uniform(1000.0);
     writeln!(md, "\n## 6. End to end on example-robot-data\n").ok();
-    writeln!(md, "Each URDF filled with a fresh cache (as the command does): parse, mesh loading, healing and integration, writing.\n").ok();
+    writeln!(md, "Each URDF filled with a fresh cache, as the command does: meshes are read and healed in parallel on all cores, so the load and heal+integrate columns are CPU time summed over threads; parse, write and total are wall time.\n").ok();
     writeln!(md, "| URDF | links | faces | parse ms | load ms | heal+integrate ms | write ms | total ms | M faces/s |\n|---|---|---|---|---|---|---|---|---|").ok();
     let mut shared = MeshCache::default();
     let mut shared_faces = 0usize;
@@ -688,7 +688,7 @@ fn corpus(md: &mut String, share: &std::path::Path) {
     }
     writeln!(
         md,
-        "\nEvery collision mesh of the corpus loaded once (one cache across all {} URDFs): {} files, loading {:.2} s, healing and integration {:.2} s.",
+        "\nEvery collision mesh of the corpus loaded once (one cache across all {} URDFs): {} files, loading {:.2} s, healing and integration {:.2} s (CPU time).",
         urdfs.len(),
         shared.files(),
         shared.load_time.as_secs_f64(),
