@@ -104,8 +104,7 @@ struct Errors {
 fn smallest_exact(exact: &ExactMass) -> f64 {
     // The Rayleigh quotient of the exact tensor at the eigenvector of its f64 rounding: second-order
     // accurate in the eigenvector's error, so exact to far below f64 for the smallest moment.
-    let rounded = [0, 1, 2].map(|i| [0, 1, 2].map(|j| exact.inertia[i][j].to_f64().unwrap()));
-    let (_, axes) = urdf_inertia::mass::jacobi::symmetric_eigen(rounded);
+    let (_, axes) = urdf_inertia::mass::jacobi::symmetric_eigen(rounded(&exact.inertia));
     let n: Vec<BigRational> = (0..3).map(|r| rat(axes[r][0])).collect();
     let mut num = BigRational::from_integer(0.into());
     for i in 0..3 {
@@ -377,8 +376,7 @@ fn main() -> std::io::Result<()> {
     for (name, (v, f), size) in &cases {
         let exact = exact_mass(&exact_integrals(v, f));
         let small = smallest_exact(&exact);
-        let rounded = [0, 1, 2].map(|i| [0, 1, 2].map(|j| exact.inertia[i][j].to_f64().unwrap()));
-        let floor = inertia_error(&rounded, &exact.inertia);
+        let floor = floor_error(&exact.inertia);
         let polys = Polygons::from_triangles(f);
         for (variant, vname) in VARIANTS {
             let mp = MassProperties::from_integrals(&integrate(variant, v, f, &polys), 1.0);
@@ -399,8 +397,7 @@ fn main() -> std::io::Result<()> {
     for (name, raw, outward) in &repair_cases {
         let exact = exact_mass(&exact_integrals(&outward.0, &outward.1));
         let small = smallest_exact(&exact);
-        let rounded = [0, 1, 2].map(|i| [0, 1, 2].map(|j| exact.inertia[i][j].to_f64().unwrap()));
-        let floor = inertia_error(&rounded, &exact.inertia);
+        let floor = floor_error(&exact.inertia);
         let polys = Polygons::from_triangles(&raw.1);
         for (variant, vname) in VARIANTS {
             let mp =

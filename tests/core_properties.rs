@@ -237,13 +237,10 @@ fn principal_frame_of_a_stiff_body() {
     let (v, f) = transform(&box_mesh([1e-6, 1e-6, 1.0]), 1.0, &r, [1e4, -2e4, 3e4]);
     let mp = MassProperties::from_trimesh(&v, &f, 1.0);
     let p = mp.principal();
-    let m = 1e-12;
-    let small = m * 2e-12 / 12.0;
-    // The needle's small moment is below the round-off of the large ones (relative 1e-12 of 1e-16):
-    // the eigen-solver cannot resolve it from the tensor, but it must stay tiny and non-negative-ish,
-    // and the long axis must be recovered.
+    // The smallest moment is 1e12 below the others, so any f64 tensor fixes it only to about
+    // eps·1e12 ≈ 1e-4 relative (docs/accuracy.md measures it): it must stay tiny, and the long axis must
+    // be recovered to full precision.
     assert!(p.moments[0].abs() < 1e-6 * p.moments[2], "{:?}", p.moments);
-    assert!(small > 0.0);
     let axis = [r[0][2], r[1][2], r[2][2]];
     let got = [p.axes[0][0], p.axes[1][0], p.axes[2][0]];
     let dot: f64 = (0..3).map(|k| axis[k] * got[k]).sum();

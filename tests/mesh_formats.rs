@@ -481,3 +481,39 @@ fn open_tube_is_capped_not_trusted() {
         closed.mass
     );
 }
+
+/// The overlap estimate's point-in-mesh test (ray parity over a bucket grid) against the exact winding
+/// number, on a grid of points through a sphere, including points level with its vertices.
+#[test]
+fn mesh_locator_agrees_with_the_winding_number() {
+    use urdf_inertia::overlap::{winding_number, MeshLocator};
+    let (v, f) = common::icosphere(4);
+    let raw = mesh::RawMesh {
+        vertices: v,
+        faces: urdf_inertia::mass::Polygons::from_triangles(&f),
+        notes: Vec::new(),
+    };
+    let solid = mesh::health::make_solid(&raw, Path::new("sphere"), HealthOptions::default())
+        .expect("solid");
+    let locator = MeshLocator::new(&solid);
+    let mut disagree = 0;
+    for i in 0..21 {
+        for j in 0..21 {
+            for k in 0..21 {
+                let q = [
+                    -1.0 + 0.1 * i as f64,
+                    -1.0 + 0.1 * j as f64,
+                    -1.0 + 0.1 * k as f64,
+                ];
+                let w = winding_number(&solid, q);
+                if w.abs() > 1e-6 && (w - 1.0).abs() > 1e-6 {
+                    continue; // on the surface
+                }
+                if locator.contains(q) != (w > 0.5) {
+                    disagree += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(disagree, 0);
+}

@@ -152,7 +152,7 @@ impl Polygons {
         self.starts.windows(2).all(|w| w[1] - w[0] == 3)
     }
 
-    /// Fan-triangulates every face (used by the health checks and the hull, not by the integrals).
+    /// Fan-triangulates every face (for point-in-solid tests; the integrals take polygons directly).
     pub fn triangles(&self) -> Vec<[u32; 3]> {
         let mut out = Vec::with_capacity(self.indices.len());
         for f in self.iter() {

@@ -129,6 +129,16 @@ pub fn exact_mass(t: &[BigRational; 10]) -> ExactMass {
     }
 }
 
+/// The exact central tensor rounded to f64: the best any f64 result can be.
+pub fn rounded(exact: &[[BigRational; 3]; 3]) -> [[f64; 3]; 3] {
+    [0, 1, 2].map(|i| [0, 1, 2].map(|j| exact[i][j].to_f64().unwrap()))
+}
+
+/// The f64 floor: the relative Frobenius error of the correctly rounded exact tensor.
+pub fn floor_error(exact: &[[BigRational; 3]; 3]) -> f64 {
+    inertia_error(&rounded(exact), exact)
+}
+
 /// Relative Frobenius error of a computed central inertia against the exact one.
 pub fn inertia_error(got: &[[f64; 3]; 3], exact: &[[BigRational; 3]; 3]) -> f64 {
     let mut num = 0.0;
