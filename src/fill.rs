@@ -7,7 +7,7 @@
 
 use crate::density::{DensityMap, Spec};
 use crate::mass::{mat_vec, primitives, rpy_matrix, validity, MassProperties};
-use crate::mesh::health::{HealthOptions, Solid};
+use crate::mesh::health::{ErrorEstimate, HealthOptions, ModelError, Solid, ROUND_OFF_FLOOR};
 use crate::mesh::{self, MeshError, RawMesh};
 use crate::overlap::{overlap_volume, PartShape, PlacedPart};
 use crate::urdf::resolve::PackageResolver;
@@ -19,6 +19,13 @@ use std::time::{Duration, Instant};
 
 /// A collision mesh larger than this (bounding-box diagonal, m) is almost surely in millimetres.
 const MILLIMETRE_SLIP: f64 = 10.0;
+
+/// A primitive's formulas are exact; their f64 evaluation is within a few ulps.
+const PRIMITIVE_ERROR: ErrorEstimate = ErrorEstimate {
+    round_off: ROUND_OFF_FLOOR,
+    model: 0.0,
+    source: ModelError::None,
+};
 
 /// What to compute.
 #[derive(Debug, Clone, Default)]
@@ -50,6 +57,10 @@ pub struct PartReport {
     /// Where the density came from (`[meshes] "*battery*"`, `[links] base_link`, `default`, …).
     pub density_source: String,
     pub error_estimate: f64,
+    /// What the error estimate is made of (round-off, model error and its source).
+    pub error: ErrorEstimate,
+    /// Things worth knowing that need no action (a weld within tolerance, reader notes).
+    pub notes: Vec<String>,
 }
 
 /// A link whose inertial was computed.
@@ -279,6 +290,8 @@ struct Part {
     warnings: Vec<String>,
     faces: usize,
     error_estimate: f64,
+    error: ErrorEstimate,
+    notes: Vec<String>,
     /// The solid in the link frame (for bounding boxes and the overlap estimate).
     placed: PlacedPart,
 }
@@ -329,7 +342,9 @@ fn geometry_part(
         provenance: "primitive".into(),
         warnings: Vec::new(),
         faces: 0,
-        error_estimate: 0.0,
+        error_estimate: PRIMITIVE_ERROR.total(),
+        error: PRIMITIVE_ERROR,
+        notes: Vec::new(),
         placed: PlacedPart {
             shape,
             rotation: r,
@@ -427,6 +442,8 @@ fn geometry_part(
                 warnings,
                 faces: solid.faces_read,
                 error_estimate: solid.error_estimate,
+                error: solid.error,
+                notes: solid.notes.clone(),
                 placed: PlacedPart {
                     shape: PartShape::Mesh(solid.clone()),
                     rotation: r,
@@ -611,6 +628,8 @@ pub fn compute_with(
                 density,
                 density_source: source,
                 error_estimate: p.error_estimate,
+                error: p.error,
+                notes: p.notes.clone(),
             });
         }
         let computed: MassProperties = bodies.into_iter().sum();

@@ -148,11 +148,11 @@ fn same_solid_through_every_reader() {
     assert_box(&p, [1.0; 3], SIZE, CENTRE);
     let s = mesh::load_solid(&p, [1.0; 3], HealthOptions::default()).unwrap();
     assert!(
-        s.warnings
+        s.notes
             .iter()
             .any(|w| w.contains("header says 0 triangles")),
         "{:?}",
-        s.warnings
+        s.notes
     );
     assert_box(
         &write(d, "quads.obj", obj_text(&v).as_bytes()),

@@ -61,7 +61,11 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
                 "faces_read": solid.faces_read,
                 "vertices": solid.vertices.len(),
                 "error_estimate": solid.error_estimate,
+                "error_round_off": solid.error.round_off,
+                "error_model": solid.error.model,
+                "error_model_source": solid.error.source.name(),
                 "warnings": solid.warnings,
+                "notes": solid.notes,
             });
             println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
         }
@@ -111,12 +115,15 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
                 );
             }
             println!(
-                "  error estimate    {:.1e} (relative, central inertia)",
-                solid.error_estimate
+                "  error estimate    {} (relative bound on volume and central inertia)",
+                solid.error.describe()
             );
             println!("  time              {:.3} ms", elapsed.as_secs_f64() * 1e3);
             for w in &solid.warnings {
                 println!("  warning: {w}");
+            }
+            for n in &solid.notes {
+                println!("  note: {n}");
             }
         }
     }

@@ -180,7 +180,11 @@ fn summary_json(robot: &Robot, report: &FillReport, seconds: f64) -> serde_json:
                     "density": p.density,
                     "density_source": p.density_source,
                     "error_estimate": p.error_estimate,
+                    "error_round_off": p.error.round_off,
+                    "error_model": p.error.model,
+                    "error_model_source": p.error.source.name(),
                     "warnings": p.warnings,
+                    "notes": p.notes,
                 })).collect::<Vec<_>>(),
             })
         })
@@ -289,10 +293,13 @@ pub fn fill(a: &FillArgs) -> ExitStatus {
             .iter()
             .flat_map(|l| l.parts.iter().map(move |p| (p.error_estimate, l, p)))
             .max_by(|a, b| a.0.total_cmp(&b.0));
-        if let Some((e, l, p)) = worst {
+        if let Some((_, l, p)) = worst {
             eprintln!(
-                "  worst error estimate: {e:.1e} (relative, link `{}`, collision {}: {})",
-                l.name, p.collision, p.provenance
+                "  worst error estimate: {} (relative bound on volume and inertia; link `{}`, collision {}: {})",
+                p.error.describe(),
+                l.name,
+                p.collision,
+                p.provenance
             );
         }
     }

@@ -137,6 +137,9 @@ impl ErrorEstimate {
 
     /// One line for people: `3.1e-16 (round-off)` or `2.0e-4 (model: caps; round-off 3.1e-16)`.
     pub fn describe(&self) -> String {
+        if !self.total().is_finite() {
+            return format!("unbounded (model: {})", self.source.name());
+        }
         if self.source == ModelError::None || self.model == 0.0 {
             format!("{:.1e} (round-off)", self.total())
         } else {
@@ -158,6 +161,8 @@ pub struct Solid {
     pub rung: Rung,
     /// Messages for the user: what was done to the mesh and why.
     pub warnings: Vec<String>,
+    /// What the user may want to know but need not act on (a weld within tolerance, reader notes).
+    pub notes: Vec<String>,
     /// Mass properties at density 1 (mass = volume), in the mesh frame.
     pub unit: MassProperties,
     /// Bound on the relative error of volume and central inertia: `error.total()`.
@@ -377,6 +382,7 @@ struct Ladder<'a> {
     path: &'a Path,
     options: HealthOptions,
     warnings: Vec<String>,
+    notes: Vec<String>,
     faces_read: usize,
 }
 
@@ -393,18 +399,33 @@ impl Ladder<'_> {
         }
     }
 
-    /// Integrates, checks the volume and estimates the error: the last step of every rung.
+    /// Integrates, checks the volume and estimates the error: the last step of every rung. `model`
+    /// is the volume (m³) by which the solid can differ from the stored surface, and what it is made
+    /// of; `message` turns the relative model error into the rung's warning, if it has one.
     fn finish(
-        self,
+        mut self,
         vertices: Vec<[f64; 3]>,
         faces: Polygons,
         rung: Rung,
         model: (f64, ModelError),
+        message: impl FnOnce(f64) -> Option<String>,
     ) -> Result<Solid, MeshError> {
         let unit = unit_props(&vertices, &faces, None);
         check_volume(&vertices, &faces, unit.mass, self.path)?;
         let round_off = round_off(&vertices, &faces, &unit);
-        let (model_error, source) = model;
+        let (delta, source) = model;
+        let model_error = relative_model(delta, &unit, &vertices);
+        if let Some(m) = message(model_error) {
+            self.warnings.push(m);
+        }
+        let mut rung = rung;
+        if let Rung::Capped {
+            relative_uncertainty,
+            ..
+        } = &mut rung
+        {
+            *relative_uncertainty = model_error;
+        }
         let error = ErrorEstimate {
             round_off,
             model: model_error,
@@ -419,6 +440,7 @@ impl Ladder<'_> {
             faces,
             rung,
             warnings: self.warnings,
+            notes: self.notes,
             unit,
             error_estimate: error.total(),
             error,
@@ -427,24 +449,54 @@ impl Ladder<'_> {
     }
 }
 
+/// The relative error that a volume `delta` (m³) moved, added or removed anywhere within the solid's
+/// reach can cause, against the true value (which is at least the computed one less the change):
+/// for the volume δ/(V − δ); for the central inertia 3·δ·R²/(‖I‖ − 3·δ·R²), R the largest distance
+/// of a vertex from the centre of mass (a point mass δ at distance R changes the tensor by at most
+/// √2·δ·R², and the centre of mass it moves by as much again). Unbounded when the change could be
+/// as large as the value itself.
+fn relative_model(delta: f64, unit: &MassProperties, vertices: &[[f64; 3]]) -> f64 {
+    if delta == 0.0 {
+        return 0.0;
+    }
+    let reach2 = vertices
+        .iter()
+        .map(|v| {
+            let d = sub(*v, unit.com);
+            dot(d, d)
+        })
+        .fold(0.0, f64::max);
+    let bounded = |change: f64, value: f64| {
+        if change < value {
+            change / (value - change)
+        } else {
+            f64::INFINITY
+        }
+    };
+    let volume = bounded(delta, unit.mass);
+    let inertia = bounded(3.0 * delta * reach2, frobenius(&unit.inertia));
+    volume.max(inertia)
+}
+
 /// Turns a scaled mesh into a solid by the ladder in the module docs, its coordinates taken as f64
 /// values (see [`make_solid_stored_as`] for meshes stored in f32).
 pub fn make_solid(mesh: &RawMesh, path: &Path, options: HealthOptions) -> Result<Solid, MeshError> {
-    make_solid_stored_as(mesh, path, options, weld::Precision::F64)
+    make_solid_stored_as(mesh, path, options, || weld::Precision::F64)
 }
 
-/// Turns a scaled mesh into a solid; `precision` is how its file stored the coordinates, which sets the
-/// tolerance of the second welding pass.
+/// Turns a scaled mesh into a solid; `precision` tells how its file stored the coordinates, which sets
+/// the tolerance of the second welding pass (asked only when that pass runs).
 pub fn make_solid_stored_as(
     mesh: &RawMesh,
     path: &Path,
     options: HealthOptions,
-    precision: weld::Precision,
+    precision: impl FnOnce() -> weld::Precision,
 ) -> Result<Solid, MeshError> {
     let mut ladder = Ladder {
         path,
         options,
-        warnings: mesh.notes.clone(),
+        warnings: Vec::new(),
+        notes: mesh.notes.clone(),
         faces_read: mesh.faces.len(),
     };
     let exact = weld::exact(&mesh.vertices, &mesh.faces);
@@ -459,24 +511,40 @@ pub fn make_solid_stored_as(
     }
     let e = edges(&exact.faces);
     if e.closed() && e.inconsistent == 0 {
-        return consistent_closed(ladder, exact.vertices, exact.faces, Rung::Exact, 0.0);
+        return consistent_closed(
+            ladder,
+            exact.vertices,
+            exact.faces,
+            None,
+            &e.pairs,
+            Rung::Exact,
+            0.0,
+        );
     }
-    let w = tolerant_welding(exact, &e, precision);
+    let w = tolerant_welding(exact, &e, precision());
     let te = edges(&w.topology);
     if w.collapsed > 0 {
         ladder.warnings.push(format!(
             "{} sliver faces collapse when corners within {:.1e} m are welded; left out of the topology",
-            w.collapsed, w.tolerant.tolerance
+            w.collapsed, w.tolerant.tolerance.largest
         ));
     }
     if te.closed() && te.inconsistent == 0 {
         let rung = Rung::Welded {
             merged_vertices: w.tolerant.merged,
             widest_crack: w.tolerant.widest,
-            tolerance: w.tolerant.tolerance,
+            tolerance: w.tolerant.tolerance.largest,
         };
         let cracks = w.crack_area;
-        return consistent_closed(ladder, w.vertices, w.stored, rung, cracks);
+        return consistent_closed(
+            ladder,
+            w.vertices,
+            w.stored,
+            Some(w.kept),
+            &te.pairs,
+            rung,
+            cracks,
+        );
     }
     if te.closed() {
         if let Some(o) = orient(w.topology.len(), &te.pairs) {
@@ -486,20 +554,31 @@ pub fn make_solid_stored_as(
     open_or_nonmanifold(ladder, w, &te)
 }
 
-/// Closed and consistent (bit-exact or after the tolerant weld): as stored, or flipped if inward.
+/// Closed and consistent (bit-exact or after the tolerant weld): as stored, flipped if inward, or with
+/// the components re-oriented whose winding contradicts their nesting.
+///
+/// `kept` are the faces the topology (`pairs`) numbers, `None` when they are `stored` themselves.
 fn consistent_closed(
     mut ladder: Ladder<'_>,
     vertices: Vec<[f64; 3]>,
-    mut faces: Polygons,
+    stored: Polygons,
+    kept: Option<Polygons>,
+    pairs: &[(u32, u32, bool)],
     rung: Rung,
     crack_area: f64,
 ) -> Result<Solid, MeshError> {
-    let t = volume_integrals(&vertices, &faces, &IntegrationOptions::accurate());
+    let t = volume_integrals(&vertices, &stored, &IntegrationOptions::accurate());
+    let inverted = t.t1 < 0.0;
+    let mut faces = stored;
+    let mut kept = kept;
     let mut rung = rung;
-    if t.t1 < 0.0 {
+    if inverted {
         ladder.strict("closed mesh wound inward")?;
-        for i in 0..faces.len() {
-            faces.reverse_face(i);
+        let all = vec![true; faces.len()];
+        apply(&mut faces, &all);
+        if let Some(k) = kept.as_mut() {
+            let all = vec![true; k.len()];
+            apply(k, &all);
         }
         ladder.warnings.push(format!(
             "all {} faces wound inward (negative volume); flipped",
@@ -507,28 +586,111 @@ fn consistent_closed(
         ));
         rung = Rung::Inverted;
     }
+    let topology_faces = kept.as_ref().unwrap_or(&faces);
+    let (comp, ncomp) = components(topology_faces.len(), pairs);
+    if ncomp > 1 {
+        let flip = misoriented(&vertices, topology_faces, &comp, ncomp);
+        if flip.iter().any(|f| *f) {
+            ladder.strict("a closed component is wound inward")?;
+            let reversed: Vec<bool> = comp.iter().map(|&c| flip[c as usize]).collect();
+            let mut out = topology_faces.clone();
+            apply(&mut out, &reversed);
+            let flipped = reversed.iter().filter(|r| **r).count();
+            let turned = flip.iter().filter(|f| **f).count();
+            ladder.warnings.push(format!(
+                "{turned} of {ncomp} closed components wound inward although no other component encloses them (a cavity must lie inside a solid); {flipped} faces flipped"
+            ));
+            let model = crack_volume(crack_area, &vertices);
+            let rung = Rung::Reoriented {
+                faces_flipped: flipped,
+                components: ncomp,
+            };
+            return ladder.finish(vertices, out, rung, (model, ModelError::Cracks), |_| None);
+        }
+    }
     if let Rung::Welded {
         merged_vertices,
         widest_crack,
         tolerance,
     } = rung
     {
-        ladder.warnings.push(format!(
+        ladder.notes.push(format!(
             "closed once {merged_vertices} corners stored up to {widest_crack:.1e} m apart are welded (tolerance {tolerance:.1e} m); integrated as stored"
         ));
     }
-    let model = crack_model(crack_area, &vertices, t.t1.abs());
-    ladder.finish(vertices, faces, rung, (model, ModelError::Cracks))
+    let model = crack_volume(crack_area, &vertices);
+    ladder.finish(vertices, faces, rung, (model, ModelError::Cracks), |_| None)
 }
 
-/// Relative model error of cracks of total area `area`: the flux of the integrands through them,
-/// at most area × (diagonal) against the volume, doubled for the second moments.
-fn crack_model(area: f64, vertices: &[[f64; 3]], volume: f64) -> f64 {
+/// Connected components of faces over manifold edges (union-find): per-face component ids and the
+/// number of components.
+fn components(nfaces: usize, pairs: &[(u32, u32, bool)]) -> (Vec<u32>, usize) {
+    let mut parent: Vec<u32> = (0..nfaces as u32).collect();
+    fn root(parent: &mut [u32], mut x: u32) -> u32 {
+        while parent[x as usize] != x {
+            let up = parent[parent[x as usize] as usize];
+            parent[x as usize] = up;
+            x = up;
+        }
+        x
+    }
+    for &(a, b, _) in pairs {
+        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+        if ra != rb {
+            parent[ra.max(rb) as usize] = ra.min(rb);
+        }
+    }
+    let mut id = vec![u32::MAX; nfaces];
+    let mut comp = Vec::with_capacity(nfaces);
+    let mut n = 0u32;
+    for f in 0..nfaces as u32 {
+        let r = root(&mut parent, f) as usize;
+        if id[r] == u32::MAX {
+            id[r] = n;
+            n += 1;
+        }
+        comp.push(id[r]);
+    }
+    (comp, n as usize)
+}
+
+/// Components beyond this many are not checked for nesting (quadratic in the components).
+const NESTING_CHECK: usize = 2_000;
+
+/// Which components to flip: those wound inward (negative volume) at an even nesting depth, where a
+/// component's depth is the number of larger components whose bounding boxes contain its own. A
+/// component wound inward that nothing encloses cannot be a cavity. An outward component at an odd
+/// depth is kept: bounding boxes cannot tell a cavity wound the wrong way from a part lying in
+/// another's concavity.
+fn misoriented(vertices: &[[f64; 3]], faces: &Polygons, comp: &[u32], ncomp: usize) -> Vec<bool> {
+    if ncomp > NESTING_CHECK {
+        return vec![false; ncomp];
+    }
+    let vol = component_volumes(vertices, faces, comp, ncomp);
+    if vol.iter().all(|v| *v >= 0.0) {
+        return vec![false; ncomp];
+    }
+    let boxes = component_boxes(vertices, faces, comp, ncomp);
+    (0..ncomp)
+        .map(|c| {
+            let depth = (0..ncomp)
+                .filter(|&d| {
+                    d != c && vol[d].abs() > vol[c].abs() && contains(&boxes[d], &boxes[c])
+                })
+                .count();
+            vol[c] < 0.0 && depth % 2 == 0
+        })
+        .collect()
+}
+
+/// Volume that cracks of total area `area` can hold: the flux of the integrands through them is at
+/// most area × (diagonal).
+fn crack_volume(area: f64, vertices: &[[f64; 3]]) -> f64 {
     if area == 0.0 {
         return 0.0;
     }
     let (lo, hi) = bbox(vertices);
-    2.0 * area * dist(lo, hi) / volume
+    area * dist(lo, hi)
 }
 
 /// Closed after the tolerant weld but wound inconsistently: each component made consistent and outward.
@@ -559,14 +721,13 @@ fn reoriented(
         faces_flipped: flipped,
         components: o.ncomp,
     };
-    let volume = signed_volume(&w.vertices, &faces);
-    let model = crack_model(w.crack_area, &w.vertices, volume) + nested / volume;
+    let model = crack_volume(w.crack_area, &w.vertices) + nested;
     let source = if nested > 0.0 {
         ModelError::Orientation
     } else {
         ModelError::Cracks
     };
-    ladder.finish(w.vertices, faces, rung, (model, source))
+    ladder.finish(w.vertices, faces, rung, (model, source), |_| None)
 }
 
 /// Each face's reversal under an orientation that turns every component outward by its own signed
@@ -640,7 +801,7 @@ fn open_or_nonmanifold(mut ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result
                 ladder.warnings.push(format!("mesh is {what} but has no holes: integrated as it is{flips} (a region enclosed by two overlapping shells would count twice)"));
                 // Integrated as stored (up to the faces re-oriented): a region that two shells
                 // enclose counts twice here exactly as in the stored surface, which the warning says.
-                let model = crack_model(w.crack_area, &w.vertices, volume) + nested / volume;
+                let model = crack_volume(w.crack_area, &w.vertices) + nested;
                 let rung = Rung::NonManifold {
                     nonmanifold_edges: te.nonmanifold,
                     faces_flipped: flipped,
@@ -650,7 +811,7 @@ fn open_or_nonmanifold(mut ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result
                 } else {
                     ModelError::Cracks
                 };
-                return ladder.finish(w.vertices, faces, rung, (model, source));
+                return ladder.finish(w.vertices, faces, rung, (model, source), |_| None);
             }
             continue;
         }
@@ -668,23 +829,29 @@ fn open_or_nonmanifold(mut ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result
         if !(volume > 0.0 && uncertainty <= CAPPED) {
             continue;
         }
-        let cracks = crack_model(w.crack_area, &w.vertices, volume);
+        let cracks = crack_volume(w.crack_area, &w.vertices);
         // Whatever surface really spans the loops, its contribution is at most (its area) × diagonal.
         let (lo, hi) = bbox(&w.vertices);
-        let spans = caps.area * dist(lo, hi) / volume;
-        if spans + uncertainty + cracks <= SLIVERS && flipped == 0 {
+        let spans = caps.area * dist(lo, hi);
+        if (spans + caps.bound + cracks) / volume <= SLIVERS && flipped == 0 {
             // The "holes" are slivers: the stored triangles are closed up to round-off.
-            ladder.warnings.push(format!(
+            ladder.notes.push(format!(
                 "closed up to slivers once corners within {:.1e} m are welded ({} boundary edges bound {:.1e} m² in all); integrated as stored",
-                w.tolerant.tolerance, te.boundary, caps.area
+                w.tolerant.tolerance.largest, te.boundary, caps.area
             ));
             let rung = Rung::Welded {
                 merged_vertices: w.tolerant.merged,
                 widest_crack: w.tolerant.widest,
-                tolerance: w.tolerant.tolerance,
+                tolerance: w.tolerant.tolerance.largest,
             };
-            let model = spans + uncertainty + cracks;
-            return ladder.finish(w.vertices, w.stored, rung, (model, ModelError::Cracks));
+            let model = spans + caps.bound + cracks;
+            return ladder.finish(
+                w.vertices,
+                w.stored,
+                rung,
+                (model, ModelError::Cracks),
+                |_| None,
+            );
         }
         ladder.strict(&format!("mesh is {what}"))?;
         let mut done = Vec::new();
@@ -697,30 +864,26 @@ fn open_or_nonmanifold(mut ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result
                 caps.cracks
             ));
         }
-        let model = uncertainty + cracks + nested / volume;
-        ladder.warnings.push(format!(
-            "mesh is {what}: {}{flips}; its volume {volume:.6e} m³ is uncertain by at most {model:.1e} (relative) because of them",
-            done.join(", "),
-        ));
+        let model = caps.bound + cracks + nested;
         let rung = Rung::Capped {
             holes: caps.holes,
             boundary_edges: te.boundary,
             nonmanifold_edges: te.nonmanifold,
             faces_flipped: flipped,
-            relative_uncertainty: model,
+            relative_uncertainty: 0.0,
         };
-        return ladder.finish(vertices, capped, rung, (model, ModelError::Caps));
+        let done = done.join(", ");
+        return ladder.finish(vertices, capped, rung, (model, ModelError::Caps), |m| {
+            Some(format!(
+                "mesh is {what}: {done}{flips}; its volume {volume:.6e} m³ and inertia are uncertain by at most {m:.1e} (relative) because of them"
+            ))
+        });
     }
     convex_hull(ladder, w, te, &what)
 }
 
 /// The convex hull of the vertices, with the numbers that say how far that is from the mesh.
-fn convex_hull(
-    mut ladder: Ladder<'_>,
-    w: Welding,
-    te: &Edges,
-    what: &str,
-) -> Result<Solid, MeshError> {
+fn convex_hull(ladder: Ladder<'_>, w: Welding, te: &Edges, what: &str) -> Result<Solid, MeshError> {
     let (lo, hi) = bbox(&w.vertices);
     let diag = dist(lo, hi);
     // The stored surface's signed volume, and how much it moves over reference points in the box.
@@ -752,16 +915,24 @@ fn convex_hull(
     let hull_faces = Polygons::from_triangles(&ht);
     let hull_volume = signed_volume(&hv, &hull_faces);
     ladder.strict(&format!("mesh is {what}"))?;
-    let model = ((own - hull_volume).abs() + moves) / hull_volume;
-    ladder.warnings.push(format!(
-        "mesh is {what}; used its convex hull ({} vertices, volume {:.6e} m³). The mesh's own signed volume is {:.6e} m³ ({:+.1}% of the hull) and moves by up to {:.2e} m³ with the reference point, so it is not a solid; the hull's numbers are uncertain by {:.1e} (relative)",
-        hv.len(),
-        hull_volume,
-        own,
-        if hull_volume != 0.0 { 100.0 * (own - hull_volume) / hull_volume } else { 0.0 },
-        moves,
-        model
-    ));
+    // The mesh's own volume is the truth up to `moves`; the hull differs from it by this much.
+    let model = (own - hull_volume).abs() + moves;
+    let nv = hv.len();
+    let share = if hull_volume != 0.0 {
+        100.0 * (own - hull_volume) / hull_volume
+    } else {
+        0.0
+    };
+    let message = move |m: f64| {
+        let bound = if m.is_finite() {
+            format!("uncertain by at most {m:.1e} (relative)")
+        } else {
+            "not bounded: the mesh's own volume is too uncertain to compare".to_string()
+        };
+        Some(format!(
+            "mesh is {what}; used its convex hull ({nv} vertices, volume {hull_volume:.6e} m³). The mesh's own signed volume is {own:.6e} m³ ({share:+.1}% of the hull) and moves by up to {moves:.2e} m³ with the reference point, so it is not a solid; the hull's numbers are {bound}"
+        ))
+    };
     let rung = Rung::ConvexHull {
         boundary_edges: te.boundary,
         nonmanifold_edges: te.nonmanifold,
@@ -769,7 +940,7 @@ fn convex_hull(
         hull_volume,
         volume_moves_by: moves,
     };
-    ladder.finish(hv, hull_faces, rung, (model, ModelError::Hull))
+    ladder.finish(hv, hull_faces, rung, (model, ModelError::Hull), message)
 }
 
 fn unit_props(

@@ -210,8 +210,9 @@ pub fn solid_from_raw(
     let scaled = apply_scale(raw, scale, path)?;
     // The precision of the file's own numbers, before the scale multiplies them; the largest
     // coordinate scales with them, so the tolerance in ulps of it stays right.
-    let precision = weld::Precision::of(&raw.vertices);
-    health::make_solid_stored_as(&scaled, path, options, precision)
+    health::make_solid_stored_as(&scaled, path, options, || {
+        weld::Precision::of(&raw.vertices)
+    })
 }
 
 /// Parses a float the way all three formats write them, NaN and infinities included (they are caught

@@ -105,30 +105,83 @@ pub fn remap_faces(faces: &Polygons, remap: &[u32]) -> (Polygons, Vec<bool>) {
     (out, kept)
 }
 
-/// How a file stored the coordinates: a mesh stored in f32 (binary STL, glTF) cannot tell apart
-/// corners closer than its own rounding, so its cracks are up to an f32 ulp of the largest coordinate.
+/// How a file stored the coordinates. A file that rounds each facet's corners independently stores a
+/// shared corner up to one unit in the last place apart in each coordinate: an f32 ulp (binary STL,
+/// glTF), or a unit of the last decimal digit (ASCII exporters writing 6 to 9 significant digits).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Precision {
-    F32,
     F64,
+    F32,
+    /// Every coordinate has at most this many significant decimal digits (6 to 9).
+    Decimal(u8),
 }
 
 impl Precision {
-    /// The precision of coordinates as read (before scaling): f32 when every one is an f32 value.
+    /// The precision of coordinates as read (before scaling): f32 when every one is an f32 value;
+    /// else decimal when every one has at most 9 significant digits and some have 6 or more (fewer
+    /// everywhere is a designed shape, 0.5 and 0.25, not a rounded one); else f64.
     pub fn of(vertices: &[[f64; 3]]) -> Precision {
         let f32_exact = |x: f64| f64::from(x as f32) == x;
         if vertices.iter().flatten().all(|&x| f32_exact(x)) {
-            Precision::F32
+            return Precision::F32;
+        }
+        let mut most = 0;
+        for &x in vertices.iter().flatten() {
+            let digits = significant_digits(x);
+            if digits > 9 {
+                return Precision::F64;
+            }
+            most = most.max(digits);
+        }
+        if most >= 6 {
+            Precision::Decimal(most as u8)
         } else {
             Precision::F64
         }
     }
+
+    /// A unit in the last place, relative to the magnitude (an upper bound).
+    pub fn relative_ulp(self) -> f64 {
+        match self {
+            Precision::F64 => 0.0,
+            Precision::F32 => f64::from(f32::EPSILON),
+            Precision::Decimal(d) => 10f64.powi(1 - i32::from(d)),
+        }
+    }
 }
 
-/// The tolerance of the second pass for these vertices: `max(1e-9 × extent, 16 ulp of the largest
-/// coordinate)`, and for coordinates stored as f32 at least two f32 ulps of the largest one (a corner
-/// rounded up in one facet and down in the next is one ulp off in each coordinate).
-pub fn tolerance(vertices: &[[f64; 3]], precision: Precision) -> f64 {
+/// Significant digits of the shortest decimal that reads back as `x`.
+fn significant_digits(x: f64) -> usize {
+    if x == 0.0 {
+        return 0;
+    }
+    let text = format!("{:e}", x.abs());
+    let mantissa = text.split('e').next().unwrap_or("");
+    mantissa.bytes().filter(u8::is_ascii_digit).count()
+}
+
+/// The tolerance of the second pass: `max(base, 2 × relative ulp × |p|∞)` at a vertex `p`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerance {
+    /// `max(1e-9 × extent, 16 ulp of the largest |coordinate|)`, m.
+    pub base: f64,
+    /// The stored precision's relative ulp (0 for f64).
+    pub relative_ulp: f64,
+    /// The largest tolerance at any vertex, m.
+    pub largest: f64,
+}
+
+impl Tolerance {
+    /// The tolerance at `p`: two units in the last place of its largest coordinate (a corner rounded
+    /// up in one facet and down in the next is one unit off in each coordinate, √3 in distance).
+    pub fn at(&self, p: &[f64; 3]) -> f64 {
+        let m = p[0].abs().max(p[1].abs()).max(p[2].abs());
+        self.base.max(2.0 * self.relative_ulp * m)
+    }
+}
+
+/// The tolerance of the second pass for these (scaled) vertices stored with `precision`.
+pub fn tolerance(vertices: &[[f64; 3]], precision: Precision) -> Tolerance {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     let mut largest = 0.0f64;
@@ -140,13 +193,13 @@ pub fn tolerance(vertices: &[[f64; 3]], precision: Precision) -> f64 {
         }
     }
     let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0f64, f64::max);
-    let stored = match precision {
-        Precision::F32 => 2.0 * f64::from(f32::EPSILON) * largest,
-        Precision::F64 => 0.0,
-    };
-    (RELATIVE_TOLERANCE * extent)
-        .max(ULPS * f64::EPSILON * largest)
-        .max(stored)
+    let base = (RELATIVE_TOLERANCE * extent).max(ULPS * f64::EPSILON * largest);
+    let relative_ulp = precision.relative_ulp();
+    Tolerance {
+        base,
+        relative_ulp,
+        largest: base.max(2.0 * relative_ulp * largest),
+    }
 }
 
 /// Vertices merged within a tolerance.
@@ -158,15 +211,17 @@ pub struct TolerantWeld {
     pub merged: usize,
     /// Largest distance of a vertex from its representative.
     pub widest: f64,
-    pub tolerance: f64,
+    pub tolerance: Tolerance,
 }
 
-/// Merges vertices within `tol` of an earlier representative (Euclidean distance), greedily in index
-/// order, on a hash grid of cell size `tol`.
-pub fn tolerant(vertices: &[[f64; 3]], tol: f64) -> TolerantWeld {
+/// Merges each vertex into the nearest earlier representative within the larger of their two
+/// tolerances (Euclidean distance), greedily in index order, on a hash grid whose cells are the
+/// largest tolerance wide.
+pub fn tolerant(vertices: &[[f64; 3]], tol: Tolerance) -> TolerantWeld {
     let n = vertices.len();
     let mut representative: Vec<u32> = (0..n as u32).collect();
-    if !(tol > 0.0 && tol.is_finite()) || n == 0 {
+    let cell_size = tol.largest;
+    if !(cell_size > 0.0 && cell_size.is_finite()) || n == 0 {
         return TolerantWeld {
             representative,
             merged: 0,
@@ -175,21 +230,21 @@ pub fn tolerant(vertices: &[[f64; 3]], tol: f64) -> TolerantWeld {
         };
     }
     let origin = vertices[0];
+    // Cell indices stay within ±1e9 for a mesh whose extent is at most 1e9 tolerances (the base
+    // tolerance is 1e-9 of the extent); `as` saturates rather than wrapping beyond that.
     let cell = |p: &[f64; 3]| -> [i64; 3] {
-        // Saturating casts: a cell index beyond i64 cannot happen for finite meshes whose extent is
-        // at most 1e9 tolerances, but the cast must not wrap if it did.
-        [0, 1, 2].map(|k| ((p[k] - origin[k]) / tol).floor() as i64)
+        [0, 1, 2].map(|k| ((p[k] - origin[k]) / cell_size).floor() as i64)
     };
     let mut grid: FxHashMap<[i64; 3], Vec<u32>> =
         FxHashMap::with_capacity_and_hasher(n, Default::default());
-    let tol2 = tol * tol;
     let mut merged = 0;
     let mut widest = 0.0f64;
     for i in 0..n {
         let p = &vertices[i];
+        let tp = tol.at(p);
         let c = cell(p);
         let mut found: Option<(u32, f64)> = None;
-        'search: for dx in -1..=1i64 {
+        for dx in -1..=1i64 {
             for dy in -1..=1i64 {
                 for dz in -1..=1i64 {
                     let key = [
@@ -200,23 +255,21 @@ pub fn tolerant(vertices: &[[f64; 3]], tol: f64) -> TolerantWeld {
                     let Some(reps) = grid.get(&key) else { continue };
                     for &r in reps {
                         let q = &vertices[r as usize];
-                        let d2 =
-                            (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2);
-                        if d2 <= tol2 && found.is_none_or(|(_, best)| d2 < best) {
-                            found = Some((r, d2));
-                            if d2 == 0.0 {
-                                break 'search;
-                            }
+                        let d =
+                            ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2))
+                                .sqrt();
+                        if d <= tp.max(tol.at(q)) && found.is_none_or(|(_, best)| d < best) {
+                            found = Some((r, d));
                         }
                     }
                 }
             }
         }
         match found {
-            Some((r, d2)) => {
+            Some((r, d)) => {
                 representative[i] = r;
                 merged += 1;
-                widest = widest.max(d2.sqrt());
+                widest = widest.max(d);
             }
             None => grid.entry(c).or_default().push(i as u32),
         }
@@ -244,6 +297,26 @@ mod tests {
         let t = tolerant(&v, tolerance(&v, Precision::F64));
         assert_eq!(t.representative, vec![0, 1, 1, 3, 4]);
         assert_eq!(t.merged, 1);
+        // The same in f32: two f32 ulps of 1 m is 2.4e-7 m, forty times below the slot.
+        let v32: Vec<[f64; 3]> = v.iter().map(|p| p.map(|x| f64::from(x as f32))).collect();
+        let mut nudged = v32[1];
+        nudged[0] = f64::from(f32::from_bits((nudged[0] as f32).to_bits() + 1));
+        let mut v32 = v32;
+        v32.push(nudged);
+        let t = tolerant(&v32, tolerance(&v32, Precision::of(&v32)));
+        assert_eq!(Precision::of(&v32), Precision::F32);
+        assert_eq!(t.representative, vec![0, 1, 1, 3, 4, 1]);
+    }
+
+    #[test]
+    fn decimal_precision_is_recognised() {
+        let v = vec![[0.123457, 1.5, 2.0], [0.5, 0.25, 100.001]];
+        assert_eq!(Precision::of(&v), Precision::Decimal(6));
+        let designed = vec![[0.5, 0.25, 1.0], [2.0, 3.0, 4.0]];
+        // f32 values, so F32; a shape with few digits that is not f32 stays F64.
+        assert_eq!(Precision::of(&designed), Precision::F32);
+        assert_eq!(Precision::of(&[[0.1, 0.2, 0.3]]), Precision::F64);
+        assert_eq!(Precision::of(&[[0.1 + 0.2, 0.2, 0.3]]), Precision::F64);
     }
 
     #[test]
@@ -251,7 +324,7 @@ mod tests {
         // A 1 mm part 1 km away: its round-off is 16 ulp of 1e3, above 1e-9 of 1e-3.
         let v = vec![[1e3, 0.0, 0.0], [1e3 + 1e-3, 1e-3, 1e-3]];
         assert_eq!(
-            tolerance(&v, Precision::F64),
+            tolerance(&v, Precision::F64).base,
             16.0 * f64::EPSILON * (1e3 + 1e-3)
         );
     }
