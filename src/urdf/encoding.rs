@@ -262,4 +262,25 @@ mod tests {
         let e = decode(b"<?xml version='1.0' encoding='klingon'?><robot/>".to_vec()).unwrap_err();
         assert!(e.message.contains("`klingon`"), "{}", e.message);
     }
+
+    #[test]
+    fn truncated_and_odd_inputs_never_panic() {
+        let utf16: Vec<u8> = [0xfeff_u16]
+            .into_iter()
+            .chain("<?xml version='1.0'?><robot name='\u{e9}\u{1F916}'/>".encode_utf16())
+            .flat_map(|u| u.to_be_bytes())
+            .collect();
+        let latin1 = b"<?xml version='1.0' encoding='latin1'?><robot name='\xe9'/>".to_vec();
+        for bytes in [utf16, latin1] {
+            for n in 0..=bytes.len() {
+                if let Ok((text, enc)) = decode(bytes[..n].to_vec()) {
+                    let _ = enc.encode(&text);
+                }
+                let _ = declared_encoding(&bytes[..n]);
+            }
+        }
+        // A lone surrogate is an error naming its offset, not a panic or a replacement.
+        let e = decode(vec![0xff, 0xfe, b'<', 0, 0x00, 0xd8, b'>', 0]).unwrap_err();
+        assert_eq!(e.offset, 4);
+    }
 }
