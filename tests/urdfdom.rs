@@ -465,8 +465,23 @@ fn xacro_files_get_one_note() {
     assert_eq!(stderr.matches("run `xacro").count(), 1, "{stderr}");
     assert!(
         stderr.contains("note: ")
-            && stderr.contains("arm.urdf.xacro:1: this file uses xacro")
+            && stderr.contains("arm.urdf.xacro:2: this file uses xacro")
             && stderr.contains("links inside xacro macros are not seen"),
+        "{stderr}"
+    );
+    // Only the declaration (xacro's output keeps it): a softer note, still one.
+    let urdf = write(
+        tmp.path(),
+        "expanded.urdf",
+        "<robot name=\"arm\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">\n  <link name=\"base\"><collision><geometry><box size=\"1 1 1\"/></geometry></collision></link>\n</robot>\n",
+    );
+    let out = run(&["fill", s(&urdf), "--density", "1000"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert_eq!(stderr.matches("run `xacro").count(), 1, "{stderr}");
+    assert!(
+        stderr
+            .contains("expanded.urdf:1: the root declares xmlns:xacro: if this is a xacro source"),
         "{stderr}"
     );
 }

@@ -358,6 +358,8 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
     let mut notes: Vec<ScanNote> = Vec::new();
     // Line of the first sign of xacro (xmlns:xacro on the root, a <xacro:…> element).
     let mut xacro: Option<usize> = None;
+    // Line of the root if it declares xmlns:xacro (xacro's own output keeps the declaration).
+    let mut xacro_namespace: Option<usize> = None;
 
     loop {
         let pos = bom + reader.buffer_position() as usize;
@@ -409,7 +411,7 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
             (0, "robot") => {
                 robot_name = Some(a.get("name").cloned().unwrap_or_default());
                 if a.contains_key("xmlns:xacro") {
-                    xacro.get_or_insert(line);
+                    xacro_namespace = Some(line);
                 }
             }
             (0, other) => return Err(err(pos, format!("the root element is <{other}>, not <robot>: this is not a URDF (run xacro first if it is a .xacro file)"))),
@@ -553,12 +555,18 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
             ),
         ));
     }
-    if let Some(line) = xacro {
+    let xacro_note = match (xacro, xacro_namespace) {
+        (Some(line), _) => Some((line, "this file uses xacro (<xacro:…> elements): links inside xacro macros are not seen and ${…} expressions are not expanded; run `xacro FILE.urdf.xacro > FILE.urdf` first and give urdf-inertia the result")),
+        // xacro's output keeps the declaration, so most expanded URDFs have it: a softer note.
+        (None, Some(line)) => Some((line, "the root declares xmlns:xacro: if this is a xacro source rather than xacro's output, links inside its macros are not seen; run `xacro FILE.urdf.xacro > FILE.urdf` first")),
+        (None, None) => None,
+    };
+    if let Some((line, message)) = xacro_note {
         notes.push(ScanNote {
             level: NoteLevel::Note,
             line,
             link: None,
-            message: "this file uses xacro (xmlns:xacro or <xacro:…> elements): links inside xacro macros are not seen and ${…} expressions are not expanded; run `xacro FILE.urdf.xacro > FILE.urdf` first and give urdf-inertia the result".into(),
+            message: message.into(),
         });
     }
     notes.sort_by_key(|n| n.line);
@@ -1044,7 +1052,7 @@ mod tests {
             .filter(|n| n.message.contains("run `xacro"))
             .collect();
         assert_eq!(xacro.len(), 1);
-        assert_eq!((xacro[0].line, xacro[0].level), (1, NoteLevel::Note));
+        assert_eq!((xacro[0].line, xacro[0].level), (2, NoteLevel::Note));
         let r = scan(
             "<robot name=\"r\"><xacro:include filename=\"x.xacro\"/></robot>".into(),
             Path::new("x.urdf"),
