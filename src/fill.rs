@@ -244,6 +244,26 @@ pub fn existing_props(inertial: &Inertial) -> Option<MassProperties> {
     Some(mp.transformed(&r, inertial.origin.xyz))
 }
 
+/// The problem of a link with several `<inertial>` elements: urdfdom reads the first and ignores the
+/// rest, so the file says two things.
+pub fn duplicate_inertials(link: &Link) -> Option<String> {
+    let first = link.inertial.as_ref()?;
+    if link.extra_inertials.is_empty() {
+        return None;
+    }
+    let lines: Vec<String> = link
+        .extra_inertials
+        .iter()
+        .map(|s| s.line.to_string())
+        .collect();
+    Some(format!(
+        "{} <inertial> elements: urdfdom reads the first (line {}) and ignores the rest (line {}); remove them, or let `fill` replace them all with one",
+        1 + link.extra_inertials.len(),
+        first.line,
+        lines.join(", ")
+    ))
+}
+
 /// Problems of a link's existing `<inertial>` (missing parts, unreadable numbers, physical validity).
 ///
 /// One exception: an all-zero inertial (mass 0, zero tensor) on a link *without* collision geometry is
@@ -252,7 +272,8 @@ pub fn existing_problems(link: &Link) -> Vec<String> {
     let Some(span) = &link.inertial else {
         return vec!["no <inertial>".into()];
     };
-    if link.collisions.is_empty()
+    let mut out: Vec<String> = duplicate_inertials(link).into_iter().collect();
+    if !link.has_collision_geometry()
         && span.problem.is_none()
         && span.value.mass == Some(0.0)
         && span
@@ -260,12 +281,12 @@ pub fn existing_problems(link: &Link) -> Vec<String> {
             .inertia
             .is_none_or(|i| i.iter().all(|x| *x == 0.0))
     {
-        return Vec::new();
+        return out;
     }
     if let Some(p) = &span.problem {
-        return vec![format!("<inertial> cannot be read: {p}")];
+        out.push(format!("<inertial> cannot be read: {p}"));
+        return out;
     }
-    let mut out = Vec::new();
     if span.value.mass.is_none() {
         out.push("<inertial> has no <mass>".into());
     }
@@ -356,6 +377,9 @@ fn geometry_part(
     };
 
     Ok(match &c.geometry {
+        Geometry::Invalid { line, message } => {
+            return Err(format!("collision {} (line {line}): {message}", c.index))
+        }
         Geometry::Box { size } => primitive(
             primitives::cuboid(*size, 1.0),
             format!("box {}", fmt3(*size)),
@@ -482,7 +506,7 @@ pub fn compute_with(
     let wanted: Vec<(PathBuf, [f64; 3])> = robot
         .links
         .iter()
-        .filter(|l| !l.collisions.is_empty() && is_target(l, opts))
+        .filter(|l| l.has_collision_geometry() && is_target(l, opts))
         .flat_map(|l| l.collisions.iter())
         .filter_map(|c| match &c.geometry {
             Geometry::Mesh { filename, scale } => resolver
@@ -503,7 +527,9 @@ pub fn compute_with(
     // Links whose mass follows from densities (scaled by total_mass), as indices into report.links.
     let mut density_links: Vec<usize> = Vec::new();
     for (li, link) in robot.links.iter().enumerate() {
-        if link.collisions.is_empty() {
+        // Links without collision geometry, or whose only parts are zero-size primitives, are left as
+        // they are (the scan notes the latter).
+        if !link.has_collision_geometry() {
             report.without_geometry += 1;
             continue;
         }
@@ -513,7 +539,11 @@ pub fn compute_with(
         }
         let mut parts = Vec::new();
         let mut failed = None;
-        for c in &link.collisions {
+        for c in link
+            .collisions
+            .iter()
+            .filter(|c| !c.geometry.is_zero_size())
+        {
             match geometry_part(c, robot, resolver, cache, opts) {
                 Ok(p) => parts.push(p),
                 Err(m) => {

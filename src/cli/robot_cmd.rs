@@ -7,7 +7,7 @@ use crate::fill::{self, existing_problems, existing_props, FillOptions, FillRepo
 use crate::mass::{frobenius, MassProperties};
 use crate::urdf::resolve::PackageResolver;
 use crate::urdf::write::{splice, WriteOptions};
-use crate::urdf::{scan, Robot};
+use crate::urdf::{scan_bytes, Geometry, NoteLevel, Robot};
 use serde_json::json;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -68,17 +68,15 @@ fn prepare(
     Ok((src, map, robot))
 }
 
+/// Reads, decodes and scans a URDF, printing the scan's warnings and notes to stderr.
 fn read_robot(path: &Path) -> Result<Robot, String> {
     let bytes = std::fs::read(path)
         .map_err(|e| format!("{}: cannot read the URDF: {e}", path.display()))?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        format!(
-            "{}: the URDF is not valid UTF-8 (byte {})",
-            path.display(),
-            e.utf8_error().valid_up_to()
-        )
-    })?;
-    scan(text, path).map_err(|e| e.to_string())
+    let robot = scan_bytes(bytes, path).map_err(|e| e.to_string())?;
+    for note in &robot.notes {
+        eprintln!("{}", note.render(&robot.path));
+    }
+    Ok(robot)
 }
 
 fn print_failures(robot: &Robot, report: &FillReport) {
@@ -99,7 +97,7 @@ fn print_failures(robot: &Robot, report: &FillReport) {
 
 /// Writes `text` to `path` through a temporary file in the same directory and a rename, so the target is
 /// never left half-written.
-fn write_atomically(path: &Path, text: &str) -> Result<(), String> {
+fn write_atomically(path: &Path, text: &[u8]) -> Result<(), String> {
     // Through a symlink, replace its target: renaming onto the link would turn it into a plain file.
     let resolved = if path.is_symlink() {
         std::fs::canonicalize(path).ok()
@@ -118,7 +116,7 @@ fn write_atomically(path: &Path, text: &str) -> Result<(), String> {
     let tmp = dir.join(format!(".{name}.urdf-inertia.{}.tmp", std::process::id()));
     let result = (|| -> std::io::Result<()> {
         let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(text.as_bytes())?;
+        f.write_all(text)?;
         f.sync_all()?;
         if let Ok(meta) = std::fs::metadata(path) {
             std::fs::set_permissions(&tmp, meta.permissions())?;
@@ -198,6 +196,7 @@ fn summary_json(robot: &Robot, report: &FillReport, seconds: f64) -> serde_json:
         "mesh_files": report.mesh_files,
         "faces": report.faces,
         "errors": report.failures.iter().map(|f| json!({"link": f.name, "line": f.line, "message": f.message})).collect::<Vec<_>>(),
+        "notes": robot.notes.iter().map(|n| json!({"level": match n.level { NoteLevel::Warning => "warning", NoteLevel::Note => "note" }, "line": n.line, "link": n.link, "message": n.message})).collect::<Vec<_>>(),
         "seconds": seconds,
         "seconds_load": report.timing.load.as_secs_f64(),
         "seconds_integrate": report.timing.integrate.as_secs_f64(),
@@ -229,6 +228,14 @@ pub fn fill(a: &FillArgs) -> ExitStatus {
             principal: a.principal,
         },
     );
+    // Written back in the file's own encoding (UTF-16 and declared single-byte files included).
+    let text = match robot.encoding.encode(&text) {
+        Ok(bytes) => bytes,
+        Err(e) => {
+            eprintln!("error: {}: {e}", robot.path.display());
+            return ExitStatus::Error;
+        }
+    };
     let target: Option<PathBuf> = if a.in_place {
         Some(a.urdf.clone())
     } else {
@@ -243,11 +250,7 @@ pub fn fill(a: &FillArgs) -> ExitStatus {
         }
         None => {
             let mut out = std::io::stdout().lock();
-            if out
-                .write_all(text.as_bytes())
-                .and_then(|_| out.flush())
-                .is_err()
-            {
+            if out.write_all(&text).and_then(|_| out.flush()).is_err() {
                 return ExitStatus::Error;
             }
         }
@@ -508,7 +511,7 @@ pub fn check(a: &CheckArgs) -> ExitStatus {
                 continue;
             }
             if link.inertial.is_none() {
-                if !link.collisions.is_empty() {
+                if link.has_collision_geometry() {
                     report_line(
                         link.line,
                         &link.name,
@@ -518,11 +521,35 @@ pub fn check(a: &CheckArgs) -> ExitStatus {
                 continue;
             }
             let line = link.inertial.as_ref().map(|s| s.line).unwrap_or(link.line);
+            // Several <inertial> elements are a problem whatever the link: the file says two things.
+            let duplicates = fill::duplicate_inertials(link);
             for p in existing_problems(link) {
-                if link.collisions.is_empty() && !a.all_links {
+                if !link.has_collision_geometry() && !a.all_links && duplicates.as_ref() != Some(&p)
+                {
                     eprintln!("note: {}:{line}: link `{}` (no collision geometry, so fill cannot compute it): {p}", path.display(), link.name);
                 } else {
                     report_line(line, &link.name, &p);
+                }
+            }
+        }
+        if src.map.is_none() {
+            // Without densities nothing is computed, but a collision that cannot be is still an error.
+            for link in robot
+                .links
+                .iter()
+                .filter(|l| fill::selected(&l.name, &src.options))
+            {
+                for c in &link.collisions {
+                    if let Geometry::Invalid { line, message } = &c.geometry {
+                        eprintln!(
+                            "error: {}:{}: link `{}`: collision {} (line {line}): {message}",
+                            path.display(),
+                            link.line,
+                            link.name,
+                            c.index
+                        );
+                        errors += 1;
+                    }
                 }
             }
         }

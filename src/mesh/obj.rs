@@ -20,6 +20,9 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     let mut faces = Polygons::new();
     let mut face: Vec<u32> = Vec::new();
     let mut objects = 0usize;
+    // Faces with fewer than three vertices: how many, and the line of the first.
+    let mut degenerate: Option<usize> = None;
+    let mut degenerate_count = 0usize;
     let err =
         |line: usize, msg: String| MeshError::new(path, Some(line), MeshErrorKind::Syntax(msg));
     let mut pending = String::new();
@@ -89,8 +92,12 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
                     }
                     face.push(resolved as u32);
                 }
+                // A face of fewer than three vertices encloses nothing: skipped and counted, as other
+                // OBJ readers (assimp, tinyobjloader) do.
                 if face.len() < 3 {
-                    return Err(err(lineno, format!("a face with {} vertices", face.len())));
+                    degenerate.get_or_insert(lineno);
+                    degenerate_count += 1;
+                    continue;
                 }
                 faces.push(&face);
             }
@@ -105,9 +112,35 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
             "{objects} objects/groups, all counted as one solid"
         ));
     }
+    if let Some(line) = degenerate {
+        notes.push(format!(
+            "{degenerate_count} face(s) with fewer than three vertices skipped (the first on line {line})"
+        ));
+    }
     Ok(RawMesh {
         vertices,
         faces,
         notes,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    // Issue 11: a face with two vertices is skipped and counted, not the whole file's failure.
+    #[test]
+    fn degenerate_faces_are_skipped_with_a_note() {
+        let text =
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2\nf 1 2 4\nf 1 4 3\nf 3\nf 2 3 4\n";
+        let m = parse(text, Path::new("t.obj")).expect("degenerate faces are skipped");
+        assert_eq!(m.faces.len(), 4);
+        assert_eq!(
+            m.notes,
+            vec![
+                "2 face(s) with fewer than three vertices skipped (the first on line 6)"
+                    .to_string()
+            ]
+        );
+    }
 }

@@ -85,7 +85,13 @@ impl PackageResolver {
             });
         }
         let path = if let Some(rest) = uri.strip_prefix("file://") {
-            let p = PathBuf::from(rest);
+            // As ROS's resource_retriever (curl) reads it: `file://localhost/…` is `file:///…`, and
+            // percent escapes (`my%20robot`) are decoded.
+            let rest = rest
+                .strip_prefix("localhost")
+                .filter(|r| r.starts_with('/'))
+                .unwrap_or(rest);
+            let p = PathBuf::from(percent_decode(rest));
             if p.is_absolute() {
                 p
             } else {
@@ -158,6 +164,31 @@ impl PackageResolver {
         }
         out
     }
+}
+
+/// Decodes `%XX` escapes (an invalid escape stays as it is). Bytes that do not form UTF-8 are replaced.
+pub fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        match (
+            b[i],
+            b.get(i + 1).and_then(|&c| hex(c)),
+            b.get(i + 2).and_then(|&c| hex(c)),
+        ) {
+            (b'%', Some(h), Some(l)) => {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+            }
+            (c, _, _) => {
+                out.push(c);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8(out).unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned())
 }
 
 /// Whether `dir` is package `pkg`: its `package.xml` names it, or the directory has the package's name.
@@ -235,6 +266,24 @@ mod tests {
             .unwrap_err()
             .hint
             .contains("xacro"));
+        // file:// percent-decoded, as resource_retriever does (issue 11).
+        let spaced = tmp.path().join("my robot");
+        std::fs::create_dir_all(&spaced).expect("mkdir");
+        std::fs::write(spaced.join("part one.stl"), "solid x\nendsolid x\n").expect("write");
+        let uri = format!("file://{}/my%20robot/part%20one.stl", tmp.path().display());
+        assert_eq!(
+            r.resolve(&uri, &urdf).expect("percent"),
+            spaced.join("part one.stl")
+        );
+        let uri = format!(
+            "file://localhost{}/my%20robot/part%20one.stl",
+            tmp.path().display()
+        );
+        assert_eq!(
+            r.resolve(&uri, &urdf).expect("localhost"),
+            spaced.join("part one.stl")
+        );
+        assert_eq!(percent_decode("a%2"), "a%2");
         let nf = r.resolve("package://nope/meshes/a.stl", &urdf).unwrap_err();
         assert!(nf.hint.contains("--package-path nope=DIR"));
     }

@@ -1,12 +1,23 @@
 //! A one-pass scan of a URDF: links, their collisions, their existing `<inertial>` and the byte spans
 //! the writer needs.
+//!
+//! It reads what urdfdom (behind ROS, Gazebo, MoveIt, pinocchio) reads: the first `<inertial>` of a link,
+//! the first `<origin>` and `<geometry>` of a collision and the first child element of `<geometry>`;
+//! later ones are ignored with a warning. Zero-size primitives are valid (they have no volume). Anything
+//! wrong inside one collision (an unknown shape, a bad number) is that collision's
+//! [`Geometry::Invalid`], the link's failure, not the file's; malformed XML and duplicate link names
+//! are the file's.
 
+use crate::mass::primitives;
 use crate::text::LineCounter;
+use quick_xml::events::attributes::AttrError;
 use quick_xml::events::{BytesStart, Event};
 use quick_xml::reader::Reader;
 use std::collections::HashMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
+
+pub use super::encoding::SourceEncoding;
 
 /// A pose: translation and URDF roll-pitch-yaw (fixed axes X, Y, Z).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -18,11 +29,48 @@ pub struct Pose {
 /// A collision geometry as the URDF gives it.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Geometry {
-    Mesh { filename: String, scale: [f64; 3] },
-    Box { size: [f64; 3] },
-    Cylinder { radius: f64, length: f64 },
-    Sphere { radius: f64 },
-    Capsule { radius: f64, length: f64 },
+    Mesh {
+        filename: String,
+        scale: [f64; 3],
+    },
+    Box {
+        size: [f64; 3],
+    },
+    Cylinder {
+        radius: f64,
+        length: f64,
+    },
+    Sphere {
+        radius: f64,
+    },
+    Capsule {
+        radius: f64,
+        length: f64,
+    },
+    /// A collision that cannot be computed (an unknown shape, a bad or overflowing number): the failure
+    /// of its link only. `line` is where the problem is.
+    Invalid {
+        line: usize,
+        message: String,
+    },
+}
+
+impl Geometry {
+    /// Whether this is a primitive without volume (`<sphere radius="0"/>`, `<box size="0 0 0"/>`, a
+    /// zero-length cylinder): valid URDF that contributes nothing.
+    pub fn is_zero_size(&self) -> bool {
+        match self {
+            Geometry::Box { size } => primitives::cuboid(*size, 1.0).mass == 0.0,
+            Geometry::Cylinder { radius, length } => {
+                primitives::cylinder(*radius, *length, 1.0).mass == 0.0
+            }
+            Geometry::Sphere { radius } => primitives::sphere(*radius, 1.0).mass == 0.0,
+            Geometry::Capsule { radius, length } => {
+                primitives::capsule(*radius, *length, 1.0).mass == 0.0
+            }
+            Geometry::Mesh { .. } | Geometry::Invalid { .. } => false,
+        }
+    }
 }
 
 /// One `<collision>` of a link.
@@ -70,8 +118,62 @@ pub struct Link {
     pub indent: String,
     /// Whitespace before the link's first child element on its line, if the link has children on lines of their own.
     pub child_indent: Option<String>,
+    /// The first `<inertial>`: the one urdfdom reads.
     pub inertial: Option<InertialSpan>,
+    /// Further `<inertial>` elements, which urdfdom ignores (only their spans are read: `fill` removes them).
+    pub extra_inertials: Vec<InertialSpan>,
     pub collisions: Vec<Collision>,
+}
+
+impl Link {
+    /// Whether the link has collision geometry to compute (or to fail on): a collision that is not a
+    /// zero-size primitive. A link with none is left as it is, like a frame without collisions.
+    pub fn has_collision_geometry(&self) -> bool {
+        self.collisions.iter().any(|c| !c.geometry.is_zero_size())
+    }
+}
+
+/// How much a scan note matters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NoteLevel {
+    /// Something urdfdom reads differently from what the file seems to say (an ignored duplicate).
+    Warning,
+    /// Information (a zero-size part, xacro in the file).
+    Note,
+}
+
+/// Something the scan noticed that does not stop the robot from being read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScanNote {
+    pub level: NoteLevel,
+    pub line: usize,
+    /// The link, if the note is about one.
+    pub link: Option<String>,
+    pub message: String,
+}
+
+impl ScanNote {
+    /// `warning: PATH:LINE: link `NAME`: MESSAGE`.
+    pub fn render(&self, path: &Path) -> String {
+        let level = match self.level {
+            NoteLevel::Warning => "warning",
+            NoteLevel::Note => "note",
+        };
+        match &self.link {
+            Some(l) => format!(
+                "{level}: {}:{}: link `{l}`: {}",
+                path.display(),
+                self.line,
+                self.message
+            ),
+            None => format!(
+                "{level}: {}:{}: {}",
+                path.display(),
+                self.line,
+                self.message
+            ),
+        }
+    }
 }
 
 /// A scanned URDF.
@@ -79,10 +181,15 @@ pub struct Link {
 pub struct Robot {
     pub path: PathBuf,
     pub name: String,
+    /// The file's text, decoded to UTF-8 (see [`SourceEncoding`]).
     pub text: String,
     pub links: Vec<Link>,
     /// "\r\n" when the file uses CRLF line endings.
     pub newline: &'static str,
+    /// The file's encoding, to write it back in.
+    pub encoding: SourceEncoding,
+    /// Warnings and notes, in file order.
+    pub notes: Vec<ScanNote>,
 }
 
 /// Why a URDF cannot be read.
@@ -123,9 +230,24 @@ pub fn line_col(text: &str, pos: usize) -> (usize, usize) {
     (line, col)
 }
 
-fn attrs(e: &BytesStart<'_>) -> HashMap<String, String> {
+/// The attributes of a start tag. A duplicate or malformed attribute is malformed XML (urdfdom's
+/// TinyXML refuses the file): its offset in the tag (after `<`) and the message.
+fn attrs(e: &BytesStart<'_>) -> Result<HashMap<String, String>, (usize, String)> {
     let mut m = HashMap::new();
-    for a in e.attributes().with_checks(false).flatten() {
+    for a in e.attributes().with_checks(true) {
+        let a = a.map_err(|err| match err {
+            AttrError::Duplicated(at, _) => {
+                let key: String = String::from_utf8_lossy(e.get(at..).unwrap_or_default())
+                    .chars()
+                    .take_while(|c| *c != '=' && !c.is_whitespace())
+                    .collect();
+                (at, format!("attribute `{key}` is given twice in <{}>; an attribute may appear once (which value is meant?)", String::from_utf8_lossy(e.name().as_ref())))
+            }
+            AttrError::ExpectedEq(at)
+            | AttrError::ExpectedValue(at)
+            | AttrError::UnquotedValue(at)
+            | AttrError::ExpectedQuote(at, _) => (at, format!("malformed attribute: {err}")),
+        })?;
         let key = String::from_utf8_lossy(a.key.as_ref()).into_owned();
         let v = a
             .unescape_value()
@@ -133,7 +255,7 @@ fn attrs(e: &BytesStart<'_>) -> HashMap<String, String> {
             .unwrap_or_else(|_| String::from_utf8_lossy(&a.value).into_owned());
         m.insert(key, v);
     }
-    m
+    Ok(m)
 }
 
 fn indent_before(text: &str, pos: usize) -> Option<String> {
@@ -145,21 +267,76 @@ fn indent_before(text: &str, pos: usize) -> Option<String> {
         None
     }
 }
+/// Adds the xacro hint to a message that holds an unexpanded `${…}` or `$(…)`.
+fn xacro_hint(message: String) -> String {
+    if message.contains("${") || message.contains("$(") {
+        format!("{message} (an unexpanded xacro expression: run `xacro FILE.urdf.xacro > FILE.urdf` first)")
+    } else {
+        message
+    }
+}
+
+/// Decodes a URDF file's bytes (see [`super::encoding`]) and scans the text.
+pub fn scan_bytes(bytes: Vec<u8>, path: &Path) -> Result<Robot, UrdfError> {
+    let (text, encoding) = match super::encoding::decode(bytes) {
+        Ok(d) => d,
+        Err(e) => {
+            return Err(UrdfError {
+                path: path.to_path_buf(),
+                line: e.line,
+                column: e.column,
+                message: e.message,
+            })
+        }
+    };
+    let mut robot = scan(text, path)?;
+    robot.encoding = encoding;
+    Ok(robot)
+}
+
+/// The `<collision>` being read.
+struct CollisionInProgress {
+    index: usize,
+    line: usize,
+    name: Option<String>,
+    origin: Pose,
+    /// Line of the first `<origin>` (the one urdfdom reads).
+    origin_line: Option<usize>,
+    /// `<geometry>` elements seen so far.
+    geometries: usize,
+    /// The first child element of the first `<geometry>`: what it became, its name and line.
+    shape: Option<(Geometry, String, usize)>,
+    /// A problem with the collision's own `<origin>` (a [`Geometry::Invalid`]).
+    error: Option<Geometry>,
+}
+
+/// The `<inertial>` being read.
+struct InertialInProgress {
+    span: InertialSpan,
+    /// Whether it is the link's first (only the first is read).
+    first: bool,
+    /// Lines of the `<origin>`, `<mass>` and `<inertia>` read so far.
+    seen: HashMap<String, usize>,
+}
+
+fn warning(line: usize, link: &Option<Link>, message: String) -> ScanNote {
+    ScanNote {
+        level: NoteLevel::Warning,
+        line,
+        link: link.as_ref().map(|l| l.name.clone()),
+        message,
+    }
+}
 
 /// Scans URDF text. `path` is used in messages and for resolving relative mesh paths.
 pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
     let err = |pos: usize, message: String| {
         let (line, column) = line_col(&text, pos);
-        let message = if message.contains("${") || message.contains("$(") {
-            format!("{message} (an unexpanded xacro expression: run `xacro FILE.urdf.xacro > FILE.urdf` first)")
-        } else {
-            message
-        };
         UrdfError {
             path: path.to_path_buf(),
             line,
             column,
-            message,
+            message: xacro_hint(message),
         }
     };
     // quick-xml does not count a UTF-8 byte-order mark in its positions: read after it and add it back.
@@ -175,9 +352,14 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
     let mut robot_name: Option<String> = None;
     let mut links: Vec<Link> = Vec::new();
     let mut current: Option<Link> = None;
-    let mut collision: CollisionInProgress = None;
-    let mut inertial: Option<InertialSpan> = None;
+    let mut collision: Option<CollisionInProgress> = None;
+    let mut inertial: Option<InertialInProgress> = None;
     let mut seen: HashMap<String, usize> = HashMap::new();
+    let mut notes: Vec<ScanNote> = Vec::new();
+    // Line of the first sign of xacro (xmlns:xacro on the root, a <xacro:…> element).
+    let mut xacro: Option<usize> = None;
+    // Line of the root if it declares xmlns:xacro (xacro's own output keeps the declaration).
+    let mut xacro_namespace: Option<usize> = None;
 
     loop {
         let pos = bom + reader.buffer_position() as usize;
@@ -198,16 +380,17 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
                 let end = bom + reader.buffer_position() as usize;
                 match (stack.len(), name.as_str()) {
                     (1, "link") => {
-                        if let Some(mut link) = current.take() {
-                            link.inertial = link.inertial.take();
-                            links.push(link);
+                        if let Some(link) = current.take() {
+                            finish_link(link, &mut links, &mut notes);
                         }
                     }
-                    (2, "collision") => finish_collision(&mut collision, &mut current),
+                    (2, "collision") => {
+                        finish_collision(collision.take(), &mut current, &mut notes)
+                    }
                     (2, "inertial") => {
-                        if let (Some(mut span), Some(link)) = (inertial.take(), current.as_mut()) {
-                            span.end = end;
-                            link.inertial = Some(span);
+                        if let Some(mut i) = inertial.take() {
+                            i.span.end = end;
+                            finish_inertial(i, &mut current, &mut notes);
                         }
                     }
                     _ => {}
@@ -219,15 +402,23 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
         };
         let name = String::from_utf8_lossy(e.name().as_ref()).into_owned();
         let depth = stack.len();
-        let a = attrs(&e);
+        let a = attrs(&e).map_err(|(at, m)| err(pos + 1 + at, m))?;
+        let line = lines.at(pos);
+        if name.starts_with("xacro:") {
+            xacro.get_or_insert(line);
+        }
         match (depth, name.as_str()) {
-            (0, "robot") => robot_name = Some(a.get("name").cloned().unwrap_or_default()),
+            (0, "robot") => {
+                robot_name = Some(a.get("name").cloned().unwrap_or_default());
+                if a.contains_key("xmlns:xacro") {
+                    xacro_namespace = Some(line);
+                }
+            }
             (0, other) => return Err(err(pos, format!("the root element is <{other}>, not <robot>: this is not a URDF (run xacro first if it is a .xacro file)"))),
             (1, "link") => {
                 let lname = a.get("name").cloned().ok_or_else(|| err(pos, "<link> without a name".into()))?;
-                let line = lines.at(pos);
                 if let Some(first) = seen.insert(lname.clone(), line) {
-                    return Err(err(pos, format!("duplicate link name `{lname}` (first defined on line {first}); link names must be unique")));
+                    return Err(err(pos, format!("duplicate link name `{lname}` on lines {first} and {line}; link names must be unique (urdfdom refuses the file too)")));
                 }
                 let link = Link {
                     name: lname,
@@ -238,10 +429,11 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
                     indent: indent_before(&text, pos).unwrap_or_default(),
                     child_indent: None,
                     inertial: None,
+                    extra_inertials: Vec::new(),
                     collisions: Vec::new(),
                 };
                 if empty {
-                    links.push(link);
+                    finish_link(link, &mut links, &mut notes);
                 } else {
                     current = Some(link);
                 }
@@ -255,20 +447,28 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
                 match child {
                     "collision" => {
                         let index = current.as_ref().map(|l| l.collisions.len() + 1).unwrap_or(1);
-                        collision = Some((index, lines.at(pos), a.get("name").cloned(), Pose::default(), None));
+                        collision = Some(CollisionInProgress {
+                            index,
+                            line,
+                            name: a.get("name").cloned(),
+                            origin: Pose::default(),
+                            origin_line: None,
+                            geometries: 0,
+                            shape: None,
+                            error: None,
+                        });
                         if empty {
-                            finish_collision(&mut collision, &mut current);
+                            finish_collision(collision.take(), &mut current, &mut notes);
                         }
                     }
                     "inertial" => {
-                        let line = lines.at(pos);
+                        let first = current.as_ref().is_some_and(|l| l.inertial.is_none());
                         let span = InertialSpan { start: pos, end: bom + reader.buffer_position() as usize, line, value: Inertial::default(), problem: None };
+                        let i = InertialInProgress { span, first, seen: HashMap::new() };
                         if empty {
-                            if let Some(link) = current.as_mut() {
-                                link.inertial = Some(span);
-                            }
+                            finish_inertial(i, &mut current, &mut notes);
                         } else {
-                            inertial = Some(span);
+                            inertial = Some(i);
                         }
                     }
                     _ => {}
@@ -276,28 +476,66 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
             }
             (3, "origin") if stack[2] == "collision" => {
                 if let Some(c) = collision.as_mut() {
-                    c.3 = pose(&a).map_err(|m| err(pos, format!("link `{}`: collision origin: {m}", link_name(&current))))?;
+                    match c.origin_line {
+                        None => {
+                            c.origin_line = Some(line);
+                            match pose(&a) {
+                                Ok(p) => c.origin = p,
+                                Err(m) => c.error = Some(Geometry::Invalid { line, message: xacro_hint(format!("<origin> {m}")) }),
+                            }
+                        }
+                        Some(first) => notes.push(warning(line, &current, format!("collision {}: a second <origin> is ignored (urdfdom reads the first, on line {first}); remove one", c.index))),
+                    }
+                }
+            }
+            (3, "geometry") if stack[2] == "collision" => {
+                if let Some(c) = collision.as_mut() {
+                    c.geometries += 1;
+                    if c.geometries > 1 {
+                        notes.push(warning(line, &current, format!("collision {}: a second <geometry> is ignored (urdfdom reads the first); give each shape its own <collision>", c.index)));
+                    }
                 }
             }
             (4, g) if stack[2] == "collision" && stack[3] == "geometry" => {
-                if let Some(c) = collision.as_mut() {
-                    let lname = link_name(&current);
-                    c.4 = Some(geometry(g, &a).map_err(|m| err(pos, format!("link `{lname}`, collision {}: {m}", c.0)))?);
+                if let Some(c) = collision.as_mut().filter(|c| c.geometries == 1) {
+                    match &c.shape {
+                        None => {
+                            let geometry = if g == "origin" {
+                                Geometry::Invalid { line, message: "<origin> is the first element of <geometry>, where the shape (box, cylinder, sphere, capsule or mesh) must be, so urdfdom refuses this collision; move the <origin> into <collision>, before <geometry>".into() }
+                            } else {
+                                geometry(g, &a).unwrap_or_else(|m| Geometry::Invalid { line, message: xacro_hint(m) })
+                            };
+                            c.shape = Some((geometry, g.to_string(), line));
+                        }
+                        Some((_, first, first_line)) => {
+                            let message = if g == "origin" {
+                                format!("collision {}: <origin> inside <geometry> is ignored (as urdfdom does): an origin belongs in <collision>, before <geometry>", c.index)
+                            } else {
+                                format!("collision {}: a second shape <{g}> in <geometry> is ignored (urdfdom reads only the first, <{first}> on line {first_line}); give each shape its own <collision>", c.index)
+                            };
+                            notes.push(warning(line, &current, message));
+                        }
+                    }
                 }
             }
-            (3, child) if stack[2] == "inertial" => {
-                if let Some(span) = inertial.as_mut() {
-                    let r = match child {
-                        "origin" => pose(&a).map(|p| span.value.origin = p),
-                        "mass" => num(&a, "value").map(|m| span.value.mass = Some(m)),
-                        "inertia" => (|| {
-                            Ok([num(&a, "ixx")?, num(&a, "ixy")?, num(&a, "ixz")?, num(&a, "iyy")?, num(&a, "iyz")?, num(&a, "izz")?])
-                        })()
-                        .map(|i| span.value.inertia = Some(i)),
-                        _ => Ok(()),
-                    };
-                    if let Err(m) = r {
-                        span.problem.get_or_insert(format!("line {}: <{child}>: {m}", lines.at(pos)));
+            (3, child @ ("origin" | "mass" | "inertia")) if stack[2] == "inertial" => {
+                if let Some(i) = inertial.as_mut().filter(|i| i.first) {
+                    if let Some(first) = i.seen.get(child) {
+                        notes.push(warning(line, &current, format!("a second <{child}> in <inertial> is ignored (urdfdom reads the first, on line {first})")));
+                    } else {
+                        i.seen.insert(child.to_string(), line);
+                        let span = &mut i.span;
+                        let r = match child {
+                            "origin" => pose(&a).map(|p| span.value.origin = p),
+                            "mass" => num(&a, "value").map(|m| span.value.mass = Some(m)),
+                            _ => (|| {
+                                Ok([num(&a, "ixx")?, num(&a, "ixy")?, num(&a, "ixz")?, num(&a, "iyy")?, num(&a, "iyz")?, num(&a, "izz")?])
+                            })()
+                            .map(|i| span.value.inertia = Some(i)),
+                        };
+                        if let Err(m) = r {
+                            span.problem.get_or_insert(format!("line {line}: <{child}>: {m}"));
+                        }
                     }
                 }
             }
@@ -317,6 +555,21 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
             ),
         ));
     }
+    let xacro_note = match (xacro, xacro_namespace) {
+        (Some(line), _) => Some((line, "this file uses xacro (<xacro:…> elements): links inside xacro macros are not seen and ${…} expressions are not expanded; run `xacro FILE.urdf.xacro > FILE.urdf` first and give urdf-inertia the result")),
+        // xacro's output keeps the declaration, so most expanded URDFs have it: a softer note.
+        (None, Some(line)) => Some((line, "the root declares xmlns:xacro: if this is a xacro source rather than xacro's output, links inside its macros are not seen; run `xacro FILE.urdf.xacro > FILE.urdf` first")),
+        (None, None) => None,
+    };
+    if let Some((line, message)) = xacro_note {
+        notes.push(ScanNote {
+            level: NoteLevel::Note,
+            line,
+            link: None,
+            message: message.into(),
+        });
+    }
+    notes.sort_by_key(|n| n.line);
     let newline = if text.contains("\r\n") { "\r\n" } else { "\n" };
     Ok(Robot {
         path: path.to_path_buf(),
@@ -324,35 +577,127 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
         text,
         links,
         newline,
+        encoding: SourceEncoding::Utf8,
+        notes,
     })
 }
 
-fn link_name(link: &Option<Link>) -> String {
-    link.as_ref().map(|l| l.name.clone()).unwrap_or_default()
+/// A short description of a geometry for messages: `box 1 2 3`, `sphere radius 0`.
+pub fn describe(g: &Geometry) -> String {
+    let n = crate::cli::shortest;
+    match g {
+        Geometry::Mesh { filename, .. } => format!("mesh {filename}"),
+        Geometry::Box { size } => format!("box size {} {} {}", n(size[0]), n(size[1]), n(size[2])),
+        Geometry::Cylinder { radius, length } => {
+            format!("cylinder radius {} length {}", n(*radius), n(*length))
+        }
+        Geometry::Sphere { radius } => format!("sphere radius {}", n(*radius)),
+        Geometry::Capsule { radius, length } => {
+            format!("capsule radius {} length {}", n(*radius), n(*length))
+        }
+        Geometry::Invalid { message, .. } => message.clone(),
+    }
 }
 
-type CollisionInProgress = Option<(usize, usize, Option<String>, Pose, Option<Geometry>)>;
+/// Ends a link: notes for its zero-size parts, then into the list.
+fn finish_link(link: Link, links: &mut Vec<Link>, notes: &mut Vec<ScanNote>) {
+    let zero: Vec<&Collision> = link
+        .collisions
+        .iter()
+        .filter(|c| c.geometry.is_zero_size())
+        .collect();
+    let note = |line: usize, message: String| ScanNote {
+        level: NoteLevel::Note,
+        line,
+        link: Some(link.name.clone()),
+        message,
+    };
+    if !zero.is_empty() && !link.has_collision_geometry() {
+        let parts: Vec<String> = zero
+            .iter()
+            .map(|c| format!("collision {}: {}", c.index, describe(&c.geometry)))
+            .collect();
+        notes.push(note(link.line, format!("its collision geometry has no volume ({}): the link is left as it is, like a link without collision geometry", parts.join("; "))));
+    } else {
+        for c in zero {
+            notes.push(note(
+                c.line,
+                format!(
+                    "collision {}: {} has no volume and contributes nothing",
+                    c.index,
+                    describe(&c.geometry)
+                ),
+            ));
+        }
+    }
+    links.push(link);
+}
 
-/// Ends the `<collision>` being read. One without geometry (urdfdom rejects it; some generators emit
-/// it) contributes nothing.
-fn finish_collision(collision: &mut CollisionInProgress, current: &mut Option<Link>) {
-    if let (Some((index, line, name, origin, Some(geometry))), Some(link)) =
-        (collision.take(), current.as_mut())
-    {
-        link.collisions.push(Collision {
-            index,
-            name,
-            line,
-            origin,
-            geometry,
+/// Ends the `<collision>` being read. One without a shape (urdfdom refuses it; some generators emit it)
+/// contributes nothing, with a warning.
+fn finish_collision(
+    collision: Option<CollisionInProgress>,
+    current: &mut Option<Link>,
+    notes: &mut Vec<ScanNote>,
+) {
+    let (Some(c), Some(link)) = (collision, current.as_mut()) else {
+        return;
+    };
+    let geometry = match (c.error, c.shape) {
+        (Some(e), _) => e,
+        (None, Some((g, _, _))) => g,
+        (None, None) => {
+            let what = if c.geometries == 0 {
+                "has no <geometry>"
+            } else {
+                "has an empty <geometry>"
+            };
+            notes.push(ScanNote {
+                level: NoteLevel::Warning,
+                line: c.line,
+                link: Some(link.name.clone()),
+                message: format!(
+                    "a collision {what}: it is ignored (urdfdom refuses such a collision)"
+                ),
+            });
+            return;
+        }
+    };
+    link.collisions.push(Collision {
+        index: c.index,
+        name: c.name,
+        line: c.line,
+        origin: c.origin,
+        geometry,
+    });
+}
+
+/// Ends an `<inertial>`: the first is the link's, later ones are kept only to be removed by `fill`.
+fn finish_inertial(i: InertialInProgress, current: &mut Option<Link>, notes: &mut Vec<ScanNote>) {
+    let Some(link) = current.as_mut() else {
+        return;
+    };
+    if i.first {
+        link.inertial = Some(i.span);
+    } else {
+        let first = link.inertial.as_ref().map(|s| s.line).unwrap_or(link.line);
+        notes.push(ScanNote {
+            level: NoteLevel::Warning,
+            line: i.span.line,
+            link: Some(link.name.clone()),
+            message: format!("a second <inertial> is ignored (urdfdom reads the first, on line {first}); `fill` replaces them all with one"),
         });
+        link.extra_inertials.push(i.span);
     }
 }
 
 fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
     let v: Vec<&str> = s.split_ascii_whitespace().collect();
     if v.len() != 3 {
-        return Err(format!("\"{s}\" should be three numbers"));
+        return Err(format!(
+            "\"{s}\" should be three numbers, not {} (urdfdom refuses it)",
+            v.len()
+        ));
     }
     let mut out = [0.0; 3];
     for (o, w) in out.iter_mut().zip(v) {
@@ -390,17 +735,20 @@ fn num(a: &HashMap<String, String>, key: &str) -> Result<f64, String> {
         .map_err(|_| format!("{key}=\"{s}\" is not a number"))
 }
 
-fn positive(a: &HashMap<String, String>, key: &str) -> Result<f64, String> {
+/// A primitive's size: finite and not negative (zero is valid URDF).
+fn size(a: &HashMap<String, String>, key: &str) -> Result<f64, String> {
     let v = num(a, key)?;
-    if v > 0.0 && v.is_finite() {
-        Ok(v)
+    if !v.is_finite() {
+        Err(format!("{key}=\"{v}\" is not a finite number"))
+    } else if v < 0.0 {
+        Err(format!("{key}=\"{v}\" must not be negative"))
     } else {
-        Err(format!("{key}=\"{v}\" must be a positive number"))
+        Ok(v)
     }
 }
 
 fn geometry(kind: &str, a: &HashMap<String, String>) -> Result<Geometry, String> {
-    Ok(match kind {
+    let g = match kind {
         "mesh" => {
             let filename = a
                 .get("filename")
@@ -415,9 +763,12 @@ fn geometry(kind: &str, a: &HashMap<String, String>) -> Result<Geometry, String>
                         let x: f64 = v[0]
                             .parse()
                             .map_err(|_| format!("scale \"{s}\" is not a number"))?;
+                        if !x.is_finite() {
+                            return Err(format!("scale \"{s}\" is not finite"));
+                        }
                         [x; 3]
                     } else {
-                        parse_vec3(s).map_err(|m| format!("scale {m}"))?
+                        parse_vec3(s).map_err(|m| format!("mesh scale {m}"))?
                     }
                 }
             };
@@ -427,32 +778,52 @@ fn geometry(kind: &str, a: &HashMap<String, String>) -> Result<Geometry, String>
                     scale[0], scale[1], scale[2]
                 ));
             }
-            Geometry::Mesh { filename, scale }
+            return Ok(Geometry::Mesh { filename, scale });
         }
         "box" => {
             let size = parse_vec3(a.get("size").ok_or("<box> without size")?)
                 .map_err(|m| format!("box size {m}"))?;
-            if size.iter().any(|x| *x <= 0.0) {
+            if size.iter().any(|x| *x < 0.0) {
                 return Err(format!(
-                    "box size \"{} {} {}\" must be positive",
+                    "box size \"{} {} {}\" must not be negative",
                     size[0], size[1], size[2]
                 ));
             }
             Geometry::Box { size }
         }
         "cylinder" => Geometry::Cylinder {
-            radius: positive(a, "radius")?,
-            length: positive(a, "length")?,
+            radius: size(a, "radius")?,
+            length: size(a, "length")?,
         },
         "capsule" => Geometry::Capsule {
-            radius: positive(a, "radius")?,
-            length: positive(a, "length")?,
+            radius: size(a, "radius")?,
+            length: size(a, "length")?,
         },
         "sphere" => Geometry::Sphere {
-            radius: positive(a, "radius")?,
+            radius: size(a, "radius")?,
         },
-        other => return Err(format!("unknown geometry <{other}>")),
-    })
+        other => {
+            return Err(format!(
+                "unknown geometry <{other}> (urdfdom refuses it too); give this collision a <box>, <cylinder>, <sphere>, <capsule> or <mesh>"
+            ))
+        }
+    };
+    // A finite size can still overflow the volume or inertia (a box of 1e120 m): refuse it here.
+    let unit = match &g {
+        Geometry::Box { size } => primitives::cuboid(*size, 1.0),
+        Geometry::Cylinder { radius, length } => primitives::cylinder(*radius, *length, 1.0),
+        Geometry::Capsule { radius, length } => primitives::capsule(*radius, *length, 1.0),
+        Geometry::Sphere { radius } => primitives::sphere(*radius, 1.0),
+        Geometry::Mesh { .. } | Geometry::Invalid { .. } => return Ok(g),
+    };
+    if unit.mass.is_finite() && unit.inertia.iter().flatten().all(|x| x.is_finite()) {
+        Ok(g)
+    } else {
+        Err(format!(
+            "{} is too large: its volume or inertia overflows a 64-bit float (check the units: metres)",
+            describe(&g)
+        ))
+    }
 }
 
 #[cfg(test)]
@@ -512,11 +883,195 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.message.contains("duplicate link name `a`"), "{e}");
-        let e = scan("<robot name=\"r\"><link name=\"a\"><collision><origin xyz=\"${x} 0 0\"/><geometry><box size=\"1 1 1\"/></geometry></collision></link></robot>".into(), Path::new("x.urdf")).unwrap_err();
-        assert!(e.message.contains("unexpanded xacro"), "{e}");
         let e = scan("<sdf/>".into(), Path::new("x.urdf")).unwrap_err();
         assert!(e.message.contains("not a URDF"), "{e}");
-        let e = scan("<robot name=\"r\"><link name=\"a\"><collision><geometry><mesh filename=\"m.stl\" scale=\"1 x 1\"/></geometry></collision></link></robot>".into(), Path::new("x.urdf")).unwrap_err();
-        assert!(e.message.contains("link `a`, collision 1: scale"), "{e}");
+    }
+
+    /// The geometry of each collision of link `name`.
+    fn geometries(r: &Robot, name: &str) -> Vec<Geometry> {
+        r.links
+            .iter()
+            .find(|l| l.name == name)
+            .map(|l| l.collisions.iter().map(|c| c.geometry.clone()).collect())
+            .unwrap_or_default()
+    }
+
+    fn invalid(g: &Geometry) -> (usize, String) {
+        match g {
+            Geometry::Invalid { line, message } => (*line, message.clone()),
+            other => panic!("expected Invalid, got {other:?}"),
+        }
+    }
+
+    // Issue 11: a problem inside one collision is that link's, not the file's.
+    #[test]
+    fn bad_collisions_fail_their_link_only() {
+        let text = "<robot name=\"r\">\n<link name=\"plane\"><collision><geometry><plane normal=\"0 0 1\"/></geometry></collision></link>\n<link name=\"scale\"><collision><geometry><mesh filename=\"m.stl\" scale=\"1 1 1 1\"/></geometry></collision></link>\n<link name=\"neg\"><collision><geometry><cylinder radius=\"-1\" length=\"1\"/></geometry></collision></link>\n<link name=\"nan\"><collision><geometry><sphere radius=\"nan\"/></geometry></collision></link>\n<link name=\"huge\"><collision><geometry><box size=\"1e120 1e120 1e120\"/></geometry></collision></link>\n<link name=\"xacro\"><collision><origin xyz=\"${x} 0 0\"/><geometry><box size=\"1 1 1\"/></geometry></collision></link>\n<link name=\"good\"><collision><geometry><box size=\"1 2 3\"/></geometry></collision></link>\n</robot>\n";
+        let r =
+            scan(text.into(), Path::new("x.urdf")).expect("one bad link does not refuse the file");
+        let (line, m) = invalid(&geometries(&r, "plane")[0]);
+        assert_eq!(line, 2);
+        assert!(m.contains("unknown geometry <plane>"), "{m}");
+        let (line, m) = invalid(&geometries(&r, "scale")[0]);
+        assert_eq!(line, 3);
+        assert!(m.contains("should be three numbers, not 4"), "{m}");
+        assert!(invalid(&geometries(&r, "neg")[0])
+            .1
+            .contains("radius=\"-1\" must not be negative"));
+        assert!(invalid(&geometries(&r, "nan")[0])
+            .1
+            .contains("not a finite number"));
+        let (_, m) = invalid(&geometries(&r, "huge")[0]);
+        assert!(m.contains("overflows"), "{m}");
+        assert!(invalid(&geometries(&r, "xacro")[0])
+            .1
+            .contains("unexpanded xacro"));
+        assert_eq!(
+            geometries(&r, "good"),
+            vec![Geometry::Box {
+                size: [1.0, 2.0, 3.0]
+            }]
+        );
+    }
+
+    // Issue 11: urdfdom reads the first <inertial>, <origin>, <geometry> and shape; later ones warn.
+    #[test]
+    fn the_first_of_repeated_elements_wins() {
+        let text = "<robot name=\"r\">\n<link name=\"a\">\n<inertial><mass value=\"1\"/><mass value=\"5\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial>\n<inertial><mass value=\"2\"/></inertial>\n<collision>\n<origin xyz=\"1 0 0\"/>\n<origin xyz=\"2 0 0\"/>\n<geometry><box size=\"1 1 1\"/><sphere radius=\"3\"/>\n<origin xyz=\"5 5 5\"/></geometry>\n<geometry><sphere radius=\"4\"/></geometry>\n</collision>\n</link>\n</robot>\n";
+        let r = scan(text.into(), Path::new("x.urdf")).expect("scan");
+        let a = &r.links[0];
+        let first = a.inertial.as_ref().expect("inertial");
+        assert_eq!((first.line, first.value.mass), (3, Some(1.0)));
+        assert_eq!(a.extra_inertials.len(), 1);
+        assert_eq!(
+            &text[a.extra_inertials[0].start..a.extra_inertials[0].end],
+            "<inertial><mass value=\"2\"/></inertial>"
+        );
+        assert_eq!(a.collisions.len(), 1);
+        assert_eq!(a.collisions[0].origin.xyz, [1.0, 0.0, 0.0]);
+        assert_eq!(a.collisions[0].geometry, Geometry::Box { size: [1.0; 3] });
+        let notes: Vec<(usize, &str)> = r
+            .notes
+            .iter()
+            .map(|n| (n.line, n.message.as_str()))
+            .collect();
+        let has =
+            |line: usize, what: &str| notes.iter().any(|(l, m)| *l == line && m.contains(what));
+        assert!(
+            has(3, "a second <mass> in <inertial> is ignored"),
+            "{notes:?}"
+        );
+        assert!(
+            has(
+                4,
+                "a second <inertial> is ignored (urdfdom reads the first, on line 3)"
+            ),
+            "{notes:?}"
+        );
+        assert!(
+            has(
+                7,
+                "a second <origin> is ignored (urdfdom reads the first, on line 6)"
+            ),
+            "{notes:?}"
+        );
+        assert!(has(8, "a second shape <sphere>"), "{notes:?}");
+        assert!(
+            has(9, "<origin> inside <geometry> is ignored") && has(9, "belongs in <collision>"),
+            "{notes:?}"
+        );
+        assert!(has(10, "a second <geometry> is ignored"), "{notes:?}");
+        assert!(r
+            .notes
+            .iter()
+            .all(|n| n.level == NoteLevel::Warning && n.link.as_deref() == Some("a")));
+        // An <origin> where the shape should be is what urdfdom refuses: that collision's failure.
+        let r = scan("<robot name=\"r\"><link name=\"a\"><collision><geometry><origin/><box size=\"1 1 1\"/></geometry></collision></link></robot>".into(), Path::new("x.urdf")).expect("scan");
+        assert!(invalid(&geometries(&r, "a")[0])
+            .1
+            .contains("move the <origin> into <collision>"));
+    }
+
+    // Issue 11: zero-size primitives are valid URDF; a link left without volume has no collision geometry.
+    #[test]
+    fn zero_size_primitives_are_valid() {
+        let text = "<robot name=\"r\">\n<link name=\"point\"><collision><geometry><sphere radius=\"0\"/></geometry></collision><collision><geometry><box size=\"0 0 0\"/></geometry></collision><collision><geometry><cylinder radius=\"1\" length=\"0\"/></geometry></collision></link>\n<link name=\"mixed\">\n<collision><geometry><capsule radius=\"0\" length=\"1\"/></geometry></collision>\n<collision><geometry><capsule radius=\"1\" length=\"0\"/></geometry></collision>\n</link>\n</robot>\n";
+        let r = scan(text.into(), Path::new("x.urdf")).expect("zero sizes are valid");
+        assert!(!r.links[0].has_collision_geometry());
+        assert!(r.links[1].has_collision_geometry()); // a zero-length capsule is a sphere
+        assert!(r.links[1].collisions[0].geometry.is_zero_size());
+        assert!(!r.links[1].collisions[1].geometry.is_zero_size());
+        assert!(
+            r.notes
+                .iter()
+                .any(|n| n.line == 2 && n.message.contains("left as it is")),
+            "{:?}",
+            r.notes
+        );
+        assert!(
+            r.notes.iter().any(|n| n.line == 4
+                && n.message
+                    .contains("capsule radius 0 length 1 has no volume")),
+            "{:?}",
+            r.notes
+        );
+    }
+
+    // Issue 11: duplicate attributes are malformed XML; duplicate link names name both lines.
+    #[test]
+    fn duplicate_attributes_and_links_are_errors() {
+        let e = scan("<robot name=\"r\">\n  <link name=\"a\"><collision><geometry><box size=\"1 2 3\" size=\"4 5 6\"/></geometry></collision></link>\n</robot>".into(), Path::new("x.urdf")).unwrap_err();
+        assert_eq!((e.line, e.column), (2, 57), "{e}");
+        assert!(
+            e.message
+                .contains("attribute `size` is given twice in <box>"),
+            "{e}"
+        );
+        let e = scan(
+            "<robot name=\"r\">\n<link name=\"a\"/>\n<link name=\"a\"/>\n</robot>".into(),
+            Path::new("x.urdf"),
+        )
+        .unwrap_err();
+        assert_eq!(e.line, 3);
+        assert!(
+            e.message
+                .contains("duplicate link name `a` on lines 2 and 3"),
+            "{e}"
+        );
+    }
+
+    // Issue 11: xacro in the file gets one note.
+    #[test]
+    fn xacro_gets_one_note() {
+        let text = "<robot name=\"r\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">\n<xacro:macro name=\"m\"><link name=\"hidden\"/></xacro:macro>\n<xacro:m/>\n</robot>";
+        let r = scan(text.into(), Path::new("x.urdf")).expect("scan");
+        assert!(r.links.is_empty());
+        let xacro: Vec<&ScanNote> = r
+            .notes
+            .iter()
+            .filter(|n| n.message.contains("run `xacro"))
+            .collect();
+        assert_eq!(xacro.len(), 1);
+        assert_eq!((xacro[0].line, xacro[0].level), (2, NoteLevel::Note));
+        let r = scan(
+            "<robot name=\"r\"><xacro:include filename=\"x.xacro\"/></robot>".into(),
+            Path::new("x.urdf"),
+        )
+        .expect("scan");
+        assert_eq!(r.notes.len(), 1);
+    }
+
+    #[test]
+    fn latin1_bytes_scan_with_their_declaration() {
+        let bytes = b"<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?>\n<robot name=\"r\xe9\"><link name=\"\xe9\"/></robot>".to_vec();
+        let r = scan_bytes(bytes, Path::new("x.urdf")).expect("latin-1");
+        assert_eq!(r.links[0].name, "\u{e9}");
+        let e = scan_bytes(
+            b"<robot name=\"r\">\n<link name=\"\xe9\"/></robot>".to_vec(),
+            Path::new("x.urdf"),
+        )
+        .unwrap_err();
+        assert_eq!((e.line, e.column), (2, 13), "{e}");
+        assert!(!e.to_string().contains("byte 0)"), "{e}");
     }
 }

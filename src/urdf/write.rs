@@ -115,7 +115,27 @@ fn indent_unit(link: &Link) -> String {
     }
 }
 
+/// The span that removes the element `start..end`: its whole line(s) when nothing else is on them
+/// (the indentation before it and the line break after it go too), else the element alone.
+fn removal_span(text: &str, start: usize, end: usize) -> (usize, usize) {
+    let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
+    let before = &text[line_start..start];
+    let rest = &text[end..];
+    let line_end = rest.find('\n').map_or(text.len(), |i| end + i + 1);
+    let after = &text[end..line_end];
+    let blank = |s: &str| {
+        s.chars()
+            .all(|c| c == ' ' || c == '\t' || c == '\r' || c == '\n')
+    };
+    if blank(before) && blank(after) {
+        (line_start, line_end)
+    } else {
+        (start, end)
+    }
+}
+
 /// The URDF text with the given links' `<inertial>` replaced or inserted; every other byte unchanged.
+/// A link's further `<inertial>` elements (which urdfdom ignores) are removed, so exactly one remains.
 pub fn splice(robot: &Robot, updates: &[(usize, MassProperties)], opts: &WriteOptions) -> String {
     let mut edits: Vec<(usize, usize, String)> = Vec::new();
     for (li, mp) in updates {
@@ -138,6 +158,10 @@ pub fn splice(robot: &Robot, updates: &[(usize, MassProperties)], opts: &WriteOp
                     text
                 };
                 edits.push((span.start, span.end, text));
+                for extra in &link.extra_inertials {
+                    let (start, end) = removal_span(&robot.text, extra.start, extra.end);
+                    edits.push((start, end, String::new()));
+                }
             }
             None => {
                 // Insert as the link's first child, on its own line after the start tag.
@@ -153,6 +177,9 @@ pub fn splice(robot: &Robot, updates: &[(usize, MassProperties)], opts: &WriteOp
     let mut out = String::with_capacity(robot.text.len() + 256 * edits.len());
     let mut at = 0;
     for (start, end, text) in edits {
+        // Edits never overlap (elements are disjoint); clamping keeps slicing safe regardless.
+        let start = start.max(at);
+        let end = end.max(start);
         out.push_str(&robot.text[at..start]);
         out.push_str(&text);
         at = end;
