@@ -399,7 +399,7 @@ fn read_geometry(
             _ => {
                 // <polygons>: one <p> per polygon; <ph> (polygons with holes) are not supported.
                 if prim.child("ph").is_some() {
-                    notes.push("<polygons> with holes (<ph>) skipped".into());
+                    notes.push("warning: <polygons> with holes (<ph>) skipped".into());
                 }
                 for p in prim.children_named("p") {
                     let idx = numbers(p, path)?;
@@ -548,6 +548,12 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
             notes.push("no visual scene: every geometry counted once, untransformed".into());
         }
     }
-    out.notes = notes;
+    // Reader messages that say something was left out are warnings; the rest are notes.
+    for n in notes {
+        match n.strip_prefix("warning: ") {
+            Some(w) => out.warnings.push(w.to_string()),
+            None => out.notes.push(n),
+        }
+    }
     Ok(out)
 }

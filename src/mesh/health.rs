@@ -495,7 +495,7 @@ pub fn make_solid_stored_as(
     let mut ladder = Ladder {
         path,
         options,
-        warnings: Vec::new(),
+        warnings: mesh.warnings.clone(),
         notes: mesh.notes.clone(),
         faces_read: mesh.faces.len(),
     };

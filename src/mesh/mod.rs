@@ -20,8 +20,11 @@ use std::path::{Path, PathBuf};
 pub struct RawMesh {
     pub vertices: Vec<[f64; 3]>,
     pub faces: Polygons,
-    /// Things the reader tolerated (a wrong triangle count, a missing `.mtl`), for the report.
+    /// Things the reader tolerated that leave the solid as the file means it (a wrong triangle
+    /// count, several objects), for the report.
     pub notes: Vec<String>,
+    /// Things the reader left out of the solid (faces it could not use), for the report.
+    pub warnings: Vec<String>,
 }
 
 /// The mesh formats urdf-inertia reads.

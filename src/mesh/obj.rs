@@ -112,8 +112,9 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
             "{objects} objects/groups, all counted as one solid"
         ));
     }
+    let mut warnings = Vec::new();
     if let Some(line) = degenerate {
-        notes.push(format!(
+        warnings.push(format!(
             "{degenerate_count} face(s) with fewer than three vertices skipped (the first on line {line})"
         ));
     }
@@ -121,6 +122,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         vertices,
         faces,
         notes,
+        warnings,
     })
 }
 

@@ -102,6 +102,7 @@ fn binary(bytes: &[u8], n: usize, header_count: Option<usize>) -> RawMesh {
         vertices,
         faces: Polygons { indices, starts },
         notes,
+        warnings: Vec::new(),
     }
 }
 
@@ -192,6 +193,7 @@ fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         vertices,
         faces,
         notes: Vec::new(),
+        warnings: Vec::new(),
     })
 }
 
