@@ -421,14 +421,14 @@ fn main() -> std::io::Result<()> {
             let file = urdf_inertia::mesh::RawMesh {
                 vertices: moved_cube.0.clone(),
                 faces: Polygons::from_triangles(&moved_cube.1),
-                notes: Vec::new(),
+                ..Default::default()
             };
             urdf_inertia::mesh::solid_from_raw(&file, [-1.0, 1.0, 1.0], path, Default::default())
         } else {
             let mesh = urdf_inertia::mesh::RawMesh {
                 vertices: raw.0.clone(),
                 faces: polys.clone(),
-                notes: Vec::new(),
+                ..Default::default()
             };
             urdf_inertia::mesh::health::make_solid(&mesh, path, Default::default())
         }

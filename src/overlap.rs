@@ -299,7 +299,7 @@ mod tests {
         let raw = crate::mesh::RawMesh {
             vertices: v,
             faces: crate::mass::Polygons::from_triangles(&tris),
-            notes: Vec::new(),
+            ..Default::default()
         };
         let solid =
             crate::mesh::health::make_solid(&raw, std::path::Path::new("box"), Default::default())

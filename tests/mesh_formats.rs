@@ -491,7 +491,7 @@ fn mesh_locator_agrees_with_the_winding_number() {
     let raw = mesh::RawMesh {
         vertices: v,
         faces: urdf_inertia::mass::Polygons::from_triangles(&f),
-        notes: Vec::new(),
+        ..Default::default()
     };
     let solid = mesh::health::make_solid(&raw, Path::new("sphere"), HealthOptions::default())
         .expect("solid");
