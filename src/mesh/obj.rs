@@ -132,13 +132,13 @@ mod tests {
 
     // Issue 11: a face with two vertices is skipped and counted, not the whole file's failure.
     #[test]
-    fn degenerate_faces_are_skipped_with_a_note() {
+    fn degenerate_faces_are_skipped_with_a_warning() {
         let text =
             b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2\nf 1 2 4\nf 1 4 3\nf 3\nf 2 3 4\n";
         let m = parse(text, Path::new("t.obj")).expect("degenerate faces are skipped");
         assert_eq!(m.faces.len(), 4);
         assert_eq!(
-            m.notes,
+            m.warnings,
             vec![
                 "2 face(s) with fewer than three vertices skipped (the first on line 6)"
                     .to_string()
