@@ -62,12 +62,17 @@ pub struct FillArgs {
     pub urdf: PathBuf,
     #[command(flatten)]
     pub source: SourceArgs,
-    /// Write the result to this file instead of stdout.
+    /// Write the result to this file instead of stdout (`-` is stdout; devices and FIFOs are written
+    /// directly, regular files replaced through a temp file and a rename).
     #[arg(short, long, value_name = "OUT", conflicts_with = "in_place")]
     pub output: Option<PathBuf>,
     /// Rewrite the URDF in place (temp file beside it, then rename).
     #[arg(short, long)]
     pub in_place: bool,
+    /// When some links fail, still write the links that worked (the exit status is 2 all the same).
+    /// Without it, nothing is written when any link fails.
+    #[arg(long)]
+    pub keep_going: bool,
     /// Only links whose <inertial> is absent or invalid.
     #[arg(long)]
     pub missing_only: bool,

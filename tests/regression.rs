@@ -1,0 +1,320 @@
+//! Regression tests for issue 13 ("Hardening"), each named after what it covers. The real binary runs in
+//! a temp dir on inputs generated here; nothing depends on timing, and everything holds when run as root.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::os::unix::fs::{FileTypeExt, MetadataExt, PermissionsExt};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("run urdf-inertia")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A robot of boxes: `(link name, "sx sy sz", "x y z")`.
+fn boxes(links: &[(&str, &str, &str)]) -> String {
+    let mut s = String::from("<robot name=\"r\">\n");
+    for (name, size, xyz) in links {
+        s.push_str(&format!(
+            "  <link name=\"{name}\">\n    <collision><origin xyz=\"{xyz}\"/><geometry><box size=\"{size}\"/></geometry></collision>\n  </link>\n"
+        ));
+    }
+    s.push_str("</robot>\n");
+    s
+}
+
+fn one_box() -> String {
+    boxes(&[("a", "1 2 3", "0 0 0")])
+}
+
+/// A temp dir with `r.urdf` holding `text`.
+fn urdf_in_tmp(text: &str) -> (tempfile::TempDir, PathBuf) {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let p = tmp.path().join("r.urdf");
+    std::fs::write(&p, text).expect("write urdf");
+    (tmp, p)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Item 1: -o onto a device, FIFO or stdout.
+
+/// Issue 13.1: `-o FIFO` once replaced the FIFO with a regular file; it is written directly now.
+#[test]
+fn output_to_a_fifo_is_written_directly() {
+    let (tmp, urdf) = urdf_in_tmp(&one_box());
+    let fifo = tmp.path().join("out.fifo");
+    let st = Command::new("mkfifo").arg(&fifo).status().expect("mkfifo");
+    assert!(st.success());
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || {
+            let mut text = String::new();
+            std::fs::File::open(&fifo)
+                .expect("open fifo")
+                .read_to_string(&mut text)
+                .expect("read fifo");
+            text
+        })
+    };
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-o", s(&fifo)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = reader.join().expect("reader thread");
+    assert!(text.contains("<inertial>"), "{text}");
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+}
+
+/// Issue 13.1: as root, `-o /dev/null` once turned /dev/null into a regular file.
+#[test]
+fn output_to_dev_null_keeps_the_device() {
+    let (_tmp, urdf) = urdf_in_tmp(&one_box());
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-o", "/dev/null"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(std::fs::metadata("/dev/null")
+        .unwrap()
+        .file_type()
+        .is_char_device());
+}
+
+/// Issue 13.1: `-o -` and `-o /dev/stdout` write to stdout.
+#[test]
+fn output_dash_and_dev_stdout_are_stdout() {
+    let (_tmp, urdf) = urdf_in_tmp(&one_box());
+    for target in ["-", "/dev/stdout"] {
+        let out = run(&["fill", s(&urdf), "--density", "1000", "-o", target]);
+        assert!(out.status.success(), "{target}: {}", stderr(&out));
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("<inertial>"), "{target}: {text}");
+    }
+    // JSON summary and URDF cannot share stdout.
+    let out = run(&[
+        "fill",
+        s(&urdf),
+        "--density",
+        "1000",
+        "-o",
+        "-",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Item 3: nothing written when a link failed, unless --keep-going.
+
+fn with_a_failing_link() -> String {
+    "<robot name=\"r\">\n  <link name=\"good\">\n    <collision><geometry><box size=\"1 1 1\"/></geometry></collision>\n  </link>\n  <link name=\"bad\">\n    <collision><geometry><mesh filename=\"missing.stl\"/></geometry></collision>\n  </link>\n</robot>\n".into()
+}
+
+/// Issue 13.3: `fill -i` with a failing link once rewrote the file with the other links filled.
+#[test]
+fn failed_link_writes_nothing_unless_keep_going() {
+    let text = with_a_failing_link();
+    let (tmp, urdf) = urdf_in_tmp(&text);
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("nothing written to") && stderr(&out).contains("--keep-going"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
+    let o = tmp.path().join("out.urdf");
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-o", s(&o)]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!o.exists());
+    let out = run(&["fill", s(&urdf), "--density", "1000"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(out.stdout.is_empty());
+    // --keep-going: the good link is written, the bad one left alone, exit 2, summary counts 1.
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i", "--keep-going"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(err.contains("filled 1 link(s)"), "{err}");
+    assert!(
+        err.contains("not written (--keep-going): 1 link(s)"),
+        "{err}"
+    );
+    let written = std::fs::read_to_string(&urdf).unwrap();
+    assert_eq!(written.matches("<inertial>").count(), 1, "{written}");
+    assert!(written.find("<inertial>") < written.find("name=\"bad\""));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Items 4 and 5: the temp file's mode and life, and the write policy.
+
+/// Issue 13.4: the temp file was created 0644 (a world-readable copy of a 0600 URDF) and left behind on
+/// SIGTERM. It has the target's mode and is removed on SIGTERM now.
+#[test]
+fn temp_file_has_the_targets_mode_and_is_removed_on_sigterm() {
+    let text = one_box();
+    let (tmp, urdf) = urdf_in_tmp(&text);
+    std::fs::set_permissions(&urdf, std::fs::Permissions::from_mode(0o600)).unwrap();
+    let mut child = bin()
+        .args(["fill", s(&urdf), "--density", "1000", "-i"])
+        .env("URDF_INERTIA_TEST_HOLD_TEMP", "1")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    // Held open until the child has exited: `wait` would close it, and EOF releases the hold.
+    let _stdin = child.stdin.take().expect("stdin");
+    let mut lines = BufReader::new(child.stderr.take().expect("stderr")).lines();
+    let temp = loop {
+        let line = lines
+            .next()
+            .expect("the binary announces its temp file")
+            .expect("line");
+        if let Some(p) = line.strip_prefix("holding temporary file ") {
+            break PathBuf::from(p);
+        }
+    };
+    let name = temp.file_name().unwrap().to_string_lossy().into_owned();
+    assert!(
+        name.starts_with(".r.urdf.urdf-inertia.") && name.ends_with(".tmp"),
+        "{name}"
+    );
+    assert_eq!(temp.parent(), Some(tmp.path()));
+    let meta = std::fs::metadata(&temp).expect("temp file exists");
+    assert_eq!(meta.permissions().mode() & 0o777, 0o600);
+    let st = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(st.success());
+    let status = child.wait().expect("wait");
+    assert_eq!(status.code(), Some(130));
+    assert!(!temp.exists(), "temp file left behind");
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
+    // Without the signal, the result keeps the 0600 mode.
+    let mut child = bin()
+        .args(["fill", s(&urdf), "--density", "1000", "-i"])
+        .env("URDF_INERTIA_TEST_HOLD_TEMP", "1")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("spawn");
+    child
+        .stdin
+        .take()
+        .expect("stdin")
+        .write_all(b"\n")
+        .expect("release");
+    assert!(child.wait().unwrap().success());
+    let meta = std::fs::metadata(&urdf).unwrap();
+    assert_eq!(meta.permissions().mode() & 0o777, 0o600);
+    assert!(std::fs::read_to_string(&urdf)
+        .unwrap()
+        .contains("<inertial>"));
+}
+
+/// Issue 13.5: `-i` on a 0444 file once succeeded (the rename ignores the file's mode). Refused now, root
+/// included.
+#[test]
+fn read_only_target_is_refused() {
+    let text = one_box();
+    let (tmp, urdf) = urdf_in_tmp(&text);
+    std::fs::set_permissions(&urdf, std::fs::Permissions::from_mode(0o444)).unwrap();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("read-only"), "{}", stderr(&out));
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
+    let o = tmp.path().join("o.urdf");
+    std::fs::write(&o, "old").unwrap();
+    std::fs::set_permissions(&o, std::fs::Permissions::from_mode(0o444)).unwrap();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-o", s(&o)]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(std::fs::read_to_string(&o).unwrap(), "old");
+}
+
+/// Issue 13.5: `-i` on a hard-linked file once split the names (the other kept the old text). Refused.
+#[test]
+fn hard_linked_target_is_refused() {
+    let text = one_box();
+    let (tmp, urdf) = urdf_in_tmp(&text);
+    let other = tmp.path().join("other.urdf");
+    std::fs::hard_link(&urdf, &other).unwrap();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("2 hard links"), "{}", stderr(&out));
+    assert_eq!(std::fs::metadata(&urdf).unwrap().nlink(), 2);
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
+}
+
+/// Issue 13.5: as root, `-i` once gave the file to root. Owner and group are kept.
+#[test]
+fn owner_and_group_are_kept() {
+    let (_tmp, urdf) = urdf_in_tmp(&one_box());
+    let me = std::fs::metadata(&urdf).unwrap();
+    // Only root can give a file away; others check that their own ownership survives.
+    let (uid, gid) = if me.uid() == 0 {
+        std::os::unix::fs::chown(&urdf, Some(4321), Some(4322)).unwrap();
+        (4321, 4322)
+    } else {
+        (me.uid(), me.gid())
+    };
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let after = std::fs::metadata(&urdf).unwrap();
+    assert_eq!((after.uid(), after.gid()), (uid, gid));
+    assert!(std::fs::read_to_string(&urdf)
+        .unwrap()
+        .contains("<inertial>"));
+}
+
+/// Issue 13.5: `-o` onto a dangling symlink once replaced the link; it creates the link's target now.
+#[test]
+fn dangling_symlink_output_writes_the_target() {
+    let (tmp, urdf) = urdf_in_tmp(&one_box());
+    let link = tmp.path().join("out.urdf");
+    std::os::unix::fs::symlink("sub/target.urdf", &link).unwrap();
+    std::fs::create_dir(tmp.path().join("sub")).unwrap();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-o", s(&link)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert!(std::fs::read_to_string(tmp.path().join("sub/target.urdf"))
+        .unwrap()
+        .contains("<inertial>"));
+}
+
+/// Issue 13.5: a read-only directory's error once blamed the URDF; it names the directory and the temp
+/// file now (and holds for root, who bypasses the mode bits).
+#[test]
+fn read_only_directory_names_the_directory_and_the_temp_file() {
+    let text = one_box();
+    let (tmp, _) = urdf_in_tmp("");
+    let dir = tmp.path().join("ro");
+    std::fs::create_dir(&dir).unwrap();
+    let urdf = dir.join("r.urdf");
+    std::fs::write(&urdf, &text).unwrap();
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o755)).unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(
+        err.contains(&format!("cannot be created in directory {}", dir.display()))
+            && err.contains(".r.urdf.urdf-inertia."),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
+}
