@@ -318,3 +318,71 @@ fn read_only_directory_names_the_directory_and_the_temp_file() {
     );
     assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
 }
+
+// ---------------------------------------------------------------------------------------------------
+// Item 2: computed values are checked before splicing.
+
+/// Issue 13.2: boxes of 1e120 and 1e-320, parts at ±1e155, a density of 1e306 and a 1e-100-scale OBJ
+/// once wrote `mass="inf"`, NaN or an all-zero tensor with exit 0 (`--principal`: `rpy="0 NaN NaN"`).
+#[test]
+fn overflow_and_underflow_fail_the_link() {
+    let tmp = tempfile::tempdir().unwrap();
+    let tet =
+        "v 0 0 0\nv 1e-100 0 0\nv 0 1e-100 0\nv 0 0 1e-100\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    std::fs::write(tmp.path().join("tiny.obj"), tet).unwrap();
+    let link = |collisions: &str| {
+        format!("<robot name=\"r\">\n  <link name=\"ok\">\n    <collision><geometry><box size=\"1 1 1\"/></geometry></collision>\n  </link>\n  <link name=\"x\">\n{collisions}  </link>\n</robot>\n")
+    };
+    let bx = |size: &str, xyz: &str| {
+        format!("    <collision><origin xyz=\"{xyz}\"/><geometry><box size=\"{size}\"/></geometry></collision>\n")
+    };
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("huge_box", link(&bx("1e120 1e120 1e120", "0 0 0")), "1000"),
+        ("subnormal_box", link(&bx("1e-320 1 1", "0 0 0")), "1000"),
+        (
+            "far_parts",
+            link(&(bx("1 1 1", "1e155 0 0") + &bx("1 1 1", "-1e155 0 0"))),
+            "1000",
+        ),
+        ("huge_density", link(&bx("10 10 10", "0 0 0")), "1e306"),
+        (
+            "tiny_obj",
+            link("    <collision><geometry><mesh filename=\"tiny.obj\"/></geometry></collision>\n"),
+            "1000",
+        ),
+    ];
+    for (name, text, density) in cases {
+        let urdf = tmp.path().join(format!("{name}.urdf"));
+        std::fs::write(&urdf, &text).unwrap();
+        for extra in [&[][..], &["--principal"][..]] {
+            let mut args = vec!["fill", s(&urdf), "--density", density];
+            args.extend_from_slice(extra);
+            let out = run(&args);
+            let err = stderr(&out);
+            assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+            assert!(
+                err.contains("link `x`: overflow/underflow"),
+                "{name}: {err}"
+            );
+            assert!(out.stdout.is_empty(), "{name}");
+            // --keep-going writes the good link only: no inf, NaN or zero tensor anywhere.
+            args.push("--keep-going");
+            let out = run(&args);
+            assert_eq!(out.status.code(), Some(2), "{name}");
+            let text = String::from_utf8(out.stdout).unwrap();
+            assert_eq!(text.matches("<inertial>").count(), 1, "{name}: {text}");
+            assert!(
+                !text.contains("inf") && !text.contains("NaN"),
+                "{name}: {text}"
+            );
+        }
+    }
+    // The mesh command too.
+    let out = run(&["mesh", s(&tmp.path().join("tiny.obj"))]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("overflow/underflow"),
+        "{}",
+        stderr(&out)
+    );
+}

@@ -39,6 +39,10 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         (None, None) => 1.0,
     };
     let mp = solid.unit.scaled(density);
+    if let Some(why) = crate::fill::unrepresentable(&mp) {
+        errln!("error: {}: {why}", args.file.display());
+        return ExitStatus::Error;
+    }
     let pr = mp.principal();
     let elapsed = start.elapsed();
     match args.format {
