@@ -113,11 +113,14 @@ impl DensityMap {
 
     /// Reads and validates a density map file.
     pub fn load(path: &Path) -> Result<Self, MapError> {
-        let text = std::fs::read_to_string(path).map_err(|e| MapError {
+        let cannot = |e: String| MapError {
             path: path.into(),
             line: None,
             message: format!("cannot read the density map: {e}"),
-        })?;
+        };
+        let bytes = crate::input::read_file(path).map_err(cannot)?;
+        let text = String::from_utf8(bytes)
+            .map_err(|e| cannot(format!("not UTF-8 (byte {})", e.utf8_error().valid_up_to())))?;
         Self::parse(&text, path)
     }
 

@@ -386,3 +386,98 @@ fn overflow_and_underflow_fail_the_link() {
         stderr(&out)
     );
 }
+
+// ---------------------------------------------------------------------------------------------------
+// Item 6: only regular files, and no more than a limit.
+
+/// Issue 13.6: `/dev/zero`, `/dev/urandom` or a FIFO as a mesh or URDF once read without end or hung;
+/// a directory as a mesh was "not found".
+#[test]
+fn non_regular_inputs_are_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    std::os::unix::fs::symlink("/dev/zero", d.join("zero.stl")).unwrap();
+    std::os::unix::fs::symlink("/dev/urandom", d.join("random.obj")).unwrap();
+    assert!(Command::new("mkfifo")
+        .arg(d.join("fifo.dae"))
+        .status()
+        .unwrap()
+        .success());
+    assert!(Command::new("mkfifo")
+        .arg(d.join("fifo.urdf"))
+        .status()
+        .unwrap()
+        .success());
+    std::fs::create_dir(d.join("dir.stl")).unwrap();
+    for mesh in ["zero.stl", "random.obj", "fifo.dae", "dir.stl"] {
+        let urdf = d.join("r.urdf");
+        std::fs::write(&urdf, format!("<robot name=\"r\">\n  <link name=\"a\">\n    <collision><geometry><mesh filename=\"{mesh}\"/></geometry></collision>\n  </link>\n</robot>\n")).unwrap();
+        let out = run(&["fill", s(&urdf), "--density", "1000"]);
+        assert_eq!(out.status.code(), Some(2), "{mesh}");
+        assert!(
+            stderr(&out).contains(&format!(
+                "{mesh}: cannot read the file: is not a regular file"
+            )),
+            "{mesh}: {}",
+            stderr(&out)
+        );
+        let out = run(&["mesh", s(&d.join(mesh))]);
+        assert_eq!(out.status.code(), Some(2), "{mesh}");
+        assert!(stderr(&out).contains("is not a regular file"), "{mesh}");
+    }
+    for urdf in [s(&d.join("fifo.urdf")), "/dev/zero", "/dev/urandom"] {
+        for cmd in ["fill", "check"] {
+            let out = run(&[cmd, urdf, "--density", "1000"]);
+            assert_eq!(out.status.code(), Some(2), "{urdf}");
+            assert!(
+                stderr(&out).contains("cannot read the URDF: is not a regular file"),
+                "{urdf}: {}",
+                stderr(&out)
+            );
+        }
+    }
+    let out = run(&["fill", s(&d.join("r.urdf")), "--density-map", "/dev/zero"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("is not a regular file"));
+}
+
+/// Issue 13.6: the size read is capped (`--max-file-size`, or URDF_INERTIA_MAX_FILE_SIZE).
+#[test]
+fn input_size_is_capped() {
+    let (_tmp, urdf) = urdf_in_tmp(&one_box());
+    let out = run(&[
+        "fill",
+        s(&urdf),
+        "--density",
+        "1000",
+        "--max-file-size",
+        "64",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("is larger than the limit of 64 bytes"),
+        "{}",
+        stderr(&out)
+    );
+    let out = bin()
+        .args(["check", s(&urdf)])
+        .env("URDF_INERTIA_MAX_FILE_SIZE", "1K")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let out = bin()
+        .args(["check", s(&urdf)])
+        .env("URDF_INERTIA_MAX_FILE_SIZE", "10")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let out = run(&[
+        "fill",
+        s(&urdf),
+        "--density",
+        "1000",
+        "--max-file-size",
+        "lots",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+}

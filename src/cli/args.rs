@@ -54,6 +54,10 @@ pub struct SourceArgs {
     /// Leave these links alone (glob, repeatable).
     #[arg(long, value_name = "GLOB")]
     pub skip: Vec<String>,
+    /// Largest input file read (URDF, mesh, density map): bytes or K/M/G; default 1G, or the
+    /// URDF_INERTIA_MAX_FILE_SIZE environment variable.
+    #[arg(long, value_name = "SIZE")]
+    pub max_file_size: Option<String>,
 }
 
 #[derive(Debug, Clone, ClapArgs)]
@@ -131,4 +135,7 @@ pub struct MeshArgs {
     pub strict: bool,
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
+    /// Largest mesh file read: bytes or K/M/G; default 1G, or URDF_INERTIA_MAX_FILE_SIZE.
+    #[arg(long, value_name = "SIZE")]
+    pub max_file_size: Option<String>,
 }

@@ -47,6 +47,25 @@ pub fn main() -> i32 {
         }
     };
     write::remove_temp_files_on_signal();
+    let max_size = match &args.command {
+        Command::Mesh(m) => m.max_file_size.clone(),
+        Command::Fill(f) => f.source.max_file_size.clone(),
+        Command::Diff(d) => d.source.max_file_size.clone(),
+        Command::Check(c) => c.source.max_file_size.clone(),
+    };
+    let from_env = std::env::var(crate::input::MAX_FILE_SIZE_ENV).ok();
+    if let Some((what, s)) = max_size
+        .map(|s| ("--max-file-size", s))
+        .or(from_env.map(|s| (crate::input::MAX_FILE_SIZE_ENV, s)))
+    {
+        match crate::input::parse_size(&s) {
+            Ok(n) => crate::input::set_max_file_size(n),
+            Err(e) => {
+                errln!("error: {what}: {e}");
+                return ExitStatus::Error as i32;
+            }
+        }
+    }
     let status = match args.command {
         Command::Mesh(m) => mesh_cmd::run(&m),
         Command::Fill(f) => robot_cmd::fill(&f),

@@ -68,7 +68,7 @@ fn prepare(
 }
 
 fn read_robot(path: &Path) -> Result<Robot, String> {
-    let bytes = std::fs::read(path)
+    let bytes = crate::input::read_file(path)
         .map_err(|e| format!("{}: cannot read the URDF: {e}", path.display()))?;
     let text = String::from_utf8(bytes).map_err(|e| {
         format!(

@@ -133,8 +133,8 @@ pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
             .unwrap_or_else(|| "(no extension)".into());
         MeshError::new(path, None, MeshErrorKind::UnknownFormat(ext))
     })?;
-    let bytes = std::fs::read(path)
-        .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e.to_string())))?;
+    let bytes = crate::input::read_file(path)
+        .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e)))?;
     let mesh = match format {
         MeshFormat::Stl => stl::parse(&bytes, path)?,
         MeshFormat::Obj => obj::parse(&bytes, path)?,
