@@ -481,3 +481,173 @@ fn input_size_is_capped() {
     ]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+// ---------------------------------------------------------------------------------------------------
+// Items 7 to 10 and id-less geometries: hostile COLLADA, generated here.
+
+/// A closed box `size` at `at`, as a `<geometry>` (with `id` if given), 12 outward triangles.
+fn dae_box(id: Option<&str>, size: f64, at: f64) -> String {
+    let mut pos = String::new();
+    for i in 0..8 {
+        for k in 0..3 {
+            let c = if i >> k & 1 == 1 { size } else { 0.0 };
+            pos.push_str(&format!("{} ", at + c));
+        }
+    }
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let p: Vec<String> = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .map(|t| format!("{} {} {}", t[0], t[1], t[2]))
+        .collect();
+    let id = id.map(|i| format!(" id=\"{i}\"")).unwrap_or_default();
+    format!(
+        "<geometry{id}><mesh>\n<source id=\"pos\"><float_array id=\"pa\" count=\"24\">{pos}</float_array>\n<technique_common><accessor source=\"#pa\" count=\"8\" stride=\"3\"/></technique_common></source>\n<triangles count=\"12\"><input semantic=\"VERTEX\" source=\"#pos\" offset=\"0\"/><p>{}</p></triangles>\n</mesh></geometry>\n",
+        p.join(" ")
+    )
+}
+
+fn dae(body: &str) -> String {
+    format!("<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">\n{body}</COLLADA>\n")
+}
+
+/// Runs `mesh`, `fill` and `check` on a generated COLLADA file; returns the three outputs.
+fn dae_through_every_command(name: &str, text: &str) -> Vec<Output> {
+    let tmp = tempfile::tempdir().unwrap();
+    let mesh = tmp.path().join(name);
+    std::fs::write(&mesh, text).unwrap();
+    let urdf = tmp.path().join("r.urdf");
+    std::fs::write(&urdf, format!("<robot name=\"r\">\n  <link name=\"a\">\n    <inertial><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial>\n    <collision><geometry><mesh filename=\"{name}\"/></geometry></collision>\n  </link>\n</robot>\n")).unwrap();
+    vec![
+        run(&["mesh", s(&mesh), "--format", "json"]),
+        run(&["fill", s(&urdf), "--density", "1000"]),
+        run(&["check", s(&urdf), "--density", "1000"]),
+    ]
+}
+
+fn assert_fails_with(name: &str, text: &str, message: &str) {
+    for out in dae_through_every_command(name, text) {
+        assert_eq!(out.status.code(), Some(2), "{name}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains(message),
+            "{name}: expected `{message}` in {}",
+            stderr(&out)
+        );
+    }
+}
+
+/// Issue 13.7: an `<accessor offset>` beyond the stride, an `<input offset>` near u64::MAX and a huge
+/// `<vcount>` once panicked (exit 101, also inside `check`). Each is an error with its line now.
+#[test]
+fn collada_offsets_and_counts_are_checked() {
+    let good = dae_box(Some("g"), 1.0, 0.0);
+    let accessor = good.replace("stride=\"3\"/>", "stride=\"3\" offset=\"2\"/>");
+    assert_fails_with(
+        "accessor.dae",
+        &dae(&format!(
+            "<library_geometries>{accessor}</library_geometries>\n"
+        )),
+        "accessor.dae:5: <accessor> of `pos`: offset 2 leaves no room",
+    );
+    let input = good.replace("offset=\"0\"/>", "offset=\"18446744073709551615\"/>");
+    assert_fails_with(
+        "input.dae",
+        &dae(&format!(
+            "<library_geometries>{input}</library_geometries>\n"
+        )),
+        "<input> offset too large",
+    );
+    let poly = good
+        .replace("<triangles count=\"12\">", "<polylist count=\"1\">")
+        .replace("</triangles>", "</polylist>")
+        .replace("<p>", "<vcount>4611686018427387904</vcount><p>");
+    let poly = poly.replace(
+        "offset=\"0\"/>",
+        "offset=\"0\"/><input semantic=\"NORMAL\" source=\"#pos\" offset=\"3\"/>",
+    );
+    assert_fails_with(
+        "vcount.dae",
+        &dae(&format!(
+            "<library_geometries>{poly}</library_geometries>\n"
+        )),
+        "<vcount> asks for more indices than <p> holds",
+    );
+}
+
+/// Issue 13.8: 40 levels of `<instance_node>`, each instancing the next twice (a few KB), once allocated
+/// until the process aborted. A budget on instanced geometry stops it.
+#[test]
+fn collada_instance_fan_out_has_a_budget() {
+    let mut nodes = String::new();
+    for i in 0..40 {
+        nodes.push_str(&format!(
+            "<node id=\"n{i}\"><instance_node url=\"#n{}\"/><instance_node url=\"#n{}\"/></node>\n",
+            i + 1,
+            i + 1
+        ));
+    }
+    nodes.push_str("<node id=\"n40\"><instance_geometry url=\"#g\"/></node>\n");
+    let text = dae(&format!(
+        "<library_geometries>{}</library_geometries>\n<library_nodes>\n{nodes}</library_nodes>\n<library_visual_scenes><visual_scene id=\"s\"><node><instance_node url=\"#n0\"/></node></visual_scene></library_visual_scenes>\n<scene><instance_visual_scene url=\"#s\"/></scene>\n",
+        dae_box(Some("g"), 1.0, 0.0)
+    ));
+    assert!(text.len() < 8000);
+    assert_fails_with("fan.dae", &text, "the scene instances more than");
+    // Without geometry at the leaves, the node visits are bounded too.
+    let empty = text.replace("<instance_geometry url=\"#g\"/>", "");
+    for out in dae_through_every_command("fan.dae", &empty) {
+        assert_eq!(out.status.code(), Some(2));
+        assert!(stderr(&out).contains("nodes"), "{}", stderr(&out));
+    }
+}
+
+/// Issue 13.9: 100k nested elements once overflowed the stack of fill's worker threads (recursive drop
+/// and walk). Nesting is bounded with an error now.
+#[test]
+fn collada_deep_nesting_is_an_error() {
+    let depth = 100_000;
+    let body = format!(
+        "{}{}<library_geometries>{}</library_geometries>\n",
+        "<extra>".repeat(depth),
+        "</extra>".repeat(depth),
+        dae_box(Some("g"), 1.0, 0.0)
+    );
+    assert_fails_with("deep.dae", &dae(&body), "nested deeper than 512 levels");
+}
+
+/// Issue 13.10: one element with 80k attributes took 8 s (quadratic duplicate check). Read linearly
+/// now; the result is still the box.
+#[test]
+fn collada_many_attributes_are_read() {
+    let attrs: String = (0..80_000).map(|i| format!(" a{i}=\"{i}\"")).collect();
+    let body = format!(
+        "<asset{attrs}/>\n<library_geometries>{}</library_geometries>\n",
+        dae_box(Some("g"), 1.0, 0.0)
+    );
+    let outs = dae_through_every_command("attrs.dae", &dae(&body));
+    assert!(outs[0].status.success(), "{}", stderr(&outs[0]));
+    let v: serde_json::Value = serde_json::from_slice(&outs[0].stdout).unwrap();
+    assert_eq!(v["volume"].as_f64(), Some(1.0));
+}
+
+/// Issue 13 (collada.rs): two `<geometry>` without an `id` once became two copies of the first. Each is
+/// its own geometry now: the volume is the sum.
+#[test]
+fn collada_geometries_without_id_are_distinct() {
+    let body = format!(
+        "<library_geometries>{}{}</library_geometries>\n",
+        dae_box(None, 1.0, 0.0),
+        dae_box(None, 2.0, 5.0)
+    );
+    let outs = dae_through_every_command("noid.dae", &dae(&body));
+    assert!(outs[0].status.success(), "{}", stderr(&outs[0]));
+    let v: serde_json::Value = serde_json::from_slice(&outs[0].stdout).unwrap();
+    assert_eq!(v["volume"].as_f64(), Some(9.0));
+}

@@ -77,6 +77,8 @@ pub enum MeshErrorKind {
     Strict(String),
     /// A scale with a zero or non-finite factor.
     BadScale([f64; 3]),
+    /// A reader or the healing panicked (a bug): caught, so that it fails only this mesh.
+    Internal(String),
 }
 
 impl fmt::Display for MeshError {
@@ -107,6 +109,10 @@ impl fmt::Display for MeshError {
             MeshErrorKind::BadScale(s) => {
                 write!(f, "scale \"{} {} {}\" has a zero or non-finite factor", s[0], s[1], s[2])
             }
+            MeshErrorKind::Internal(msg) => write!(
+                f,
+                "internal error while processing the mesh (a bug in urdf-inertia; please report it with the file): {msg}"
+            ),
         }
     }
 }
@@ -123,8 +129,28 @@ impl MeshError {
     }
 }
 
+/// Runs `f`, turning a panic into this mesh's [`MeshErrorKind::Internal`] error: a backstop so that a
+/// bug in a reader or in the healing fails one mesh (one link), never the whole run.
+fn catching_panics<T>(
+    path: &Path,
+    f: impl FnOnce() -> Result<T, MeshError>,
+) -> Result<T, MeshError> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
+        let msg = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "panic".into());
+        Err(MeshError::new(path, None, MeshErrorKind::Internal(msg)))
+    })
+}
+
 /// Reads a mesh file of any supported format (by extension).
 pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
+    catching_panics(path, || read_unguarded(path))
+}
+
+fn read_unguarded(path: &Path) -> Result<RawMesh, MeshError> {
     let format = MeshFormat::from_path(path).ok_or_else(|| {
         let ext = path
             .extension()
@@ -203,12 +229,34 @@ pub fn solid_from_raw(
     path: &Path,
     options: health::HealthOptions,
 ) -> Result<health::Solid, MeshError> {
-    let scaled = apply_scale(raw, scale, path)?;
-    health::make_solid(&scaled, path, options)
+    catching_panics(path, || {
+        let scaled = apply_scale(raw, scale, path)?;
+        health::make_solid(&scaled, path, options)
+    })
 }
 
 /// Parses a float the way all three formats write them, NaN and infinities included (they are caught
 /// afterwards with a clearer message).
 pub(crate) fn parse_f64(s: &str) -> Option<f64> {
     s.parse::<f64>().ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 13.7: a panic in a reader or in the healing fails that mesh, not the run.
+    #[test]
+    fn a_panic_becomes_the_meshs_error() {
+        let p = Path::new("m.dae");
+        let r: Result<(), MeshError> = catching_panics(p, || panic!("boom"));
+        let e = r.unwrap_err();
+        assert_eq!(e.kind, MeshErrorKind::Internal("boom".into()));
+        assert!(e.to_string().starts_with("m.dae: internal error"));
+        let r: Result<(), MeshError> = catching_panics(p, || panic!("{} {}", "formatted", 1));
+        assert_eq!(
+            r.unwrap_err().kind,
+            MeshErrorKind::Internal("formatted 1".into())
+        );
+    }
 }
