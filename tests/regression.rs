@@ -651,3 +651,91 @@ fn collada_geometries_without_id_are_distinct() {
     let v: serde_json::Value = serde_json::from_slice(&outs[0].stdout).unwrap();
     assert_eq!(v["volume"].as_f64(), Some(9.0));
 }
+
+// ---------------------------------------------------------------------------------------------------
+// Item 14: stdout and stderr errors.
+
+fn dev_full() -> Stdio {
+    Stdio::from(
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .expect("/dev/full"),
+    )
+}
+
+/// A robot with a finding for `check` (a link with geometry and no inertial) and a `diff` row.
+fn robot_with_a_finding() -> (tempfile::TempDir, PathBuf) {
+    urdf_in_tmp(&boxes(&[("a", "1 2 3", "0 0 0"), ("b", "1 1 1", "0 0 1")]))
+}
+
+/// Issue 13.14: `diff … | head` and `check | head` once panicked on the broken pipe (exit 101). A closed
+/// pipe ends the output quietly, with the status the work earned.
+#[test]
+fn broken_pipe_ends_quietly_with_the_earned_status() {
+    let (_tmp, urdf) = robot_with_a_finding();
+    for (args, code) in [
+        (vec!["diff", s(&urdf), "--density", "1000"], 0),
+        (vec!["check", s(&urdf)], 1),
+        (vec!["fill", s(&urdf), "--density", "1000"], 0),
+        (vec!["mesh", "/nonexistent.stl"], 2),
+    ] {
+        let mut child = bin()
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // The reader goes away before the first byte is written: every write gets EPIPE.
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(!err.contains("cannot write to stdout"), "{args:?}: {err}");
+    }
+}
+
+/// Issue 13.14: `fill >/dev/full` once exited 2 without a word. Other stdout errors are reported and exit
+/// 2, except the summary printed after the URDF was written to a file.
+#[test]
+fn stdout_errors_are_reported() {
+    let (tmp, urdf) = robot_with_a_finding();
+    for args in [
+        vec!["fill", s(&urdf), "--density", "1000"],
+        vec!["diff", s(&urdf), "--density", "1000"],
+        vec!["check", s(&urdf)],
+        vec!["fill", s(&urdf), "--density", "1000", "-o", "-"],
+    ] {
+        let out = bin().args(&args).stdout(dev_full()).output().unwrap();
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains("cannot write to stdout: "), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+    let o = tmp.path().join("o.urdf");
+    let out = bin()
+        .args([
+            "fill",
+            s(&urdf),
+            "--density",
+            "1000",
+            "-o",
+            s(&o),
+            "--format",
+            "json",
+        ])
+        .stdout(dev_full())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(stderr(&out).contains("cannot write to stdout: "));
+    assert!(std::fs::read_to_string(&o).unwrap().contains("<inertial>"));
+    // A failing stderr is not a panic either.
+    let out = bin()
+        .args(["fill", "/nonexistent.urdf", "--density", "1000"])
+        .stderr(dev_full())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}
