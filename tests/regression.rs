@@ -785,3 +785,229 @@ fn density_map_with_thousands_of_rules() {
     let e = DensityMap::parse(&text, Path::new("d.toml")).unwrap_err();
     assert_eq!(e.line, Some(n + 2));
 }
+
+// ---------------------------------------------------------------------------------------------------
+// docs/reliability.md: regenerate with
+//   cargo test --release --test regression -- --ignored write_reliability_table
+
+/// The first `error:` line of stderr (else its first line, else the volume `mesh` printed), then what
+/// was (not) written, with temp paths removed.
+fn what_it_says(out: &Output, tmp: &Path) -> String {
+    let err = stderr(out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let first = err
+        .lines()
+        .find(|l| l.starts_with("error:"))
+        .or_else(|| err.lines().next())
+        .or_else(|| stdout.lines().find(|l| l.contains("volume")))
+        .map(str::trim)
+        .unwrap_or("(nothing)");
+    let written = err
+        .lines()
+        .find(|l| l.contains("nothing written") || l.contains("not written (--keep-going)"))
+        .filter(|l| l.trim() != first);
+    let line = match written {
+        Some(w) => format!("{first} → {}", w.trim()),
+        None => first.to_string(),
+    };
+    let mut line = line.replace(&format!("{}/", tmp.display()), "");
+    line = line.replace(&tmp.display().to_string(), ".");
+    // Process ids and counters in temp-file names vary from run to run.
+    if let Some(i) = line.find(".urdf-inertia.") {
+        let end = line[i..].find(".tmp").map_or(line.len(), |e| i + e);
+        line.replace_range(i..end, ".urdf-inertia.PID.N");
+    }
+    line.replace('|', "\\|")
+}
+
+#[test]
+#[ignore = "writes docs/reliability.md; run on purpose"]
+fn write_reliability_table() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let write = |name: &str, text: &str| {
+        let p = d.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    write("r.urdf", &one_box());
+    let mesh_urdf = |mesh: &str| {
+        write(
+            &format!("{}.urdf", mesh.replace('.', "_")),
+            &format!("<robot name=\"r\">\n  <link name=\"a\">\n    <collision><geometry><mesh filename=\"{mesh}\"/></geometry></collision>\n  </link>\n</robot>\n"),
+        )
+    };
+    let mut rows: Vec<(String, Output)> = Vec::new();
+    let mut add = |what: &str, args: Vec<String>, stdout: Option<Stdio>| {
+        let mut c = bin();
+        c.args(&args).current_dir(d).stdin(Stdio::null());
+        if let Some(s) = stdout {
+            c.stdout(s);
+        }
+        rows.push((what.to_string(), c.output().unwrap()));
+    };
+    let a = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    add(
+        "`fill -o /dev/null`",
+        a(&["fill", "r.urdf", "--density", "1000", "-o", "/dev/null"]),
+        None,
+    );
+    add(
+        "`fill -o -`, `-o /dev/stdout`",
+        a(&["fill", "r.urdf", "--density", "1000", "-o", "/dev/stdout"]),
+        None,
+    );
+    let ro = write("ro.urdf", &one_box());
+    std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o444)).unwrap();
+    add(
+        "`fill -i` on a 0444 file (also as root)",
+        a(&["fill", "ro.urdf", "--density", "1000", "-i"]),
+        None,
+    );
+    let hl = write("hl.urdf", &one_box());
+    std::fs::hard_link(&hl, d.join("hl2.urdf")).unwrap();
+    add(
+        "`fill -i` on a hard-linked file",
+        a(&["fill", "hl.urdf", "--density", "1000", "-i"]),
+        None,
+    );
+    std::fs::create_dir(d.join("rodir")).unwrap();
+    std::fs::write(d.join("rodir/r.urdf"), one_box()).unwrap();
+    std::fs::set_permissions(d.join("rodir"), std::fs::Permissions::from_mode(0o555)).unwrap();
+    add(
+        "`fill -i` in a read-only directory (also as root)",
+        a(&["fill", "rodir/r.urdf", "--density", "1000", "-i"]),
+        None,
+    );
+    std::os::unix::fs::symlink("made.urdf", d.join("dangling.urdf")).unwrap();
+    add(
+        "`fill -o` onto a dangling symlink (creates its target)",
+        a(&["fill", "r.urdf", "--density", "1000", "-o", "dangling.urdf"]),
+        None,
+    );
+    write("fail.urdf", &with_a_failing_link());
+    add(
+        "`fill -i` with a link that fails",
+        a(&["fill", "fail.urdf", "--density", "1000", "-i"]),
+        None,
+    );
+    add(
+        "the same with `--keep-going`",
+        a(&[
+            "fill",
+            "fail.urdf",
+            "--density",
+            "1000",
+            "-i",
+            "--keep-going",
+        ]),
+        None,
+    );
+    for (what, size, xyz, density) in [
+        ("a 1e120 box", "1e120 1e120 1e120", "0 0 0", "1000"),
+        ("a 1e-320 box", "1e-320 1 1", "0 0 0", "1000"),
+        ("a density of 1e306", "10 10 10", "0 0 0", "1e306"),
+    ] {
+        let name = format!("{}.urdf", what.replace(' ', "_"));
+        write(&name, &boxes(&[("a", size, xyz)]));
+        add(what, a(&["fill", &name, "--density", density]), None);
+    }
+    write("far.urdf", &boxes(&[("a", "1 1 1", "1e155 0 0")]).replace("</link>", "<collision><origin xyz=\"-1e155 0 0\"/><geometry><box size=\"1 1 1\"/></geometry></collision></link>"));
+    add(
+        "parts at ±1e155",
+        a(&["fill", "far.urdf", "--density", "1000", "--principal"]),
+        None,
+    );
+    write(
+        "tiny.obj",
+        "v 0 0 0\nv 1e-100 0 0\nv 0 1e-100 0\nv 0 0 1e-100\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+    );
+    add("a 1e-100-scale OBJ", a(&["mesh", "tiny.obj"]), None);
+    std::os::unix::fs::symlink("/dev/zero", d.join("zero.stl")).unwrap();
+    mesh_urdf("zero.stl");
+    add(
+        "`/dev/zero` as a mesh",
+        a(&["fill", "zero_stl.urdf", "--density", "1000"]),
+        None,
+    );
+    assert!(Command::new("mkfifo")
+        .arg(d.join("fifo.urdf"))
+        .status()
+        .unwrap()
+        .success());
+    add("a FIFO as the URDF", a(&["check", "fifo.urdf"]), None);
+    std::fs::create_dir(d.join("dir.stl")).unwrap();
+    mesh_urdf("dir.stl");
+    add(
+        "a directory as a mesh",
+        a(&["fill", "dir_stl.urdf", "--density", "1000"]),
+        None,
+    );
+    add(
+        "a URDF over `--max-file-size`",
+        a(&[
+            "fill",
+            "r.urdf",
+            "--density",
+            "1000",
+            "--max-file-size",
+            "64",
+        ]),
+        None,
+    );
+    let good = dae_box(Some("g"), 1.0, 0.0);
+    let lib = |g: &str| dae(&format!("<library_geometries>{g}</library_geometries>\n"));
+    let mut fan = String::new();
+    for i in 0..40 {
+        fan.push_str(&format!("<node id=\"n{i}\"><instance_node url=\"#n{0}\"/><instance_node url=\"#n{0}\"/></node>\n", i + 1));
+    }
+    fan.push_str("<node id=\"n40\"><instance_geometry url=\"#g\"/></node>\n");
+    let dae_cases = [
+        ("COLLADA `<accessor offset>` beyond the stride", lib(&good.replace("stride=\"3\"/>", "stride=\"3\" offset=\"2\"/>"))),
+        ("COLLADA `<input offset>` near u64::MAX", lib(&good.replace("offset=\"0\"/>", "offset=\"18446744073709551615\"/>"))),
+        ("COLLADA huge `<vcount>`", lib(&good.replace("<triangles count=\"12\">", "<polylist count=\"1\">").replace("</triangles>", "</polylist>").replace("<p>", "<vcount>4611686018427387904</vcount><p>"))),
+        ("COLLADA `<instance_node>` fan-out (40 levels × 2, < 8 KB)", dae(&format!("<library_geometries>{good}</library_geometries>\n<library_nodes>\n{fan}</library_nodes>\n<library_visual_scenes><visual_scene id=\"s\"><node><instance_node url=\"#n0\"/></node></visual_scene></library_visual_scenes>\n<scene><instance_visual_scene url=\"#s\"/></scene>\n"))),
+        ("COLLADA 100k nested elements", dae(&format!("{}{}<library_geometries>{good}</library_geometries>\n", "<extra>".repeat(100_000), "</extra>".repeat(100_000)))),
+        ("COLLADA element with 80k attributes", dae(&format!("<asset{}/>\n<library_geometries>{good}</library_geometries>\n", (0..80_000).map(|i| format!(" a{i}=\"{i}\"")).collect::<String>()))),
+        ("COLLADA two `<geometry>` without `id` (volumes add)", lib(&(dae_box(None, 1.0, 0.0) + &dae_box(None, 2.0, 5.0)))),
+    ];
+    for (i, (what, text)) in dae_cases.iter().enumerate() {
+        let name = format!("c{i}.dae");
+        write(&name, text);
+        add(what, a(&["mesh", &name]), None);
+    }
+    let full = || Some(dev_full());
+    add(
+        "`fill >/dev/full`",
+        a(&["fill", "r.urdf", "--density", "1000"]),
+        full(),
+    );
+    // A broken pipe: the reader is gone before the first write.
+    let mut child = bin()
+        .args(["diff", "r.urdf", "--density", "1000"])
+        .current_dir(d)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    rows.push((
+        "`diff … \\| head` (broken pipe)".into(),
+        child.wait_with_output().unwrap(),
+    ));
+    std::fs::set_permissions(d.join("rodir"), std::fs::Permissions::from_mode(0o755)).unwrap();
+
+    let mut md = String::from("# Reliability: hostile input, what urdf-inertia does, exit code\n\nGenerated by `cargo test --release --test regression -- --ignored write_reliability_table` (every input is made by the test in a temp dir; file names are relative to it). Exit codes: 0 ok, 1 `check` found problems, 2 error. Each row has a regression test in `tests/regression.rs`. SIGINT/SIGTERM during a write removes the temporary file and exits 130 (`temp_file_has_the_targets_mode_and_is_removed_on_sigterm`).\n\n| hostile input | what the tool does (first error line, or first line of stderr) | exit |\n| --- | --- | --- |\n");
+    for (what, out) in &rows {
+        let code = out
+            .status
+            .code()
+            .map_or("signal".to_string(), |c| c.to_string());
+        md.push_str(&format!("| {what} | {} | {code} |\n", what_it_says(out, d)));
+    }
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/reliability.md");
+    std::fs::write(&path, md).unwrap();
+    for (what, out) in &rows {
+        assert_ne!(out.status.code(), Some(101), "{what} panicked");
+    }
+}
