@@ -86,10 +86,12 @@ struct RawMap {
     total_mass: Option<Spanned<f64>>,
     #[serde(default)]
     materials: BTreeMap<String, Spanned<toml::Value>>,
+    /// Entries with their spans: the span gives each rule's line and its place in the file, however it
+    /// was written (`[links] "a" = …` or dotted `links."a" = …`).
     #[serde(default)]
-    links: toml::Table,
+    links: BTreeMap<String, Spanned<toml::Value>>,
     #[serde(default)]
-    meshes: toml::Table,
+    meshes: BTreeMap<String, Spanned<toml::Value>>,
 }
 
 /// A validated density map.
@@ -113,18 +115,25 @@ impl DensityMap {
 
     /// Reads and validates a density map file.
     pub fn load(path: &Path) -> Result<Self, MapError> {
-        let text = std::fs::read_to_string(path).map_err(|e| MapError {
+        let cannot = |e: String| MapError {
             path: path.into(),
             line: None,
             message: format!("cannot read the density map: {e}"),
-        })?;
+        };
+        let bytes = crate::input::read_file(path).map_err(cannot)?;
+        let text = String::from_utf8(bytes)
+            .map_err(|e| cannot(format!("not UTF-8 (byte {})", e.utf8_error().valid_up_to())))?;
         Self::parse(&text, path)
     }
 
     /// Parses and validates density map text.
     pub fn parse(text: &str, path: &Path) -> Result<Self, MapError> {
+        // Line starts, once: each lookup is a binary search (a map with thousands of rules stays linear).
+        let line_starts: Vec<usize> = std::iter::once(0)
+            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
         let line_of = |span: std::ops::Range<usize>| {
-            Some(1 + text[..span.start.min(text.len())].matches('\n').count())
+            Some(line_starts.partition_point(|&s| s <= span.start.min(text.len())))
         };
         let err = |span: Option<std::ops::Range<usize>>, message: String| MapError {
             path: path.into(),
@@ -212,49 +221,23 @@ impl DensityMap {
         if let Some(t) = &raw.total_mass {
             check_positive(*t.get_ref(), "total_mass").map_err(|m| err(Some(t.span()), m))?;
         }
-        // Spans of individual entries: toml's Table does not keep them, so find each key's line in the text.
-        let key_line = |section: &str, key: &str| -> Option<usize> {
-            let mut in_section = false;
-            for (i, line) in text.lines().enumerate() {
-                let t = line.trim();
-                if t.starts_with('[') {
-                    in_section = t.trim_start_matches('[').trim_end_matches(']').trim() == section;
-                    continue;
-                }
-                let k = t
-                    .split('=')
-                    .next()
-                    .unwrap_or("")
-                    .trim()
-                    .trim_matches('"')
-                    .trim_matches('\'');
-                if in_section && k == key {
-                    return Some(i + 1);
-                }
-            }
-            None
+        // Rules in file order (for tie-breaking), each error on its entry's line.
+        let rules = |section: &str,
+                     table: &BTreeMap<String, Spanned<toml::Value>>|
+         -> Result<Vec<(String, Spec)>, MapError> {
+            let mut entries: Vec<(&String, &Spanned<toml::Value>)> = table.iter().collect();
+            entries.sort_by_key(|(_, v)| v.span().start);
+            entries
+                .into_iter()
+                .map(|(k, v)| {
+                    spec(v.get_ref(), true, &format!("[{section}] `{k}`"))
+                        .map(|s| (k.clone(), s))
+                        .map_err(|m| err(Some(v.span()), m))
+                })
+                .collect()
         };
-        let mut links = Vec::new();
-        for (k, v) in &raw.links {
-            let s = spec(v, true, &format!("[links] `{k}`")).map_err(|m| MapError {
-                path: path.into(),
-                line: key_line("links", k),
-                message: m,
-            })?;
-            links.push((k.clone(), s));
-        }
-        let mut meshes = Vec::new();
-        for (k, v) in &raw.meshes {
-            let s = spec(v, true, &format!("[meshes] `{k}`")).map_err(|m| MapError {
-                path: path.into(),
-                line: key_line("meshes", k),
-                message: m,
-            })?;
-            meshes.push((k.clone(), s));
-        }
-        // File order for tie-breaking.
-        links.sort_by_key(|(k, _)| key_line("links", k).unwrap_or(usize::MAX));
-        meshes.sort_by_key(|(k, _)| key_line("meshes", k).unwrap_or(usize::MAX));
+        let links = rules("links", &raw.links)?;
+        let meshes = rules("meshes", &raw.meshes)?;
         Ok(DensityMap {
             default,
             total_mass: raw.total_mass.map(|t| *t.get_ref()),

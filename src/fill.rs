@@ -738,12 +738,64 @@ pub fn compute_with(
             });
         }
     }
+    reject_unrepresentable(&mut report);
     report.mesh_files = cache.files() - files0;
     report.timing = Timing {
         load: cache.load_time - load0,
         integrate: cache.integrate_time - integrate0,
     };
     report
+}
+
+/// Why computed mass properties cannot be written, if they cannot: every check of
+/// [`validity::check`], plus finite principal axes (what `--principal` writes).
+pub fn unrepresentable(mp: &MassProperties) -> Option<String> {
+    let mut problems: Vec<String> = validity::check(mp, validity::DEFAULT_TOLERANCE)
+        .iter()
+        .map(ToString::to_string)
+        .collect();
+    let largest_moment = (0..3).fold(0.0f64, |a, k| a.max(mp.inertia[k][k].abs()));
+    if problems.is_empty() && (mp.mass < f64::MIN_POSITIVE || largest_moment < f64::MIN_POSITIVE) {
+        // Subnormal: representable, but with most of its digits gone.
+        problems.push(format!(
+            "mass {:e} kg and largest moment {largest_moment:e} kg·m² are below the smallest normal f64 ({:e})",
+            mp.mass,
+            f64::MIN_POSITIVE
+        ));
+    }
+    if problems.is_empty() {
+        let p = mp.principal();
+        if !p
+            .moments
+            .iter()
+            .chain(p.axes.iter().flatten())
+            .all(|x| x.is_finite())
+        {
+            problems.push("its principal axes are not finite".into());
+        }
+    }
+    (!problems.is_empty()).then(|| {
+        format!(
+            "overflow/underflow: the computed inertial is not usable ({}); sizes, positions, scales or densities this large or small are beyond f64",
+            problems.join("; ")
+        )
+    })
+}
+
+/// The backstop after composition: a link whose values overflowed or underflowed (mass `inf`, a NaN,
+/// an all-zero tensor) becomes that link's failure instead of being written.
+fn reject_unrepresentable(report: &mut FillReport) {
+    let links = std::mem::take(&mut report.links);
+    for l in links {
+        match unrepresentable(&l.computed) {
+            None => report.links.push(l),
+            Some(message) => report.failures.push(LinkFailure {
+                name: l.name,
+                line: l.line,
+                message,
+            }),
+        }
+    }
 }
 
 /// The largest pairwise overlap of the parts' bounding boxes, capped by the smaller part's volume, when it

@@ -9,6 +9,7 @@
 pub mod cli;
 pub mod density;
 pub mod fill;
+pub mod input;
 pub mod mass;
 pub mod mesh;
 pub mod overlap;

@@ -188,7 +188,19 @@ fn one_bad_link_does_not_cost_the_rest() {
 ";
     let urdf = write(tmp.path(), "bad.urdf", text);
     let filled = tmp.path().join("filled.urdf");
+    // Without --keep-going nothing is written (the hardening issue's policy); with it, the rest is.
     let out = run(&["fill", s(&urdf), "--density", "1000", "-o", s(&filled)]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!filled.exists());
+    let out = run(&[
+        "fill",
+        s(&urdf),
+        "--density",
+        "1000",
+        "-o",
+        s(&filled),
+        "--keep-going",
+    ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     for expect in [

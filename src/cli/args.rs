@@ -54,6 +54,10 @@ pub struct SourceArgs {
     /// Leave these links alone (glob, repeatable).
     #[arg(long, value_name = "GLOB")]
     pub skip: Vec<String>,
+    /// Largest input file read (URDF, mesh, density map): bytes or K/M/G; default 1G, or the
+    /// URDF_INERTIA_MAX_FILE_SIZE environment variable.
+    #[arg(long, value_name = "SIZE")]
+    pub max_file_size: Option<String>,
 }
 
 #[derive(Debug, Clone, ClapArgs)]
@@ -62,12 +66,17 @@ pub struct FillArgs {
     pub urdf: PathBuf,
     #[command(flatten)]
     pub source: SourceArgs,
-    /// Write the result to this file instead of stdout.
+    /// Write the result to this file instead of stdout (`-` is stdout; devices and FIFOs are written
+    /// directly, regular files replaced through a temp file and a rename).
     #[arg(short, long, value_name = "OUT", conflicts_with = "in_place")]
     pub output: Option<PathBuf>,
     /// Rewrite the URDF in place (temp file beside it, then rename).
     #[arg(short, long)]
     pub in_place: bool,
+    /// When some links fail, still write the links that worked (the exit status is 2 all the same).
+    /// Without it, nothing is written when any link fails.
+    #[arg(long)]
+    pub keep_going: bool,
     /// Only links whose <inertial> is absent or invalid.
     #[arg(long)]
     pub missing_only: bool,
@@ -126,4 +135,7 @@ pub struct MeshArgs {
     pub strict: bool,
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
+    /// Largest mesh file read: bytes or K/M/G; default 1G, or URDF_INERTIA_MAX_FILE_SIZE.
+    #[arg(long, value_name = "SIZE")]
+    pub max_file_size: Option<String>,
 }

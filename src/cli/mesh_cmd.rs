@@ -13,7 +13,7 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
     for (name, v) in [("--density", args.density), ("--mass", args.mass)] {
         if let Some(v) = v {
             if !(v > 0.0 && v.is_finite()) {
-                eprintln!("error: {name} {v} must be a positive number");
+                errln!("error: {name} {v} must be a positive number");
                 return ExitStatus::Error;
             }
         }
@@ -28,7 +28,7 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
     ) {
         Ok(s) => s,
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             return ExitStatus::Error;
         }
     };
@@ -39,6 +39,10 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         (None, None) => 1.0,
     };
     let mp = solid.unit.scaled(density);
+    if let Some(why) = crate::fill::unrepresentable(&mp) {
+        errln!("error: {}: {why}", args.file.display());
+        return ExitStatus::Error;
+    }
     let pr = mp.principal();
     let elapsed = start.elapsed();
     match args.format {
@@ -67,63 +71,65 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
                 "warnings": solid.warnings,
                 "notes": solid.notes,
             });
-            println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+            outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
         }
         Format::Text => {
-            println!(
+            outln!(
                 "{}  (scale {} {} {})",
                 args.file.display(),
                 scale[0],
                 scale[1],
                 scale[2]
             );
-            println!(
+            outln!(
                 "  health            {} ({} faces read; the solid has {} faces, {} vertices)",
                 solid.rung.name(),
                 solid.faces_read,
                 solid.faces.len(),
                 solid.vertices.len()
             );
-            println!("  volume            {} m³", shortest(volume));
-            println!("  density           {} kg/m³", shortest(density));
-            println!("  mass              {} kg", shortest(mp.mass));
-            println!(
+            outln!("  volume            {} m³", shortest(volume));
+            outln!("  density           {} kg/m³", shortest(density));
+            outln!("  mass              {} kg", shortest(mp.mass));
+            outln!(
                 "  centre of mass    {} {} {} m",
                 shortest(mp.com[0]),
                 shortest(mp.com[1]),
                 shortest(mp.com[2])
             );
-            println!("  inertia about the COM (kg·m², mesh axes)");
+            outln!("  inertia about the COM (kg·m², mesh axes)");
             for row in &mp.inertia {
-                println!(
+                outln!(
                     "    {:>24} {:>24} {:>24}",
                     shortest(row[0]),
                     shortest(row[1]),
                     shortest(row[2])
                 );
             }
-            println!(
+            outln!(
                 "  principal moments {} {} {}",
                 shortest(pr.moments[0]),
                 shortest(pr.moments[1]),
                 shortest(pr.moments[2])
             );
             for (k, name) in ["axis 1", "axis 2", "axis 3"].iter().enumerate() {
-                println!(
+                outln!(
                     "  principal {name}  {:.9} {:.9} {:.9}",
-                    pr.axes[0][k], pr.axes[1][k], pr.axes[2][k]
+                    pr.axes[0][k],
+                    pr.axes[1][k],
+                    pr.axes[2][k]
                 );
             }
-            println!(
+            outln!(
                 "  error estimate    {} (relative bound on volume and central inertia)",
                 solid.error.describe()
             );
-            println!("  time              {:.3} ms", elapsed.as_secs_f64() * 1e3);
+            outln!("  time              {:.3} ms", elapsed.as_secs_f64() * 1e3);
             for w in &solid.warnings {
-                println!("  warning: {w}");
+                outln!("  warning: {w}");
             }
             for n in &solid.notes {
-                println!("  note: {n}");
+                outln!("  note: {n}");
             }
         }
     }

@@ -1,9 +1,21 @@
 //! Command line: clap parses raw arguments, they are validated into a configuration before any work
 //! starts, and each command returns an [`ExitStatus`]: 0 ok, 1 check found problems, 2 error.
 
+/// `println!` through [`output`]: never panics on a closed pipe or a full disk.
+macro_rules! outln {
+    ($($t:tt)*) => { $crate::cli::output::out_line(&format!($($t)*)) };
+}
+
+/// `eprintln!` that ignores a failing stderr.
+macro_rules! errln {
+    ($($t:tt)*) => { $crate::cli::output::err_line(&format!($($t)*)) };
+}
+
 mod args;
 mod mesh_cmd;
+pub mod output;
 mod robot_cmd;
+pub mod write;
 
 use clap::Parser;
 
@@ -34,12 +46,35 @@ pub fn main() -> i32 {
             return code;
         }
     };
+    write::remove_temp_files_on_signal();
+    let max_size = match &args.command {
+        Command::Mesh(m) => m.max_file_size.clone(),
+        Command::Fill(f) => f.source.max_file_size.clone(),
+        Command::Diff(d) => d.source.max_file_size.clone(),
+        Command::Check(c) => c.source.max_file_size.clone(),
+    };
+    let from_env = std::env::var(crate::input::MAX_FILE_SIZE_ENV).ok();
+    if let Some((what, s)) = max_size
+        .map(|s| ("--max-file-size", s))
+        .or(from_env.map(|s| (crate::input::MAX_FILE_SIZE_ENV, s)))
+    {
+        match crate::input::parse_size(&s) {
+            Ok(n) => crate::input::set_max_file_size(n),
+            Err(e) => {
+                errln!("error: {what}: {e}");
+                return ExitStatus::Error as i32;
+            }
+        }
+    }
     let status = match args.command {
         Command::Mesh(m) => mesh_cmd::run(&m),
         Command::Fill(f) => robot_cmd::fill(&f),
         Command::Diff(d) => robot_cmd::diff(&d),
         Command::Check(c) => robot_cmd::check(&c),
     };
+    if output::stdout_failed() {
+        return ExitStatus::Error as i32;
+    }
     status as i32
 }
 

@@ -1,7 +1,7 @@
 //! `fill`, `diff` and `check`: the commands that work on a URDF.
 
 use super::args::{CheckArgs, DiffArgs, FillArgs, Format, SourceArgs};
-use super::{shortest, ExitStatus};
+use super::{output, shortest, write, ExitStatus};
 use crate::density::DensityMap;
 use crate::fill::{self, existing_problems, existing_props, FillOptions, FillReport, LinkReport};
 use crate::mass::{frobenius, MassProperties};
@@ -9,7 +9,6 @@ use crate::urdf::resolve::PackageResolver;
 use crate::urdf::write::{splice, WriteOptions};
 use crate::urdf::{scan_bytes, Geometry, NoteLevel, Robot};
 use serde_json::json;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -56,7 +55,7 @@ fn prepare(
     command: &str,
 ) -> Result<(Sources, DensityMap, Robot), ExitStatus> {
     let report = |e: String| {
-        eprintln!("error: {e}");
+        errln!("error: {e}");
         ExitStatus::Error
     };
     let mut src = sources(source).map_err(report)?;
@@ -70,11 +69,11 @@ fn prepare(
 
 /// Reads, decodes and scans a URDF, printing the scan's warnings and notes to stderr.
 fn read_robot(path: &Path) -> Result<Robot, String> {
-    let bytes = std::fs::read(path)
+    let bytes = crate::input::read_file(path)
         .map_err(|e| format!("{}: cannot read the URDF: {e}", path.display()))?;
     let robot = scan_bytes(bytes, path).map_err(|e| e.to_string())?;
     for note in &robot.notes {
-        eprintln!("{}", note.render(&robot.path));
+        errln!("{}", note.render(&robot.path));
     }
     Ok(robot)
 }
@@ -82,9 +81,9 @@ fn read_robot(path: &Path) -> Result<Robot, String> {
 fn print_failures(robot: &Robot, report: &FillReport) {
     for f in &report.failures {
         if f.name.is_empty() {
-            eprintln!("error: {}: {}", robot.path.display(), f.message);
+            errln!("error: {}: {}", robot.path.display(), f.message);
         } else {
-            eprintln!(
+            errln!(
                 "error: {}:{}: link `{}`: {}",
                 robot.path.display(),
                 f.line,
@@ -93,40 +92,6 @@ fn print_failures(robot: &Robot, report: &FillReport) {
             );
         }
     }
-}
-
-/// Writes `text` to `path` through a temporary file in the same directory and a rename, so the target is
-/// never left half-written.
-fn write_atomically(path: &Path, text: &[u8]) -> Result<(), String> {
-    // Through a symlink, replace its target: renaming onto the link would turn it into a plain file.
-    let resolved = if path.is_symlink() {
-        std::fs::canonicalize(path).ok()
-    } else {
-        None
-    };
-    let path = resolved.as_deref().unwrap_or(path);
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "urdf".into());
-    let tmp = dir.join(format!(".{name}.urdf-inertia.{}.tmp", std::process::id()));
-    let result = (|| -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(text)?;
-        f.sync_all()?;
-        if let Ok(meta) = std::fs::metadata(path) {
-            std::fs::set_permissions(&tmp, meta.permissions())?;
-        }
-        std::fs::rename(&tmp, path)
-    })();
-    result.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("{}: cannot write: {e}", path.display())
-    })
 }
 
 fn part_lines(l: &LinkReport) -> Vec<String> {
@@ -206,8 +171,9 @@ fn summary_json(robot: &Robot, report: &FillReport, seconds: f64) -> serde_json:
 
 pub fn fill(a: &FillArgs) -> ExitStatus {
     let start = Instant::now();
-    if a.format == Format::Json && !a.in_place && a.output.is_none() {
-        eprintln!("error: --format json prints the summary on stdout, where the URDF goes without -o OUT or -i");
+    let to_stdout = !a.in_place && a.output.as_ref().is_none_or(|p| p.as_os_str() == "-");
+    if a.format == Format::Json && to_stdout {
+        errln!("error: --format json prints the summary on stdout, where the URDF goes without -o OUT or -i");
         return ExitStatus::Error;
     }
     let (mut src, map, robot) = match prepare(&a.source, &a.urdf, "fill") {
@@ -232,40 +198,52 @@ pub fn fill(a: &FillArgs) -> ExitStatus {
     let text = match robot.encoding.encode(&text) {
         Ok(bytes) => bytes,
         Err(e) => {
-            eprintln!("error: {}: {e}", robot.path.display());
+            errln!("error: {}: {e}", robot.path.display());
             return ExitStatus::Error;
         }
     };
     let target: Option<PathBuf> = if a.in_place {
         Some(a.urdf.clone())
     } else {
-        a.output.clone()
+        a.output.clone().filter(|p| p.as_os_str() != "-")
     };
-    match &target {
-        Some(path) => {
-            if let Err(e) = write_atomically(path, &text) {
-                eprintln!("error: {e}");
-                return ExitStatus::Error;
-            }
+    let where_to = target
+        .as_ref()
+        .map_or_else(|| "stdout".to_string(), |p| p.display().to_string());
+    // Selected links with geometry that were not computed.
+    let failed_links = report.failures.len();
+    if !report.failures.is_empty() && !a.keep_going {
+        errln!(
+            "error: {} link(s) could not be computed: nothing written to {where_to} (--keep-going writes the links that worked, and still exits 2)",
+            failed_links
+        );
+        return ExitStatus::Error;
+    }
+    let written = match &target {
+        Some(path) => write::write_output(path, &text),
+        None => write::write_output(Path::new("-"), &text),
+    };
+    if let Err(e) = written {
+        // A failing stdout was reported where it failed.
+        if target.is_some() {
+            errln!("error: {e}");
         }
-        None => {
-            let mut out = std::io::stdout().lock();
-            if out.write_all(&text).and_then(|_| out.flush()).is_err() {
-                return ExitStatus::Error;
-            }
-        }
+        return ExitStatus::Error;
+    }
+    if target.is_some() {
+        output::stdout_is_summary();
     }
     let write_time = t_write.elapsed();
     let seconds = start.elapsed().as_secs_f64();
     if a.format == Format::Json && target.is_some() {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&summary_json(&robot, &report, seconds))
                 .unwrap_or_default()
         );
     } else {
         let parts: usize = report.links.iter().map(|l| l.parts.len()).sum();
-        eprintln!(
+        errln!(
             "urdf-inertia: robot `{}`: filled {} link(s) ({} parts, {} mesh files, {} faces) in {:.3} s (CPU time over all cores: mesh loading {:.3} s, healing and integration {:.3} s; writing {:.3} s)",
             robot.name,
             report.links.len(),
@@ -278,17 +256,23 @@ pub fn fill(a: &FillArgs) -> ExitStatus {
             write_time.as_secs_f64()
         );
         if robot.name.is_empty() {
-            eprintln!("  warning: <robot> has no name attribute: urdfdom (ROS, pinocchio) refuses such a file");
+            errln!("  warning: <robot> has no name attribute: urdfdom (ROS, pinocchio) refuses such a file");
+        }
+        if !report.failures.is_empty() {
+            errln!(
+                "  not written (--keep-going): {failed_links} link(s) that failed, left as they were"
+            );
         }
         if report.without_geometry + report.not_selected > 0 {
-            eprintln!(
+            errln!(
                 "  left as they are: {} link(s) without collision geometry, {} not selected",
-                report.without_geometry, report.not_selected
+                report.without_geometry,
+                report.not_selected
             );
         }
         for l in &report.links {
             for line in part_lines(l) {
-                eprintln!("  warning: {line}");
+                errln!("  warning: {line}");
             }
         }
         let worst = report
@@ -297,7 +281,7 @@ pub fn fill(a: &FillArgs) -> ExitStatus {
             .flat_map(|l| l.parts.iter().map(move |p| (p.error_estimate, l, p)))
             .max_by(|a, b| a.0.total_cmp(&b.0));
         if let Some((_, l, p)) = worst {
-            eprintln!(
+            errln!(
                 "  worst error estimate: {} (relative bound on volume and inertia; link `{}`, collision {}: {})",
                 p.error.describe(),
                 l.name,
@@ -428,17 +412,22 @@ pub fn diff(a: &DiffArgs) -> ExitStatus {
                     })
                 })
                 .collect();
-            println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+            outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
         }
         Format::Text => {
-            println!(
+            outln!(
                 "{:<28} {:>12} {:>12} {:>9} {:>10} {:>10}  notes",
-                "link", "existing kg", "computed kg", "ratio", "COM Δ/size", "inertia Δ"
+                "link",
+                "existing kg",
+                "computed kg",
+                "ratio",
+                "COM Δ/size",
+                "inertia Δ"
             );
             for (l, e, c) in &rows {
                 match (e, c) {
                     (Some(e), Some(c)) => {
-                        println!(
+                        outln!(
                             "{:<28} {:>12.5} {:>12.5} {:>9.4} {:>10.3e} {:>10.3e}  {}",
                             l.name,
                             e.mass,
@@ -450,7 +439,7 @@ pub fn diff(a: &DiffArgs) -> ExitStatus {
                         );
                         let pe = e.principal().moments;
                         let pc = l.computed.principal().moments;
-                        println!(
+                        outln!(
                             "{:<28} principal moments existing {} {} {}, computed {} {} {}",
                             "",
                             shortest(pe[0]),
@@ -461,9 +450,14 @@ pub fn diff(a: &DiffArgs) -> ExitStatus {
                             shortest(pc[2])
                         );
                     }
-                    _ => println!(
+                    _ => outln!(
                         "{:<28} {:>12} {:>12.5} {:>9} {:>10} {:>10}  no existing <inertial>",
-                        l.name, "-", l.computed.mass, "-", "-", "-"
+                        l.name,
+                        "-",
+                        l.computed.mass,
+                        "-",
+                        "-",
+                        "-"
                     ),
                 }
             }
@@ -480,12 +474,12 @@ pub fn check(a: &CheckArgs) -> ExitStatus {
     let src = match sources(&a.source) {
         Ok(s) => s,
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             return ExitStatus::Error;
         }
     };
     if !(a.tolerance > 0.0 && a.tolerance.is_finite()) {
-        eprintln!(
+        errln!(
             "error: --tolerance {} must be a positive number",
             a.tolerance
         );
@@ -497,13 +491,13 @@ pub fn check(a: &CheckArgs) -> ExitStatus {
         let robot = match read_robot(path) {
             Ok(r) => r,
             Err(e) => {
-                eprintln!("error: {e}");
+                errln!("error: {e}");
                 errors += 1;
                 continue;
             }
         };
         let mut report_line = |line: usize, link: &str, msg: &str| {
-            println!("{}:{line}: link `{link}`: {msg}", path.display());
+            outln!("{}:{line}: link `{link}`: {msg}", path.display());
             findings += 1;
         };
         for link in &robot.links {
@@ -526,7 +520,7 @@ pub fn check(a: &CheckArgs) -> ExitStatus {
             for p in existing_problems(link) {
                 if !link.has_collision_geometry() && !a.all_links && duplicates.as_ref() != Some(&p)
                 {
-                    eprintln!("note: {}:{line}: link `{}` (no collision geometry, so fill cannot compute it): {p}", path.display(), link.name);
+                    errln!("note: {}:{line}: link `{}` (no collision geometry, so fill cannot compute it): {p}", path.display(), link.name);
                 } else {
                     report_line(line, &link.name, &p);
                 }
@@ -541,7 +535,7 @@ pub fn check(a: &CheckArgs) -> ExitStatus {
             {
                 for c in &link.collisions {
                     if let Geometry::Invalid { line, message } = &c.geometry {
-                        eprintln!(
+                        errln!(
                             "error: {}:{}: link `{}`: collision {} (line {line}): {message}",
                             path.display(),
                             link.line,
@@ -610,7 +604,7 @@ pub fn check(a: &CheckArgs) -> ExitStatus {
     if errors > 0 {
         ExitStatus::Error
     } else if findings > 0 {
-        eprintln!("urdf-inertia check: {findings} problem(s) found; `urdf-inertia fill -i FILE --density-map …` computes correct values");
+        errln!("urdf-inertia check: {findings} problem(s) found; `urdf-inertia fill -i FILE --density-map …` computes correct values");
         ExitStatus::Problems
     } else {
         ExitStatus::Success

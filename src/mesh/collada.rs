@@ -43,13 +43,25 @@ impl El {
     fn children_named<'a>(&'a self, name: &'a str) -> impl Iterator<Item = &'a El> + 'a {
         self.children.iter().filter(move |c| c.name == name)
     }
+    /// Every element of the tree, in document order (iterative: deep files must not overflow the stack).
     fn walk<'a>(&'a self, out: &mut Vec<&'a El>) {
-        out.push(self);
-        for c in &self.children {
-            c.walk(out);
+        let mut stack = vec![self];
+        while let Some(e) = stack.pop() {
+            out.push(e);
+            stack.extend(e.children.iter().rev());
         }
     }
 }
+
+/// Deepest element nesting accepted. The tree is dropped recursively (and real files nest a few dozen
+/// levels), so a bound keeps a hostile file from overflowing a worker thread's stack.
+const MAX_DEPTH: usize = 512;
+
+/// Budget for what the scene graph may instance (`<instance_node>` can double a mesh per level, so a few
+/// kilobytes could ask for 2^40 copies): vertices, polygon corners and node visits.
+const MAX_INSTANCED_VERTICES: usize = 1 << 24;
+const MAX_INSTANCED_CORNERS: usize = 1 << 26;
+const MAX_NODE_VISITS: usize = 1 << 20;
 
 fn local(name: &[u8]) -> String {
     let s = String::from_utf8_lossy(name);
@@ -65,7 +77,8 @@ fn element(e: &quick_xml::events::BytesStart<'_>, line: usize) -> El {
         line,
         ..Default::default()
     };
-    for a in e.attributes().flatten() {
+    // Without the duplicate check, which compares each attribute with all before it (quadratic).
+    for a in e.attributes().with_checks(false).flatten() {
         let v = a
             .unescape_value()
             .map(|v| v.into_owned())
@@ -95,7 +108,15 @@ fn parse_tree(bytes: &[u8], path: &Path) -> Result<El, MeshError> {
             )
         })?;
         match event {
-            Event::Start(e) => stack.push(element(&e, lines.at(pos))),
+            Event::Start(e) => {
+                if stack.len() > MAX_DEPTH {
+                    return Err(syntax(
+                        pos,
+                        format!("elements nested deeper than {MAX_DEPTH} levels"),
+                    ));
+                }
+                stack.push(element(&e, lines.at(pos)));
+            }
             Event::Empty(e) => {
                 let el = element(&e, lines.at(pos));
                 if let Some(parent) = stack.last_mut() {
@@ -250,14 +271,14 @@ fn read_geometry(
     let err =
         |line: usize, msg: String| MeshError::new(path, Some(line), MeshErrorKind::Syntax(msg));
     // Sources by id.
-    let mut sources: HashMap<&str, (Vec<f64>, usize, usize)> = HashMap::new();
+    let mut sources: HashMap<&str, (Vec<f64>, usize, usize, usize)> = HashMap::new();
     for src in mesh.children_named("source") {
         let Some(id) = src.attr("id") else { continue };
         let Some(arr) = src.child("float_array") else {
             continue;
         };
         let data = numbers(arr, path)?;
-        let (stride, offset) = src
+        let (stride, offset, line) = src
             .child("technique_common")
             .and_then(|t| t.child("accessor"))
             .map(|a| {
@@ -268,10 +289,11 @@ fn read_geometry(
                     a.attr("offset")
                         .and_then(|s| s.parse().ok())
                         .unwrap_or(0usize),
+                    a.line,
                 )
             })
-            .unwrap_or((3, 0));
-        sources.insert(id, (data, stride.max(1), offset));
+            .unwrap_or((3, 0, src.line));
+        sources.insert(id, (data, stride.max(1), offset, line));
     }
     let positions_of = |source_ref: &str, line: usize| -> Result<Vec<[f64; 3]>, MeshError> {
         let id = source_ref.trim_start_matches('#');
@@ -288,13 +310,19 @@ fn read_geometry(
         } else {
             id
         };
-        let (data, stride, offset) = sources
+        let (data, stride, offset, accessor_line) = sources
             .get(id)
             .ok_or_else(|| err(line, format!("no <source id=\"{id}\">")))?;
         if *stride < 3 {
             return Err(err(
                 line,
                 format!("position source `{id}` has stride {stride}"),
+            ));
+        }
+        if offset.checked_add(3).is_none_or(|end| end > *stride) {
+            return Err(err(
+                *accessor_line,
+                format!("<accessor> of `{id}`: offset {offset} leaves no room for x, y, z in its stride {stride}"),
             ));
         }
         Ok(data
@@ -325,7 +353,13 @@ fn read_geometry(
             .filter_map(|i| i.attr("offset").and_then(|o| o.parse::<usize>().ok()))
             .max()
             .unwrap_or(0)
-            + 1;
+            .checked_add(1)
+            .ok_or_else(|| {
+                err(
+                    prim.line,
+                    format!("<{kind}> has an <input> offset too large"),
+                )
+            })?;
         let vin = inputs
             .iter()
             .find(|i| i.attr("semantic") == Some("VERTEX"))
@@ -361,7 +395,13 @@ fn read_geometry(
             "triangles" => {
                 let Some(p) = prim.child("p") else { continue };
                 let idx = numbers(p, path)?;
-                for tri in idx.chunks_exact(3 * stride) {
+                let chunk = stride.checked_mul(3).ok_or_else(|| {
+                    err(
+                        prim.line,
+                        format!("<{kind}> has an <input> offset too large"),
+                    )
+                })?;
+                for tri in idx.chunks_exact(chunk) {
                     face.clear();
                     for k in 0..3 {
                         face.push(index(tri[k * stride + voff], p.line)?);
@@ -378,13 +418,23 @@ fn read_geometry(
                     .transpose()?
                     .unwrap_or_default();
                 let mut at = 0usize;
+                let more = || {
+                    err(
+                        p.line,
+                        "<polylist> <vcount> asks for more indices than <p> holds".into(),
+                    )
+                };
                 for n in vcount {
+                    if !(n >= 0.0 && n.fract() == 0.0 && n <= idx.len() as f64) {
+                        return Err(more());
+                    }
                     let n = n as usize;
-                    if (at + n) * stride > idx.len() {
-                        return Err(err(
-                            p.line,
-                            "<polylist> <vcount> asks for more indices than <p> holds".into(),
-                        ));
+                    let end = at
+                        .checked_add(n)
+                        .and_then(|e| e.checked_mul(stride))
+                        .ok_or_else(more)?;
+                    if end > idx.len() {
+                        return Err(more());
                     }
                     face.clear();
                     for k in 0..n {
@@ -446,7 +496,9 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         .filter_map(|e| e.attr("id").map(|id| (id, *e)))
         .collect();
 
-    let mut geom_cache: HashMap<String, (Vec<[f64; 3]>, Polygons)> = HashMap::new();
+    // Keyed by element, not by id: id-less geometries are each their own.
+    let mut geom_cache: HashMap<*const El, (Vec<[f64; 3]>, Polygons)> = HashMap::new();
+    let mut corners = 0usize;
     let mut out = RawMesh {
         faces: Polygons::new(),
         ..Default::default()
@@ -456,12 +508,25 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
                    out: &mut RawMesh,
                    notes: &mut Vec<String>|
      -> Result<(), MeshError> {
-        let id = geom.attr("id").unwrap_or("").to_string();
-        if !geom_cache.contains_key(&id) {
-            let g = read_geometry(geom, path, notes)?;
-            geom_cache.insert(id.clone(), g);
+        let key: *const El = geom;
+        let (v, f) = match geom_cache.entry(key) {
+            std::collections::hash_map::Entry::Occupied(e) => &*e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                &*e.insert(read_geometry(geom, path, notes)?)
+            }
+        };
+        corners = corners.saturating_add(f.indices.len());
+        if out.vertices.len().saturating_add(v.len()) > MAX_INSTANCED_VERTICES
+            || corners > MAX_INSTANCED_CORNERS
+        {
+            return Err(MeshError::new(
+                path,
+                Some(geom.line),
+                MeshErrorKind::Syntax(format!(
+                    "the scene instances more than {MAX_INSTANCED_VERTICES} vertices or {MAX_INSTANCED_CORNERS} polygon corners (nested <instance_node> multiply their geometry); simplify the collision mesh"
+                )),
+            ));
         }
-        let (v, f) = &geom_cache[&id];
         let base = out.vertices.len() as u32;
         for p in v {
             let q = crate::mass::mat_vec(&xf.0, *p);
@@ -501,7 +566,18 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
                 .children_named("node")
                 .map(|n| (n, IDENTITY, 0))
                 .collect();
+            let mut visits = 0usize;
             while let Some((node, parent, depth)) = stack.pop() {
+                visits += 1;
+                if visits > MAX_NODE_VISITS {
+                    return Err(MeshError::new(
+                        path,
+                        Some(node.line),
+                        MeshErrorKind::Syntax(format!(
+                            "the scene instances more than {MAX_NODE_VISITS} nodes (nested <instance_node> multiply); simplify the collision mesh"
+                        )),
+                    ));
+                }
                 if depth > 64 {
                     return Err(MeshError::new(
                         path,

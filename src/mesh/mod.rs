@@ -83,6 +83,8 @@ pub enum MeshErrorKind {
     BadScale([f64; 3]),
     /// An open mesh whose convex hull could not be built either.
     Hull(String),
+    /// A reader or the healing panicked (a bug): caught, so that it fails only this mesh.
+    Internal(String),
 }
 
 impl fmt::Display for MeshError {
@@ -114,6 +116,10 @@ impl fmt::Display for MeshError {
             MeshErrorKind::BadScale(s) => {
                 write!(f, "scale \"{} {} {}\" has a zero or non-finite factor", s[0], s[1], s[2])
             }
+            MeshErrorKind::Internal(msg) => write!(
+                f,
+                "internal error while processing the mesh (a bug in urdf-inertia; please report it with the file): {msg}"
+            ),
         }
     }
 }
@@ -130,8 +136,28 @@ impl MeshError {
     }
 }
 
+/// Runs `f`, turning a panic into this mesh's [`MeshErrorKind::Internal`] error: a backstop so that a
+/// bug in a reader or in the healing fails one mesh (one link), never the whole run.
+fn catching_panics<T>(
+    path: &Path,
+    f: impl FnOnce() -> Result<T, MeshError>,
+) -> Result<T, MeshError> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
+        let msg = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "panic".into());
+        Err(MeshError::new(path, None, MeshErrorKind::Internal(msg)))
+    })
+}
+
 /// Reads a mesh file of any supported format (by extension).
 pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
+    catching_panics(path, || read_unguarded(path))
+}
+
+fn read_unguarded(path: &Path) -> Result<RawMesh, MeshError> {
     let format = MeshFormat::from_path(path).ok_or_else(|| {
         let ext = path
             .extension()
@@ -140,8 +166,8 @@ pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
             .unwrap_or_else(|| "(no extension)".into());
         MeshError::new(path, None, MeshErrorKind::UnknownFormat(ext))
     })?;
-    let bytes = std::fs::read(path)
-        .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e.to_string())))?;
+    let bytes = crate::input::read_file(path)
+        .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e)))?;
     let mesh = match format {
         MeshFormat::Stl => stl::parse(&bytes, path)?,
         MeshFormat::Obj => obj::parse(&bytes, path)?,
@@ -210,11 +236,13 @@ pub fn solid_from_raw(
     path: &Path,
     options: health::HealthOptions,
 ) -> Result<health::Solid, MeshError> {
-    let scaled = apply_scale(raw, scale, path)?;
-    // The precision of the file's own numbers, before the scale multiplies them; the largest
-    // coordinate scales with them, so the tolerance in ulps of it stays right.
-    health::make_solid_stored_as(&scaled, path, options, || {
-        weld::Precision::of(&raw.vertices)
+    catching_panics(path, || {
+        let scaled = apply_scale(raw, scale, path)?;
+        // The precision of the file's own numbers, before the scale multiplies them; the largest
+        // coordinate scales with them, so the tolerance in ulps of it stays right.
+        health::make_solid_stored_as(&scaled, path, options, || {
+            weld::Precision::of(&raw.vertices)
+        })
     })
 }
 
@@ -222,4 +250,24 @@ pub fn solid_from_raw(
 /// afterwards with a clearer message).
 pub(crate) fn parse_f64(s: &str) -> Option<f64> {
     s.parse::<f64>().ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 13.7: a panic in a reader or in the healing fails that mesh, not the run.
+    #[test]
+    fn a_panic_becomes_the_meshs_error() {
+        let p = Path::new("m.dae");
+        let r: Result<(), MeshError> = catching_panics(p, || panic!("boom"));
+        let e = r.unwrap_err();
+        assert_eq!(e.kind, MeshErrorKind::Internal("boom".into()));
+        assert!(e.to_string().starts_with("m.dae: internal error"));
+        let r: Result<(), MeshError> = catching_panics(p, || panic!("{} {}", "formatted", 1));
+        assert_eq!(
+            r.unwrap_err().kind,
+            MeshErrorKind::Internal("formatted 1".into())
+        );
+    }
 }

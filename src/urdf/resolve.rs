@@ -71,6 +71,10 @@ impl PackageResolver {
                 }
                 searched.push(p);
             }
+            // Something that is there but not a file (a directory, a FIFO): reading it says so.
+            if let Some(p) = searched.iter().find(|p| !inner.is_empty() && p.exists()) {
+                return Ok(p.clone());
+            }
             return Err(NotFound {
                 uri: uri.to_string(),
                 searched,
@@ -111,7 +115,8 @@ impl PackageResolver {
                 base.join(p)
             }
         };
-        if path.is_file() {
+        // Anything that exists: reading a directory or a device says "is not a regular file".
+        if path.exists() {
             Ok(path)
         } else {
             Err(NotFound {

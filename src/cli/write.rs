@@ -1,0 +1,247 @@
+//! Writing the filled URDF (`-o FILE`, `-o -`, `-i`): the write policy documented in the README.
+//!
+//! * A regular file (or a symlink to one, followed to its target, dangling ones included) is replaced
+//!   atomically: a temporary file `.NAME.urdf-inertia.PID.N.tmp` in the target's directory, created with
+//!   the target's mode (never wider), given the target's owner and group where the process may, synced,
+//!   then renamed over the target. It is removed on error, SIGINT and SIGTERM.
+//! * Anything else that exists (a character device such as `/dev/null`, a FIFO, `/dev/stdout` and other
+//!   `/proc` or `/dev/fd` links) is opened for writing and written directly: never replaced, never
+//!   truncated unless it turns out to be a regular file.
+//! * `-` is stdout.
+//! * Refused, with the reason: a target without any write bit (also as root, who bypasses mode bits), a
+//!   target with more than one hard link (a rename would split it from its other names), a directory
+//!   without any write bit, a directory as target.
+
+use super::output;
+use std::fs::{self, File, OpenOptions};
+use std::io::{self, Write};
+use std::os::unix::fs::{MetadataExt, OpenOptionsExt, PermissionsExt};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+/// Temporary files that exist right now, removed by the SIGINT/SIGTERM handler.
+static LIVE_TEMPS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+static TEMP_COUNTER: AtomicUsize = AtomicUsize::new(0);
+
+/// Exit status after SIGINT or SIGTERM (128 + SIGINT, as shells report an interrupted command).
+const SIGNAL_EXIT: i32 = 130;
+
+/// Test hook: with this variable set, a write pauses after its temporary file is complete and before the
+/// rename, says so on stderr and waits for a line on stdin (lets a test deliver a signal at that point
+/// without depending on timing).
+const HOLD_ENV: &str = "URDF_INERTIA_TEST_HOLD_TEMP";
+
+/// Installs the SIGINT/SIGTERM handler that removes live temporary files, then exits 130.
+pub fn remove_temp_files_on_signal() {
+    // An error means a handler is already installed (a second call): nothing to do.
+    let _ = ctrlc::set_handler(|| {
+        remove_live_temps();
+        std::process::exit(SIGNAL_EXIT);
+    });
+}
+
+fn remove_live_temps() {
+    let live = match LIVE_TEMPS.lock() {
+        Ok(g) => g,
+        Err(poisoned) => poisoned.into_inner(),
+    };
+    for p in live.iter() {
+        let _ = fs::remove_file(p);
+    }
+}
+
+fn register(p: &Path) {
+    if let Ok(mut g) = LIVE_TEMPS.lock() {
+        g.push(p.to_path_buf());
+    }
+}
+
+fn unregister(p: &Path) {
+    if let Ok(mut g) = LIVE_TEMPS.lock() {
+        g.retain(|q| q != p);
+    }
+}
+
+/// Where a path leads once symlinks are followed.
+#[derive(Debug)]
+enum Resolved {
+    /// A regular file: replace it through a temporary file.
+    Regular(PathBuf, fs::Metadata),
+    /// Nothing there yet (the path, or a dangling symlink's target): create it through a temporary file.
+    New(PathBuf),
+    /// A device, FIFO, socket or a `/proc` fd link: write it directly.
+    Direct(PathBuf),
+}
+
+fn resolve(path: &Path) -> Result<Resolved, String> {
+    let mut p = path.to_path_buf();
+    for _ in 0..40 {
+        // /dev/stdout, /dev/fd/N and /proc/self/fd/N lead to whatever the descriptor is: open them.
+        if p.starts_with("/proc") || p.starts_with("/dev/fd") {
+            return Ok(Resolved::Direct(path.to_path_buf()));
+        }
+        let meta = match fs::symlink_metadata(&p) {
+            Ok(m) => m,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Resolved::New(p)),
+            Err(e) => return Err(format!("{}: cannot write: {e}", p.display())),
+        };
+        let ft = meta.file_type();
+        if ft.is_symlink() {
+            let target = fs::read_link(&p)
+                .map_err(|e| format!("{}: cannot read the symlink: {e}", p.display()))?;
+            p = match p.parent() {
+                Some(dir) if target.is_relative() => dir.join(target),
+                _ => target,
+            };
+        } else if ft.is_dir() {
+            return Err(format!("{}: is a directory", p.display()));
+        } else if ft.is_file() {
+            return Ok(Resolved::Regular(p, meta));
+        } else {
+            return Ok(Resolved::Direct(p));
+        }
+    }
+    Err(format!(
+        "{}: too many levels of symbolic links",
+        path.display()
+    ))
+}
+
+/// Writes `text` to `path` (`-` is stdout) following the module's write policy.
+pub fn write_output(path: &Path, text: &[u8]) -> Result<(), String> {
+    if path.as_os_str() == "-" {
+        return output::write_stdout(text).map_err(|e| format!("cannot write to stdout: {e}"));
+    }
+    match resolve(path)? {
+        Resolved::Direct(p) => write_direct(&p, text),
+        Resolved::New(p) => replace_through_temp(&p, None, text),
+        Resolved::Regular(p, meta) => {
+            let mode = meta.permissions().mode() & 0o7777;
+            if mode & 0o222 == 0 {
+                return Err(format!(
+                    "{}: the file is read-only (mode {mode:04o}); make it writable (chmod u+w) to let urdf-inertia rewrite it",
+                    p.display()
+                ));
+            }
+            if meta.nlink() > 1 {
+                return Err(format!(
+                    "{}: the file has {} hard links; replacing it would split this name from the others (write with -o NEW and copy NEW over it to update every link)",
+                    p.display(),
+                    meta.nlink()
+                ));
+            }
+            // The permission check the kernel would do for an ordinary writer (root passes it).
+            OpenOptions::new()
+                .write(true)
+                .open(&p)
+                .map_err(|e| format!("{}: cannot write: {e}", p.display()))?;
+            replace_through_temp(&p, Some(&meta), text)
+        }
+    }
+}
+
+fn write_direct(p: &Path, text: &[u8]) -> Result<(), String> {
+    let fail = |e: io::Error| format!("{}: cannot write: {e}", p.display());
+    let mut f = OpenOptions::new().write(true).open(p).map_err(fail)?;
+    // `/dev/stdout` redirected to a file: start it afresh, as `>` does. Devices and FIFOs are not touched.
+    if f.metadata().map(|m| m.is_file()).unwrap_or(false) {
+        f.set_len(0).map_err(fail)?;
+    }
+    f.write_all(text).and_then(|()| f.flush()).map_err(fail)
+}
+
+/// Writes `text` to a temporary file beside `target` and renames it over `target`. `original` is the
+/// target's metadata when it exists (mode, owner and group to keep).
+fn replace_through_temp(
+    target: &Path,
+    original: Option<&fs::Metadata>,
+    text: &[u8],
+) -> Result<(), String> {
+    let dir = target
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = target
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "urdf".into());
+    let tmp = dir.join(format!(
+        ".{name}.urdf-inertia.{}.{}.tmp",
+        std::process::id(),
+        TEMP_COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let dir_error = |e: &dyn std::fmt::Display| {
+        format!(
+            "{}: cannot write {}: the temporary file {} cannot be created in directory {}: {e}",
+            target.display(),
+            target.display(),
+            tmp.display(),
+            dir.display()
+        )
+    };
+    // Root ignores a directory's mode bits; the policy does not.
+    if let Ok(m) = fs::metadata(dir) {
+        let mode = m.permissions().mode() & 0o7777;
+        if mode & 0o222 == 0 {
+            return Err(dir_error(&format!(
+                "the directory is read-only (mode {mode:04o})"
+            )));
+        }
+    }
+    let mode = original.map_or(0o666, |m| m.permissions().mode() & 0o7777);
+    let mut file = OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .mode(mode)
+        .open(&tmp)
+        .map_err(|e| dir_error(&e))?;
+    register(&tmp);
+    let result = fill_temp(&mut file, &tmp, original, mode, text).and_then(|()| {
+        hold_for_test(&tmp);
+        fs::rename(&tmp, target).map_err(|e| {
+            format!(
+                "{}: cannot replace it with the temporary file {}: {e}",
+                target.display(),
+                tmp.display()
+            )
+        })
+    });
+    if result.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    unregister(&tmp);
+    result
+}
+
+fn fill_temp(
+    file: &mut File,
+    tmp: &Path,
+    original: Option<&fs::Metadata>,
+    mode: u32,
+    text: &[u8],
+) -> Result<(), String> {
+    let fail = |e: io::Error| format!("{}: cannot write the temporary file: {e}", tmp.display());
+    if let Some(m) = original {
+        // Keep the owner and group; only root may give a file away, others may still keep the group.
+        let mine = file.metadata().map_err(fail)?;
+        if (mine.uid() != m.uid() || mine.gid() != m.gid())
+            && std::os::unix::fs::chown(tmp, Some(m.uid()), Some(m.gid())).is_err()
+        {
+            let _ = std::os::unix::fs::chown(tmp, None, Some(m.gid()));
+        }
+        // Exactly the original's mode: creation masked it with the umask, and chown clears set-id bits.
+        file.set_permissions(fs::Permissions::from_mode(mode))
+            .map_err(fail)?;
+    }
+    file.write_all(text).map_err(fail)?;
+    file.sync_all().map_err(fail)
+}
+
+fn hold_for_test(tmp: &Path) {
+    if std::env::var_os(HOLD_ENV).is_some() {
+        output::err_line(&format!("holding temporary file {}", tmp.display()));
+        let mut line = String::new();
+        let _ = io::stdin().read_line(&mut line);
+    }
+}

@@ -1,0 +1,128 @@
+//! Reading input files (URDF, meshes, density maps) with two guards: only regular files are read (a
+//! FIFO would hang, `/dev/zero` or `/dev/urandom` never end), and no more than a size limit, 1 GiB by
+//! default, set with `--max-file-size` or the `URDF_INERTIA_MAX_FILE_SIZE` environment variable.
+
+use std::fs::{self, File};
+use std::io::Read;
+use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// The default limit on one input file: 1 GiB.
+pub const DEFAULT_MAX_FILE_SIZE: u64 = 1 << 30;
+
+/// The environment variable that sets the limit when `--max-file-size` is not given.
+pub const MAX_FILE_SIZE_ENV: &str = "URDF_INERTIA_MAX_FILE_SIZE";
+
+static MAX_FILE_SIZE: AtomicU64 = AtomicU64::new(DEFAULT_MAX_FILE_SIZE);
+
+/// Sets the process-wide limit on the size of one input file, in bytes.
+pub fn set_max_file_size(bytes: u64) {
+    MAX_FILE_SIZE.store(bytes, Ordering::Relaxed);
+}
+
+/// The process-wide limit on the size of one input file, in bytes.
+pub fn max_file_size() -> u64 {
+    MAX_FILE_SIZE.load(Ordering::Relaxed)
+}
+
+/// Parses a size: bytes, or a number with a `K`, `M` or `G` suffix (powers of 1024).
+pub fn parse_size(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let (digits, unit) = match t.char_indices().find(|(_, c)| !c.is_ascii_digit()) {
+        Some((i, _)) => (&t[..i], &t[i..]),
+        None => (t, ""),
+    };
+    let factor: u64 = match unit.to_ascii_uppercase().trim_end_matches(['B', 'I']) {
+        "" => 1,
+        "K" => 1 << 10,
+        "M" => 1 << 20,
+        "G" => 1 << 30,
+        _ => {
+            return Err(format!(
+                "`{s}` is not a size (bytes, or a number with K, M or G)"
+            ))
+        }
+    };
+    digits
+        .parse::<u64>()
+        .ok()
+        .and_then(|n| n.checked_mul(factor))
+        .ok_or_else(|| format!("`{s}` is not a size (bytes, or a number with K, M or G)"))
+}
+
+fn kind(ft: fs::FileType) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    if ft.is_dir() {
+        "a directory"
+    } else if ft.is_fifo() {
+        "a FIFO"
+    } else if ft.is_char_device() {
+        "a character device"
+    } else if ft.is_block_device() {
+        "a block device"
+    } else if ft.is_socket() {
+        "a socket"
+    } else {
+        "not a file"
+    }
+}
+
+/// The whole content of a regular file no larger than [`max_file_size`]. The error says why, without
+/// the path (callers name the file and what it is).
+pub fn read_file(path: &Path) -> Result<Vec<u8>, String> {
+    let regular = |meta: &fs::Metadata| {
+        if meta.is_file() {
+            Ok(())
+        } else {
+            Err(format!(
+                "is not a regular file ({})",
+                kind(meta.file_type())
+            ))
+        }
+    };
+    // Checked before opening: opening a FIFO for reading blocks until someone writes.
+    regular(&fs::metadata(path).map_err(|e| e.to_string())?)?;
+    let file = File::open(path).map_err(|e| e.to_string())?;
+    let meta = file.metadata().map_err(|e| e.to_string())?;
+    regular(&meta)?;
+    let limit = max_file_size();
+    let too_large = || {
+        format!("is larger than the limit of {limit} bytes (raise it with --max-file-size or {MAX_FILE_SIZE_ENV})")
+    };
+    if meta.len() > limit {
+        return Err(too_large());
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(|e| e.to_string())?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large());
+    }
+    Ok(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse() {
+        assert_eq!(parse_size("123"), Ok(123));
+        assert_eq!(parse_size("2K"), Ok(2048));
+        assert_eq!(parse_size("1GiB"), Ok(1 << 30));
+        assert_eq!(parse_size("3m"), Ok(3 << 20));
+        assert!(parse_size("x").is_err());
+        assert!(parse_size("99999999999999999999G").is_err());
+    }
+
+    #[test]
+    fn devices_and_directories_are_refused() {
+        assert!(read_file(Path::new("/dev/zero"))
+            .unwrap_err()
+            .contains("is not a regular file (a character device)"));
+        assert!(read_file(Path::new("/"))
+            .unwrap_err()
+            .contains("is not a regular file (a directory)"));
+    }
+}

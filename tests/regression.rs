@@ -1,0 +1,1016 @@
+//! Regression tests for issue 13 ("Hardening"), each named after what it covers. The real binary runs in
+//! a temp dir on inputs generated here; nothing depends on timing, and everything holds when run as root.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::os::unix::fs::{FileTypeExt, MetadataExt, PermissionsExt};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("run urdf-inertia")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A robot of boxes: `(link name, "sx sy sz", "x y z")`.
+fn boxes(links: &[(&str, &str, &str)]) -> String {
+    let mut s = String::from("<robot name=\"r\">\n");
+    for (name, size, xyz) in links {
+        s.push_str(&format!(
+            "  <link name=\"{name}\">\n    <collision><origin xyz=\"{xyz}\"/><geometry><box size=\"{size}\"/></geometry></collision>\n  </link>\n"
+        ));
+    }
+    s.push_str("</robot>\n");
+    s
+}
+
+fn one_box() -> String {
+    boxes(&[("a", "1 2 3", "0 0 0")])
+}
+
+/// A temp dir with `r.urdf` holding `text`.
+fn urdf_in_tmp(text: &str) -> (tempfile::TempDir, PathBuf) {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let p = tmp.path().join("r.urdf");
+    std::fs::write(&p, text).expect("write urdf");
+    (tmp, p)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Item 1: -o onto a device, FIFO or stdout.
+
+/// Issue 13.1: `-o FIFO` once replaced the FIFO with a regular file; it is written directly now.
+#[test]
+fn output_to_a_fifo_is_written_directly() {
+    let (tmp, urdf) = urdf_in_tmp(&one_box());
+    let fifo = tmp.path().join("out.fifo");
+    let st = Command::new("mkfifo").arg(&fifo).status().expect("mkfifo");
+    assert!(st.success());
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || {
+            let mut text = String::new();
+            std::fs::File::open(&fifo)
+                .expect("open fifo")
+                .read_to_string(&mut text)
+                .expect("read fifo");
+            text
+        })
+    };
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-o", s(&fifo)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = reader.join().expect("reader thread");
+    assert!(text.contains("<inertial>"), "{text}");
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+}
+
+/// Issue 13.1: as root, `-o /dev/null` once turned /dev/null into a regular file.
+#[test]
+fn output_to_dev_null_keeps_the_device() {
+    let (_tmp, urdf) = urdf_in_tmp(&one_box());
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-o", "/dev/null"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(std::fs::metadata("/dev/null")
+        .unwrap()
+        .file_type()
+        .is_char_device());
+}
+
+/// Issue 13.1: `-o -` and `-o /dev/stdout` write to stdout.
+#[test]
+fn output_dash_and_dev_stdout_are_stdout() {
+    let (_tmp, urdf) = urdf_in_tmp(&one_box());
+    for target in ["-", "/dev/stdout"] {
+        let out = run(&["fill", s(&urdf), "--density", "1000", "-o", target]);
+        assert!(out.status.success(), "{target}: {}", stderr(&out));
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("<inertial>"), "{target}: {text}");
+    }
+    // JSON summary and URDF cannot share stdout.
+    let out = run(&[
+        "fill",
+        s(&urdf),
+        "--density",
+        "1000",
+        "-o",
+        "-",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Item 3: nothing written when a link failed, unless --keep-going.
+
+fn with_a_failing_link() -> String {
+    "<robot name=\"r\">\n  <link name=\"good\">\n    <collision><geometry><box size=\"1 1 1\"/></geometry></collision>\n  </link>\n  <link name=\"bad\">\n    <collision><geometry><mesh filename=\"missing.stl\"/></geometry></collision>\n  </link>\n</robot>\n".into()
+}
+
+/// Issue 13.3: `fill -i` with a failing link once rewrote the file with the other links filled.
+#[test]
+fn failed_link_writes_nothing_unless_keep_going() {
+    let text = with_a_failing_link();
+    let (tmp, urdf) = urdf_in_tmp(&text);
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("nothing written to") && stderr(&out).contains("--keep-going"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
+    let o = tmp.path().join("out.urdf");
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-o", s(&o)]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!o.exists());
+    let out = run(&["fill", s(&urdf), "--density", "1000"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(out.stdout.is_empty());
+    // --keep-going: the good link is written, the bad one left alone, exit 2, summary counts 1.
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i", "--keep-going"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(err.contains("filled 1 link(s)"), "{err}");
+    assert!(
+        err.contains("not written (--keep-going): 1 link(s)"),
+        "{err}"
+    );
+    let written = std::fs::read_to_string(&urdf).unwrap();
+    assert_eq!(written.matches("<inertial>").count(), 1, "{written}");
+    assert!(written.find("<inertial>") < written.find("name=\"bad\""));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Items 4 and 5: the temp file's mode and life, and the write policy.
+
+/// Issue 13.4: the temp file was created 0644 (a world-readable copy of a 0600 URDF) and left behind on
+/// SIGTERM. It has the target's mode and is removed on SIGTERM now.
+#[test]
+fn temp_file_has_the_targets_mode_and_is_removed_on_sigterm() {
+    let text = one_box();
+    let (tmp, urdf) = urdf_in_tmp(&text);
+    std::fs::set_permissions(&urdf, std::fs::Permissions::from_mode(0o600)).unwrap();
+    let mut child = bin()
+        .args(["fill", s(&urdf), "--density", "1000", "-i"])
+        .env("URDF_INERTIA_TEST_HOLD_TEMP", "1")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    // Held open until the child has exited: `wait` would close it, and EOF releases the hold.
+    let _stdin = child.stdin.take().expect("stdin");
+    let mut lines = BufReader::new(child.stderr.take().expect("stderr")).lines();
+    let temp = loop {
+        let line = lines
+            .next()
+            .expect("the binary announces its temp file")
+            .expect("line");
+        if let Some(p) = line.strip_prefix("holding temporary file ") {
+            break PathBuf::from(p);
+        }
+    };
+    let name = temp.file_name().unwrap().to_string_lossy().into_owned();
+    assert!(
+        name.starts_with(".r.urdf.urdf-inertia.") && name.ends_with(".tmp"),
+        "{name}"
+    );
+    assert_eq!(temp.parent(), Some(tmp.path()));
+    let meta = std::fs::metadata(&temp).expect("temp file exists");
+    assert_eq!(meta.permissions().mode() & 0o777, 0o600);
+    let st = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(st.success());
+    let status = child.wait().expect("wait");
+    assert_eq!(status.code(), Some(130));
+    assert!(!temp.exists(), "temp file left behind");
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
+    // Without the signal, the result keeps the 0600 mode.
+    let mut child = bin()
+        .args(["fill", s(&urdf), "--density", "1000", "-i"])
+        .env("URDF_INERTIA_TEST_HOLD_TEMP", "1")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("spawn");
+    child
+        .stdin
+        .take()
+        .expect("stdin")
+        .write_all(b"\n")
+        .expect("release");
+    assert!(child.wait().unwrap().success());
+    let meta = std::fs::metadata(&urdf).unwrap();
+    assert_eq!(meta.permissions().mode() & 0o777, 0o600);
+    assert!(std::fs::read_to_string(&urdf)
+        .unwrap()
+        .contains("<inertial>"));
+}
+
+/// Issue 13.5: `-i` on a 0444 file once succeeded (the rename ignores the file's mode). Refused now, root
+/// included.
+#[test]
+fn read_only_target_is_refused() {
+    let text = one_box();
+    let (tmp, urdf) = urdf_in_tmp(&text);
+    std::fs::set_permissions(&urdf, std::fs::Permissions::from_mode(0o444)).unwrap();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("read-only"), "{}", stderr(&out));
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
+    let o = tmp.path().join("o.urdf");
+    std::fs::write(&o, "old").unwrap();
+    std::fs::set_permissions(&o, std::fs::Permissions::from_mode(0o444)).unwrap();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-o", s(&o)]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(std::fs::read_to_string(&o).unwrap(), "old");
+}
+
+/// Issue 13.5: `-i` on a hard-linked file once split the names (the other kept the old text). Refused.
+#[test]
+fn hard_linked_target_is_refused() {
+    let text = one_box();
+    let (tmp, urdf) = urdf_in_tmp(&text);
+    let other = tmp.path().join("other.urdf");
+    std::fs::hard_link(&urdf, &other).unwrap();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("2 hard links"), "{}", stderr(&out));
+    assert_eq!(std::fs::metadata(&urdf).unwrap().nlink(), 2);
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
+}
+
+/// Issue 13.5: as root, `-i` once gave the file to root. Owner and group are kept.
+#[test]
+fn owner_and_group_are_kept() {
+    let (_tmp, urdf) = urdf_in_tmp(&one_box());
+    let me = std::fs::metadata(&urdf).unwrap();
+    // Only root can give a file away; others check that their own ownership survives.
+    let (uid, gid) = if me.uid() == 0 {
+        std::os::unix::fs::chown(&urdf, Some(4321), Some(4322)).unwrap();
+        (4321, 4322)
+    } else {
+        (me.uid(), me.gid())
+    };
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let after = std::fs::metadata(&urdf).unwrap();
+    assert_eq!((after.uid(), after.gid()), (uid, gid));
+    assert!(std::fs::read_to_string(&urdf)
+        .unwrap()
+        .contains("<inertial>"));
+}
+
+/// Issue 13.5: `-o` onto a dangling symlink once replaced the link; it creates the link's target now.
+#[test]
+fn dangling_symlink_output_writes_the_target() {
+    let (tmp, urdf) = urdf_in_tmp(&one_box());
+    let link = tmp.path().join("out.urdf");
+    std::os::unix::fs::symlink("sub/target.urdf", &link).unwrap();
+    std::fs::create_dir(tmp.path().join("sub")).unwrap();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-o", s(&link)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert!(std::fs::read_to_string(tmp.path().join("sub/target.urdf"))
+        .unwrap()
+        .contains("<inertial>"));
+}
+
+/// Issue 13.5: a read-only directory's error once blamed the URDF; it names the directory and the temp
+/// file now (and holds for root, who bypasses the mode bits).
+#[test]
+fn read_only_directory_names_the_directory_and_the_temp_file() {
+    let text = one_box();
+    let (tmp, _) = urdf_in_tmp("");
+    let dir = tmp.path().join("ro");
+    std::fs::create_dir(&dir).unwrap();
+    let urdf = dir.join("r.urdf");
+    std::fs::write(&urdf, &text).unwrap();
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o755)).unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(
+        err.contains(&format!("cannot be created in directory {}", dir.display()))
+            && err.contains(".r.urdf.urdf-inertia."),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Item 2: computed values are checked before splicing.
+
+/// Issue 13.2: boxes of 1e120 and 1e-320, parts at ±1e155, a density of 1e306 and a 1e-100-scale OBJ
+/// once wrote `mass="inf"`, NaN or an all-zero tensor with exit 0 (`--principal`: `rpy="0 NaN NaN"`).
+#[test]
+fn overflow_and_underflow_fail_the_link() {
+    let tmp = tempfile::tempdir().unwrap();
+    let tet =
+        "v 0 0 0\nv 1e-100 0 0\nv 0 1e-100 0\nv 0 0 1e-100\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    std::fs::write(tmp.path().join("tiny.obj"), tet).unwrap();
+    let link = |collisions: &str| {
+        format!("<robot name=\"r\">\n  <link name=\"ok\">\n    <collision><geometry><box size=\"1 1 1\"/></geometry></collision>\n  </link>\n  <link name=\"x\">\n{collisions}  </link>\n</robot>\n")
+    };
+    let bx = |size: &str, xyz: &str| {
+        format!("    <collision><origin xyz=\"{xyz}\"/><geometry><box size=\"{size}\"/></geometry></collision>\n")
+    };
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("huge_box", link(&bx("1e120 1e120 1e120", "0 0 0")), "1000"),
+        ("subnormal_box", link(&bx("1e-320 1 1", "0 0 0")), "1000"),
+        (
+            "far_parts",
+            link(&(bx("1 1 1", "1e155 0 0") + &bx("1 1 1", "-1e155 0 0"))),
+            "1000",
+        ),
+        ("huge_density", link(&bx("10 10 10", "0 0 0")), "1e306"),
+        (
+            "tiny_obj",
+            link("    <collision><geometry><mesh filename=\"tiny.obj\"/></geometry></collision>\n"),
+            "1000",
+        ),
+    ];
+    for (name, text, density) in cases {
+        let urdf = tmp.path().join(format!("{name}.urdf"));
+        std::fs::write(&urdf, &text).unwrap();
+        for extra in [&[][..], &["--principal"][..]] {
+            let mut args = vec!["fill", s(&urdf), "--density", density];
+            args.extend_from_slice(extra);
+            let out = run(&args);
+            let err = stderr(&out);
+            assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+            // The scanner rejects a size whose volume overflows at parse time; the rest fail after
+            // composition.
+            assert!(
+                err.contains("link `x`: overflow/underflow")
+                    || (err.contains("link `x`") && err.contains("overflows a 64-bit float")),
+                "{name}: {err}"
+            );
+            assert!(out.stdout.is_empty(), "{name}");
+            // --keep-going writes the good link only: no inf, NaN or zero tensor anywhere.
+            args.push("--keep-going");
+            let out = run(&args);
+            assert_eq!(out.status.code(), Some(2), "{name}");
+            let text = String::from_utf8(out.stdout).unwrap();
+            assert_eq!(text.matches("<inertial>").count(), 1, "{name}: {text}");
+            assert!(
+                !text.contains("inf") && !text.contains("NaN"),
+                "{name}: {text}"
+            );
+        }
+    }
+    // The mesh command too.
+    let out = run(&["mesh", s(&tmp.path().join("tiny.obj"))]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("overflow/underflow"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Item 6: only regular files, and no more than a limit.
+
+/// Issue 13.6: `/dev/zero`, `/dev/urandom` or a FIFO as a mesh or URDF once read without end or hung;
+/// a directory as a mesh was "not found".
+#[test]
+fn non_regular_inputs_are_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    std::os::unix::fs::symlink("/dev/zero", d.join("zero.stl")).unwrap();
+    std::os::unix::fs::symlink("/dev/urandom", d.join("random.obj")).unwrap();
+    assert!(Command::new("mkfifo")
+        .arg(d.join("fifo.dae"))
+        .status()
+        .unwrap()
+        .success());
+    assert!(Command::new("mkfifo")
+        .arg(d.join("fifo.urdf"))
+        .status()
+        .unwrap()
+        .success());
+    std::fs::create_dir(d.join("dir.stl")).unwrap();
+    for mesh in ["zero.stl", "random.obj", "fifo.dae", "dir.stl"] {
+        let urdf = d.join("r.urdf");
+        std::fs::write(&urdf, format!("<robot name=\"r\">\n  <link name=\"a\">\n    <collision><geometry><mesh filename=\"{mesh}\"/></geometry></collision>\n  </link>\n</robot>\n")).unwrap();
+        let out = run(&["fill", s(&urdf), "--density", "1000"]);
+        assert_eq!(out.status.code(), Some(2), "{mesh}");
+        assert!(
+            stderr(&out).contains(&format!(
+                "{mesh}: cannot read the file: is not a regular file"
+            )),
+            "{mesh}: {}",
+            stderr(&out)
+        );
+        let out = run(&["mesh", s(&d.join(mesh))]);
+        assert_eq!(out.status.code(), Some(2), "{mesh}");
+        assert!(stderr(&out).contains("is not a regular file"), "{mesh}");
+    }
+    for urdf in [s(&d.join("fifo.urdf")), "/dev/zero", "/dev/urandom"] {
+        for cmd in ["fill", "check"] {
+            let out = run(&[cmd, urdf, "--density", "1000"]);
+            assert_eq!(out.status.code(), Some(2), "{urdf}");
+            assert!(
+                stderr(&out).contains("cannot read the URDF: is not a regular file"),
+                "{urdf}: {}",
+                stderr(&out)
+            );
+        }
+    }
+    let out = run(&["fill", s(&d.join("r.urdf")), "--density-map", "/dev/zero"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("is not a regular file"));
+}
+
+/// Issue 13.6: the size read is capped (`--max-file-size`, or URDF_INERTIA_MAX_FILE_SIZE).
+#[test]
+fn input_size_is_capped() {
+    let (_tmp, urdf) = urdf_in_tmp(&one_box());
+    let out = run(&[
+        "fill",
+        s(&urdf),
+        "--density",
+        "1000",
+        "--max-file-size",
+        "64",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("is larger than the limit of 64 bytes"),
+        "{}",
+        stderr(&out)
+    );
+    let out = bin()
+        .args(["check", s(&urdf)])
+        .env("URDF_INERTIA_MAX_FILE_SIZE", "1K")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let out = bin()
+        .args(["check", s(&urdf)])
+        .env("URDF_INERTIA_MAX_FILE_SIZE", "10")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let out = run(&[
+        "fill",
+        s(&urdf),
+        "--density",
+        "1000",
+        "--max-file-size",
+        "lots",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Items 7 to 10 and id-less geometries: hostile COLLADA, generated here.
+
+/// A closed box `size` at `at`, as a `<geometry>` (with `id` if given), 12 outward triangles.
+fn dae_box(id: Option<&str>, size: f64, at: f64) -> String {
+    let mut pos = String::new();
+    for i in 0..8 {
+        for k in 0..3 {
+            let c = if i >> k & 1 == 1 { size } else { 0.0 };
+            pos.push_str(&format!("{} ", at + c));
+        }
+    }
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let p: Vec<String> = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .map(|t| format!("{} {} {}", t[0], t[1], t[2]))
+        .collect();
+    let id = id.map(|i| format!(" id=\"{i}\"")).unwrap_or_default();
+    format!(
+        "<geometry{id}><mesh>\n<source id=\"pos\"><float_array id=\"pa\" count=\"24\">{pos}</float_array>\n<technique_common><accessor source=\"#pa\" count=\"8\" stride=\"3\"/></technique_common></source>\n<triangles count=\"12\"><input semantic=\"VERTEX\" source=\"#pos\" offset=\"0\"/><p>{}</p></triangles>\n</mesh></geometry>\n",
+        p.join(" ")
+    )
+}
+
+fn dae(body: &str) -> String {
+    format!("<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">\n{body}</COLLADA>\n")
+}
+
+/// Runs `mesh`, `fill` and `check` on a generated COLLADA file; returns the three outputs.
+fn dae_through_every_command(name: &str, text: &str) -> Vec<Output> {
+    let tmp = tempfile::tempdir().unwrap();
+    let mesh = tmp.path().join(name);
+    std::fs::write(&mesh, text).unwrap();
+    let urdf = tmp.path().join("r.urdf");
+    std::fs::write(&urdf, format!("<robot name=\"r\">\n  <link name=\"a\">\n    <inertial><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial>\n    <collision><geometry><mesh filename=\"{name}\"/></geometry></collision>\n  </link>\n</robot>\n")).unwrap();
+    vec![
+        run(&["mesh", s(&mesh), "--format", "json"]),
+        run(&["fill", s(&urdf), "--density", "1000"]),
+        run(&["check", s(&urdf), "--density", "1000"]),
+    ]
+}
+
+fn assert_fails_with(name: &str, text: &str, message: &str) {
+    for out in dae_through_every_command(name, text) {
+        assert_eq!(out.status.code(), Some(2), "{name}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains(message),
+            "{name}: expected `{message}` in {}",
+            stderr(&out)
+        );
+    }
+}
+
+/// Issue 13.7: an `<accessor offset>` beyond the stride, an `<input offset>` near u64::MAX and a huge
+/// `<vcount>` once panicked (exit 101, also inside `check`). Each is an error with its line now.
+#[test]
+fn collada_offsets_and_counts_are_checked() {
+    let good = dae_box(Some("g"), 1.0, 0.0);
+    let accessor = good.replace("stride=\"3\"/>", "stride=\"3\" offset=\"2\"/>");
+    assert_fails_with(
+        "accessor.dae",
+        &dae(&format!(
+            "<library_geometries>{accessor}</library_geometries>\n"
+        )),
+        "accessor.dae:5: <accessor> of `pos`: offset 2 leaves no room",
+    );
+    let input = good.replace("offset=\"0\"/>", "offset=\"18446744073709551615\"/>");
+    assert_fails_with(
+        "input.dae",
+        &dae(&format!(
+            "<library_geometries>{input}</library_geometries>\n"
+        )),
+        "<input> offset too large",
+    );
+    let poly = good
+        .replace("<triangles count=\"12\">", "<polylist count=\"1\">")
+        .replace("</triangles>", "</polylist>")
+        .replace("<p>", "<vcount>4611686018427387904</vcount><p>");
+    let poly = poly.replace(
+        "offset=\"0\"/>",
+        "offset=\"0\"/><input semantic=\"NORMAL\" source=\"#pos\" offset=\"3\"/>",
+    );
+    assert_fails_with(
+        "vcount.dae",
+        &dae(&format!(
+            "<library_geometries>{poly}</library_geometries>\n"
+        )),
+        "<vcount> asks for more indices than <p> holds",
+    );
+}
+
+/// Issue 13.8: 40 levels of `<instance_node>`, each instancing the next twice (a few KB), once allocated
+/// until the process aborted. A budget on instanced geometry stops it.
+#[test]
+fn collada_instance_fan_out_has_a_budget() {
+    let mut nodes = String::new();
+    for i in 0..40 {
+        nodes.push_str(&format!(
+            "<node id=\"n{i}\"><instance_node url=\"#n{}\"/><instance_node url=\"#n{}\"/></node>\n",
+            i + 1,
+            i + 1
+        ));
+    }
+    nodes.push_str("<node id=\"n40\"><instance_geometry url=\"#g\"/></node>\n");
+    let text = dae(&format!(
+        "<library_geometries>{}</library_geometries>\n<library_nodes>\n{nodes}</library_nodes>\n<library_visual_scenes><visual_scene id=\"s\"><node><instance_node url=\"#n0\"/></node></visual_scene></library_visual_scenes>\n<scene><instance_visual_scene url=\"#s\"/></scene>\n",
+        dae_box(Some("g"), 1.0, 0.0)
+    ));
+    assert!(text.len() < 8000);
+    assert_fails_with("fan.dae", &text, "the scene instances more than");
+    // Without geometry at the leaves, the node visits are bounded too.
+    let empty = text.replace("<instance_geometry url=\"#g\"/>", "");
+    for out in dae_through_every_command("fan.dae", &empty) {
+        assert_eq!(out.status.code(), Some(2));
+        assert!(stderr(&out).contains("nodes"), "{}", stderr(&out));
+    }
+}
+
+/// Issue 13.9: 100k nested elements once overflowed the stack of fill's worker threads (recursive drop
+/// and walk). Nesting is bounded with an error now.
+#[test]
+fn collada_deep_nesting_is_an_error() {
+    let depth = 100_000;
+    let body = format!(
+        "{}{}<library_geometries>{}</library_geometries>\n",
+        "<extra>".repeat(depth),
+        "</extra>".repeat(depth),
+        dae_box(Some("g"), 1.0, 0.0)
+    );
+    assert_fails_with("deep.dae", &dae(&body), "nested deeper than 512 levels");
+}
+
+/// Issue 13.10: one element with 80k attributes took 8 s (quadratic duplicate check). Read linearly
+/// now; the result is still the box.
+#[test]
+fn collada_many_attributes_are_read() {
+    let attrs: String = (0..80_000).map(|i| format!(" a{i}=\"{i}\"")).collect();
+    let body = format!(
+        "<asset{attrs}/>\n<library_geometries>{}</library_geometries>\n",
+        dae_box(Some("g"), 1.0, 0.0)
+    );
+    let outs = dae_through_every_command("attrs.dae", &dae(&body));
+    assert!(outs[0].status.success(), "{}", stderr(&outs[0]));
+    let v: serde_json::Value = serde_json::from_slice(&outs[0].stdout).unwrap();
+    assert_eq!(v["volume"].as_f64(), Some(1.0));
+}
+
+/// Issue 13 (collada.rs): two `<geometry>` without an `id` once became two copies of the first. Each is
+/// its own geometry now: the volume is the sum.
+#[test]
+fn collada_geometries_without_id_are_distinct() {
+    let body = format!(
+        "<library_geometries>{}{}</library_geometries>\n",
+        dae_box(None, 1.0, 0.0),
+        dae_box(None, 2.0, 5.0)
+    );
+    let outs = dae_through_every_command("noid.dae", &dae(&body));
+    assert!(outs[0].status.success(), "{}", stderr(&outs[0]));
+    let v: serde_json::Value = serde_json::from_slice(&outs[0].stdout).unwrap();
+    assert_eq!(v["volume"].as_f64(), Some(9.0));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Item 14: stdout and stderr errors.
+
+fn dev_full() -> Stdio {
+    Stdio::from(
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .expect("/dev/full"),
+    )
+}
+
+/// A robot with a finding for `check` (a link with geometry and no inertial) and a `diff` row.
+fn robot_with_a_finding() -> (tempfile::TempDir, PathBuf) {
+    urdf_in_tmp(&boxes(&[("a", "1 2 3", "0 0 0"), ("b", "1 1 1", "0 0 1")]))
+}
+
+/// Issue 13.14: `diff … | head` and `check | head` once panicked on the broken pipe (exit 101). A closed
+/// pipe ends the output quietly, with the status the work earned.
+#[test]
+fn broken_pipe_ends_quietly_with_the_earned_status() {
+    let (_tmp, urdf) = robot_with_a_finding();
+    for (args, code) in [
+        (vec!["diff", s(&urdf), "--density", "1000"], 0),
+        (vec!["check", s(&urdf)], 1),
+        (vec!["fill", s(&urdf), "--density", "1000"], 0),
+        (vec!["mesh", "/nonexistent.stl"], 2),
+    ] {
+        let mut child = bin()
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // The reader goes away before the first byte is written: every write gets EPIPE.
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(!err.contains("cannot write to stdout"), "{args:?}: {err}");
+    }
+}
+
+/// Issue 13.14: `fill >/dev/full` once exited 2 without a word. Other stdout errors are reported and exit
+/// 2, except the summary printed after the URDF was written to a file.
+#[test]
+fn stdout_errors_are_reported() {
+    let (tmp, urdf) = robot_with_a_finding();
+    for args in [
+        vec!["fill", s(&urdf), "--density", "1000"],
+        vec!["diff", s(&urdf), "--density", "1000"],
+        vec!["check", s(&urdf)],
+        vec!["fill", s(&urdf), "--density", "1000", "-o", "-"],
+    ] {
+        let out = bin().args(&args).stdout(dev_full()).output().unwrap();
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains("cannot write to stdout: "), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+    let o = tmp.path().join("o.urdf");
+    let out = bin()
+        .args([
+            "fill",
+            s(&urdf),
+            "--density",
+            "1000",
+            "-o",
+            s(&o),
+            "--format",
+            "json",
+        ])
+        .stdout(dev_full())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(stderr(&out).contains("cannot write to stdout: "));
+    assert!(std::fs::read_to_string(&o).unwrap().contains("<inertial>"));
+    // A failing stderr is not a panic either.
+    let out = bin()
+        .args(["fill", "/nonexistent.urdf", "--density", "1000"])
+        .stderr(dev_full())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Item 11: the density map.
+
+/// Issue 13.11: `[links] "b_*" = …` and dotted `links."b_*" = …` once gave different rule orders (the
+/// dotted form fell back to alphabetical order, so a tie went to the wrong rule and errors had no line).
+#[test]
+fn density_map_rule_order_is_file_order_however_written() {
+    use urdf_inertia::density::{DensityMap, Spec};
+    let p = Path::new("d.toml");
+    let section = "[links]\n\"b_*\" = 1.0\n\"*_x\" = 2.0\n";
+    let dotted = "links.\"b_*\" = 1.0\nlinks.\"*_x\" = 2.0\n";
+    for text in [section, dotted] {
+        let m = DensityMap::parse(text, p).unwrap();
+        let order: Vec<&str> = m.links.iter().map(|(k, _)| k.as_str()).collect();
+        assert_eq!(order, ["b_*", "*_x"], "{text}");
+        // Equal length: the first written wins.
+        assert_eq!(
+            m.link_rule("b_x"),
+            Some(("b_*", Spec::Density(1.0))),
+            "{text}"
+        );
+    }
+    let e =
+        DensityMap::parse("default = 1\nlinks.a = 2\nlinks.b = \"unobtainium\"\n", p).unwrap_err();
+    assert_eq!(e.line, Some(3), "{e}");
+}
+
+/// Issue 13.11: 8000 `[links]` entries took 28 s (each key's line found by rescanning the text inside a
+/// sort). Read from the entries' spans now; every rule is there, in order, with its line on error.
+#[test]
+fn density_map_with_thousands_of_rules() {
+    use urdf_inertia::density::DensityMap;
+    let n = 8000;
+    let mut text = String::from("[links]\n");
+    for i in (0..n).rev() {
+        text.push_str(&format!("\"link_{i}\" = {}.0\n", 1000 + i));
+    }
+    let m = DensityMap::parse(&text, Path::new("d.toml")).unwrap();
+    assert_eq!(m.links.len(), n);
+    assert_eq!(m.links[0].0, format!("link_{}", n - 1));
+    assert_eq!(m.links[n - 1].0, "link_0");
+    text.push_str("bad = \"unobtainium\"\n");
+    let e = DensityMap::parse(&text, Path::new("d.toml")).unwrap_err();
+    assert_eq!(e.line, Some(n + 2));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// docs/reliability.md: regenerate with
+//   cargo test --release --test regression -- --ignored write_reliability_table
+
+/// The first `error:` line of stderr (else its first line, else the volume `mesh` printed), then what
+/// was (not) written, with temp paths removed.
+fn what_it_says(out: &Output, tmp: &Path) -> String {
+    let err = stderr(out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let first = err
+        .lines()
+        .find(|l| l.starts_with("error:"))
+        .or_else(|| err.lines().next())
+        .or_else(|| stdout.lines().find(|l| l.contains("volume")))
+        .map(str::trim)
+        .unwrap_or("(nothing)");
+    let written = err
+        .lines()
+        .find(|l| l.contains("nothing written") || l.contains("not written (--keep-going)"))
+        .filter(|l| l.trim() != first);
+    let line = match written {
+        Some(w) => format!("{first} → {}", w.trim()),
+        None => first.to_string(),
+    };
+    let mut line = line.replace(&format!("{}/", tmp.display()), "");
+    line = line.replace(&tmp.display().to_string(), ".");
+    // Process ids and counters in temp-file names vary from run to run.
+    if let Some(i) = line.find(".urdf-inertia.") {
+        let end = line[i..].find(".tmp").map_or(line.len(), |e| i + e);
+        line.replace_range(i..end, ".urdf-inertia.PID.N");
+    }
+    line.replace('|', "\\|")
+}
+
+#[test]
+#[ignore = "writes docs/reliability.md; run on purpose"]
+fn write_reliability_table() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let write = |name: &str, text: &str| {
+        let p = d.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    write("r.urdf", &one_box());
+    let mesh_urdf = |mesh: &str| {
+        write(
+            &format!("{}.urdf", mesh.replace('.', "_")),
+            &format!("<robot name=\"r\">\n  <link name=\"a\">\n    <collision><geometry><mesh filename=\"{mesh}\"/></geometry></collision>\n  </link>\n</robot>\n"),
+        )
+    };
+    let mut rows: Vec<(String, Output)> = Vec::new();
+    let mut add = |what: &str, args: Vec<String>, stdout: Option<Stdio>| {
+        let mut c = bin();
+        c.args(&args).current_dir(d).stdin(Stdio::null());
+        if let Some(s) = stdout {
+            c.stdout(s);
+        }
+        rows.push((what.to_string(), c.output().unwrap()));
+    };
+    let a = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    add(
+        "`fill -o /dev/null`",
+        a(&["fill", "r.urdf", "--density", "1000", "-o", "/dev/null"]),
+        None,
+    );
+    add(
+        "`fill -o -`, `-o /dev/stdout`",
+        a(&["fill", "r.urdf", "--density", "1000", "-o", "/dev/stdout"]),
+        None,
+    );
+    let ro = write("ro.urdf", &one_box());
+    std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o444)).unwrap();
+    add(
+        "`fill -i` on a 0444 file (also as root)",
+        a(&["fill", "ro.urdf", "--density", "1000", "-i"]),
+        None,
+    );
+    let hl = write("hl.urdf", &one_box());
+    std::fs::hard_link(&hl, d.join("hl2.urdf")).unwrap();
+    add(
+        "`fill -i` on a hard-linked file",
+        a(&["fill", "hl.urdf", "--density", "1000", "-i"]),
+        None,
+    );
+    std::fs::create_dir(d.join("rodir")).unwrap();
+    std::fs::write(d.join("rodir/r.urdf"), one_box()).unwrap();
+    std::fs::set_permissions(d.join("rodir"), std::fs::Permissions::from_mode(0o555)).unwrap();
+    add(
+        "`fill -i` in a read-only directory (also as root)",
+        a(&["fill", "rodir/r.urdf", "--density", "1000", "-i"]),
+        None,
+    );
+    std::os::unix::fs::symlink("made.urdf", d.join("dangling.urdf")).unwrap();
+    add(
+        "`fill -o` onto a dangling symlink (creates its target)",
+        a(&["fill", "r.urdf", "--density", "1000", "-o", "dangling.urdf"]),
+        None,
+    );
+    write("fail.urdf", &with_a_failing_link());
+    add(
+        "`fill -i` with a link that fails",
+        a(&["fill", "fail.urdf", "--density", "1000", "-i"]),
+        None,
+    );
+    add(
+        "the same with `--keep-going`",
+        a(&[
+            "fill",
+            "fail.urdf",
+            "--density",
+            "1000",
+            "-i",
+            "--keep-going",
+        ]),
+        None,
+    );
+    for (what, size, xyz, density) in [
+        ("a 1e120 box", "1e120 1e120 1e120", "0 0 0", "1000"),
+        ("a 1e-320 box", "1e-320 1 1", "0 0 0", "1000"),
+        ("a density of 1e306", "10 10 10", "0 0 0", "1e306"),
+    ] {
+        let name = format!("{}.urdf", what.replace(' ', "_"));
+        write(&name, &boxes(&[("a", size, xyz)]));
+        add(what, a(&["fill", &name, "--density", density]), None);
+    }
+    write("far.urdf", &boxes(&[("a", "1 1 1", "1e155 0 0")]).replace("</link>", "<collision><origin xyz=\"-1e155 0 0\"/><geometry><box size=\"1 1 1\"/></geometry></collision></link>"));
+    add(
+        "parts at ±1e155",
+        a(&["fill", "far.urdf", "--density", "1000", "--principal"]),
+        None,
+    );
+    write(
+        "tiny.obj",
+        "v 0 0 0\nv 1e-100 0 0\nv 0 1e-100 0\nv 0 0 1e-100\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+    );
+    add("a 1e-100-scale OBJ", a(&["mesh", "tiny.obj"]), None);
+    std::os::unix::fs::symlink("/dev/zero", d.join("zero.stl")).unwrap();
+    mesh_urdf("zero.stl");
+    add(
+        "`/dev/zero` as a mesh",
+        a(&["fill", "zero_stl.urdf", "--density", "1000"]),
+        None,
+    );
+    assert!(Command::new("mkfifo")
+        .arg(d.join("fifo.urdf"))
+        .status()
+        .unwrap()
+        .success());
+    add("a FIFO as the URDF", a(&["check", "fifo.urdf"]), None);
+    std::fs::create_dir(d.join("dir.stl")).unwrap();
+    mesh_urdf("dir.stl");
+    add(
+        "a directory as a mesh",
+        a(&["fill", "dir_stl.urdf", "--density", "1000"]),
+        None,
+    );
+    add(
+        "a URDF over `--max-file-size`",
+        a(&[
+            "fill",
+            "r.urdf",
+            "--density",
+            "1000",
+            "--max-file-size",
+            "64",
+        ]),
+        None,
+    );
+    let good = dae_box(Some("g"), 1.0, 0.0);
+    let lib = |g: &str| dae(&format!("<library_geometries>{g}</library_geometries>\n"));
+    let mut fan = String::new();
+    for i in 0..40 {
+        fan.push_str(&format!("<node id=\"n{i}\"><instance_node url=\"#n{0}\"/><instance_node url=\"#n{0}\"/></node>\n", i + 1));
+    }
+    fan.push_str("<node id=\"n40\"><instance_geometry url=\"#g\"/></node>\n");
+    let dae_cases = [
+        ("COLLADA `<accessor offset>` beyond the stride", lib(&good.replace("stride=\"3\"/>", "stride=\"3\" offset=\"2\"/>"))),
+        ("COLLADA `<input offset>` near u64::MAX", lib(&good.replace("offset=\"0\"/>", "offset=\"18446744073709551615\"/>"))),
+        ("COLLADA huge `<vcount>`", lib(&good.replace("<triangles count=\"12\">", "<polylist count=\"1\">").replace("</triangles>", "</polylist>").replace("<p>", "<vcount>4611686018427387904</vcount><p>"))),
+        ("COLLADA `<instance_node>` fan-out (40 levels × 2, < 8 KB)", dae(&format!("<library_geometries>{good}</library_geometries>\n<library_nodes>\n{fan}</library_nodes>\n<library_visual_scenes><visual_scene id=\"s\"><node><instance_node url=\"#n0\"/></node></visual_scene></library_visual_scenes>\n<scene><instance_visual_scene url=\"#s\"/></scene>\n"))),
+        ("COLLADA 100k nested elements", dae(&format!("{}{}<library_geometries>{good}</library_geometries>\n", "<extra>".repeat(100_000), "</extra>".repeat(100_000)))),
+        ("COLLADA element with 80k attributes", dae(&format!("<asset{}/>\n<library_geometries>{good}</library_geometries>\n", (0..80_000).map(|i| format!(" a{i}=\"{i}\"")).collect::<String>()))),
+        ("COLLADA two `<geometry>` without `id` (volumes add)", lib(&(dae_box(None, 1.0, 0.0) + &dae_box(None, 2.0, 5.0)))),
+    ];
+    for (i, (what, text)) in dae_cases.iter().enumerate() {
+        let name = format!("c{i}.dae");
+        write(&name, text);
+        add(what, a(&["mesh", &name]), None);
+    }
+    let full = || Some(dev_full());
+    add(
+        "`fill >/dev/full`",
+        a(&["fill", "r.urdf", "--density", "1000"]),
+        full(),
+    );
+    // A broken pipe: the reader is gone before the first write.
+    let mut child = bin()
+        .args(["diff", "r.urdf", "--density", "1000"])
+        .current_dir(d)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    rows.push((
+        "`diff … \\| head` (broken pipe)".into(),
+        child.wait_with_output().unwrap(),
+    ));
+    std::fs::set_permissions(d.join("rodir"), std::fs::Permissions::from_mode(0o755)).unwrap();
+
+    let mut md = String::from("# Reliability: hostile input, what urdf-inertia does, exit code\n\nGenerated by `cargo test --release --test regression -- --ignored write_reliability_table` (every input is made by the test in a temp dir; file names are relative to it). Exit codes: 0 ok, 1 `check` found problems, 2 error. Each row has a regression test in `tests/regression.rs`. SIGINT/SIGTERM during a write removes the temporary file and exits 130 (`temp_file_has_the_targets_mode_and_is_removed_on_sigterm`).\n\n| hostile input | what the tool does (first error line, or first line of stderr) | exit |\n| --- | --- | --- |\n");
+    for (what, out) in &rows {
+        let code = out
+            .status
+            .code()
+            .map_or("signal".to_string(), |c| c.to_string());
+        md.push_str(&format!("| {what} | {} | {code} |\n", what_it_says(out, d)));
+    }
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/reliability.md");
+    std::fs::write(&path, md).unwrap();
+    for (what, out) in &rows {
+        assert_ne!(out.status.code(), Some(101), "{what} panicked");
+    }
+}
