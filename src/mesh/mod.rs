@@ -1,10 +1,12 @@
-//! Collision meshes: reading STL, OBJ and COLLADA into vertices plus polygons, applying the URDF `scale`,
+//! Collision meshes: reading STL, OBJ, COLLADA and glTF into vertices plus polygons, applying the URDF `scale`,
 //! and turning the result into a solid the mass core can integrate (see [`health`]).
 //!
 //! Each format is a thin module with its own parsing and a `file:line` location where the format has
-//! lines. Polygons stay polygons. Coordinates are read as f64 (binary STL's f32 values convert exactly).
+//! lines. Polygons stay polygons. Coordinates are read as f64 (binary STL's and glTF's f32 values convert
+//! exactly).
 
 pub mod collada;
+pub mod gltf;
 pub mod health;
 pub mod hull;
 pub mod obj;
@@ -29,6 +31,8 @@ pub enum MeshFormat {
     Stl,
     Obj,
     Collada,
+    /// glTF 2.0, JSON (.gltf) or binary (.glb).
+    Gltf,
 }
 
 impl MeshFormat {
@@ -39,6 +43,7 @@ impl MeshFormat {
             "stl" => Some(MeshFormat::Stl),
             "obj" => Some(MeshFormat::Obj),
             "dae" => Some(MeshFormat::Collada),
+            "gltf" | "glb" => Some(MeshFormat::Gltf),
             _ => None,
         }
     }
@@ -59,7 +64,7 @@ pub struct MeshError {
 pub enum MeshErrorKind {
     /// The file could not be read at all.
     Io(String),
-    /// The extension is not one of .stl, .obj, .dae.
+    /// The extension is not one of .stl, .obj, .dae, .gltf, .glb.
     UnknownFormat(String),
     /// The content does not follow the format.
     Syntax(String),
@@ -77,6 +82,8 @@ pub enum MeshErrorKind {
     Strict(String),
     /// A scale with a zero or non-finite factor.
     BadScale([f64; 3]),
+    /// A feature of the format urdf-inertia does not read (a glTF compression extension, ...), named.
+    Unsupported(String),
 }
 
 impl fmt::Display for MeshError {
@@ -90,7 +97,7 @@ impl fmt::Display for MeshError {
             MeshErrorKind::Io(e) => write!(f, "cannot read the file: {e}"),
             MeshErrorKind::UnknownFormat(ext) => write!(
                 f,
-                "unsupported mesh format `{ext}`; urdf-inertia reads .stl, .obj and .dae (convert the collision mesh, e.g. with meshlab or blender)"
+                "unsupported mesh format `{ext}`; urdf-inertia reads .stl, .obj, .dae, .gltf and .glb (convert the collision mesh, e.g. with meshlab or blender)"
             ),
             MeshErrorKind::Syntax(msg) => write!(f, "{msg}"),
             MeshErrorKind::Truncated(msg) => write!(f, "truncated file: {msg}; re-export the mesh"),
@@ -107,6 +114,7 @@ impl fmt::Display for MeshError {
             MeshErrorKind::BadScale(s) => {
                 write!(f, "scale \"{} {} {}\" has a zero or non-finite factor", s[0], s[1], s[2])
             }
+            MeshErrorKind::Unsupported(msg) => write!(f, "{msg}"),
         }
     }
 }
@@ -139,6 +147,7 @@ pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
         MeshFormat::Stl => stl::parse(&bytes, path)?,
         MeshFormat::Obj => obj::parse(&bytes, path)?,
         MeshFormat::Collada => collada::parse(&bytes, path)?,
+        MeshFormat::Gltf => gltf::parse(&bytes, path)?,
     };
     validate(&mesh, path)?;
     Ok(mesh)
