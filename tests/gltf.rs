@@ -127,7 +127,18 @@ fn strips_fans_and_unindexed_primitives() {
     assert_reference_box(&write(
         d,
         "strip_fan.glb",
-        &box_strip_fan(SIZE, CENTRE).glb(),
+        &box_strip_fan(SIZE, CENTRE, false).glb(),
+    ));
+    // The same on three nodes, and a box split into two triangle primitives of one mesh.
+    assert_reference_box(&write(
+        d,
+        "strip_fan_nodes.glb",
+        &box_strip_fan(SIZE, CENTRE, true).glb(),
+    ));
+    assert_reference_box(&write(
+        d,
+        "two_primitives.glb",
+        &box_two_primitives(SIZE, CENTRE).glb(),
     ));
     assert_reference_box(&write(
         d,

@@ -231,8 +231,9 @@ pub fn box_builder(size: [f32; 3], centre: [f32; 3], node: Value) -> GltfBuilder
 }
 
 /// The same box as one triangle strip around its four sides and two fans for its caps (U16 strip, U8
-/// fans), corners c0..c3 counter-clockwise seen from +Z.
-pub fn box_strip_fan(size: [f32; 3], centre: [f32; 3]) -> GltfBuilder {
+/// fans), corners c0..c3 counter-clockwise seen from +Z: three primitives of one mesh, or with
+/// `separate_nodes` three meshes on three nodes.
+pub fn box_strip_fan(size: [f32; 3], centre: [f32; 3], separate_nodes: bool) -> GltfBuilder {
     let mut b = GltfBuilder::new();
     let (v, _) = box_corners(size, centre);
     // Corner index by (x bit, y bit, z bit); ring order c0=(-,-), c1=(+,-), c2=(+,+), c3=(-,+).
@@ -248,10 +249,38 @@ pub fn box_strip_fan(size: [f32; 3], centre: [f32; 3]) -> GltfBuilder {
     let s = b.indices(&strip, U16);
     let top_fan = b.indices(&[top(0), top(1), top(2), top(3)], U8);
     let bottom_fan = b.indices(&[bottom(0), bottom(3), bottom(2), bottom(1)], U8);
-    let mesh = b.mesh(&[
+    let prims = [
         (pos, Some(s), TRIANGLE_STRIP),
         (pos, Some(top_fan), TRIANGLE_FAN),
         (pos, Some(bottom_fan), TRIANGLE_FAN),
+    ];
+    let roots: Vec<usize> = if separate_nodes {
+        prims
+            .iter()
+            .map(|p| {
+                let mesh = b.mesh(&[*p]);
+                b.node(json!({ "mesh": mesh }))
+            })
+            .collect()
+    } else {
+        let mesh = b.mesh(&prims);
+        vec![b.node(json!({ "mesh": mesh }))]
+    };
+    let sc = b.add_scene(&roots);
+    b.scene = Some(sc);
+    b
+}
+
+/// The box as two triangle primitives of one mesh (six triangles each) over one POSITION accessor.
+pub fn box_two_primitives(size: [f32; 3], centre: [f32; 3]) -> GltfBuilder {
+    let mut b = GltfBuilder::new();
+    let (v, t) = box_corners(size, centre);
+    let pos = b.positions(&v);
+    let first = b.indices(&t[..18], U16);
+    let second = b.indices(&t[18..], U32);
+    let mesh = b.mesh(&[
+        (pos, Some(first), TRIANGLES),
+        (pos, Some(second), TRIANGLES),
     ]);
     let n = b.node(json!({ "mesh": mesh }));
     let sc = b.add_scene(&[n]);
