@@ -434,3 +434,29 @@ fn broken_files_are_errors_never_panics() {
         }
     }
 }
+
+/// The binary fills a link whose collision is a .glb, with the mesh `scale` applied (×2 on every axis).
+#[test]
+fn fill_a_urdf_with_a_glb_collision() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let d = tmp.path();
+    write(d, "part.glb", &box_builder(SIZE, CENTRE, json!({})).glb());
+    let urdf = write(
+        d,
+        "r.urdf",
+        br#"<robot name="r"><link name="a"><collision><geometry><mesh filename="part.glb" scale="2 2 2"/></geometry></collision></link></robot>"#,
+    );
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
+        .args(["fill", urdf.to_str().unwrap(), "--density", "1000"])
+        .output()
+        .expect("run urdf-inertia");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // 8 × 0.015625 m³ × 1000 kg/m³ = 125 kg, COM at 2 × (1, 2, 3).
+    assert!(stdout.contains(r#"<mass value="125"/>"#), "{stdout}");
+    assert!(stdout.contains(r#"xyz="2 4 6""#), "{stdout}");
+}
