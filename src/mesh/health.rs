@@ -1,37 +1,47 @@
 //! Mesh health: from a (scaled) mesh as read to a closed, outward solid, or a precise reason why not.
 //!
-//! Coincident vertices are welded (bit-exact, after scaling) and degenerate faces dropped. Then the edge
-//! structure decides the rung:
+//! Welding decides the topology ([`super::weld`]): bit-identical corners first (all a clean mesh pays
+//! for), then, only when that leaves the surface open or inconsistently wound, corners that coincide up
+//! to a tolerance relative to the mesh's size. Welding never moves a vertex; the triangles are
+//! integrated as stored. Then the edge structure decides the rung:
 //!
-//! 1. [`Rung::Exact`]: closed, manifold, consistently wound outward. No message.
-//! 2. [`Rung::Reoriented`]: closed, but some faces wound against their neighbours: each connected
+//! 1. [`Rung::Exact`]: closed, manifold, consistently wound outward under bit-exact welding.
+//! 2. [`Rung::Welded`]: the same after the tolerant weld: a closed surface whose shared corners were
+//!    stored in slightly different ways (float-noise cracks). Integrated as stored, no repair.
+//! 3. [`Rung::Reoriented`]: closed, but some faces wound against their neighbours: each connected
 //!    component is made consistent, then turned outward by its signed volume.
-//! 3. [`Rung::Inverted`]: closed and consistent but wound inward (negative volume): flipped.
-//! 4. Open (boundary edges) or non-manifold, after orienting what the manifold edges allow:
-//!    * [`Rung::Capped`]: each boundary loop is closed by a fan from its centroid. For a planar hole that
-//!      cap is exact; for a non-planar one, any cap spanning the loop differs from it by at most about
-//!      (the loop's largest distance from its mean plane) × (the cap's area). When that bound, summed over
-//!      the holes, is below 1e-3 of the volume, the capped mesh is used and the bound reported.
-//!    * [`Rung::NonManifold`]: no boundary edges but edges shared by three or more faces (solids touching
-//!      along an edge, or overlapping shells): the surface still bounds a region, integrated as it is
-//!      (a region enclosed twice counts twice: a warning says so).
-//!    * [`Rung::ConvexHull`] otherwise: the convex hull of its vertices, with the numbers that say how far
-//!      that is from the mesh.
-//! 5. Zero or near-zero volume: an error.
+//! 4. [`Rung::Inverted`]: closed and consistent but wound inward (negative volume): flipped.
+//! 5. Open (boundary edges) or non-manifold, after orienting what the manifold edges allow:
+//!    * [`Rung::Capped`]: each boundary loop is closed by a fan from its centroid. When the caps'
+//!      uncertainty (below) is under 1e-3 of the volume, the capped mesh is used. When it is below
+//!      1e-12 (the "holes" are slivers), the triangles are integrated as stored and the rung is
+//!      [`Rung::Welded`].
+//!    * [`Rung::NonManifold`]: no boundary edges but edges shared by three or more faces: the surface
+//!      still bounds a region, integrated as it is (a region enclosed twice counts twice).
+//!    * [`Rung::ConvexHull`] otherwise: the convex hull of its vertices.
+//! 6. No volume against the round-off of its faces: an error.
 //!
-//! A consistently wound closed mesh is only flipped when its *total* volume is negative, so a shell with
-//! an inward cavity keeps its cavity.
+//! Every solid carries an [`ErrorEstimate`]: a bound on the relative error of its volume and central
+//! inertia, made of the integration's round-off and, below the exact rungs, the model error (how far
+//! the solid integrated can be from the surface stored). See [`ModelError`] for each term.
 
-use super::{hull, MeshError, MeshErrorKind, RawMesh};
+use super::{hull, weld, MeshError, MeshErrorKind, RawMesh};
 use crate::mass::integrals::{bounding_box_centre, volume_integrals};
 use crate::mass::{frobenius, IntegrationOptions, MassProperties, Polygons};
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 use std::path::Path;
 
 /// Which rung of the repair ladder produced a solid's numbers.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Rung {
     Exact,
+    /// Closed and consistent once corners within `tolerance` (m) are welded; integrated as stored.
+    Welded {
+        merged_vertices: usize,
+        /// Largest distance between corners welded together, m.
+        widest_crack: f64,
+        tolerance: f64,
+    },
     Reoriented {
         faces_flipped: usize,
         components: usize,
@@ -62,6 +72,7 @@ impl Rung {
     pub fn name(&self) -> &'static str {
         match self {
             Rung::Exact => "exact",
+            Rung::Welded { .. } => "welded",
             Rung::Reoriented { .. } => "reoriented",
             Rung::Inverted => "inverted",
             Rung::Capped { .. } => "capped",
@@ -70,9 +81,72 @@ impl Rung {
         }
     }
 
-    /// Whether the solid is the mesh itself (possibly re-wound), not a stand-in.
-    pub fn is_mesh_itself(&self) -> bool {
-        !matches!(self, Rung::ConvexHull { .. })
+    /// Whether the numbers are the stored surface's own, without repair (exact or welded).
+    pub fn is_as_stored(&self) -> bool {
+        matches!(self, Rung::Exact | Rung::Welded { .. })
+    }
+}
+
+/// Where the model error of a solid comes from: how far the solid integrated can be from the surface
+/// stored in the file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModelError {
+    /// The solid is the stored surface: no model error.
+    None,
+    /// Float-noise cracks left after welding (their area times the mesh's size).
+    Cracks,
+    /// Re-oriented components, any of which could be a cavity (their volumes).
+    Orientation,
+    /// Flat caps over holes (each loop's deviation from its plane times the cap's area).
+    Caps,
+    /// The convex hull instead of the mesh (|mesh − hull| / hull, with the mesh's own volume taken at
+    /// its least favourable reference point).
+    Hull,
+}
+
+impl ModelError {
+    /// A short name for JSON and the summary.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelError::None => "none",
+            ModelError::Cracks => "cracks",
+            ModelError::Orientation => "orientation",
+            ModelError::Caps => "caps",
+            ModelError::Hull => "convex hull",
+        }
+    }
+}
+
+/// A bound on the relative error of a solid's volume and central inertia (Frobenius norm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ErrorEstimate {
+    /// Round-off of the integration: the disagreement of two integrations about different reference
+    /// points, and never less than [`ROUND_OFF_FLOOR`].
+    pub round_off: f64,
+    /// How far the solid can be from the stored surface (0 for exact and clean welded meshes).
+    pub model: f64,
+    /// What the model error is made of (the largest term).
+    pub source: ModelError,
+}
+
+impl ErrorEstimate {
+    /// The bound: round-off plus model error.
+    pub fn total(&self) -> f64 {
+        self.round_off + self.model
+    }
+
+    /// One line for people: `3.1e-16 (round-off)` or `2.0e-4 (model: caps; round-off 3.1e-16)`.
+    pub fn describe(&self) -> String {
+        if self.source == ModelError::None || self.model == 0.0 {
+            format!("{:.1e} (round-off)", self.total())
+        } else {
+            format!(
+                "{:.1e} (model: {}; round-off {:.1e})",
+                self.total(),
+                self.source.name(),
+                self.round_off
+            )
+        }
     }
 }
 
@@ -86,9 +160,10 @@ pub struct Solid {
     pub warnings: Vec<String>,
     /// Mass properties at density 1 (mass = volume), in the mesh frame.
     pub unit: MassProperties,
-    /// Relative disagreement of the central inertia integrated about two reference points (a closed
-    /// surface gives the same result about any point; round-off alone separates them).
+    /// Bound on the relative error of volume and central inertia: `error.total()`.
     pub error_estimate: f64,
+    /// The bound's parts.
+    pub error: ErrorEstimate,
     /// Faces in the file (before welding and dropping degenerate ones).
     pub faces_read: usize,
 }
@@ -96,94 +171,22 @@ pub struct Solid {
 /// Options of the ladder.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct HealthOptions {
-    /// Every rung below [`Rung::Exact`] is an error.
+    /// Every rung below [`Rung::Welded`] is an error.
     pub strict: bool,
 }
 
-/// Relative volume below which a solid counts as empty (against the bounding-box diagonal cubed).
-const ZERO_VOLUME: f64 = 1e-12;
+/// A solid's volume below this many f64 round-offs of its faces' contributions counts as empty.
+const ZERO_VOLUME_ROUNDOFFS: f64 = 1e3;
 
 /// Largest relative volume uncertainty of the caps for which a capped mesh is used.
 const CAPPED: f64 = 1e-3;
 
-/// A multiply-rotate hasher (rustc's Fx hash, with a finalising mix) for integer keys: welding 4 M
-/// vertices with the default SipHash took 390 ns per face, most of the healing time.
-#[derive(Debug, Default, Clone, Copy)]
-struct FxHasher(u64);
+/// Caps whose uncertainty is below this (relative) close slivers, not holes: integrate as stored.
+const SLIVERS: f64 = 1e-12;
 
-impl std::hash::Hasher for FxHasher {
-    fn write(&mut self, bytes: &[u8]) {
-        for chunk in bytes.chunks(8) {
-            let mut b = [0u8; 8];
-            b[..chunk.len()].copy_from_slice(chunk);
-            self.write_u64(u64::from_le_bytes(b));
-        }
-    }
-    fn write_u64(&mut self, x: u64) {
-        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-    fn write_u32(&mut self, x: u32) {
-        self.write_u64(x as u64);
-    }
-    fn write_usize(&mut self, x: usize) {
-        self.write_u64(x as u64);
-    }
-    fn finish(&self) -> u64 {
-        // Coordinates read from f32 have 29 zero low bits, which a plain multiply keeps in the low bits
-        // the table indexes by: fold the high half down (MurmurHash3's finaliser step).
-        let h = self.0 ^ (self.0 >> 33);
-        h.wrapping_mul(0xff51_afd7_ed55_8ccd) ^ (h >> 29)
-    }
-}
-
-type FxMap<K, V> = HashMap<K, V, std::hash::BuildHasherDefault<FxHasher>>;
-
-/// Welds bit-identical vertices and drops faces that collapse to fewer than three distinct vertices.
-pub fn weld(mesh: &RawMesh) -> (Vec<[f64; 3]>, Polygons, usize) {
-    let mut map: FxMap<[u64; 3], u32> =
-        FxMap::with_capacity_and_hasher(mesh.vertices.len() / 2, Default::default());
-    let mut vertices = Vec::new();
-    let remap: Vec<u32> = mesh
-        .vertices
-        .iter()
-        .map(|p| {
-            // +0.0 folds -0.0 into 0.0 so that both weld.
-            let key = [
-                (p[0] + 0.0).to_bits(),
-                (p[1] + 0.0).to_bits(),
-                (p[2] + 0.0).to_bits(),
-            ];
-            *map.entry(key).or_insert_with(|| {
-                vertices.push([p[0] + 0.0, p[1] + 0.0, p[2] + 0.0]);
-                (vertices.len() - 1) as u32
-            })
-        })
-        .collect();
-    let mut faces = Polygons::new();
-    let mut dropped = 0;
-    let mut f: Vec<u32> = Vec::new();
-    for face in mesh.faces.iter() {
-        f.clear();
-        for &i in face {
-            let j = remap[i as usize];
-            if f.last() != Some(&j) {
-                f.push(j);
-            }
-        }
-        while f.len() > 1 && f.first() == f.last() {
-            f.pop();
-        }
-        let mut distinct = f.clone();
-        distinct.sort_unstable();
-        distinct.dedup();
-        if distinct.len() < 3 {
-            dropped += 1;
-        } else {
-            faces.push(&f);
-        }
-    }
-    (vertices, faces, dropped)
-}
+/// Smallest round-off estimate: the compensated kernel's results are within a few units of 2⁻⁵³ of
+/// the exact value on every stiff case measured (docs/accuracy.md); 8·2⁻⁵³ leaves a margin.
+pub const ROUND_OFF_FLOOR: f64 = 4.0 * f64::EPSILON;
 
 /// Edge structure of a welded mesh.
 #[derive(Debug, Default)]
@@ -197,12 +200,36 @@ struct Edges {
     boundary_half_edges: Vec<(u32, u32)>,
 }
 
+impl Edges {
+    fn closed(&self) -> bool {
+        self.boundary == 0 && self.nonmanifold == 0
+    }
+
+    fn describe(&self) -> String {
+        if self.boundary > 0 && self.nonmanifold > 0 {
+            format!(
+                "open ({} boundary edges) and non-manifold ({} edges shared by 3+ faces)",
+                self.boundary, self.nonmanifold
+            )
+        } else if self.boundary > 0 {
+            format!("open ({} boundary edges)", self.boundary)
+        } else if self.nonmanifold > 0 {
+            format!(
+                "non-manifold ({} edges shared by 3+ faces)",
+                self.nonmanifold
+            )
+        } else {
+            "closed but not orientable".to_string()
+        }
+    }
+}
+
 fn edges(faces: &Polygons) -> Edges {
     let mut rec: Vec<(u64, u32, bool)> = Vec::with_capacity(faces.indices.len());
     for (fi, face) in faces.iter().enumerate() {
         for k in 0..face.len() {
             let (u, v) = (face[k], face[(k + 1) % face.len()]);
-            let key = ((u.min(v) as u64) << 32) | u.max(v) as u64;
+            let key = (u64::from(u.min(v)) << 32) | u64::from(u.max(v));
             rec.push((key, fi as u32, u < v));
         }
     }
@@ -241,9 +268,15 @@ fn edges(faces: &Polygons) -> Edges {
     e
 }
 
-/// Orients each connected component consistently. Returns per-face flips and component ids, or `None`
-/// when a component cannot be oriented (a Möbius-like surface).
-fn orient(nfaces: usize, pairs: &[(u32, u32, bool)]) -> Option<(Vec<bool>, Vec<u32>, usize)> {
+/// A consistent orientation of each connected component (over manifold edges): per-face flips,
+/// component ids and the number of components; `None` when a component is not orientable.
+struct Orientation {
+    flip: Vec<bool>,
+    comp: Vec<u32>,
+    ncomp: usize,
+}
+
+fn orient(nfaces: usize, pairs: &[(u32, u32, bool)]) -> Option<Orientation> {
     let mut adj: Vec<Vec<(u32, bool)>> = vec![Vec::new(); nfaces];
     for &(a, b, same) in pairs {
         adj[a as usize].push((b, same));
@@ -274,7 +307,469 @@ fn orient(nfaces: usize, pairs: &[(u32, u32, bool)]) -> Option<(Vec<bool>, Vec<u
         }
         ncomp += 1;
     }
-    Some((flip, comp, ncomp as usize))
+    Some(Orientation {
+        flip,
+        comp,
+        ncomp: ncomp as usize,
+    })
+}
+
+/// The mesh after both welding passes: stored vertices (bit-exact welded), the stored faces, and the
+/// topology the tolerant weld gives them.
+struct Welding {
+    vertices: Vec<[f64; 3]>,
+    /// All faces as stored (bit-exact welded).
+    stored: Polygons,
+    /// The stored faces that survive the tolerant weld, in stored vertex indices.
+    kept: Polygons,
+    /// The same faces in representative indices: the topology.
+    topology: Polygons,
+    tolerant: weld::TolerantWeld,
+    /// Faces that collapsed under the tolerant weld.
+    collapsed: usize,
+    /// Bound on the area of the cracks the tolerant weld closed, plus the collapsed faces' area, m².
+    crack_area: f64,
+}
+
+fn tolerant_welding(
+    exact: weld::ExactWeld,
+    exact_edges: &Edges,
+    precision: weld::Precision,
+) -> Welding {
+    let tol = weld::tolerance(&exact.vertices, precision);
+    let tolerant = weld::tolerant(&exact.vertices, tol);
+    let (topology, kept_mask) = weld::remap_faces(&exact.faces, &tolerant.representative);
+    let mut kept = Polygons::new();
+    let mut crack_area = 0.0;
+    for (i, face) in exact.faces.iter().enumerate() {
+        if kept_mask[i] {
+            kept.push(face);
+        } else {
+            crack_area += polygon_area(&exact.vertices, face);
+        }
+    }
+    let rep = &tolerant.representative;
+    let disp = |i: u32| {
+        dist(
+            exact.vertices[i as usize],
+            exact.vertices[rep[i as usize] as usize],
+        )
+    };
+    for &(u, v) in &exact_edges.boundary_half_edges {
+        let (du, dv) = (disp(u), disp(v));
+        if du > 0.0 || dv > 0.0 {
+            crack_area += dist(exact.vertices[u as usize], exact.vertices[v as usize]) * (du + dv);
+        }
+    }
+    Welding {
+        collapsed: kept_mask.iter().filter(|k| !**k).count(),
+        vertices: exact.vertices,
+        stored: exact.faces,
+        kept,
+        topology,
+        tolerant,
+        crack_area,
+    }
+}
+
+/// Shared by the rungs: where the mesh came from and what has been said about it.
+struct Ladder<'a> {
+    path: &'a Path,
+    options: HealthOptions,
+    warnings: Vec<String>,
+    faces_read: usize,
+}
+
+impl Ladder<'_> {
+    fn strict(&self, what: &str) -> Result<(), MeshError> {
+        if self.options.strict {
+            Err(MeshError::new(
+                self.path,
+                None,
+                MeshErrorKind::Strict(what.to_string()),
+            ))
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Integrates, checks the volume and estimates the error: the last step of every rung.
+    fn finish(
+        self,
+        vertices: Vec<[f64; 3]>,
+        faces: Polygons,
+        rung: Rung,
+        model: (f64, ModelError),
+    ) -> Result<Solid, MeshError> {
+        let unit = unit_props(&vertices, &faces, None);
+        check_volume(&vertices, &faces, unit.mass, self.path)?;
+        let round_off = round_off(&vertices, &faces, &unit);
+        let (model_error, source) = model;
+        let error = ErrorEstimate {
+            round_off,
+            model: model_error,
+            source: if model_error > 0.0 {
+                source
+            } else {
+                ModelError::None
+            },
+        };
+        Ok(Solid {
+            vertices,
+            faces,
+            rung,
+            warnings: self.warnings,
+            unit,
+            error_estimate: error.total(),
+            error,
+            faces_read: self.faces_read,
+        })
+    }
+}
+
+/// Turns a scaled mesh into a solid by the ladder in the module docs, its coordinates taken as f64
+/// values (see [`make_solid_stored_as`] for meshes stored in f32).
+pub fn make_solid(mesh: &RawMesh, path: &Path, options: HealthOptions) -> Result<Solid, MeshError> {
+    make_solid_stored_as(mesh, path, options, weld::Precision::F64)
+}
+
+/// Turns a scaled mesh into a solid; `precision` is how its file stored the coordinates, which sets the
+/// tolerance of the second welding pass.
+pub fn make_solid_stored_as(
+    mesh: &RawMesh,
+    path: &Path,
+    options: HealthOptions,
+    precision: weld::Precision,
+) -> Result<Solid, MeshError> {
+    let mut ladder = Ladder {
+        path,
+        options,
+        warnings: mesh.notes.clone(),
+        faces_read: mesh.faces.len(),
+    };
+    let exact = weld::exact(&mesh.vertices, &mesh.faces);
+    if exact.dropped > 0 {
+        ladder.warnings.push(format!(
+            "{} degenerate faces (repeated vertices) dropped",
+            exact.dropped
+        ));
+    }
+    if exact.faces.is_empty() {
+        return Err(MeshError::new(path, None, MeshErrorKind::Empty));
+    }
+    let e = edges(&exact.faces);
+    if e.closed() && e.inconsistent == 0 {
+        return consistent_closed(ladder, exact.vertices, exact.faces, Rung::Exact, 0.0);
+    }
+    let w = tolerant_welding(exact, &e, precision);
+    let te = edges(&w.topology);
+    if w.collapsed > 0 {
+        ladder.warnings.push(format!(
+            "{} sliver faces collapse when corners within {:.1e} m are welded; left out of the topology",
+            w.collapsed, w.tolerant.tolerance
+        ));
+    }
+    if te.closed() && te.inconsistent == 0 {
+        let rung = Rung::Welded {
+            merged_vertices: w.tolerant.merged,
+            widest_crack: w.tolerant.widest,
+            tolerance: w.tolerant.tolerance,
+        };
+        let cracks = w.crack_area;
+        return consistent_closed(ladder, w.vertices, w.stored, rung, cracks);
+    }
+    if te.closed() {
+        if let Some(o) = orient(w.topology.len(), &te.pairs) {
+            return reoriented(ladder, w, &te, &o);
+        }
+    }
+    open_or_nonmanifold(ladder, w, &te)
+}
+
+/// Closed and consistent (bit-exact or after the tolerant weld): as stored, or flipped if inward.
+fn consistent_closed(
+    mut ladder: Ladder<'_>,
+    vertices: Vec<[f64; 3]>,
+    mut faces: Polygons,
+    rung: Rung,
+    crack_area: f64,
+) -> Result<Solid, MeshError> {
+    let t = volume_integrals(&vertices, &faces, &IntegrationOptions::accurate());
+    let mut rung = rung;
+    if t.t1 < 0.0 {
+        ladder.strict("closed mesh wound inward")?;
+        for i in 0..faces.len() {
+            faces.reverse_face(i);
+        }
+        ladder.warnings.push(format!(
+            "all {} faces wound inward (negative volume); flipped",
+            faces.len()
+        ));
+        rung = Rung::Inverted;
+    }
+    if let Rung::Welded {
+        merged_vertices,
+        widest_crack,
+        tolerance,
+    } = rung
+    {
+        ladder.warnings.push(format!(
+            "closed once {merged_vertices} corners stored up to {widest_crack:.1e} m apart are welded (tolerance {tolerance:.1e} m); integrated as stored"
+        ));
+    }
+    let model = crack_model(crack_area, &vertices, t.t1.abs());
+    ladder.finish(vertices, faces, rung, (model, ModelError::Cracks))
+}
+
+/// Relative model error of cracks of total area `area`: the flux of the integrands through them,
+/// at most area × (diagonal) against the volume, doubled for the second moments.
+fn crack_model(area: f64, vertices: &[[f64; 3]], volume: f64) -> f64 {
+    if area == 0.0 {
+        return 0.0;
+    }
+    let (lo, hi) = bbox(vertices);
+    2.0 * area * dist(lo, hi) / volume
+}
+
+/// Closed after the tolerant weld but wound inconsistently: each component made consistent and outward.
+fn reoriented(
+    mut ladder: Ladder<'_>,
+    w: Welding,
+    te: &Edges,
+    o: &Orientation,
+) -> Result<Solid, MeshError> {
+    let Outward {
+        reversed,
+        flipped,
+        nested,
+    } = outward(&w.vertices, &w.kept, o);
+    let mut faces = w.kept.clone();
+    apply(&mut faces, &reversed);
+    ladder.strict(&format!(
+        "{} faces wound against their neighbours",
+        te.inconsistent
+    ))?;
+    ladder.warnings.push(format!(
+        "closed, but {flipped} of {} faces were wound against their neighbours ({} edges disagreed); re-oriented each of {} component(s) outward",
+        faces.len(),
+        te.inconsistent,
+        o.ncomp
+    ));
+    let rung = Rung::Reoriented {
+        faces_flipped: flipped,
+        components: o.ncomp,
+    };
+    let volume = signed_volume(&w.vertices, &faces);
+    let model = crack_model(w.crack_area, &w.vertices, volume) + nested / volume;
+    let source = if nested > 0.0 {
+        ModelError::Orientation
+    } else {
+        ModelError::Cracks
+    };
+    ladder.finish(w.vertices, faces, rung, (model, source))
+}
+
+/// Each face's reversal under an orientation that turns every component outward by its own signed
+/// volume, how many faces that flips, and the volume of components lying inside another one's
+/// bounding box (counted twice: a cavity turned outward adds its volume instead of removing it).
+struct Outward {
+    reversed: Vec<bool>,
+    flipped: usize,
+    nested: f64,
+}
+
+fn outward(vertices: &[[f64; 3]], faces: &Polygons, o: &Orientation) -> Outward {
+    let mut trial = faces.clone();
+    apply(&mut trial, &o.flip);
+    let vol = component_volumes(vertices, &trial, &o.comp, o.ncomp);
+    let reversed: Vec<bool> = (0..faces.len())
+        .map(|i| o.flip[i] ^ (vol[o.comp[i] as usize] < 0.0))
+        .collect();
+    let flipped = reversed.iter().filter(|r| **r).count();
+    let mut nested = 0.0;
+    if o.ncomp > 1 {
+        let boxes = component_boxes(vertices, faces, &o.comp, o.ncomp);
+        for c in 0..o.ncomp {
+            if (0..o.ncomp).any(|d| d != c && contains(&boxes[d], &boxes[c])) {
+                nested += 2.0 * vol[c].abs() / 6.0;
+            }
+        }
+    }
+    Outward {
+        reversed,
+        flipped,
+        nested,
+    }
+}
+
+/// Reverses the faces marked.
+fn apply(faces: &mut Polygons, reversed: &[bool]) {
+    for (i, r) in reversed.iter().enumerate() {
+        if *r {
+            faces.reverse_face(i);
+        }
+    }
+}
+
+/// Open or non-manifold: caps, integration as it is, or the convex hull.
+fn open_or_nonmanifold(mut ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result<Solid, MeshError> {
+    let what = te.describe();
+    // Orient what the manifold edges allow, each component outward; failing that (contradicting
+    // edges, or open sheets whose sign is meaningless), the winding as the file gives it.
+    let mut candidates: Vec<(Polygons, Polygons, usize, f64)> = Vec::new();
+    if let Some(o) = orient(w.topology.len(), &te.pairs) {
+        let out = outward(&w.vertices, &w.kept, &o);
+        if out.flipped > 0 {
+            let (mut kept, mut topology) = (w.kept.clone(), w.topology.clone());
+            apply(&mut kept, &out.reversed);
+            apply(&mut topology, &out.reversed);
+            candidates.push((kept, topology, out.flipped, out.nested));
+        }
+    }
+    candidates.push((w.kept.clone(), w.topology.clone(), 0, 0.0));
+    for (faces, topology, flipped, nested) in candidates {
+        let flips = if flipped > 0 {
+            format!(", {flipped} faces re-oriented")
+        } else {
+            String::new()
+        };
+        if te.boundary == 0 {
+            let volume = signed_volume(&w.vertices, &faces);
+            if volume > 0.0 {
+                ladder.strict(&format!("mesh is {what}"))?;
+                ladder.warnings.push(format!("mesh is {what} but has no holes: integrated as it is{flips} (a region enclosed by two overlapping shells would count twice)"));
+                // Integrated as stored (up to the faces re-oriented): a region that two shells
+                // enclose counts twice here exactly as in the stored surface, which the warning says.
+                let model = crack_model(w.crack_area, &w.vertices, volume) + nested / volume;
+                let rung = Rung::NonManifold {
+                    nonmanifold_edges: te.nonmanifold,
+                    faces_flipped: flipped,
+                };
+                let source = if nested > 0.0 {
+                    ModelError::Orientation
+                } else {
+                    ModelError::Cracks
+                };
+                return ladder.finish(w.vertices, faces, rung, (model, source));
+            }
+            continue;
+        }
+        let Some(caps) = cap_holes(&w.vertices, &topology) else {
+            continue;
+        };
+        let mut vertices = w.vertices.clone();
+        vertices.extend_from_slice(&caps.centroids);
+        let mut capped = faces.clone();
+        for f in caps.faces.iter() {
+            capped.push(f);
+        }
+        let volume = signed_volume(&vertices, &capped);
+        let uncertainty = caps.bound / volume.abs();
+        if !(volume > 0.0 && uncertainty <= CAPPED) {
+            continue;
+        }
+        let cracks = crack_model(w.crack_area, &w.vertices, volume);
+        // Whatever surface really spans the loops, its contribution is at most (its area) × diagonal.
+        let (lo, hi) = bbox(&w.vertices);
+        let spans = caps.area * dist(lo, hi) / volume;
+        if spans + uncertainty + cracks <= SLIVERS && flipped == 0 {
+            // The "holes" are slivers: the stored triangles are closed up to round-off.
+            ladder.warnings.push(format!(
+                "closed up to slivers once corners within {:.1e} m are welded ({} boundary edges bound {:.1e} m² in all); integrated as stored",
+                w.tolerant.tolerance, te.boundary, caps.area
+            ));
+            let rung = Rung::Welded {
+                merged_vertices: w.tolerant.merged,
+                widest_crack: w.tolerant.widest,
+                tolerance: w.tolerant.tolerance,
+            };
+            let model = spans + uncertainty + cracks;
+            return ladder.finish(w.vertices, w.stored, rung, (model, ModelError::Cracks));
+        }
+        ladder.strict(&format!("mesh is {what}"))?;
+        let mut done = Vec::new();
+        if caps.holes > 0 {
+            done.push(format!("closed its {} hole(s) with flat caps", caps.holes));
+        }
+        if caps.cracks > 0 {
+            done.push(format!(
+                "left {} edge(s) of cracks or T-junctions open",
+                caps.cracks
+            ));
+        }
+        let model = uncertainty + cracks + nested / volume;
+        ladder.warnings.push(format!(
+            "mesh is {what}: {}{flips}; its volume {volume:.6e} m³ is uncertain by at most {model:.1e} (relative) because of them",
+            done.join(", "),
+        ));
+        let rung = Rung::Capped {
+            holes: caps.holes,
+            boundary_edges: te.boundary,
+            nonmanifold_edges: te.nonmanifold,
+            faces_flipped: flipped,
+            relative_uncertainty: model,
+        };
+        return ladder.finish(vertices, capped, rung, (model, ModelError::Caps));
+    }
+    convex_hull(ladder, w, te, &what)
+}
+
+/// The convex hull of the vertices, with the numbers that say how far that is from the mesh.
+fn convex_hull(
+    mut ladder: Ladder<'_>,
+    w: Welding,
+    te: &Edges,
+    what: &str,
+) -> Result<Solid, MeshError> {
+    let (lo, hi) = bbox(&w.vertices);
+    let diag = dist(lo, hi);
+    // The stored surface's signed volume, and how much it moves over reference points in the box.
+    let own = signed_volume(&w.vertices, &w.stored);
+    let moves = vector_area(&w.vertices, &w.stored) * diag / 6.0;
+    let (hv, ht) = hull::convex_hull(&w.vertices).map_err(|err| match err {
+        hull::HullError::Degenerate => MeshError::new(
+            ladder.path,
+            None,
+            MeshErrorKind::ZeroVolume {
+                volume: own,
+                bbox_volume: (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]),
+            },
+        ),
+        hull::HullError::Failed(m) => MeshError::new(
+            ladder.path,
+            None,
+            MeshErrorKind::Hull(format!("the mesh is {what}, and its convex hull failed: {m}")),
+        ),
+        hull::HullError::TooManyPoints(n) => MeshError::new(
+            ladder.path,
+            None,
+            MeshErrorKind::Hull(format!(
+                "the mesh is {what}, and its convex hull (the last resort) would need {n} candidate points, over the limit of {} that bounds its memory",
+                hull::MAX_POINTS
+            )),
+        ),
+    })?;
+    let hull_faces = Polygons::from_triangles(&ht);
+    let hull_volume = signed_volume(&hv, &hull_faces);
+    ladder.strict(&format!("mesh is {what}"))?;
+    let model = ((own - hull_volume).abs() + moves) / hull_volume;
+    ladder.warnings.push(format!(
+        "mesh is {what}; used its convex hull ({} vertices, volume {:.6e} m³). The mesh's own signed volume is {:.6e} m³ ({:+.1}% of the hull) and moves by up to {:.2e} m³ with the reference point, so it is not a solid; the hull's numbers are uncertain by {:.1e} (relative)",
+        hv.len(),
+        hull_volume,
+        own,
+        if hull_volume != 0.0 { 100.0 * (own - hull_volume) / hull_volume } else { 0.0 },
+        moves,
+        model
+    ));
+    let rung = Rung::ConvexHull {
+        boundary_edges: te.boundary,
+        nonmanifold_edges: te.nonmanifold,
+        mesh_volume: own,
+        hull_volume,
+        volume_moves_by: moves,
+    };
+    ladder.finish(hv, hull_faces, rung, (model, ModelError::Hull))
 }
 
 fn unit_props(
@@ -289,6 +784,10 @@ fn unit_props(
     MassProperties::from_integrals(&volume_integrals(vertices, faces, &opts), 1.0)
 }
 
+fn signed_volume(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
+    volume_integrals(vertices, faces, &IntegrationOptions::accurate()).t1
+}
+
 fn bbox(vertices: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
@@ -301,8 +800,9 @@ fn bbox(vertices: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
     (lo, hi)
 }
 
-/// The relative disagreement of the central inertia about two reference points.
-fn estimate(vertices: &[[f64; 3]], faces: &Polygons, base: &MassProperties) -> f64 {
+/// The round-off estimate: the relative disagreement of volume and central inertia integrated about
+/// two reference points (bounding-box centre and corner), never below [`ROUND_OFF_FLOOR`].
+fn round_off(vertices: &[[f64; 3]], faces: &Polygons, base: &MassProperties) -> f64 {
     let (lo, _) = bbox(vertices);
     let other = unit_props(vertices, faces, Some(lo));
     let mut d = [[0.0; 3]; 3];
@@ -312,289 +812,34 @@ fn estimate(vertices: &[[f64; 3]], faces: &Polygons, base: &MassProperties) -> f
         }
     }
     let n = frobenius(&base.inertia);
-    if n > 0.0 {
+    let inertia = if n > 0.0 {
         frobenius(&d) / n
     } else {
         f64::INFINITY
-    }
+    };
+    let volume = ((other.mass - base.mass) / base.mass).abs();
+    inertia.max(volume).max(ROUND_OFF_FLOOR)
 }
 
-/// Turns a scaled mesh into a solid by the ladder in the module docs.
-pub fn make_solid(mesh: &RawMesh, path: &Path, options: HealthOptions) -> Result<Solid, MeshError> {
-    let faces_read = mesh.faces.len();
-    let (vertices, mut faces, dropped) = weld(mesh);
-    let mut warnings: Vec<String> = mesh.notes.clone();
-    if dropped > 0 {
-        warnings.push(format!(
-            "{dropped} degenerate faces (repeated vertices) dropped"
-        ));
-    }
-    if faces.is_empty() {
-        return Err(MeshError::new(path, None, MeshErrorKind::Empty));
-    }
-    let (lo, hi) = bbox(&vertices);
-    let diag = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
-    let bbox_volume = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
-    let strict = |what: String| -> Result<(), MeshError> {
-        if options.strict {
-            Err(MeshError::new(path, None, MeshErrorKind::Strict(what)))
-        } else {
-            Ok(())
-        }
-    };
-    let e = edges(&faces);
-    let closed = e.boundary == 0 && e.nonmanifold == 0;
-    // Orientation is only worked out when some edge says it is needed.
-    let oriented = if closed && e.inconsistent > 0 {
-        orient(faces.len(), &e.pairs)
-    } else {
-        None
-    };
-
-    let rung;
-    let mut integrals = None;
-    if closed && e.inconsistent == 0 {
-        let t = volume_integrals(&vertices, &faces, &IntegrationOptions::accurate());
-        if t.t1 < 0.0 {
-            strict("closed mesh wound inward".into())?;
-            for i in 0..faces.len() {
-                faces.reverse_face(i);
-            }
-            warnings.push(format!(
-                "all {} faces wound inward (negative volume); flipped",
-                faces.len()
-            ));
-            integrals = Some(t.negated());
-            rung = Rung::Inverted;
-        } else {
-            integrals = Some(t);
-            rung = Rung::Exact;
-        }
-    } else if let Some((flip, comp, ncomp)) = oriented {
-        {
-            for (i, f) in flip.iter().enumerate() {
-                if *f {
-                    faces.reverse_face(i);
-                }
-            }
-            // Each component outward by its own signed volume.
-            let vol = component_volumes(&vertices, &faces, &comp, ncomp);
-            let mut flipped = 0usize;
-            for i in 0..faces.len() {
-                let turned = flip[i] ^ (vol[comp[i] as usize] < 0.0);
-                if vol[comp[i] as usize] < 0.0 {
-                    faces.reverse_face(i);
-                }
-                if turned {
-                    flipped += 1;
-                }
-            }
-            strict(format!(
-                "{} faces wound against their neighbours",
-                e.inconsistent
-            ))?;
-            warnings.push(format!(
-                "closed, but {flipped} of {} faces were wound against their neighbours ({} edges disagreed); re-oriented each of {ncomp} component(s) outward",
-                faces.len(),
-                e.inconsistent
-            ));
-            rung = Rung::Reoriented {
-                faces_flipped: flipped,
-                components: ncomp,
-            };
-        }
-    } else {
-        let what = if e.boundary > 0 && e.nonmanifold > 0 {
-            format!(
-                "open ({} boundary edges) and non-manifold ({} edges shared by 3+ faces)",
-                e.boundary, e.nonmanifold
-            )
-        } else if e.boundary > 0 {
-            format!("open ({} boundary edges)", e.boundary)
-        } else if e.nonmanifold > 0 {
-            format!("non-manifold ({} edges shared by 3+ faces)", e.nonmanifold)
-        } else {
-            "closed but not orientable".to_string()
-        };
-        // Orient what the manifold edges allow, each component outward; failing that (contradicting
-        // edges, or open sheets whose sign is meaningless), the winding as the file gives it. Then close
-        // the holes, if they are small enough for flat caps to be trusted.
-        let mut candidates: Vec<(Polygons, usize)> = Vec::new();
-        if let Some((flip, comp, ncomp)) = orient(faces.len(), &e.pairs) {
-            let mut trial = faces.clone();
-            for (i, f) in flip.iter().enumerate() {
-                if *f {
-                    trial.reverse_face(i);
-                }
-            }
-            let vol = component_volumes(&vertices, &trial, &comp, ncomp);
-            let mut flipped = 0;
-            for i in 0..trial.len() {
-                if vol[comp[i] as usize] < 0.0 {
-                    trial.reverse_face(i);
-                }
-                if flip[i] ^ (vol[comp[i] as usize] < 0.0) {
-                    flipped += 1;
-                }
-            }
-            if flipped > 0 {
-                candidates.push((trial, flipped));
-            }
-        }
-        candidates.push((faces.clone(), 0));
-        for (trial, flipped) in candidates {
-            let flips = if flipped > 0 {
-                format!(", {flipped} faces re-oriented")
-            } else {
-                String::new()
-            };
-            if e.boundary == 0 {
-                let unit = unit_props(&vertices, &trial, None);
-                if unit.mass > 0.0 {
-                    strict(format!("mesh is {what}"))?;
-                    warnings.push(format!("mesh is {what} but has no holes: integrated as it is{flips} (a region enclosed by two overlapping shells would count twice)"));
-                    check_volume(unit.mass, diag, bbox_volume, path)?;
-                    let error_estimate = estimate(&vertices, &trial, &unit);
-                    let rung = Rung::NonManifold {
-                        nonmanifold_edges: e.nonmanifold,
-                        faces_flipped: flipped,
-                    };
-                    return Ok(Solid {
-                        vertices,
-                        faces: trial,
-                        rung,
-                        warnings,
-                        unit,
-                        error_estimate,
-                        faces_read,
-                    });
-                }
-                continue;
-            }
-            let Some(Capping {
-                vertices: cv,
-                faces: cf,
-                holes,
-                cracks,
-                bound,
-            }) = cap_holes(&vertices, &trial)
-            else {
-                continue;
-            };
-            let unit = unit_props(&cv, &cf, None);
-            let uncertainty = bound / unit.mass.abs();
-            if unit.mass > 0.0 && uncertainty <= CAPPED {
-                strict(format!("mesh is {what}"))?;
-                let mut done = Vec::new();
-                if holes > 0 {
-                    done.push(format!("closed its {holes} hole(s) with flat caps"));
-                }
-                if cracks > 0 {
-                    done.push(format!(
-                        "left {cracks} edge(s) of cracks or T-junctions open"
-                    ));
-                }
-                warnings.push(format!(
-                    "mesh is {what}: {}{flips}; its volume {:.6e} m³ is uncertain by at most {:.1e} (relative) because of them",
-                    done.join(", "),
-                    unit.mass,
-                    uncertainty
-                ));
-                check_volume(unit.mass, diag, bbox_volume, path)?;
-                let rung = Rung::Capped {
-                    holes,
-                    boundary_edges: e.boundary,
-                    nonmanifold_edges: e.nonmanifold,
-                    faces_flipped: flipped,
-                    relative_uncertainty: uncertainty,
-                };
-                let error_estimate = uncertainty.max(estimate(&cv, &cf, &unit));
-                return Ok(Solid {
-                    vertices: cv,
-                    faces: cf,
-                    rung,
-                    warnings,
-                    unit,
-                    error_estimate,
-                    faces_read,
-                });
-            }
-        }
-        // Open or non-manifold: the mesh's own signed volume depends on the reference point.
-        let own = unit_props(&vertices, &faces, None).mass;
-        let own_corner = unit_props(&vertices, &faces, Some(lo)).mass;
-        let (hv, ht) = hull::convex_hull(&vertices).map_err(|err| match err {
-            hull::HullError::Degenerate => MeshError::new(
-                path,
-                None,
-                MeshErrorKind::ZeroVolume {
-                    volume: 0.0,
-                    bbox_volume,
-                },
-            ),
-            hull::HullError::Failed(m) => MeshError::new(
-                path,
-                None,
-                MeshErrorKind::Syntax(format!("open mesh, and its convex hull failed: {m}")),
-            ),
-        })?;
-        let hull_faces = Polygons::from_triangles(&ht);
-        let hull_volume = unit_props(&hv, &hull_faces, None).mass;
-        strict(format!("mesh is {what}"))?;
-        let moves = (own - own_corner).abs();
-        warnings.push(format!(
-            "mesh is {what}; used its convex hull ({} vertices, volume {:.6e} m³). The mesh's own signed volume is {:.6e} m³ ({:+.1}% of the hull) and moves by {:.2e} m³ when the reference point moves, so it is not a solid",
-            hv.len(),
-            hull_volume,
-            own,
-            if hull_volume != 0.0 { 100.0 * (own - hull_volume) / hull_volume } else { 0.0 },
-            moves
-        ));
-        rung = Rung::ConvexHull {
-            boundary_edges: e.boundary,
-            nonmanifold_edges: e.nonmanifold,
-            mesh_volume: own,
-            hull_volume,
-            volume_moves_by: moves,
-        };
-        let unit = unit_props(&hv, &hull_faces, None);
-        check_volume(unit.mass, diag, bbox_volume, path)?;
-        let error_estimate = estimate(&hv, &hull_faces, &unit);
-        return Ok(Solid {
-            vertices: hv,
-            faces: hull_faces,
-            rung,
-            warnings,
-            unit,
-            error_estimate,
-            faces_read,
-        });
-    }
-    let unit = match integrals {
-        Some(t) => MassProperties::from_integrals(&t, 1.0),
-        None => unit_props(&vertices, &faces, None),
-    };
-    check_volume(unit.mass, diag, bbox_volume, path)?;
-    let error_estimate = estimate(&vertices, &faces, &unit);
-    Ok(Solid {
-        vertices,
-        faces,
-        rung,
-        warnings,
-        unit,
-        error_estimate,
-        faces_read,
-    })
-}
-
-fn check_volume(volume: f64, diag: f64, bbox_volume: f64, path: &Path) -> Result<(), MeshError> {
-    if volume.is_nan() || volume <= ZERO_VOLUME * diag.powi(3) {
+/// A solid is empty when its volume is within a thousand round-offs of its faces' contributions
+/// (Σ face area × diagonal): relative to the surface, so a needle 1e-6 × 1e-6 × 1 (volume 1e-12 of
+/// its diagonal cubed), rotated or not, is a solid, and a flat or doubly covered sheet is not.
+fn check_volume(
+    vertices: &[[f64; 3]],
+    faces: &Polygons,
+    volume: f64,
+    path: &Path,
+) -> Result<(), MeshError> {
+    let (lo, hi) = bbox(vertices);
+    let area: f64 = faces.iter().map(|f| polygon_area(vertices, f)).sum();
+    let floor = ZERO_VOLUME_ROUNDOFFS * f64::EPSILON * area * dist(lo, hi);
+    if volume.is_nan() || volume <= floor {
         return Err(MeshError::new(
             path,
             None,
             MeshErrorKind::ZeroVolume {
                 volume,
-                bbox_volume,
+                bbox_volume: (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]),
             },
         ));
     }
@@ -615,23 +860,64 @@ fn component_volumes(
         for k in 1..face.len() - 1 {
             let b = sub(vertices[face[k] as usize], centre);
             let c = sub(vertices[face[k + 1] as usize], centre);
-            vol[comp[i] as usize] += a[0] * (b[1] * c[2] - b[2] * c[1])
-                + a[1] * (b[2] * c[0] - b[0] * c[2])
-                + a[2] * (b[0] * c[1] - b[1] * c[0]);
+            vol[comp[i] as usize] += dot(a, cross(b, c));
         }
     }
     vol
 }
 
+type Aabb = ([f64; 3], [f64; 3]);
+
+fn component_boxes(
+    vertices: &[[f64; 3]],
+    faces: &Polygons,
+    comp: &[u32],
+    ncomp: usize,
+) -> Vec<Aabb> {
+    let mut boxes = vec![([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]); ncomp];
+    for (i, face) in faces.iter().enumerate() {
+        let b = &mut boxes[comp[i] as usize];
+        for &v in face {
+            for k in 0..3 {
+                b.0[k] = b.0[k].min(vertices[v as usize][k]);
+                b.1[k] = b.1[k].max(vertices[v as usize][k]);
+            }
+        }
+    }
+    boxes
+}
+
+fn contains(outer: &Aabb, inner: &Aabb) -> bool {
+    (0..3).all(|k| outer.0[k] <= inner.0[k] && inner.1[k] <= outer.1[k])
+}
+
+/// Boundary loops closed by fans from their centroids.
+struct Caps {
+    /// One new vertex per hole (its centroid), numbered after the mesh's vertices.
+    centroids: Vec<[f64; 3]>,
+    faces: Polygons,
+    holes: usize,
+    /// Boundary edges left open (cracks, T-junctions).
+    cracks: usize,
+    /// Bound on the volume uncertainty the caps and cracks leave, m³.
+    bound: f64,
+    /// Total area of the caps, m².
+    area: f64,
+}
+
 /// Closes every boundary loop of `faces` with a fan from the loop's centroid, wound against the loop's
-/// edges so the result is consistently oriented. Returns the new vertices and faces, the number of holes,
-/// and the volume uncertainty bound Σ (largest distance of a loop vertex from the loop's mean plane) ×
-/// (cap area). `None` when the boundary edges do not chain into loops (inconsistent winding at a hole).
-fn cap_holes(vertices: &[[f64; 3]], faces: &Polygons) -> Option<Capping> {
+/// edges so the result is consistently oriented. The volume uncertainty bound: two surfaces spanning
+/// a loop that both lie within the loop's largest distance `d` from its mean plane enclose at most
+/// 2·d × (cap area) between them; boundary chains that do not close add |vector area| × diagonal / 6.
+/// `None` when there are no boundary edges.
+fn cap_holes(vertices: &[[f64; 3]], faces: &Polygons) -> Option<Caps> {
     let half = edges(faces).boundary_half_edges;
+    if half.is_empty() {
+        return None;
+    }
     // Walk boundary edges as undirected (cracks and slivers often have both sides in one direction),
     // preferring the mesh's own direction; each cap triangle is wound against its own edge.
-    let mut out_of: HashMap<u32, Vec<(u32, usize, bool)>> = HashMap::new();
+    let mut out_of: FxHashMap<u32, Vec<(u32, usize, bool)>> = FxHashMap::default();
     for (i, &(u, v)) in half.iter().enumerate() {
         out_of.entry(u).or_default().push((v, i, true));
     }
@@ -639,11 +925,15 @@ fn cap_holes(vertices: &[[f64; 3]], faces: &Polygons) -> Option<Capping> {
         out_of.entry(v).or_default().push((u, i, false));
     }
     let mut used = vec![false; half.len()];
-    let mut v_out = vertices.to_vec();
-    let mut f_out = faces.clone();
-    let mut holes = 0;
-    let mut cracks = 0;
-    let mut bound = 0.0;
+    let base = vertices.len() as u32;
+    let mut caps = Caps {
+        centroids: Vec::new(),
+        faces: Polygons::new(),
+        holes: 0,
+        cracks: 0,
+        bound: 0.0,
+        area: 0.0,
+    };
     for start in 0..half.len() {
         if used[start] {
             continue;
@@ -669,60 +959,47 @@ fn cap_holes(vertices: &[[f64; 3]], faces: &Polygons) -> Option<Capping> {
         if !closed {
             // A chain that does not close is a crack or a T-junction, not a hole: left open, and
             // accounted for below by the vector area that remains.
-            cracks += steps.len();
+            caps.cracks += steps.len();
             continue;
         }
         let lp: Vec<u32> = steps.iter().map(|s| s.0).collect();
-        holes += 1;
+        caps.holes += 1;
         let n = lp.len() as f64;
         let c = [0, 1, 2].map(|k| lp.iter().map(|&i| vertices[i as usize][k]).sum::<f64>() / n);
-        let ci = v_out.len() as u32;
-        v_out.push(c);
+        let ci = base + caps.centroids.len() as u32;
+        caps.centroids.push(c);
         let mut area = [0.0f64; 3];
         for &(_, a, b) in &steps {
             // The mesh has a → b on its boundary; the cap runs b → a.
-            f_out.push(&[ci, b, a]);
-            let p = sub(vertices[b as usize], c);
-            let q = sub(vertices[a as usize], c);
-            area[0] += 0.5 * (p[1] * q[2] - p[2] * q[1]);
-            area[1] += 0.5 * (p[2] * q[0] - p[0] * q[2]);
-            area[2] += 0.5 * (p[0] * q[1] - p[1] * q[0]);
+            caps.faces.push(&[ci, b, a]);
+            let x = cross(sub(vertices[b as usize], c), sub(vertices[a as usize], c));
+            for k in 0..3 {
+                area[k] += 0.5 * x[k];
+            }
         }
-        let len = (area[0] * area[0] + area[1] * area[1] + area[2] * area[2]).sqrt();
+        let len = dot(area, area).sqrt();
+        caps.area += len;
         if len > 0.0 {
             let nrm = area.map(|x| x / len);
-            let dev = lp.iter().map(|&i| {
-                let d = sub(vertices[i as usize], c);
-                (d[0] * nrm[0] + d[1] * nrm[1] + d[2] * nrm[2]).abs()
-            });
-            bound += dev.fold(0.0, f64::max) * len;
+            let dev = lp
+                .iter()
+                .map(|&i| dot(sub(vertices[i as usize], c), nrm).abs())
+                .fold(0.0, f64::max);
+            caps.bound += 2.0 * dev * len;
         }
     }
-    if cracks > 0 {
+    if caps.cracks > 0 {
         // What is left open makes the result depend on the reference point by at most |A|·diag/6.
         let (lo, hi) = bbox(vertices);
-        let diag =
-            ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
-        bound += vector_area(&v_out, &f_out) * diag / 6.0;
+        let mut all = vertices.to_vec();
+        all.extend_from_slice(&caps.centroids);
+        let mut f = faces.clone();
+        for face in caps.faces.iter() {
+            f.push(face);
+        }
+        caps.bound += vector_area(&all, &f) * dist(lo, hi) / 6.0;
     }
-    Some(Capping {
-        vertices: v_out,
-        faces: f_out,
-        holes,
-        cracks,
-        bound,
-    })
-}
-
-/// A mesh with its holes capped.
-struct Capping {
-    vertices: Vec<[f64; 3]>,
-    faces: Polygons,
-    holes: usize,
-    /// Boundary edges left open (cracks, T-junctions).
-    cracks: usize,
-    /// Bound on the volume uncertainty the caps and cracks leave, m³.
-    bound: f64,
+    Some(caps)
 }
 
 /// The length of the surface's vector area `Σ N/2` (zero for a closed surface).
@@ -734,14 +1011,48 @@ fn vector_area(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
         for k in 1..face.len() - 1 {
             let e1 = sub(sub(vertices[face[k] as usize], centre), p);
             let e2 = sub(sub(vertices[face[k + 1] as usize], centre), p);
-            a[0] += 0.5 * (e1[1] * e2[2] - e1[2] * e2[1]);
-            a[1] += 0.5 * (e1[2] * e2[0] - e1[0] * e2[2]);
-            a[2] += 0.5 * (e1[0] * e2[1] - e1[1] * e2[0]);
+            let x = cross(e1, e2);
+            for j in 0..3 {
+                a[j] += 0.5 * x[j];
+            }
         }
     }
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+    dot(a, a).sqrt()
+}
+
+/// Area of a planar polygon (fan from its first vertex).
+fn polygon_area(vertices: &[[f64; 3]], face: &[u32]) -> f64 {
+    let p = vertices[face[0] as usize];
+    let mut a = [0.0f64; 3];
+    for k in 1..face.len().saturating_sub(1) {
+        let x = cross(
+            sub(vertices[face[k] as usize], p),
+            sub(vertices[face[k + 1] as usize], p),
+        );
+        for j in 0..3 {
+            a[j] += 0.5 * x[j];
+        }
+    }
+    dot(a, a).sqrt()
 }
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let d = sub(a, b);
+    dot(d, d).sqrt()
 }

@@ -11,6 +11,7 @@ pub mod health;
 pub mod hull;
 pub mod obj;
 pub mod stl;
+pub mod weld;
 
 use crate::mass::Polygons;
 use std::fmt;
@@ -82,6 +83,8 @@ pub enum MeshErrorKind {
     Strict(String),
     /// A scale with a zero or non-finite factor.
     BadScale([f64; 3]),
+    /// An open mesh whose convex hull could not be built either.
+    Hull(String),
     /// A feature of the format urdf-inertia does not read (a glTF compression extension, ...), named.
     Unsupported(String),
 }
@@ -111,6 +114,7 @@ impl fmt::Display for MeshError {
                 "the mesh encloses no volume ({volume:.3e} m³ against a bounding box of {bbox_volume:.3e} m³): it is flat or degenerate; give the link a primitive collision shape or a closed mesh"
             ),
             MeshErrorKind::Strict(msg) => write!(f, "{msg} (an error under --strict)"),
+            MeshErrorKind::Hull(msg) => write!(f, "{msg}; close the mesh or give the link a primitive collision shape"),
             MeshErrorKind::BadScale(s) => {
                 write!(f, "scale \"{} {} {}\" has a zero or non-finite factor", s[0], s[1], s[2])
             }
@@ -213,7 +217,10 @@ pub fn solid_from_raw(
     options: health::HealthOptions,
 ) -> Result<health::Solid, MeshError> {
     let scaled = apply_scale(raw, scale, path)?;
-    health::make_solid(&scaled, path, options)
+    // The precision of the file's own numbers, before the scale multiplies them; the largest
+    // coordinate scales with them, so the tolerance in ulps of it stays right.
+    let precision = weld::Precision::of(&raw.vertices);
+    health::make_solid_stored_as(&scaled, path, options, precision)
 }
 
 /// Parses a float the way all three formats write them, NaN and infinities included (they are caught
