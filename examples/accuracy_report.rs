@@ -298,7 +298,7 @@ fn main() -> std::io::Result<()> {
 
     // 3. Stiff and extreme cases, every variant.
     writeln!(md, "\n## 3. Stiff and extreme cases\n").ok();
-    writeln!(md, "Relative errors against exact rationals: mass, COM (distance over the body's size), central inertia (Frobenius), smallest principal moment (against the exact tensor's Rayleigh quotient). The floor is the exact central tensor rounded to f64.\n").ok();
+    writeln!(md, "Relative errors against exact rationals: mass, COM (distance over the body's size), central inertia (Frobenius), smallest principal moment (against the exact tensor's Rayleigh quotient). The floor is the exact central tensor rounded to f64. Binary STL and glTF store positions as f32 by the format (read exactly as f64, so the stored mesh is integrated at the floor): the rows \"ours on f32-rounded input\" show how far that one rounding moves the result from the designed f64 shape.\n").ok();
     let sphere = icosphere(6);
     let cubem = box_mesh([1.0, 1.0, 1.0]);
     let plate = box_mesh([1.0, 1.0, 1e-6]);

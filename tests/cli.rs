@@ -469,9 +469,9 @@ fn bad_input_is_reported_and_files_are_never_damaged() {
         ("scale.urdf", "<robot name=\"r\"><link name=\"a\"><collision><geometry><mesh filename=\"../meshes/battery.stl\" scale=\"1 0 1\"/></geometry></collision></link></robot>".into(), &[], "zero factor"),
         ("rpy.urdf", "<robot name=\"r\"><link name=\"a\"><collision><origin rpy=\"0 x 0\"/><geometry><box size=\"1 1 1\"/></geometry></collision></link></robot>".into(), &[], "rpy"),
         ("missing.urdf", "<robot name=\"r\">\n<link name=\"arm\"><collision><geometry><mesh filename=\"package://nope_description/meshes/arm.stl\"/></geometry></collision></link></robot>".into(), &[], "link `arm`: collision 1 (line 2): mesh `package://nope_description/meshes/arm.stl` not found"),
-        ("format.urdf", "<robot name=\"r\"><link name=\"a\"><collision><geometry><mesh filename=\"../meshes/part.glb\"/></geometry></collision></link></robot>".into(), &[], "unsupported mesh format `.glb`"),
+        ("format.urdf", "<robot name=\"r\"><link name=\"a\"><collision><geometry><mesh filename=\"../meshes/part.ply\"/></geometry></collision></link></robot>".into(), &[], "unsupported mesh format `.ply`"),
     ];
-    std::fs::write(dir.parent().unwrap().join("meshes/part.glb"), b"glTF").unwrap();
+    std::fs::write(dir.parent().unwrap().join("meshes/part.ply"), b"ply").unwrap();
     for (name, text, extra, expect) in cases {
         let path = dir.join(name);
         std::fs::write(&path, &text).unwrap();

@@ -343,8 +343,8 @@ fn broken_meshes_take_the_documented_rung() {
             vertices: 3
         }
     ));
-    // .glb and .ply: unsupported format, named.
-    for name in ["part.glb", "part.ply"] {
+    // .ply and .3mf: unsupported format, named.
+    for name in ["part.ply", "part.3mf"] {
         let e = mesh::load_solid(&write(d, name, b"data"), [1.0; 3], HealthOptions::default())
             .unwrap_err();
         assert!(matches!(e.kind, MeshErrorKind::UnknownFormat(_)), "{e}");

@@ -12,4 +12,5 @@ fi
 share="$("$venv/bin/python" -c 'import sysconfig, pathlib; print(pathlib.Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share")')"
 cargo build --release --quiet
 "$venv/bin/python" validation/meshes.py --binary target/release/urdf-inertia --share "$share" --out "$(dirname "$out")/MESHES.md"
+"$venv/bin/python" validation/gltf_coal.py --binary target/release/urdf-inertia
 "$venv/bin/python" validation/validate.py --binary target/release/urdf-inertia --share "$share" --out "$out" --work validation/work

@@ -119,7 +119,7 @@ pub struct CheckArgs {
 
 #[derive(Debug, Clone, ClapArgs)]
 pub struct MeshArgs {
-    /// STL, OBJ or COLLADA file.
+    /// STL, OBJ, COLLADA or glTF (.gltf, .glb) file.
     pub file: PathBuf,
     /// Per-axis scale, as in the URDF's <mesh scale>.
     #[arg(long, num_args = 3, value_names = ["SX", "SY", "SZ"], allow_negative_numbers = true)]

@@ -1,10 +1,12 @@
-//! Collision meshes: reading STL, OBJ and COLLADA into vertices plus polygons, applying the URDF `scale`,
+//! Collision meshes: reading STL, OBJ, COLLADA and glTF into vertices plus polygons, applying the URDF `scale`,
 //! and turning the result into a solid the mass core can integrate (see [`health`]).
 //!
 //! Each format is a thin module with its own parsing and a `file:line` location where the format has
-//! lines. Polygons stay polygons. Coordinates are read as f64 (binary STL's f32 values convert exactly).
+//! lines. Polygons stay polygons. Coordinates are read as f64 (binary STL's and glTF's f32 values convert
+//! exactly).
 
 pub mod collada;
+pub mod gltf;
 pub mod health;
 pub mod hull;
 pub mod obj;
@@ -33,6 +35,8 @@ pub enum MeshFormat {
     Stl,
     Obj,
     Collada,
+    /// glTF 2.0, JSON (.gltf) or binary (.glb).
+    Gltf,
 }
 
 impl MeshFormat {
@@ -43,6 +47,7 @@ impl MeshFormat {
             "stl" => Some(MeshFormat::Stl),
             "obj" => Some(MeshFormat::Obj),
             "dae" => Some(MeshFormat::Collada),
+            "gltf" | "glb" => Some(MeshFormat::Gltf),
             _ => None,
         }
     }
@@ -63,7 +68,7 @@ pub struct MeshError {
 pub enum MeshErrorKind {
     /// The file could not be read at all.
     Io(String),
-    /// The extension is not one of .stl, .obj, .dae.
+    /// The extension is not one of .stl, .obj, .dae, .gltf, .glb.
     UnknownFormat(String),
     /// The content does not follow the format.
     Syntax(String),
@@ -85,6 +90,8 @@ pub enum MeshErrorKind {
     Hull(String),
     /// A reader or the healing panicked (a bug): caught, so that it fails only this mesh.
     Internal(String),
+    /// A feature of the format urdf-inertia does not read (a glTF compression extension, ...), named.
+    Unsupported(String),
 }
 
 impl fmt::Display for MeshError {
@@ -98,7 +105,7 @@ impl fmt::Display for MeshError {
             MeshErrorKind::Io(e) => write!(f, "cannot read the file: {e}"),
             MeshErrorKind::UnknownFormat(ext) => write!(
                 f,
-                "unsupported mesh format `{ext}`; urdf-inertia reads .stl, .obj and .dae (convert the collision mesh, e.g. with meshlab or blender)"
+                "unsupported mesh format `{ext}`; urdf-inertia reads .stl, .obj, .dae, .gltf and .glb (convert the collision mesh, e.g. with meshlab or blender)"
             ),
             MeshErrorKind::Syntax(msg) => write!(f, "{msg}"),
             MeshErrorKind::Truncated(msg) => write!(f, "truncated file: {msg}; re-export the mesh"),
@@ -120,6 +127,7 @@ impl fmt::Display for MeshError {
                 f,
                 "internal error while processing the mesh (a bug in urdf-inertia; please report it with the file): {msg}"
             ),
+            MeshErrorKind::Unsupported(msg) => write!(f, "{msg}"),
         }
     }
 }
@@ -172,6 +180,7 @@ fn read_unguarded(path: &Path) -> Result<RawMesh, MeshError> {
         MeshFormat::Stl => stl::parse(&bytes, path)?,
         MeshFormat::Obj => obj::parse(&bytes, path)?,
         MeshFormat::Collada => collada::parse(&bytes, path)?,
+        MeshFormat::Gltf => gltf::parse(&bytes, path)?,
     };
     validate(&mesh, path)?;
     Ok(mesh)

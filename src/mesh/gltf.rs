@@ -1,0 +1,608 @@
+//! glTF 2.0 (.gltf and .glb), read with the `gltf` crate.
+//!
+//! Convention:
+//! * every mesh instanced by a node of the default scene (the first scene without a default; every mesh
+//!   once, untransformed, when the file has no scene) counts, moved by the composition of its ancestors'
+//!   node transforms (`matrix`, or translation · rotation · scale), composed in f64;
+//! * positions are taken as written: glTF's +Y up is **not** rotated into +Z. That is what pinocchio
+//!   (coal's assimp loader) and RViz do; Drake rotates Y-up into Z-up for glTF, and the README says so.
+//!   Coal also skips the transform of a single root node for the nodes below it (the heuristic it uses to
+//!   drop assimp's COLLADA up-axis node); this reader applies every node transform, as the format says;
+//! * triangles, triangle strips and triangle fans, indexed or not; points and lines carry no surface and
+//!   are skipped with a note; a node with a negative determinant mirrors its triangles, whose winding is
+//!   reversed to stay outward;
+//! * buffers from the GLB `BIN` chunk, base64 `data:` URIs, or files relative to the .gltf file;
+//! * positions are f32 by the format and convert exactly to f64.
+//!
+//! Refused with an error naming them: Draco (`KHR_draco_mesh_compression`) and meshopt
+//! (`EXT_meshopt_compression`) compression, sparse accessors, and any other `extensionsRequired` that can
+//! change geometry (material-only extensions are accepted). Every offset and length is checked before the
+//! crate reads an accessor, and the crate call is also guarded against panics, so no input panics.
+
+use super::{MeshError, MeshErrorKind, RawMesh};
+use crate::mass::Polygons;
+use base64::Engine as _;
+use gltf::accessor::{DataType, Dimensions};
+use gltf::mesh::Mode;
+use std::path::Path;
+
+/// Required extensions that only touch materials, textures or lights: geometry reads the same.
+const GEOMETRY_NEUTRAL_PREFIXES: &[&str] = &[
+    "KHR_materials_",
+    "KHR_texture_",
+    "EXT_texture_",
+    "KHR_lights_punctual",
+];
+
+/// A node tree deeper than this is malformed (glTF node hierarchies are trees).
+const MAX_DEPTH: usize = 256;
+/// Node visits allowed in one traversal (a node shared by many parents could otherwise explode).
+const MAX_VISITS: usize = 1_000_000;
+
+type Affine = ([[f64; 3]; 3], [f64; 3]);
+
+const IDENTITY: Affine = (
+    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+    [0.0; 3],
+);
+
+fn compose(a: &Affine, b: &Affine) -> Affine {
+    let m = crate::mass::mat_mul(&a.0, &b.0);
+    let t = crate::mass::mat_vec(&a.0, b.1);
+    (m, [t[0] + a.1[0], t[1] + a.1[1], t[2] + a.1[2]])
+}
+
+fn det(m: &[[f64; 3]; 3]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+}
+
+fn syntax(path: &Path, msg: String) -> MeshError {
+    MeshError::new(path, None, MeshErrorKind::Syntax(msg))
+}
+
+fn unsupported(path: &Path, msg: String) -> MeshError {
+    MeshError::new(path, None, MeshErrorKind::Unsupported(msg))
+}
+
+/// What the user can do about an extension we do not read.
+fn extension_advice(name: &str) -> String {
+    match name {
+        "KHR_draco_mesh_compression" => format!(
+            "`{name}` (Draco compression) is not supported; export the collision mesh without compression (e.g. `gltf-transform copy` or Blender with Draco off)"
+        ),
+        "EXT_meshopt_compression" => format!(
+            "`{name}` (meshopt compression) is not supported; export the collision mesh without compression (e.g. `gltf-transform copy`)"
+        ),
+        _ => format!(
+            "the file requires the extension `{name}`, which urdf-inertia does not read; export the collision mesh without it"
+        ),
+    }
+}
+
+/// The node transform as an affine map in f64 (column-major matrix, or T · R · S).
+fn node_transform(node: &gltf::Node<'_>, path: &Path) -> Result<Affine, MeshError> {
+    let xf = match node.transform() {
+        gltf::scene::Transform::Matrix { matrix } => {
+            let c = |col: usize, row: usize| f64::from(matrix[col][row]);
+            (
+                [
+                    [c(0, 0), c(1, 0), c(2, 0)],
+                    [c(0, 1), c(1, 1), c(2, 1)],
+                    [c(0, 2), c(1, 2), c(2, 2)],
+                ],
+                [c(3, 0), c(3, 1), c(3, 2)],
+            )
+        }
+        gltf::scene::Transform::Decomposed {
+            translation,
+            rotation,
+            scale,
+        } => {
+            let [x, y, z, w] = rotation.map(f64::from);
+            let n = (x * x + y * y + z * z + w * w).sqrt();
+            if n == 0.0 || !n.is_finite() {
+                return Err(syntax(
+                    path,
+                    format!(
+                        "node {} has a rotation quaternion of zero or non-finite length",
+                        node.index()
+                    ),
+                ));
+            }
+            // Unit quaternions are stored in f32; normalising in f64 keeps the rotation orthogonal.
+            let (x, y, z, w) = (x / n, y / n, z / n, w / n);
+            let r = [
+                [
+                    1.0 - 2.0 * (y * y + z * z),
+                    2.0 * (x * y - z * w),
+                    2.0 * (x * z + y * w),
+                ],
+                [
+                    2.0 * (x * y + z * w),
+                    1.0 - 2.0 * (x * x + z * z),
+                    2.0 * (y * z - x * w),
+                ],
+                [
+                    2.0 * (x * z - y * w),
+                    2.0 * (y * z + x * w),
+                    1.0 - 2.0 * (x * x + y * y),
+                ],
+            ];
+            let s = scale.map(f64::from);
+            let m = [0, 1, 2].map(|i| [0, 1, 2].map(|j| r[i][j] * s[j]));
+            (m, translation.map(f64::from))
+        }
+    };
+    if xf
+        .0
+        .iter()
+        .flatten()
+        .chain(xf.1.iter())
+        .any(|v| !v.is_finite())
+    {
+        return Err(syntax(
+            path,
+            format!("node {} has a non-finite transform", node.index()),
+        ));
+    }
+    Ok(xf)
+}
+
+/// Buffer contents, by buffer index.
+fn load_buffers(
+    doc: &gltf::Document,
+    blob: Option<&[u8]>,
+    path: &Path,
+    meshopt_used: bool,
+) -> Result<Vec<Vec<u8>>, MeshError> {
+    let mut out = Vec::new();
+    for buffer in doc.buffers() {
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => blob
+                .ok_or_else(|| {
+                    syntax(
+                        path,
+                        format!(
+                            "buffer {} refers to the GLB BIN chunk, but the file has none",
+                            buffer.index()
+                        ),
+                    )
+                })?
+                .to_vec(),
+            gltf::buffer::Source::Uri(uri) => read_uri(uri, path, buffer.index())?,
+        };
+        if data.len() < buffer.length() {
+            let what = format!(
+                "buffer {} declares {} bytes but holds {}",
+                buffer.index(),
+                buffer.length(),
+                data.len()
+            );
+            return Err(if meshopt_used {
+                unsupported(
+                    path,
+                    format!("{what}; {}", extension_advice("EXT_meshopt_compression")),
+                )
+            } else {
+                MeshError::new(path, None, MeshErrorKind::Truncated(what))
+            });
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+fn read_uri(uri: &str, path: &Path, index: usize) -> Result<Vec<u8>, MeshError> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let (header, payload) = rest
+            .split_once(',')
+            .ok_or_else(|| syntax(path, format!("buffer {index}: a data URI without a comma")))?;
+        if !header.ends_with(";base64") {
+            return Err(syntax(
+                path,
+                format!("buffer {index}: only base64 data URIs are supported"),
+            ));
+        }
+        return base64::engine::general_purpose::STANDARD
+            .decode(payload.trim())
+            .map_err(|e| {
+                syntax(
+                    path,
+                    format!("buffer {index}: invalid base64 data URI: {e}"),
+                )
+            });
+    }
+    if uri.contains("://") {
+        return Err(syntax(
+            path,
+            format!("buffer {index}: URI `{uri}` is not a file next to the glTF; only relative paths and data URIs are read"),
+        ));
+    }
+    let decoded = urlencoding::decode(uri).map_err(|_| {
+        syntax(
+            path,
+            format!("buffer {index}: URI `{uri}` is not valid percent-encoded UTF-8"),
+        )
+    })?;
+    let file = path
+        .parent()
+        .unwrap_or(Path::new("."))
+        .join(decoded.as_ref());
+    // Through the same guard as every input: regular files only, at most --max-file-size.
+    crate::input::read_file(&file).map_err(|e| {
+        MeshError::new(
+            path,
+            None,
+            MeshErrorKind::Io(format!("buffer {index}: {e}")),
+        )
+    })
+}
+
+/// Checks an accessor before the crate reads it: no sparse data, the expected type, and every byte it
+/// covers inside its buffer view and buffer.
+fn check_accessor(
+    acc: &gltf::Accessor<'_>,
+    buffers: &[Vec<u8>],
+    path: &Path,
+    what: &str,
+    draco_used: bool,
+) -> Result<(), MeshError> {
+    let i = acc.index();
+    if acc.sparse().is_some() {
+        return Err(unsupported(
+            path,
+            format!("{what} accessor {i} is sparse, which urdf-inertia does not read; export the collision mesh without sparse accessors"),
+        ));
+    }
+    let Some(view) = acc.view() else {
+        let msg = format!("{what} accessor {i} has no buffer view");
+        return Err(if draco_used {
+            unsupported(
+                path,
+                format!("{msg}: {}", extension_advice("KHR_draco_mesh_compression")),
+            )
+        } else {
+            syntax(path, msg)
+        });
+    };
+    let elem = acc.size();
+    let stride = view.stride().unwrap_or(elem);
+    if stride < elem {
+        return Err(syntax(
+            path,
+            format!(
+                "{what} accessor {i}: byte stride {stride} is shorter than its {elem}-byte element"
+            ),
+        ));
+    }
+    let count = acc.count();
+    let need = (count.max(1) - 1)
+        .checked_mul(stride)
+        .and_then(|n| n.checked_add(elem))
+        .and_then(|n| n.checked_add(acc.offset()));
+    let buffer = buffers
+        .get(view.buffer().index())
+        .map(Vec::len)
+        .unwrap_or(0);
+    let view_end = view.offset().checked_add(view.length());
+    match (need, view_end) {
+        (Some(need), Some(view_end)) if count == 0 || (need <= view.length() && view_end <= buffer) => Ok(()),
+        _ => Err(MeshError::new(
+            path,
+            None,
+            MeshErrorKind::Truncated(format!(
+                "{what} accessor {i} ({count} elements) reaches past its buffer view {} or buffer {}",
+                view.index(),
+                view.buffer().index()
+            )),
+        )),
+    }
+}
+
+/// Positions (world frame) and triangles of one primitive, appended to `out`.
+fn add_primitive(
+    prim: &gltf::Primitive<'_>,
+    xf: &Affine,
+    buffers: &[Vec<u8>],
+    path: &Path,
+    draco_used: bool,
+    out: &mut RawMesh,
+) -> Result<(), MeshError> {
+    let mode = prim.mode();
+    if matches!(
+        mode,
+        Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip
+    ) {
+        out.notes
+            .push(format!("a {mode:?} primitive carries no surface (skipped)"));
+        return Ok(());
+    }
+    let Some(pos) = prim.get(&gltf::Semantic::Positions) else {
+        out.notes
+            .push("a primitive without POSITION (skipped)".into());
+        return Ok(());
+    };
+    if pos.data_type() != DataType::F32 || pos.dimensions() != Dimensions::Vec3 {
+        return Err(unsupported(
+            path,
+            format!(
+                "POSITION accessor {} is {:?} {:?}, not float VEC3 (quantized positions, KHR_mesh_quantization, are not read)",
+                pos.index(),
+                pos.data_type(),
+                pos.dimensions()
+            ),
+        ));
+    }
+    check_accessor(&pos, buffers, path, "POSITION", draco_used)?;
+    let index_acc = prim.indices();
+    if let Some(acc) = &index_acc {
+        if acc.dimensions() != Dimensions::Scalar
+            || !matches!(
+                acc.data_type(),
+                DataType::U8 | DataType::U16 | DataType::U32
+            )
+        {
+            return Err(syntax(
+                path,
+                format!(
+                    "index accessor {} is not an unsigned integer scalar",
+                    acc.index()
+                ),
+            ));
+        }
+        check_accessor(acc, buffers, path, "index", draco_used)?;
+    }
+    if pos.count() == 0 {
+        return Ok(());
+    }
+    let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let positions: Vec<[f32; 3]> =
+        reader
+            .read_positions()
+            .map(|it| it.collect())
+            .ok_or_else(|| {
+                syntax(
+                    path,
+                    format!("POSITION accessor {} cannot be read", pos.index()),
+                )
+            })?;
+    let indices: Vec<u32> = match &index_acc {
+        Some(acc) if acc.count() == 0 => Vec::new(),
+        Some(acc) => reader
+            .read_indices()
+            .map(|it| it.into_u32().collect())
+            .ok_or_else(|| {
+                syntax(
+                    path,
+                    format!("index accessor {} cannot be read", acc.index()),
+                )
+            })?,
+        None => (0..positions.len() as u32).collect(),
+    };
+    let n = positions.len();
+    if let Some(&bad) = indices.iter().find(|&&i| i as usize >= n) {
+        return Err(MeshError::new(
+            path,
+            None,
+            MeshErrorKind::IndexOutOfRange {
+                index: i64::from(bad),
+                vertices: n,
+            },
+        ));
+    }
+    let base = out.vertices.len() as u32;
+    for p in &positions {
+        let q = crate::mass::mat_vec(&xf.0, p.map(f64::from));
+        out.vertices
+            .push([q[0] + xf.1[0], q[1] + xf.1[1], q[2] + xf.1[2]]);
+    }
+    let mirrored = det(&xf.0) < 0.0;
+    let mut push = |a: u32, b: u32, c: u32| {
+        let tri = if mirrored {
+            [base + a, base + c, base + b]
+        } else {
+            [base + a, base + b, base + c]
+        };
+        out.faces.push(&tri);
+    };
+    match mode {
+        Mode::TriangleStrip => {
+            // Triangle i is (v_i, v_{i+1}, v_{i+2}) with every other one reversed; triangles with a
+            // repeated vertex join strips and carry no area.
+            for i in 0..indices.len().saturating_sub(2) {
+                let (a, b, c) = (indices[i], indices[i + 1], indices[i + 2]);
+                if a == b || b == c || a == c {
+                    continue;
+                }
+                if i % 2 == 0 {
+                    push(a, b, c);
+                } else {
+                    push(b, a, c);
+                }
+            }
+        }
+        Mode::TriangleFan => {
+            for i in 1..indices.len().saturating_sub(1) {
+                let (a, b, c) = (indices[0], indices[i], indices[i + 1]);
+                if a == b || b == c || a == c {
+                    continue;
+                }
+                push(a, b, c);
+            }
+        }
+        _ => {
+            if indices.len() % 3 != 0 {
+                out.notes.push(format!(
+                    "a triangle primitive has {} indices, not a multiple of 3 (the last {} ignored)",
+                    indices.len(),
+                    indices.len() % 3
+                ));
+            }
+            for t in indices.chunks_exact(3) {
+                push(t[0], t[1], t[2]);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Checks the GLB container header before the crate parses it (the crate assumes a sane length).
+fn check_glb_header(bytes: &[u8], path: &Path) -> Result<(), MeshError> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(());
+    }
+    if bytes.len() < 20 {
+        return Err(MeshError::new(
+            path,
+            None,
+            MeshErrorKind::Truncated(format!(
+                "a GLB file needs at least 20 bytes of headers, the file has {}",
+                bytes.len()
+            )),
+        ));
+    }
+    let word = |at: usize| {
+        u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]) as usize
+    };
+    let (version, length) = (word(4), word(8));
+    if version != 2 {
+        return Err(unsupported(
+            path,
+            format!("GLB version {version}; only glTF 2.0 is read"),
+        ));
+    }
+    if length < 20 || length > bytes.len() {
+        return Err(MeshError::new(
+            path,
+            None,
+            MeshErrorKind::Truncated(format!(
+                "the GLB header says {length} bytes, the file has {}",
+                bytes.len()
+            )),
+        ));
+    }
+    Ok(())
+}
+
+/// Parses a .gltf or .glb file into one mesh in the file's frame (see the module docs for the convention).
+pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
+    check_glb_header(bytes, path)?;
+    // Offsets are checked before every read; the guard turns any panic left in the crate into an error.
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| parse_checked(bytes, path))) {
+        Ok(result) => result,
+        Err(_) => Err(syntax(
+            path,
+            "the glTF reader failed on this file (malformed data); re-export the mesh".into(),
+        )),
+    }
+}
+
+fn parse_checked(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
+    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(bytes)
+        .map_err(|e| syntax(path, format!("not a valid glTF file: {e}")))?;
+    let mut root = document.into_json();
+    if let Some(name) = root.extensions_required.iter().find(|name| {
+        !GEOMETRY_NEUTRAL_PREFIXES
+            .iter()
+            .any(|p| name.starts_with(p))
+    }) {
+        return Err(unsupported(path, extension_advice(name)));
+    }
+    let draco_used = root
+        .extensions_used
+        .iter()
+        .any(|e| e == "KHR_draco_mesh_compression");
+    let meshopt_used = root
+        .extensions_used
+        .iter()
+        .any(|e| e == "EXT_meshopt_compression");
+    // Draco's compressed accessors have no buffer view (the crate's validation would only say "missing").
+    if draco_used
+        && root
+            .accessors
+            .iter()
+            .any(|a| a.buffer_view.is_none() && a.sparse.is_none())
+    {
+        return Err(unsupported(
+            path,
+            format!(
+                "an accessor has no buffer view: {}",
+                extension_advice("KHR_draco_mesh_compression")
+            ),
+        ));
+    }
+    // gltf-json 1.4.1's validation indexes a primitive's POSITION accessor before checking it exists.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for prim in &mesh.primitives {
+            if let Some(bad) = prim
+                .attributes
+                .values()
+                .find(|a| a.value() >= root.accessors.len())
+            {
+                return Err(syntax(
+                    path,
+                    format!(
+                        "mesh {m}: a primitive names accessor {}, but the file has {}",
+                        bad.value(),
+                        root.accessors.len()
+                    ),
+                ));
+            }
+        }
+    }
+    // Material-only required extensions are accepted above; the crate's validation would refuse them.
+    root.extensions_required.clear();
+    let doc = gltf::Document::from_json(root).map_err(|e| syntax(path, format!("{e}")))?;
+    let buffers = load_buffers(&doc, blob.as_deref(), path, meshopt_used)?;
+
+    let mut out = RawMesh {
+        faces: Polygons::new(),
+        ..Default::default()
+    };
+    let scene = doc.default_scene().or_else(|| doc.scenes().next());
+    match scene {
+        Some(scene) => {
+            let mut visits = 0usize;
+            let mut stack: Vec<(gltf::Node<'_>, Affine, usize)> =
+                scene.nodes().map(|n| (n, IDENTITY, 0)).collect();
+            while let Some((node, parent, depth)) = stack.pop() {
+                visits += 1;
+                if depth > MAX_DEPTH || visits > MAX_VISITS {
+                    return Err(syntax(
+                        path,
+                        format!("the node hierarchy is deeper than {MAX_DEPTH} or reaches more than {MAX_VISITS} nodes (a cycle?)"),
+                    ));
+                }
+                let xf = compose(&parent, &node_transform(&node, path)?);
+                if let Some(mesh) = node.mesh() {
+                    if node.skin().is_some() {
+                        out.notes.push(format!(
+                            "mesh {} is skinned: its bind pose is used",
+                            mesh.index()
+                        ));
+                    }
+                    for prim in mesh.primitives() {
+                        add_primitive(&prim, &xf, &buffers, path, draco_used, &mut out)?;
+                    }
+                }
+                for child in node.children() {
+                    stack.push((child, xf, depth + 1));
+                }
+            }
+        }
+        None => {
+            for mesh in doc.meshes() {
+                for prim in mesh.primitives() {
+                    add_primitive(&prim, &IDENTITY, &buffers, path, draco_used, &mut out)?;
+                }
+            }
+            if doc.meshes().len() > 0 {
+                out.notes
+                    .push("no scene: every mesh counted once, untransformed".into());
+            }
+        }
+    }
+    Ok(out)
+}
