@@ -235,7 +235,7 @@ fn read_uri(uri: &str, path: &Path, index: usize) -> Result<Vec<u8>, MeshError> 
         MeshError::new(
             path,
             None,
-            MeshErrorKind::Io(format!("buffer {index}: {e}")),
+            MeshErrorKind::Io(format!("buffer {index}, `{}`: {e}", file.display())),
         )
     })
 }
