@@ -93,7 +93,8 @@ impl Rung {
 pub enum ModelError {
     /// The solid is the stored surface: no model error.
     None,
-    /// Float-noise cracks left after welding (their area times the mesh's size).
+    /// A surface closed only up to cracks: the volume that moves with the reference point
+    /// (|vector area| × diagonal / 6).
     Cracks,
     /// Re-oriented components, any of which could be a cavity (their volumes).
     Orientation,
@@ -323,7 +324,7 @@ fn orient(nfaces: usize, pairs: &[(u32, u32, bool)]) -> Option<Orientation> {
 /// topology the tolerant weld gives them.
 struct Welding {
     vertices: Vec<[f64; 3]>,
-    /// All faces as stored (bit-exact welded).
+    /// All faces as stored (bit-exact welded), less duplicates.
     stored: Polygons,
     /// The stored faces that survive the tolerant weld, in stored vertex indices.
     kept: Polygons,
@@ -332,49 +333,83 @@ struct Welding {
     tolerant: weld::TolerantWeld,
     /// Faces that collapsed under the tolerant weld.
     collapsed: usize,
-    /// Bound on the area of the cracks the tolerant weld closed, plus the collapsed faces' area, m².
-    crack_area: f64,
+    /// Faces dropped as duplicates (or as cancelling pairs).
+    duplicates: usize,
 }
 
-fn tolerant_welding(
-    exact: weld::ExactWeld,
-    exact_edges: &Edges,
-    precision: weld::Precision,
-) -> Welding {
+fn tolerant_welding(exact: weld::ExactWeld, precision: weld::Precision) -> Welding {
     let tol = weld::tolerance(&exact.vertices, precision);
     let tolerant = weld::tolerant(&exact.vertices, tol);
-    let (topology, kept_mask) = weld::remap_faces(&exact.faces, &tolerant.representative);
+    let (all_topology, kept_mask) = weld::remap_faces(&exact.faces, &tolerant.representative);
+    let (dropped, duplicates) = duplicate_faces(&all_topology);
+    let mut stored = Polygons::new();
     let mut kept = Polygons::new();
-    let mut crack_area = 0.0;
+    let mut topology = Polygons::new();
+    let mut t = 0;
     for (i, face) in exact.faces.iter().enumerate() {
-        if kept_mask[i] {
+        if !kept_mask[i] {
+            stored.push(face);
+            continue;
+        }
+        if !dropped[t] {
+            stored.push(face);
             kept.push(face);
-        } else {
-            crack_area += polygon_area(&exact.vertices, face);
+            topology.push(all_topology.face(t));
         }
-    }
-    let rep = &tolerant.representative;
-    let disp = |i: u32| {
-        dist(
-            exact.vertices[i as usize],
-            exact.vertices[rep[i as usize] as usize],
-        )
-    };
-    for &(u, v) in &exact_edges.boundary_half_edges {
-        let (du, dv) = (disp(u), disp(v));
-        if du > 0.0 || dv > 0.0 {
-            crack_area += dist(exact.vertices[u as usize], exact.vertices[v as usize]) * (du + dv);
-        }
+        t += 1;
     }
     Welding {
         collapsed: kept_mask.iter().filter(|k| !**k).count(),
+        duplicates,
         vertices: exact.vertices,
-        stored: exact.faces,
+        stored,
         kept,
         topology,
         tolerant,
-        crack_area,
     }
+}
+
+/// Faces that repeat another one's vertices in the same cyclic order (a duplicate: kept once) or in
+/// the reverse order (a zero-thickness wall: the pair cancels, both dropped). Returns per face whether
+/// it is dropped, and how many are.
+fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize) {
+    // Each face's vertices rotated to start at the smallest index, and whether it is reversed when
+    // compared with the same rotation read backwards.
+    let canonical = |f: &[u32]| -> (Vec<u32>, bool) {
+        let k = (0..f.len()).min_by_key(|&i| f[i]).unwrap_or(0);
+        let forward: Vec<u32> = (0..f.len()).map(|i| f[(k + i) % f.len()]).collect();
+        let backward: Vec<u32> = (0..f.len())
+            .map(|i| f[(k + f.len() - i) % f.len()])
+            .collect();
+        if forward <= backward {
+            (forward, false)
+        } else {
+            (backward, true)
+        }
+    };
+    let mut groups: FxHashMap<Vec<u32>, Vec<(usize, bool)>> = FxHashMap::default();
+    for (i, f) in faces.iter().enumerate() {
+        let (key, reversed) = canonical(f);
+        groups.entry(key).or_default().push((i, reversed));
+    }
+    let mut dropped = vec![false; faces.len()];
+    let mut count = 0;
+    for members in groups.values().filter(|m| m.len() > 1) {
+        let ahead = members.iter().filter(|m| !m.1).count();
+        let back = members.len() - ahead;
+        // Keep one face of the majority direction (none when the directions balance).
+        let keep_dir = back > ahead;
+        let mut keep = usize::from(ahead != back);
+        for &(i, reversed) in members {
+            if reversed == keep_dir && keep > 0 {
+                keep -= 1;
+            } else {
+                dropped[i] = true;
+                count += 1;
+            }
+        }
+    }
+    (dropped, count)
 }
 
 /// Shared by the rungs: where the mesh came from and what has been said about it.
@@ -518,13 +553,18 @@ pub fn make_solid_stored_as(
             None,
             &e.pairs,
             Rung::Exact,
-            0.0,
         );
     }
-    let w = tolerant_welding(exact, &e, precision());
+    let w = tolerant_welding(exact, precision());
     let te = edges(&w.topology);
-    if w.collapsed > 0 {
+    if w.duplicates > 0 {
         ladder.warnings.push(format!(
+            "{} duplicated faces dropped (a face stored twice, or a face and its reverse, adds nothing to a solid)",
+            w.duplicates
+        ));
+    }
+    if w.collapsed > 0 {
+        ladder.notes.push(format!(
             "{} sliver faces collapse when corners within {:.1e} m are welded; left out of the topology",
             w.collapsed, w.tolerant.tolerance.largest
         ));
@@ -535,16 +575,7 @@ pub fn make_solid_stored_as(
             widest_crack: w.tolerant.widest,
             tolerance: w.tolerant.tolerance.largest,
         };
-        let cracks = w.crack_area;
-        return consistent_closed(
-            ladder,
-            w.vertices,
-            w.stored,
-            Some(w.kept),
-            &te.pairs,
-            rung,
-            cracks,
-        );
+        return consistent_closed(ladder, w.vertices, w.stored, Some(w.kept), &te.pairs, rung);
     }
     if te.closed() {
         if let Some(o) = orient(w.topology.len(), &te.pairs) {
@@ -565,8 +596,9 @@ fn consistent_closed(
     kept: Option<Polygons>,
     pairs: &[(u32, u32, bool)],
     rung: Rung,
-    crack_area: f64,
 ) -> Result<Solid, MeshError> {
+    // Closed only once welded within tolerance: the stored surface's vector area is not exactly 0.
+    let welded = kept.is_some();
     let t = volume_integrals(&vertices, &stored, &IntegrationOptions::accurate());
     let inverted = t.t1 < 0.0;
     let mut faces = stored;
@@ -600,7 +632,7 @@ fn consistent_closed(
             ladder.warnings.push(format!(
                 "{turned} of {ncomp} closed components wound inward although no other component encloses them (a cavity must lie inside a solid); {flipped} faces flipped"
             ));
-            let model = crack_volume(crack_area, &vertices);
+            let model = open_volume(&vertices, &out);
             let rung = Rung::Reoriented {
                 faces_flipped: flipped,
                 components: ncomp,
@@ -618,7 +650,11 @@ fn consistent_closed(
             "closed once {merged_vertices} corners stored up to {widest_crack:.1e} m apart are welded (tolerance {tolerance:.1e} m); integrated as stored"
         ));
     }
-    let model = crack_volume(crack_area, &vertices);
+    let model = if welded {
+        open_volume(&vertices, &faces)
+    } else {
+        0.0
+    };
     ladder.finish(vertices, faces, rung, (model, ModelError::Cracks), |_| None)
 }
 
@@ -683,14 +719,12 @@ fn misoriented(vertices: &[[f64; 3]], faces: &Polygons, comp: &[u32], ncomp: usi
         .collect()
 }
 
-/// Volume that cracks of total area `area` can hold: the flux of the integrands through them is at
-/// most area × (diagonal).
-fn crack_volume(area: f64, vertices: &[[f64; 3]]) -> f64 {
-    if area == 0.0 {
-        return 0.0;
-    }
+/// The volume that moves with the reference point, over reference points in the bounding box, for a
+/// surface that is closed only up to cracks: |vector area| × diagonal / 6 (the signed volume about
+/// r is V(0) − r·A/3). Zero for a closed surface; its round-off for one closed bit for bit.
+fn open_volume(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
     let (lo, hi) = bbox(vertices);
-    area * dist(lo, hi)
+    vector_area(vertices, faces) * dist(lo, hi) / 6.0
 }
 
 /// Closed after the tolerant weld but wound inconsistently: each component made consistent and outward.
@@ -721,7 +755,7 @@ fn reoriented(
         faces_flipped: flipped,
         components: o.ncomp,
     };
-    let model = crack_volume(w.crack_area, &w.vertices) + nested;
+    let model = open_volume(&w.vertices, &faces) + nested;
     let source = if nested > 0.0 {
         ModelError::Orientation
     } else {
@@ -801,7 +835,7 @@ fn open_or_nonmanifold(mut ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result
                 ladder.warnings.push(format!("mesh is {what} but has no holes: integrated as it is{flips} (a region enclosed by two overlapping shells would count twice)"));
                 // Integrated as stored (up to the faces re-oriented): a region that two shells
                 // enclose counts twice here exactly as in the stored surface, which the warning says.
-                let model = crack_volume(w.crack_area, &w.vertices) + nested;
+                let model = open_volume(&w.vertices, &faces) + nested;
                 let rung = Rung::NonManifold {
                     nonmanifold_edges: te.nonmanifold,
                     faces_flipped: flipped,
@@ -829,7 +863,7 @@ fn open_or_nonmanifold(mut ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result
         if !(volume > 0.0 && uncertainty <= CAPPED) {
             continue;
         }
-        let cracks = crack_volume(w.crack_area, &w.vertices);
+        let cracks = open_volume(&vertices, &capped);
         // Whatever surface really spans the loops, its contribution is at most (its area) × diagonal.
         let (lo, hi) = bbox(&w.vertices);
         let spans = caps.area * dist(lo, hi);
@@ -1226,4 +1260,29 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     let d = sub(a, b);
     dot(d, d).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn duplicated_faces_are_dropped() {
+        // A tetrahedron with one face stored twice.
+        let v = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        let f = Polygons::from_triangles(&[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3], [0, 1, 3]]);
+        let raw = RawMesh {
+            vertices: v,
+            faces: f,
+            ..Default::default()
+        };
+        let s = make_solid(&raw, Path::new("t"), HealthOptions::default()).expect("solid");
+        assert_eq!(s.rung.name(), "welded", "{:?}", s.warnings);
+        assert!((s.unit.mass - 1.0 / 6.0).abs() < 1e-15, "{}", s.unit.mass);
+    }
 }
