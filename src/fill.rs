@@ -25,6 +25,7 @@ const PRIMITIVE_ERROR: ErrorEstimate = ErrorEstimate {
     round_off: ROUND_OFF_FLOOR,
     model: 0.0,
     source: ModelError::None,
+    com: 0.0,
 };
 
 /// What to compute.
@@ -832,5 +833,6 @@ fn overlap_estimate(parts: &mut [Part]) -> Option<(f64, String, usize)> {
 
 /// Whether a mesh rung is below "exact".
 pub fn repaired(provenance: &str) -> bool {
-    provenance != "exact" && provenance != "primitive"
+    // A welded mesh is integrated as stored: not a repair.
+    provenance != "exact" && provenance != "welded" && provenance != "primitive"
 }

@@ -68,6 +68,7 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
                 "error_round_off": solid.error.round_off,
                 "error_model": solid.error.model,
                 "error_model_source": solid.error.source.name(),
+                "error_center_of_mass": solid.error.com,
                 "warnings": solid.warnings,
                 "notes": solid.notes,
             });

@@ -146,6 +146,7 @@ fn summary_json(robot: &Robot, report: &FillReport, seconds: f64) -> serde_json:
                     "error_round_off": p.error.round_off,
                     "error_model": p.error.model,
                     "error_model_source": p.error.source.name(),
+                    "error_center_of_mass": p.error.com,
                     "warnings": p.warnings,
                     "notes": p.notes,
                 })).collect::<Vec<_>>(),

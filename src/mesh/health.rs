@@ -128,6 +128,9 @@ pub struct ErrorEstimate {
     pub model: f64,
     /// What the model error is made of (the largest term).
     pub source: ModelError,
+    /// Bound on the error of the centre of mass, m: the relative bound times the solid's reach (its
+    /// farthest vertex from the centre of mass), plus the round-off of the centre's own coordinates.
+    pub com: f64,
 }
 
 impl ErrorEstimate {
@@ -461,9 +464,14 @@ impl Ladder<'_> {
         {
             *relative_uncertainty = model_error;
         }
+        // A volume δ moved within the reach R shifts the centre by at most δ·R/(V − δ); round-off
+        // shifts it by the relative round-off of the first moments, about the reference point.
+        let com = (model_error + round_off) * reach(&unit, &vertices)
+            + round_off * dot(unit.com, unit.com).sqrt();
         let error = ErrorEstimate {
             round_off,
             model: model_error,
+            com,
             source: if model_error > 0.0 {
                 source
             } else {
@@ -494,13 +502,7 @@ fn relative_model(delta: f64, unit: &MassProperties, vertices: &[[f64; 3]]) -> f
     if delta == 0.0 {
         return 0.0;
     }
-    let reach2 = vertices
-        .iter()
-        .map(|v| {
-            let d = sub(*v, unit.com);
-            dot(d, d)
-        })
-        .fold(0.0, f64::max);
+    let reach2 = reach(unit, vertices).powi(2);
     let bounded = |change: f64, value: f64| {
         if change < value {
             change / (value - change)
@@ -511,6 +513,14 @@ fn relative_model(delta: f64, unit: &MassProperties, vertices: &[[f64; 3]]) -> f
     let volume = bounded(delta, unit.mass);
     let inertia = bounded(3.0 * delta * reach2, frobenius(&unit.inertia));
     volume.max(inertia)
+}
+
+/// The largest distance of a vertex from the centre of mass.
+fn reach(unit: &MassProperties, vertices: &[[f64; 3]]) -> f64 {
+    vertices
+        .iter()
+        .map(|v| dist(*v, unit.com))
+        .fold(0.0, f64::max)
 }
 
 /// Turns a scaled mesh into a solid by the ladder in the module docs, its coordinates taken as f64

@@ -357,6 +357,9 @@ pub struct Outcome {
     pub inertia_error: f64,
     pub estimate: f64,
     pub source: String,
+    /// Distance of the computed centre of mass from the exact one, m, and its bound.
+    pub com_error: f64,
+    pub com_bound: f64,
 }
 
 impl Outcome {
@@ -380,7 +383,34 @@ pub fn run(case: &Case) -> Result<Outcome, String> {
         &case.truth.0,
         &case.truth.1,
     ));
+    // The exact centre of mass is about the exact bounding-box centre of the truth's vertices.
+    let centre: [num_rational::BigRational; 3] = std::array::from_fn(|k| {
+        let lo = case
+            .truth
+            .0
+            .iter()
+            .map(|p| p[k])
+            .fold(f64::INFINITY, f64::min);
+        let hi = case
+            .truth
+            .0
+            .iter()
+            .map(|p| p[k])
+            .fold(f64::NEG_INFINITY, f64::max);
+        (super::rat(lo) + super::rat(hi)) / super::rat(2.0)
+    });
+    let com_error = (0..3)
+        .map(|k| {
+            let d = super::rat(solid.unit.com[k]) - &centre[k] - &exact.com[k];
+            num_traits::ToPrimitive::to_f64(&d)
+                .unwrap_or(f64::INFINITY)
+                .powi(2)
+        })
+        .sum::<f64>()
+        .sqrt();
     Ok(Outcome {
+        com_error,
+        com_bound: solid.error.com,
         rung: solid.rung.name().to_string(),
         volume_error: super::rel_error(solid.unit.mass, &exact.volume),
         inertia_error: super::inertia_error(&solid.unit.inertia, &exact.inertia),
