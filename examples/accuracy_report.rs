@@ -10,6 +10,8 @@
 
 #[path = "../tests/common/mod.rs"]
 mod common;
+#[path = "report/ladder.rs"]
+mod ladder;
 
 use common::*;
 use num_rational::BigRational;
@@ -612,6 +614,8 @@ fn main() -> std::io::Result<()> {
             writeln!(md, "\nSet `EXAMPLE_ROBOT_DATA_SHARE` to time the example-robot-data corpus end to end.").ok();
         }
     }
+    let share = std::env::var("EXAMPLE_ROBOT_DATA_SHARE").ok();
+    ladder::section(&mut md, share.as_deref().map(std::path::Path::new));
     std::fs::write("docs/accuracy.md", md)?;
     println!("wrote docs/accuracy.md and docs/accuracy.svg");
     Ok(())

@@ -816,114 +816,184 @@ fn apply(faces: &mut Polygons, reversed: &[bool]) {
     }
 }
 
-/// Open or non-manifold: caps, integration as it is, or the convex hull.
-fn open_or_nonmanifold(mut ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result<Solid, MeshError> {
-    let what = te.describe();
-    // Orient what the manifold edges allow, each component outward; failing that (contradicting
-    // edges, or open sheets whose sign is meaningless), the winding as the file gives it.
-    let mut candidates: Vec<(Polygons, Polygons, usize, f64)> = Vec::new();
-    if let Some(o) = orient(w.topology.len(), &te.pairs) {
-        let out = outward(&w.vertices, &w.kept, &o);
-        if out.flipped > 0 {
-            let (mut kept, mut topology) = (w.kept.clone(), w.topology.clone());
-            apply(&mut kept, &out.reversed);
-            apply(&mut topology, &out.reversed);
-            candidates.push((kept, topology, out.flipped, out.nested));
-        }
-    }
-    candidates.push((w.kept.clone(), w.topology.clone(), 0, 0.0));
-    for (faces, topology, flipped, nested) in candidates {
-        let flips = if flipped > 0 {
-            format!(", {flipped} faces re-oriented")
+/// One way to wind an open or non-manifold mesh: the stored faces kept by the weld and their
+/// topology, both with the same faces reversed.
+struct Winding {
+    faces: Polygons,
+    topology: Polygons,
+    flipped: usize,
+    /// Volume of components re-oriented inside another's bounding box (m³).
+    nested: f64,
+}
+
+impl Winding {
+    fn flips(&self) -> String {
+        if self.flipped > 0 {
+            format!(", {} faces re-oriented", self.flipped)
         } else {
             String::new()
-        };
+        }
+    }
+}
+
+/// Orient what the manifold edges allow, each component outward; failing that (contradicting edges,
+/// or open sheets whose sign is meaningless), the winding as the file gives it.
+fn windings(w: &Welding, te: &Edges) -> Vec<Winding> {
+    let mut out = Vec::new();
+    if let Some(o) = orient(w.topology.len(), &te.pairs) {
+        let turned = outward(&w.vertices, &w.kept, &o);
+        if turned.flipped > 0 {
+            let (mut faces, mut topology) = (w.kept.clone(), w.topology.clone());
+            apply(&mut faces, &turned.reversed);
+            apply(&mut topology, &turned.reversed);
+            out.push(Winding {
+                faces,
+                topology,
+                flipped: turned.flipped,
+                nested: turned.nested,
+            });
+        }
+    }
+    out.push(Winding {
+        faces: w.kept.clone(),
+        topology: w.topology.clone(),
+        flipped: 0,
+        nested: 0.0,
+    });
+    out
+}
+
+/// Open or non-manifold: integration as it is, caps, or the convex hull.
+fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result<Solid, MeshError> {
+    let what = te.describe();
+    for winding in windings(&w, te) {
         if te.boundary == 0 {
-            let volume = signed_volume(&w.vertices, &faces);
-            if volume > 0.0 {
-                ladder.strict(&format!("mesh is {what}"))?;
-                ladder.warnings.push(format!("mesh is {what} but has no holes: integrated as it is{flips} (a region enclosed by two overlapping shells would count twice)"));
-                // Integrated as stored (up to the faces re-oriented): a region that two shells
-                // enclose counts twice here exactly as in the stored surface, which the warning says.
-                let model = open_volume(&w.vertices, &faces) + nested;
-                let rung = Rung::NonManifold {
-                    nonmanifold_edges: te.nonmanifold,
-                    faces_flipped: flipped,
-                };
-                let source = if nested > 0.0 {
-                    ModelError::Orientation
-                } else {
-                    ModelError::Cracks
-                };
-                return ladder.finish(w.vertices, faces, rung, (model, source), |_| None);
+            if signed_volume(&w.vertices, &winding.faces) > 0.0 {
+                return non_manifold(ladder, w, te, winding, &what);
             }
             continue;
         }
-        let Some(caps) = cap_holes(&w.vertices, &topology) else {
+        let Some(caps) = cap_holes(&w.vertices, &winding.topology) else {
             continue;
         };
         let mut vertices = w.vertices.clone();
         vertices.extend_from_slice(&caps.centroids);
-        let mut capped = faces.clone();
+        let mut capped = winding.faces.clone();
         for f in caps.faces.iter() {
             capped.push(f);
         }
         let volume = signed_volume(&vertices, &capped);
-        let uncertainty = caps.bound / volume.abs();
-        if !(volume > 0.0 && uncertainty <= CAPPED) {
+        let cracks = open_volume(&vertices, &capped);
+        if !(volume > 0.0 && (caps.bound + cracks) / volume <= CAPPED) {
             continue;
         }
-        let cracks = open_volume(&vertices, &capped);
-        // Whatever surface really spans the loops, its contribution is at most (its area) × diagonal.
-        let (lo, hi) = bbox(&w.vertices);
-        let spans = caps.area * dist(lo, hi);
-        if (spans + caps.bound + cracks) / volume <= SLIVERS && flipped == 0 {
-            // The "holes" are slivers: the stored triangles are closed up to round-off.
-            ladder.notes.push(format!(
-                "closed up to slivers once corners within {:.1e} m are welded ({} boundary edges bound {:.1e} m² in all); integrated as stored",
-                w.tolerant.tolerance.largest, te.boundary, caps.area
-            ));
-            let rung = Rung::Welded {
-                merged_vertices: w.tolerant.merged,
-                widest_crack: w.tolerant.widest,
-                tolerance: w.tolerant.tolerance.largest,
-            };
-            let model = spans + caps.bound + cracks;
-            return ladder.finish(
-                w.vertices,
-                w.stored,
-                rung,
-                (model, ModelError::Cracks),
-                |_| None,
-            );
-        }
-        ladder.strict(&format!("mesh is {what}"))?;
-        let mut done = Vec::new();
-        if caps.holes > 0 {
-            done.push(format!("closed its {} hole(s) with flat caps", caps.holes));
-        }
-        if caps.cracks > 0 {
-            done.push(format!(
-                "left {} edge(s) of cracks or T-junctions open",
-                caps.cracks
-            ));
-        }
-        let model = caps.bound + cracks + nested;
-        let rung = Rung::Capped {
-            holes: caps.holes,
-            boundary_edges: te.boundary,
-            nonmanifold_edges: te.nonmanifold,
-            faces_flipped: flipped,
-            relative_uncertainty: 0.0,
+        let plan = CappedSolid {
+            cracks,
+            vertices,
+            faces: capped,
+            volume,
+            caps,
         };
-        let done = done.join(", ");
-        return ladder.finish(vertices, capped, rung, (model, ModelError::Caps), |m| {
-            Some(format!(
-                "mesh is {what}: {done}{flips}; its volume {volume:.6e} m³ and inertia are uncertain by at most {m:.1e} (relative) because of them"
-            ))
-        });
+        return with_caps(ladder, w, te, winding, plan, &what);
     }
     convex_hull(ladder, w, te, &what)
+}
+
+/// No boundary edges but edges shared by three or more faces: integrated as stored (up to the faces
+/// re-oriented). A region that two shells enclose counts twice here exactly as in the stored surface,
+/// which the warning says.
+fn non_manifold(
+    mut ladder: Ladder<'_>,
+    w: Welding,
+    te: &Edges,
+    winding: Winding,
+    what: &str,
+) -> Result<Solid, MeshError> {
+    ladder.strict(&format!("mesh is {what}"))?;
+    ladder.warnings.push(format!("mesh is {what} but has no holes: integrated as it is{} (a region enclosed by two overlapping shells would count twice)", winding.flips()));
+    let model = open_volume(&w.vertices, &winding.faces) + winding.nested;
+    let rung = Rung::NonManifold {
+        nonmanifold_edges: te.nonmanifold,
+        faces_flipped: winding.flipped,
+    };
+    let source = if winding.nested > 0.0 {
+        ModelError::Orientation
+    } else {
+        ModelError::Cracks
+    };
+    ladder.finish(w.vertices, winding.faces, rung, (model, source), |_| None)
+}
+
+/// A mesh with its holes capped, ready to integrate.
+struct CappedSolid {
+    vertices: Vec<[f64; 3]>,
+    faces: Polygons,
+    volume: f64,
+    caps: Caps,
+    /// Volume that moves with the reference point after capping (cracks left open), m³.
+    cracks: f64,
+}
+
+/// The capped solid, or, when the "holes" are slivers whose caps change nothing measurable, the
+/// stored triangles as they are (rung welded).
+fn with_caps(
+    mut ladder: Ladder<'_>,
+    w: Welding,
+    te: &Edges,
+    winding: Winding,
+    plan: CappedSolid,
+    what: &str,
+) -> Result<Solid, MeshError> {
+    let caps = &plan.caps;
+    // Whatever surface really spans the loops, its contribution is at most (its area) × diagonal.
+    let (lo, hi) = bbox(&w.vertices);
+    let spans = caps.area * dist(lo, hi);
+    if (spans + caps.bound + plan.cracks) / plan.volume <= SLIVERS && winding.flipped == 0 {
+        ladder.notes.push(format!(
+            "closed up to slivers once corners within {:.1e} m are welded ({} boundary edges bound {:.1e} m² in all); integrated as stored",
+            w.tolerant.tolerance.largest, te.boundary, caps.area
+        ));
+        let rung = Rung::Welded {
+            merged_vertices: w.tolerant.merged,
+            widest_crack: w.tolerant.widest,
+            tolerance: w.tolerant.tolerance.largest,
+        };
+        let model = spans + caps.bound + plan.cracks;
+        return ladder.finish(
+            w.vertices,
+            w.stored,
+            rung,
+            (model, ModelError::Cracks),
+            |_| None,
+        );
+    }
+    ladder.strict(&format!("mesh is {what}"))?;
+    let mut done = Vec::new();
+    if caps.holes > 0 {
+        done.push(format!("closed its {} hole(s) with flat caps", caps.holes));
+    }
+    if caps.cracks > 0 {
+        done.push(format!(
+            "left {} edge(s) of cracks or T-junctions open",
+            caps.cracks
+        ));
+    }
+    let model = caps.bound + plan.cracks + winding.nested;
+    let rung = Rung::Capped {
+        holes: caps.holes,
+        boundary_edges: te.boundary,
+        nonmanifold_edges: te.nonmanifold,
+        faces_flipped: winding.flipped,
+        relative_uncertainty: 0.0,
+    };
+    let done = done.join(", ");
+    let flips = winding.flips();
+    let volume = plan.volume;
+    ladder.finish(plan.vertices, plan.faces, rung, (model, ModelError::Caps), |m| {
+        Some(format!(
+            "mesh is {what}: {done}{flips}; its volume {volume:.6e} m³ and inertia are uncertain by at most {m:.1e} (relative) because of them"
+        ))
+    })
 }
 
 /// The convex hull of the vertices, with the numbers that say how far that is from the mesh.
@@ -1177,44 +1247,41 @@ fn cap_holes(vertices: &[[f64; 3]], faces: &Polygons) -> Option<Caps> {
             caps.cracks += steps.len();
             continue;
         }
-        let lp: Vec<u32> = steps.iter().map(|s| s.0).collect();
-        caps.holes += 1;
-        let n = lp.len() as f64;
-        let c = [0, 1, 2].map(|k| lp.iter().map(|&i| vertices[i as usize][k]).sum::<f64>() / n);
-        let ci = base + caps.centroids.len() as u32;
-        caps.centroids.push(c);
+        caps.close(vertices, base, &steps);
+    }
+    // What cracks leave open is accounted for by the caller: the capped surface's vector area.
+    Some(caps)
+}
+
+impl Caps {
+    /// Closes one boundary loop, given as (vertex, edge a → b as directed in the mesh) steps, with a
+    /// fan from its centroid (numbered `base` + the centroids so far), and adds its bound.
+    fn close(&mut self, vertices: &[[f64; 3]], base: u32, steps: &[(u32, u32, u32)]) {
+        self.holes += 1;
+        let n = steps.len() as f64;
+        let c = [0, 1, 2].map(|k| steps.iter().map(|s| vertices[s.0 as usize][k]).sum::<f64>() / n);
+        let ci = base + self.centroids.len() as u32;
+        self.centroids.push(c);
         let mut area = [0.0f64; 3];
-        for &(_, a, b) in &steps {
+        for &(_, a, b) in steps {
             // The mesh has a → b on its boundary; the cap runs b → a.
-            caps.faces.push(&[ci, b, a]);
+            self.faces.push(&[ci, b, a]);
             let x = cross(sub(vertices[b as usize], c), sub(vertices[a as usize], c));
             for k in 0..3 {
                 area[k] += 0.5 * x[k];
             }
         }
         let len = dot(area, area).sqrt();
-        caps.area += len;
+        self.area += len;
         if len > 0.0 {
             let nrm = area.map(|x| x / len);
-            let dev = lp
+            let dev = steps
                 .iter()
-                .map(|&i| dot(sub(vertices[i as usize], c), nrm).abs())
+                .map(|s| dot(sub(vertices[s.0 as usize], c), nrm).abs())
                 .fold(0.0, f64::max);
-            caps.bound += 2.0 * dev * len;
+            self.bound += 2.0 * dev * len;
         }
     }
-    if caps.cracks > 0 {
-        // What is left open makes the result depend on the reference point by at most |A|·diag/6.
-        let (lo, hi) = bbox(vertices);
-        let mut all = vertices.to_vec();
-        all.extend_from_slice(&caps.centroids);
-        let mut f = faces.clone();
-        for face in caps.faces.iter() {
-            f.push(face);
-        }
-        caps.bound += vector_area(&all, &f) * dist(lo, hi) / 6.0;
-    }
-    Some(caps)
 }
 
 /// The length of the surface's vector area `Σ N/2` (zero for a closed surface).
