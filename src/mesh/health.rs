@@ -376,8 +376,8 @@ fn tolerant_welding(exact: weld::ExactWeld, precision: weld::Precision) -> Weldi
 /// the reverse order (a zero-thickness wall: the pair cancels, both dropped). Returns per face whether
 /// it is dropped, and how many are.
 fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize) {
-    // Each face's vertices rotated to start at the smallest index, and whether it is reversed when
-    // compared with the same rotation read backwards.
+    // Each face's vertices rotated to start at the smallest index, in whichever direction reads
+    // smaller, and whether that was backwards. Sorting the keys groups the copies.
     let canonical = |f: &[u32]| -> (Vec<u32>, bool) {
         let k = (0..f.len()).min_by_key(|&i| f[i]).unwrap_or(0);
         let forward: Vec<u32> = (0..f.len()).map(|i| f[(k + i) % f.len()]).collect();
@@ -390,27 +390,55 @@ fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize) {
             (backward, true)
         }
     };
-    let mut groups: FxHashMap<Vec<u32>, Vec<(usize, bool)>> = FxHashMap::default();
+    // Triangles (nearly every face) without allocating: the key is the rotated triple.
+    let mut keys: Vec<([u32; 3], bool, u32)> = Vec::with_capacity(faces.len());
+    let mut others: Vec<(Vec<u32>, bool, u32)> = Vec::new();
     for (i, f) in faces.iter().enumerate() {
-        let (key, reversed) = canonical(f);
-        groups.entry(key).or_default().push((i, reversed));
+        if let [a, b, c] = *f {
+            let (x, y, z) = if a < b && a < c {
+                (a, b, c)
+            } else if b < c {
+                (b, c, a)
+            } else {
+                (c, a, b)
+            };
+            let key = if y <= z {
+                ([x, y, z], false)
+            } else {
+                ([x, z, y], true)
+            };
+            keys.push((key.0, key.1, i as u32));
+        } else {
+            let (key, reversed) = canonical(f);
+            others.push((key, reversed, i as u32));
+        }
     }
+    keys.sort_unstable();
+    others.sort_unstable();
     let mut dropped = vec![false; faces.len()];
     let mut count = 0;
-    for members in groups.values().filter(|m| m.len() > 1) {
-        let ahead = members.iter().filter(|m| !m.1).count();
+    let mut drop_group = |members: &[(bool, u32)]| {
+        let ahead = members.iter().filter(|m| !m.0).count();
         let back = members.len() - ahead;
         // Keep one face of the majority direction (none when the directions balance).
         let keep_dir = back > ahead;
         let mut keep = usize::from(ahead != back);
-        for &(i, reversed) in members {
+        for &(reversed, i) in members {
             if reversed == keep_dir && keep > 0 {
                 keep -= 1;
             } else {
-                dropped[i] = true;
+                dropped[i as usize] = true;
                 count += 1;
             }
         }
+    };
+    for group in keys.chunk_by(|a, b| a.0 == b.0).filter(|g| g.len() > 1) {
+        let members: Vec<(bool, u32)> = group.iter().map(|m| (m.1, m.2)).collect();
+        drop_group(&members);
+    }
+    for group in others.chunk_by(|a, b| a.0 == b.0).filter(|g| g.len() > 1) {
+        let members: Vec<(bool, u32)> = group.iter().map(|m| (m.1, m.2)).collect();
+        drop_group(&members);
     }
     (dropped, count)
 }
