@@ -206,6 +206,9 @@ def urdfdom_verdict(urdf):
             os.close(saved)
         log.seek(0)
         text = log.read().decode("utf-8", "replace")
+    if verdict:
+        first = [" ".join(ln.split()) for ln in text.splitlines() if ln.startswith("Error:")]
+        verdict = "urdfdom: " + (" / ".join(first[:2]) if first else verdict)
     return verdict, text
 
 
@@ -261,7 +264,7 @@ def classify(pkg, urdf, message, pkgs, dom, mesh=None, link=None):
     if "unknown geometry" in message or "should be three numbers" in message:
         verdict, log = dom
         if verdict:
-            return "invalid URDF: urdfdom refuses it too", f"pinocchio/urdfdom: {verdict}"
+            return "invalid URDF: urdfdom refuses it too", verdict
         for line in log.splitlines():
             if re.search(r"Could not parse (collision|visual) element", line) and (link is None or f"[{link}]" in line):
                 first = next((ln.strip() for ln in log.splitlines() if ln.startswith("Error:")), "")
@@ -283,7 +286,7 @@ def classify(pkg, urdf, message, pkgs, dom, mesh=None, link=None):
             return "flat collision mesh (zero volume)", f"its vertices all lie in a plane: extent {ext[0]:.4g} × {ext[1]:.4g} × {ext[2]:.4g} m (zero along {axis})"
         return None, f"extent {ext}"
     if dom[0] is not None and ("cannot parse" in message or "malformed" in message.lower()):
-        return "invalid URDF: urdfdom refuses it too", f"pinocchio/urdfdom: {dom[0]}"
+        return "invalid URDF: urdfdom refuses it too", dom[0]
     return None, "no rule matches"
 
 
@@ -337,7 +340,7 @@ def main():
             "mesh_files": Counter(p.suffix.lower() for p in pkg.mesh_files), "filled": 0, "partial": 0,
             "failed_file": 0, "links_filled": 0, "links_failed": 0, "failures": [], "check": Counter(),
             "check_problems": [], "rungs": Counter(), "mesh_errors": [], "urdfdom_refuses": [],
-            "mesh_refs": Counter(), "written": 0,
+            "mesh_refs": Counter(), "written": 0, "claims": [],
         }
         print(f"== {name} {version}: {len(pkg.urdfs)} URDF, {len(pkg.xacros)} xacro, {len(pkg.mesh_files)} mesh files", flush=True)
 
@@ -409,6 +412,9 @@ def main():
                     r["failures"].append({"urdf": rel, "link": link, "message": cm, "defect": defect,
                                           "evidence": clean(evidence, pkg), "bug": bug,
                                           "urdfdom": "refuses" if dom[0] else "accepts"})
+                    if "urdfdom refuses" in cm and not dom[0]:
+                        r["claims"].append(f"`{rel}`, link `{link}`: the message says `{re.search(r'[(]urdfdom refuses[^)]*[)]', cm).group(0)}`, "
+                                           f"but urdfdom 6.0.0 (pinocchio 4.1.0) loads this file: {evidence.split(' loads the robot but ')[-1] if ' loads the robot but ' in evidence else 'it builds the model'}")
                     if bug == "UNEXPLAINED":
                         unexplained.append(f"{rel}: {link}: {cm}")
             if "check" in res:
@@ -429,7 +435,7 @@ def main():
                     r["check_problems"].append(f"{rel}: `check --density 1000` exit {crc}: {clean((cso + cse)[:400], pkg)}")
                     unexplained.append(f"{rel}: check --density exit {crc}")
             if dom[0]:
-                r["urdfdom_refuses"].append((rel, dom[0], res["rc"]))
+                r["urdfdom_refuses"].append((rel, clean(dom[0], pkg), res["rc"]))
 
         def mesh(item):
             (key, scale), path = item
@@ -520,17 +526,26 @@ def write_report(report, out):
                 if key in seen:
                     continue
                 seen.add(key)
-                L.append(f"  - `{f['message'][:300]}` — verified: {f['evidence']}")
+                if len(seen) > 2:
+                    continue
+                L.append(f"  - `{f['message'][:300].replace('`', chr(39))}` — verified: {f['evidence']}")
+            if len(seen) > 2:
+                L.append(f"  - … and {len(seen) - 2} more messages of the same kind, each verified the same way")
         for e in r["mesh_errors"]:
             d = e["defect"] or "SUSPECTED urdf-inertia BUG"
-            L.append(f"- mesh `{e['mesh']}` — **{d}**: `{e['message'][:300]}` — verified: {e['evidence']}")
+            L.append(f"- mesh `{e['mesh']}` — **{d}**: `{e['message'][:300].replace('`', chr(39))}` — verified: {e['evidence']}")
         for c in r["check_problems"]:
             L.append(f"- **check disagrees with fill**: {c}")
         L.append("")
     if not any_fail:
         L += ["None.", ""]
 
-    L += ["## URDFs urdfdom refuses", "",
+    L += ["## Suspected urdf-inertia bugs", "",
+          "Failures not explained by a defect of the file fail the run (none are listed under Failures above when it "
+          "passes). Messages of urdf-inertia that urdfdom contradicts:", ""]
+    claims = [c for r in report.values() for c in r["claims"]]
+    L += [f"- {c}" for c in claims] or ["None."]
+    L += ["", "## URDFs urdfdom refuses", "",
           "pinocchio 4.1.0's `buildModelFromUrdf` (urdfdom 6) on every URDF; the tool must read every URDF urdfdom "
           "reads, and files urdfdom refuses are listed with what `fill` did with them.", ""]
     n = 0
