@@ -146,7 +146,7 @@ class Package:
 
     def rel(self, path):
         try:
-            return f"{self.name}/{Path(path).relative_to(self.root)}"
+            return f"{self.name}/{Path(os.path.normpath(path)).relative_to(self.root)}"
         except ValueError:
             return str(path)
 
@@ -340,7 +340,7 @@ def main():
             "mesh_files": Counter(p.suffix.lower() for p in pkg.mesh_files), "filled": 0, "partial": 0,
             "failed_file": 0, "links_filled": 0, "links_failed": 0, "failures": [], "check": Counter(),
             "check_problems": [], "rungs": Counter(), "mesh_errors": [], "urdfdom_refuses": [],
-            "mesh_refs": Counter(), "written": 0, "claims": [],
+            "mesh_refs": Counter(), "written": 0, "claims": [], "loose_caps": [],
         }
         print(f"== {name} {version}: {len(pkg.urdfs)} URDF, {len(pkg.xacros)} xacro, {len(pkg.mesh_files)} mesh files", flush=True)
 
@@ -445,8 +445,12 @@ def main():
             for path, scale, (rc, so, se, dt) in ex.map(mesh, sorted(mesh_pairs.items())):
                 timings.append((name, f"mesh {pkg.rel(path)}", dt))
                 if rc == 0:
-                    rung = json.loads(so).get("provenance", "?")
+                    d = json.loads(so)
+                    rung = d.get("provenance", "?")
                     r["rungs"][rung] += 1
+                    bound = d.get("error_estimate")
+                    if rung == "capped" and (bound is None or bound > 1e-3):
+                        r["loose_caps"].append((pkg.rel(path), scale, bound))
                 else:
                     r["rungs"]["error"] += 1
                     raw = se.strip().removeprefix("error: ")
@@ -545,6 +549,14 @@ def write_report(report, out):
           "passes). Messages of urdf-inertia that urdfdom contradicts:", ""]
     claims = [c for r in report.values() for c in r["claims"]]
     L += [f"- {c}" for c in claims] or ["None."]
+    loose = sorted(c for r in report.values() for c in r["loose_caps"])
+    L += ["", "Capped meshes whose reported error bound (`error_estimate` of `urdf-inertia mesh --format json`, relative, on "
+          "volume and inertia) is above 1e-3 or unbounded, although the README uses the capped rung only when the caps' "
+          f"volume bound is below 1e-3 of the volume ({len(loose)}; the bound's inertia term takes the farthest vertex's "
+          "distance from the COM as where the caps' volume could be, and adds the open cracks' term the rung's gate does "
+          "not test):", ""]
+    L += [f"- `{m}`{'' if sc == (1.0, 1.0, 1.0) else ' (scale ' + ' '.join(f'{x:g}' for x in sc) + ')'}: "
+          f"{'unbounded' if b is None else f'{b:.2g}'}" for m, sc, b in loose] or ["None."]
     L += ["", "## URDFs urdfdom refuses", "",
           "pinocchio 4.1.0's `buildModelFromUrdf` (urdfdom 6) on every URDF; the tool must read every URDF urdfdom "
           "reads, and files urdfdom refuses are listed with what `fill` did with them.", ""]
