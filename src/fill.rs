@@ -79,6 +79,26 @@ pub struct LinkReport {
     pub warnings: Vec<String>,
 }
 
+impl LinkReport {
+    /// The link's relative error bound: the largest of its parts' (the round-off floor at least).
+    pub fn error_estimate(&self) -> f64 {
+        self.parts
+            .iter()
+            .map(|p| p.error_estimate)
+            .fold(ROUND_OFF_FLOOR, f64::max)
+    }
+
+    /// What the splice writes for this link.
+    pub fn update(&self) -> crate::urdf::write::LinkUpdate {
+        crate::urdf::write::LinkUpdate {
+            index: self.index,
+            props: self.computed,
+            error: self.error_estimate(),
+            size: self.size,
+        }
+    }
+}
+
 /// A link that could not be computed.
 #[derive(Debug, Clone)]
 pub struct LinkFailure {
@@ -678,7 +698,8 @@ pub fn compute_with(
         if let Some((v, pair, n)) = &overlap {
             let total: f64 = parts.iter().map(|p| p.unit.mass).sum();
             warnings.push(format!(
-                "parts {pair} overlap: about {v:.3e} m³ ({:.1}% of the link's volume) is counted twice (estimated on a {n}³ grid)",
+                "parts {pair} overlap: about {} m³ ({:.1}% of the link's volume) is counted twice (estimated on a {n}³ grid)",
+                crate::text::significant(*v, 4),
                 100.0 * v / total
             ));
         }

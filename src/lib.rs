@@ -13,5 +13,5 @@ pub mod input;
 pub mod mass;
 pub mod mesh;
 pub mod overlap;
-mod text;
+pub mod text;
 pub mod urdf;

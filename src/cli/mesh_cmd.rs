@@ -1,8 +1,9 @@
 //! `urdf-inertia mesh FILE`: the mass properties of one mesh, with its health.
 
 use super::args::{Format, MeshArgs};
-use super::{shortest, ExitStatus};
+use super::ExitStatus;
 use crate::mesh::{self, health::HealthOptions};
+use crate::text::shortest;
 use serde_json::json;
 
 pub fn run(args: &MeshArgs) -> ExitStatus {

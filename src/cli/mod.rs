@@ -12,6 +12,7 @@ macro_rules! errln {
 }
 
 mod args;
+mod compare;
 mod mesh_cmd;
 pub mod output;
 mod robot_cmd;
@@ -76,18 +77,4 @@ pub fn main() -> i32 {
         return ExitStatus::Error as i32;
     }
     status as i32
-}
-
-/// Formats a number with the shortest representation that reads back to the same f64, in plain notation
-/// for ordinary magnitudes and scientific notation for very small or large ones.
-pub fn shortest(x: f64) -> String {
-    if x == 0.0 {
-        return "0".into();
-    }
-    let a = x.abs();
-    if (1e-4..1e9).contains(&a) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
 }
