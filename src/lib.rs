@@ -6,7 +6,6 @@
 //! per-link composition ([`fill`]) → splice `<inertial>` into the original bytes ([`urdf::write`]).
 #![forbid(unsafe_code)]
 
-pub mod cli;
 pub mod density;
 pub mod fill;
 pub mod input;

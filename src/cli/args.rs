@@ -85,7 +85,7 @@ pub struct FillArgs {
     /// same f64), or N significant digits (3 to 17; the rounded tensor is re-checked, and a link it
     /// cannot keep valid is an error).
     #[arg(long, value_name = "auto|full|N", default_value = "auto")]
-    pub digits: crate::text::Digits,
+    pub digits: urdf_inertia::text::Digits,
     /// Write the principal frame's rpy and a diagonal tensor instead of the tensor in link axes.
     #[arg(long)]
     pub principal: bool,

@@ -1,8 +1,8 @@
 //! Existing `<inertial>` against computed: one comparison, one set of thresholds, shared by `check` and
 //! `diff`.
 
-use crate::mass::{frobenius, validity, MassProperties, Mat3};
-use crate::text::significant;
+use urdf_inertia::mass::{frobenius, validity, MassProperties, Mat3};
+use urdf_inertia::text::significant;
 
 /// Existing against computed, for one link.
 #[derive(Debug, Clone)]
@@ -158,7 +158,7 @@ pub fn compare(existing: &MassProperties, computed: &MassProperties, size: f64) 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mass::primitives;
+    use urdf_inertia::mass::primitives;
 
     #[test]
     fn diagonal_tensors_are_never_called_mirrored() {

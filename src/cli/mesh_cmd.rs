@@ -2,9 +2,9 @@
 
 use super::args::{Format, MeshArgs};
 use super::ExitStatus;
-use crate::mesh::{self, health::HealthOptions};
-use crate::text::shortest;
 use serde_json::json;
+use urdf_inertia::mesh::{self, health::HealthOptions};
+use urdf_inertia::text::shortest;
 
 pub fn run(args: &MeshArgs) -> ExitStatus {
     let scale = match args.scale.as_deref() {
@@ -40,7 +40,7 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         (None, None) => 1.0,
     };
     let mp = solid.unit.scaled(density);
-    if let Some(why) = crate::fill::unrepresentable(&mp) {
+    if let Some(why) = urdf_inertia::fill::unrepresentable(&mp) {
         errln!("error: {}: {why}", args.file.display());
         return ExitStatus::Error;
     }

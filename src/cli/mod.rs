@@ -54,13 +54,13 @@ pub fn main() -> i32 {
         Command::Diff(d) => d.source.max_file_size.clone(),
         Command::Check(c) => c.source.max_file_size.clone(),
     };
-    let from_env = std::env::var(crate::input::MAX_FILE_SIZE_ENV).ok();
+    let from_env = std::env::var(urdf_inertia::input::MAX_FILE_SIZE_ENV).ok();
     if let Some((what, s)) = max_size
         .map(|s| ("--max-file-size", s))
-        .or(from_env.map(|s| (crate::input::MAX_FILE_SIZE_ENV, s)))
+        .or(from_env.map(|s| (urdf_inertia::input::MAX_FILE_SIZE_ENV, s)))
     {
-        match crate::input::parse_size(&s) {
-            Ok(n) => crate::input::set_max_file_size(n),
+        match urdf_inertia::input::parse_size(&s) {
+            Ok(n) => urdf_inertia::input::set_max_file_size(n),
             Err(e) => {
                 errln!("error: {what}: {e}");
                 return ExitStatus::Error as i32;

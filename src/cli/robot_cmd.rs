@@ -3,19 +3,19 @@
 use super::args::{CheckArgs, DiffArgs, FillArgs, Format, SourceArgs};
 use super::compare::{compare, Comparison};
 use super::{output, write, ExitStatus};
-use crate::density::DensityMap;
-use crate::fill::{
-    self, existing_problems, existing_props, FillOptions, FillReport, LinkReport, MeshCache,
-};
-use crate::mass::MassProperties;
-use crate::text::shortest;
-use crate::text::{self, significant, Digits};
-use crate::urdf::resolve::PackageResolver;
-use crate::urdf::write::{splice, tidy, tidy_moments, LinkUpdate, WriteOptions};
-use crate::urdf::{scan_bytes, Geometry, NoteLevel, Robot};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use urdf_inertia::density::DensityMap;
+use urdf_inertia::fill::{
+    self, existing_problems, existing_props, FillOptions, FillReport, LinkReport, MeshCache,
+};
+use urdf_inertia::mass::MassProperties;
+use urdf_inertia::text::shortest;
+use urdf_inertia::text::{self, significant, Digits};
+use urdf_inertia::urdf::resolve::PackageResolver;
+use urdf_inertia::urdf::write::{splice, tidy, tidy_moments, LinkUpdate, WriteOptions};
+use urdf_inertia::urdf::{scan_bytes, Geometry, NoteLevel, Robot};
 
 /// Validated sources: densities (if any), package paths, link selection.
 struct Sources {
@@ -36,6 +36,9 @@ fn sources(s: &SourceArgs) -> Result<Sources, String> {
         (None, None) if s.keep_mass => Some(DensityMap::default()),
         (None, None) => None,
     };
+    for g in s.only.iter().chain(&s.skip) {
+        urdf_inertia::density::glob(g).map_err(|e| format!("--only/--skip: {e}"))?;
+    }
     let mut pkgs = Vec::new();
     for p in &s.package_path {
         pkgs.push(PackageResolver::parse_package_arg(p)?);
@@ -74,7 +77,7 @@ fn prepare(
 
 /// Reads, decodes and scans a URDF, printing the scan's warnings and notes to stderr.
 fn read_robot(path: &Path) -> Result<Robot, String> {
-    let bytes = crate::input::read_file(path)
+    let bytes = urdf_inertia::input::read_file(path)
         .map_err(|e| format!("{}: cannot read the URDF: {e}", path.display()))?;
     let robot = scan_bytes(bytes, path).map_err(|e| e.to_string())?;
     for note in &robot.notes {
