@@ -447,8 +447,8 @@ fn diff_text(rows: &[Row]) {
             significant(e.mass, 6),
             significant(computed.mass, 6),
             significant(c.mass_ratio, 4),
-            significant(c.com_distance, 4),
-            significant(c.inertia_difference, 4),
+            significant(text::within(c.com_distance, l.error_estimate()), 4),
+            significant(text::within(c.inertia_difference, l.error_estimate()), 4),
             notes.join("; ")
         );
         let pe = moments(e, 0.0).map(|x| significant(x, 7));
