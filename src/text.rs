@@ -119,7 +119,7 @@ pub fn significant(x: f64, digits: u32) -> String {
 /// The decimal with the fewest significant digits within `delta` (absolute) of `x`, as an f64: `0` when
 /// `|x| ≤ delta`, `x` itself when `delta` is not a positive finite number.
 pub fn within(x: f64, delta: f64) -> f64 {
-    if !x.is_finite() || !(delta > 0.0 && delta.is_finite()) {
+    if !(x.is_finite() && delta > 0.0 && delta.is_finite()) {
         return if x == 0.0 { 0.0 } else { x };
     }
     if x.abs() <= delta {
