@@ -1,9 +1,11 @@
 //! `urdf-inertia mesh FILE`: the mass properties of one mesh, with its health.
 
 use super::args::{Format, MeshArgs};
-use super::{shortest, ExitStatus};
-use crate::mesh::{self, health::HealthOptions};
+use super::ExitStatus;
 use serde_json::json;
+use urdf_inertia::mass::{MassProperties, Principal};
+use urdf_inertia::mesh::{self, health::HealthOptions};
+use urdf_inertia::text::{shortest, within};
 
 pub fn run(args: &MeshArgs) -> ExitStatus {
     let scale = match args.scale.as_deref() {
@@ -39,11 +41,32 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         (None, None) => 1.0,
     };
     let mp = solid.unit.scaled(density);
-    if let Some(why) = crate::fill::unrepresentable(&mp) {
+    if let Some(why) = urdf_inertia::fill::unrepresentable(&mp) {
         errln!("error: {}: {why}", args.file.display());
         return ExitStatus::Error;
     }
+    // Written within the solid's own error estimate (see `text`), like every other number.
+    let err = solid.error_estimate;
+    let volume = within(volume, err * volume);
+    let length = mp.com.iter().fold(
+        solid
+            .vertices
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, x| m.max(x.abs())),
+        |m, x| m.max(x.abs()),
+    );
     let pr = mp.principal();
+    let largest = pr.moments[2].abs();
+    let mp = MassProperties {
+        mass: within(mp.mass, err * mp.mass),
+        com: mp.com.map(|x| within(x, err * length)),
+        inertia: mp.inertia.map(|r| r.map(|x| within(x, err * largest))),
+    };
+    let pr = Principal {
+        moments: pr.moments.map(|x| within(x, err * largest)),
+        axes: pr.axes,
+    };
     let elapsed = start.elapsed();
     match args.format {
         Format::Json => {

@@ -1,0 +1,112 @@
+//! The mesh cache: each file read once and each (file, scale) healed and integrated once, across the
+//! links of a robot and across robots (`check a.urdf b.urdf`, a corpus).
+
+use super::health::{HealthOptions, Solid};
+use super::{read, solid_from_raw, MeshError, RawMesh};
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Reads each file once and heals each (file, scale) once.
+#[derive(Debug, Default)]
+pub struct MeshCache {
+    raw: HashMap<PathBuf, Result<Arc<RawMesh>, MeshError>>,
+    solids: HashMap<(PathBuf, [u64; 3]), Result<Arc<Solid>, MeshError>>,
+    pub load_time: Duration,
+    pub integrate_time: Duration,
+}
+
+impl MeshCache {
+    pub fn solid(
+        &mut self,
+        path: &PathBuf,
+        scale: [f64; 3],
+        options: HealthOptions,
+    ) -> Result<Arc<Solid>, MeshError> {
+        let key = (path.clone(), scale.map(f64::to_bits));
+        if let Some(r) = self.solids.get(&key) {
+            return r.clone();
+        }
+        let t0 = Instant::now();
+        let raw = match self.raw.get(path) {
+            Some(r) => r.clone(),
+            None => {
+                let r = read(path).map(Arc::new);
+                self.raw.insert(path.clone(), r.clone());
+                r
+            }
+        };
+        let t1 = Instant::now();
+        self.load_time += t1 - t0;
+        let solid = raw
+            .and_then(|raw| solid_from_raw(&raw, scale, path, options))
+            .map(Arc::new);
+        self.integrate_time += t1.elapsed();
+        self.solids.insert(key, solid.clone());
+        solid
+    }
+
+    /// Reads and heals every not yet cached (file, scale) pair on all cores: each file once, then each
+    /// of its scales. Times are summed over threads (CPU time).
+    pub fn preload(&mut self, items: &[(PathBuf, [f64; 3])], options: HealthOptions) {
+        use rayon::prelude::*;
+        let mut by_file: HashMap<&PathBuf, Vec<[f64; 3]>> = HashMap::new();
+        for (path, scale) in items {
+            if !self
+                .solids
+                .contains_key(&(path.clone(), scale.map(f64::to_bits)))
+            {
+                let scales = by_file.entry(path).or_default();
+                if !scales
+                    .iter()
+                    .any(|s| s.map(f64::to_bits) == scale.map(f64::to_bits))
+                {
+                    scales.push(*scale);
+                }
+            }
+        }
+        type Loaded = (
+            PathBuf,
+            Result<Arc<RawMesh>, MeshError>,
+            Vec<([f64; 3], Result<Arc<Solid>, MeshError>)>,
+            Duration,
+            Duration,
+        );
+        let work: Vec<(&PathBuf, Vec<[f64; 3]>)> = by_file.into_iter().collect();
+        let loaded: Vec<Loaded> = work
+            .into_par_iter()
+            .map(|(path, scales)| {
+                let t0 = Instant::now();
+                let raw = read(path).map(Arc::new);
+                let t1 = Instant::now();
+                let solids = scales
+                    .into_iter()
+                    .map(|scale| {
+                        (
+                            scale,
+                            raw.clone()
+                                .and_then(|r| solid_from_raw(&r, scale, path, options))
+                                .map(Arc::new),
+                        )
+                    })
+                    .collect();
+                (path.clone(), raw, solids, t1 - t0, t1.elapsed())
+            })
+            .collect();
+        for (path, raw, solids, load, integrate) in loaded {
+            self.load_time += load;
+            self.integrate_time += integrate;
+            for (scale, solid) in solids {
+                self.solids
+                    .insert((path.clone(), scale.map(f64::to_bits)), solid);
+            }
+            self.raw.insert(path, raw);
+        }
+    }
+
+    /// Number of distinct files read.
+    pub fn files(&self) -> usize {
+        self.raw.len()
+    }
+}
