@@ -106,7 +106,14 @@ fn needles_through_the_mesh_command() {
         let path = tmp.path().join(name);
         std::fs::write(&path, obj).expect("write");
         let out = std::process::Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
-            .args(["mesh", path.to_str().expect("utf-8"), "--format", "json"])
+            .args([
+                "mesh",
+                path.to_str().expect("utf-8"),
+                "--format",
+                "json",
+                "--digits",
+                "full",
+            ])
             .output()
             .expect("run");
         assert_eq!(

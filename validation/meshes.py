@@ -59,7 +59,7 @@ def main():
     failures = []
     errors = []
     for robot, path, scale in meshes:
-        proc = subprocess.run([args.binary, "mesh", str(path), "--scale", *map(str, scale), "--format", "json"], capture_output=True, text=True)
+        proc = subprocess.run([args.binary, "mesh", str(path), "--scale", *map(str, scale), "--format", "json", "--digits", "full"], capture_output=True, text=True)
         if proc.returncode != 0:
             errors.append(f"{path.relative_to(robots) if path.is_relative_to(robots) else path}: {proc.stderr.strip()}")
             rungs_by_robot[robot]["error"] += 1

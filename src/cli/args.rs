@@ -142,6 +142,11 @@ pub struct MeshArgs {
     pub strict: bool,
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
+    /// Digits of the numbers: `auto` (default: the shortest decimal within the solid's error
+    /// estimate), `full` (every bit: the shortest text that reads back as the same f64), or N
+    /// significant digits (3 to 17).
+    #[arg(long, value_name = "auto|full|N", default_value = "auto")]
+    pub digits: urdf_inertia::text::Digits,
     /// Largest mesh file read: bytes or K/M/G; default 1G, or URDF_INERTIA_MAX_FILE_SIZE.
     #[arg(long, value_name = "SIZE")]
     pub max_file_size: Option<String>,

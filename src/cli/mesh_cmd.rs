@@ -5,7 +5,7 @@ use super::ExitStatus;
 use serde_json::json;
 use urdf_inertia::mass::{MassProperties, Principal};
 use urdf_inertia::mesh::{self, health::HealthOptions};
-use urdf_inertia::text::{shortest, within};
+use urdf_inertia::text::{round_significant, shortest, within, Digits};
 
 pub fn run(args: &MeshArgs) -> ExitStatus {
     let scale = match args.scale.as_deref() {
@@ -45,9 +45,15 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         errln!("error: {}: {why}", args.file.display());
         return ExitStatus::Error;
     }
-    // Written within the solid's own error estimate (see `text`), like every other number.
+    // Written within the solid's own error estimate (see `text`), like every other number; with
+    // `--digits full` every bit, with N digits rounded to N significant digits.
+    let round = |x: f64, delta: f64| match args.digits {
+        Digits::Auto => within(x, delta),
+        Digits::Full => x,
+        Digits::Fixed(n) => round_significant(x, n),
+    };
     let err = solid.error_estimate;
-    let volume = within(volume, err * volume);
+    let volume = round(volume, err * volume);
     let length = mp.com.iter().fold(
         solid
             .vertices
@@ -59,12 +65,12 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
     let pr = mp.principal();
     let largest = pr.moments[2].abs();
     let mp = MassProperties {
-        mass: within(mp.mass, err * mp.mass),
-        com: mp.com.map(|x| within(x, err * length)),
-        inertia: mp.inertia.map(|r| r.map(|x| within(x, err * largest))),
+        mass: round(mp.mass, err * mp.mass),
+        com: mp.com.map(|x| round(x, err * length)),
+        inertia: mp.inertia.map(|r| r.map(|x| round(x, err * largest))),
     };
     let pr = Principal {
-        moments: pr.moments.map(|x| within(x, err * largest)),
+        moments: pr.moments.map(|x| round(x, err * largest)),
         axes: pr.axes,
     };
     let elapsed = start.elapsed();
