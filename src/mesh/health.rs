@@ -12,10 +12,11 @@
 //!    component is made consistent, then turned outward by its signed volume.
 //! 4. [`Rung::Inverted`]: closed and consistent but wound inward (negative volume): flipped.
 //! 5. Open (boundary edges) or non-manifold, after orienting what the manifold edges allow:
-//!    * [`Rung::Capped`]: each boundary loop is closed by a fan from its centroid. When the caps'
-//!      uncertainty (below) is under 1e-3 of the volume, the capped mesh is used. When it is below
-//!      1e-12 (the "holes" are slivers), the triangles are integrated as stored and the rung is
-//!      [`Rung::Welded`].
+//!    * [`Rung::Capped`]: each boundary loop is closed by a fan from its centroid. When the bound
+//!      the caps leave on volume and inertia (below) is under 1e-3, the capped mesh is used; above
+//!      that, the convex hull is built too and the one with the smaller bound wins. When the caps'
+//!      bound is below 1e-12 (the "holes" are slivers), the triangles are integrated as stored and
+//!      the rung is [`Rung::Welded`].
 //!    * [`Rung::NonManifold`]: no boundary edges but edges shared by three or more faces: the surface
 //!      still bounds a region, integrated as it is (a region enclosed twice counts twice).
 //!    * [`Rung::ConvexHull`] otherwise: the convex hull of its vertices.
@@ -187,7 +188,7 @@ pub struct HealthOptions {
 /// A solid's volume below this many f64 round-offs of its faces' contributions counts as empty.
 const ZERO_VOLUME_ROUNDOFFS: f64 = 1e3;
 
-/// Largest relative volume uncertainty of the caps for which a capped mesh is used.
+/// Largest relative bound of the caps for which a capped mesh is used without trying the hull.
 const CAPPED: f64 = 1e-3;
 
 /// Caps whose uncertainty is below this (relative) close slivers, not holes: integrate as stored.
@@ -444,6 +445,7 @@ fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize) {
 }
 
 /// Shared by the rungs: where the mesh came from and what has been said about it.
+#[derive(Clone)]
 struct Ladder<'a> {
     path: &'a Path,
     options: HealthOptions,
@@ -473,14 +475,16 @@ impl Ladder<'_> {
         vertices: Vec<[f64; 3]>,
         faces: Polygons,
         rung: Rung,
-        model: (f64, ModelError),
+        model: impl Into<Model>,
         message: impl FnOnce(f64) -> Option<String>,
     ) -> Result<Solid, MeshError> {
         let unit = unit_props(&vertices, &faces, None);
         check_volume(&vertices, &faces, unit.mass, self.path)?;
         let round_off = round_off(&vertices, &faces, &unit);
-        let (delta, source) = model;
-        let model_error = relative_model(delta, &unit, &vertices);
+        let model = model.into();
+        let source = model.source;
+        let bound = model.bound(&unit, &vertices);
+        let model_error = bound.relative;
         if let Some(m) = message(model_error) {
             self.warnings.push(m);
         }
@@ -492,10 +496,10 @@ impl Ladder<'_> {
         {
             *relative_uncertainty = model_error;
         }
-        // A volume δ moved within the reach R shifts the centre by at most δ·R/(V − δ); round-off
-        // shifts it by the relative round-off of the first moments, about the reference point.
-        let com = (model_error + round_off) * reach(&unit, &vertices)
-            + round_off * dot(unit.com, unit.com).sqrt();
+        // Round-off shifts the centre by the relative round-off of the first moments, about the
+        // reference point.
+        let com =
+            bound.com + round_off * (reach(&unit, &vertices) + dot(unit.com, unit.com).sqrt());
         let error = ErrorEstimate {
             round_off,
             model: model_error,
@@ -520,27 +524,76 @@ impl Ladder<'_> {
     }
 }
 
-/// The relative error that a volume `delta` (m³) moved, added or removed anywhere within the solid's
-/// reach can cause, against the true value (which is at least the computed one less the change):
-/// for the volume δ/(V − δ); for the central inertia 3·δ·R²/(‖I‖ − 3·δ·R²), R the largest distance
-/// of a vertex from the centre of mass (a point mass δ at distance R changes the tensor by at most
-/// √2·δ·R², and the centre of mass it moves by as much again). Unbounded when the change could be
-/// as large as the value itself.
-fn relative_model(delta: f64, unit: &MassProperties, vertices: &[[f64; 3]]) -> f64 {
-    if delta == 0.0 {
-        return 0.0;
-    }
-    let reach2 = reach(unit, vertices).powi(2);
-    let bounded = |change: f64, value: f64| {
-        if change < value {
-            change / (value - change)
-        } else {
-            f64::INFINITY
+/// Where the volume of a model error may sit: anywhere in the solid, or near given points (the
+/// loops a cap closes).
+enum Lever {
+    Anywhere,
+    Near(Vec<[f64; 3]>),
+}
+
+/// A model error: volumes (m³) by which the solid can differ from the stored surface, each with where
+/// it sits, and what the largest is made of.
+struct Model {
+    terms: Vec<(f64, Lever)>,
+    source: ModelError,
+}
+
+impl From<(f64, ModelError)> for Model {
+    fn from((delta, source): (f64, ModelError)) -> Model {
+        Model {
+            terms: vec![(delta, Lever::Anywhere)],
+            source,
         }
-    };
-    let volume = bounded(delta, unit.mass);
-    let inertia = bounded(3.0 * delta * reach2, frobenius(&unit.inertia));
-    volume.max(inertia)
+    }
+}
+
+/// A model error as relative bounds.
+struct Bound {
+    /// On volume and central inertia.
+    relative: f64,
+    /// On the centre of mass, m.
+    com: f64,
+}
+
+impl Model {
+    /// The relative error that volumes δᵢ moved, added or removed at distances up to Rᵢ from the
+    /// centre of mass can cause, against the true value (at least the computed one less the change):
+    /// for the volume Σδ/(V − Σδ); for the central inertia 3·Σδ·R²/(‖I‖ − 3·Σδ·R²) (a point mass δ at
+    /// distance R changes the tensor by at most √2·δ·R², and the centre of mass it moves by as much
+    /// again); for the centre of mass Σδ·R/(V − Σδ). Unbounded when the change could be as large as
+    /// the value itself.
+    fn bound(&self, unit: &MassProperties, vertices: &[[f64; 3]]) -> Bound {
+        let (mut volume, mut inertia, mut moment) = (0.0, 0.0, 0.0);
+        for (delta, lever) in &self.terms {
+            if *delta == 0.0 {
+                continue;
+            }
+            let r = match lever {
+                Lever::Anywhere => reach(unit, vertices),
+                Lever::Near(points) => reach(unit, points),
+            };
+            volume += delta;
+            inertia += 3.0 * delta * r * r;
+            moment += delta * r;
+        }
+        if volume == 0.0 {
+            return Bound {
+                relative: 0.0,
+                com: 0.0,
+            };
+        }
+        let bounded = |change: f64, value: f64| {
+            if change < value {
+                change / (value - change)
+            } else {
+                f64::INFINITY
+            }
+        };
+        Bound {
+            relative: bounded(volume, unit.mass).max(bounded(inertia, frobenius(&unit.inertia))),
+            com: bounded(moment, unit.mass - volume + moment),
+        }
+    }
 }
 
 /// The largest distance of a vertex from the centre of mass.
@@ -894,6 +947,7 @@ fn windings(w: &Welding, te: &Edges) -> Vec<Winding> {
 /// Open or non-manifold: integration as it is, caps, or the convex hull.
 fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result<Solid, MeshError> {
     let what = te.describe();
+    let mut fallback: Option<(f64, Winding, CappedSolid)> = None;
     for winding in windings(&w, te) {
         if te.boundary == 0 {
             if signed_volume(&w.vertices, &winding.faces) > 0.0 {
@@ -912,7 +966,11 @@ fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result<Sol
         }
         let volume = signed_volume(&vertices, &capped);
         let cracks = open_volume(&vertices, &capped);
-        if !(volume > 0.0 && (caps.bound + cracks) / volume <= CAPPED) {
+        // The caps are used when the bound they leave on volume and inertia is small enough.
+        let relative = caps_model(&caps, cracks, winding.nested)
+            .bound(&unit_props(&vertices, &capped, None), &vertices)
+            .relative;
+        if !(volume > 0.0 && relative.is_finite()) {
             continue;
         }
         let plan = CappedSolid {
@@ -922,9 +980,21 @@ fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result<Sol
             volume,
             caps,
         };
-        return with_caps(ladder, w, te, winding, plan, &what);
+        if relative <= CAPPED {
+            return with_caps(ladder, w, te, winding, plan, &what);
+        }
+        if fallback.as_ref().is_none_or(|f| relative < f.0) {
+            fallback = Some((relative, winding, plan));
+        }
     }
-    convex_hull(ladder, w, te, &what)
+    // Caps too uncertain to trust outright: the convex hull, unless its own bound is worse.
+    let Some((relative, winding, plan)) = fallback else {
+        return convex_hull(ladder, &w, te, &what);
+    };
+    match convex_hull(ladder.clone(), &w, te, &what) {
+        Ok(hull) if hull.error_estimate < relative => Ok(hull),
+        _ => with_caps(ladder, w, te, winding, plan, &what),
+    }
 }
 
 /// No boundary edges but edges shared by three or more faces: integrated as stored (up to the faces
@@ -950,6 +1020,19 @@ fn non_manifold(
         ModelError::Cracks
     };
     ladder.finish(w.vertices, winding.faces, rung, (model, source), |_| None)
+}
+
+/// The model error of caps: their bound near the loops they close, cracks left open and components
+/// re-oriented anywhere.
+fn caps_model(caps: &Caps, cracks: f64, nested: f64) -> Model {
+    Model {
+        terms: vec![
+            (caps.bound, Lever::Near(caps.points.clone())),
+            (cracks, Lever::Anywhere),
+            (nested, Lever::Anywhere),
+        ],
+        source: ModelError::Caps,
+    }
 }
 
 /// A mesh with its holes capped, ready to integrate.
@@ -1006,7 +1089,7 @@ fn with_caps(
             caps.cracks
         ));
     }
-    let model = caps.bound + plan.cracks + winding.nested;
+    let model = caps_model(caps, plan.cracks, winding.nested);
     let rung = Rung::Capped {
         holes: caps.holes,
         boundary_edges: te.boundary,
@@ -1017,7 +1100,7 @@ fn with_caps(
     let done = done.join(", ");
     let flips = winding.flips();
     let volume = plan.volume;
-    ladder.finish(plan.vertices, plan.faces, rung, (model, ModelError::Caps), |m| {
+    ladder.finish(plan.vertices, plan.faces, rung, model, |m| {
         Some(format!(
             "mesh is {what}: {done}{flips}; its volume {volume:.6e} m³ and inertia are uncertain by at most {m:.1e} (relative) because of them"
         ))
@@ -1025,7 +1108,12 @@ fn with_caps(
 }
 
 /// The convex hull of the vertices, with the numbers that say how far that is from the mesh.
-fn convex_hull(ladder: Ladder<'_>, w: Welding, te: &Edges, what: &str) -> Result<Solid, MeshError> {
+fn convex_hull(
+    ladder: Ladder<'_>,
+    w: &Welding,
+    te: &Edges,
+    what: &str,
+) -> Result<Solid, MeshError> {
     let (lo, hi) = bbox(&w.vertices);
     let diag = dist(lo, hi);
     // The stored surface's signed volume, and how much it moves over reference points in the box.
@@ -1216,6 +1304,8 @@ struct Caps {
     bound: f64,
     /// Total area of the caps, m².
     area: f64,
+    /// The vertices of the loops closed and the caps' centres: where the caps' uncertainty sits.
+    points: Vec<[f64; 3]>,
 }
 
 /// Closes every boundary loop of `faces` with a fan from the loop's centroid, wound against the loop's
@@ -1246,6 +1336,7 @@ fn cap_holes(vertices: &[[f64; 3]], faces: &Polygons) -> Option<Caps> {
         cracks: 0,
         bound: 0.0,
         area: 0.0,
+        points: Vec::new(),
     };
     for start in 0..half.len() {
         if used[start] {
@@ -1290,6 +1381,9 @@ impl Caps {
         let c = [0, 1, 2].map(|k| steps.iter().map(|s| vertices[s.0 as usize][k]).sum::<f64>() / n);
         let ci = base + self.centroids.len() as u32;
         self.centroids.push(c);
+        self.points.push(c);
+        self.points
+            .extend(steps.iter().map(|s| vertices[s.0 as usize]));
         let mut area = [0.0f64; 3];
         for &(_, a, b) in steps {
             // The mesh has a → b on its boundary; the cap runs b → a.
@@ -1370,6 +1464,57 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A unit cube without its top face, one top corner raised 1e-3, beside a closed 1 cm
+    /// tetrahedron `far` metres away: the caps' uncertainty sits at the hole, not at the far part.
+    fn open_cube_and_far_tetrahedron(far: f64) -> RawMesh {
+        let mut v: Vec<[f64; 3]> = (0..8)
+            .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+            .collect();
+        v[7][2] += 1e-3;
+        let quads = [
+            [0, 2, 3, 1],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        let mut tris: Vec<[u32; 3]> = quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect();
+        let t = 0.01;
+        v.extend([
+            [far, 0.0, 0.0],
+            [far + t, 0.0, 0.0],
+            [far, t, 0.0],
+            [far, 0.0, t],
+        ]);
+        tris.extend([[8, 10, 9], [8, 9, 11], [8, 11, 10], [9, 10, 11]]);
+        RawMesh {
+            vertices: v,
+            faces: Polygons::from_triangles(&tris),
+            ..Default::default()
+        }
+    }
+
+    // Corpus finding: a capped mesh reported an unbounded estimate when a small part lay far away.
+    #[test]
+    fn caps_bound_does_not_grow_with_far_parts() {
+        for far in [10.0, 30.0, 1000.0] {
+            let s = make_solid(
+                &open_cube_and_far_tetrahedron(far),
+                Path::new("t"),
+                HealthOptions::default(),
+            )
+            .expect("solid");
+            assert_eq!(s.rung.name(), "capped", "{far}");
+            // The cap over the raised corner: 2 × 5e-4 (deviation) × 1 (area) = 1e-3 m³ of volume
+            // at most 1.5 m from the cube's centre, against 1 m³ and the cube's inertia.
+            assert!(s.error_estimate < 2e-2, "{far}: {}", s.error_estimate);
+            assert!(s.error.com < 2e-2, "{far}: {}", s.error.com);
+        }
+    }
 
     #[test]
     fn duplicated_faces_are_dropped() {
