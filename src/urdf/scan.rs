@@ -695,7 +695,7 @@ fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
     let v: Vec<&str> = s.split_ascii_whitespace().collect();
     if v.len() != 3 {
         return Err(format!(
-            "\"{s}\" should be three numbers, not {} (urdfdom refuses it)",
+            "\"{s}\" should be three numbers, not {} (urdfdom logs an error and drops this link's collision geometry)",
             v.len()
         ));
     }
@@ -804,7 +804,7 @@ fn geometry(kind: &str, a: &HashMap<String, String>) -> Result<Geometry, String>
         },
         other => {
             return Err(format!(
-                "unknown geometry <{other}> (urdfdom refuses it too); give this collision a <box>, <cylinder>, <sphere>, <capsule> or <mesh>"
+                "unknown geometry <{other}> (urdfdom logs an error and drops this link's collision geometry); give this collision a <box>, <cylinder>, <sphere>, <capsule> or <mesh>"
             ))
         }
     };
