@@ -90,7 +90,12 @@ pub fn convex_hull(points: &[[f64; 3]]) -> Result<TriangleMesh, HullError> {
     if tris.is_empty() || volume < 1e-12 {
         return Err(HullError::Degenerate);
     }
-    // Orient every facet outward: away from the hull's interior point (the vertex mean).
+    orient_outward(&verts, &mut tris);
+    Ok((vertices, tris))
+}
+
+/// Orients every facet outward: away from the hull's interior point (the vertex mean).
+fn orient_outward(verts: &[[f64; 3]], tris: &mut [[u32; 3]]) {
     let n = verts.len() as f64;
     let inner = [0, 1, 2].map(|k| verts.iter().map(|p| p[k]).sum::<f64>() / n);
     for t in tris.iter_mut() {
@@ -112,7 +117,6 @@ pub fn convex_hull(points: &[[f64; 3]]) -> Result<TriangleMesh, HullError> {
             t.swap(1, 2);
         }
     }
-    Ok((vertices, tris))
 }
 
 /// Drops points that cannot be hull vertices: those strictly inside the hull of an evenly spaced
