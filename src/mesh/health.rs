@@ -337,15 +337,18 @@ struct Welding {
     tolerant: weld::TolerantWeld,
     /// Faces that collapsed under the tolerant weld.
     collapsed: usize,
-    /// Faces dropped as duplicates (or as cancelling pairs).
+    /// Faces dropped as extra copies of a face (same direction), which the stored integral counts
+    /// twice.
     duplicates: usize,
+    /// Faces dropped in pairs, a face and its reverse, which cancel in the integral anyway.
+    cancelled: usize,
 }
 
 fn tolerant_welding(exact: weld::ExactWeld, precision: weld::Precision) -> Welding {
     let tol = weld::tolerance(&exact.vertices, precision);
     let tolerant = weld::tolerant(&exact.vertices, tol);
     let (all_topology, kept_mask) = weld::remap_faces(&exact.faces, &tolerant.representative);
-    let (dropped, duplicates) = duplicate_faces(&all_topology);
+    let (dropped, duplicates, cancelled) = duplicate_faces(&all_topology);
     let mut stored = Polygons::new();
     let mut kept = Polygons::new();
     let mut topology = Polygons::new();
@@ -365,6 +368,7 @@ fn tolerant_welding(exact: weld::ExactWeld, precision: weld::Precision) -> Weldi
     Welding {
         collapsed: kept_mask.iter().filter(|k| !**k).count(),
         duplicates,
+        cancelled,
         vertices: exact.vertices,
         stored,
         kept,
@@ -375,8 +379,8 @@ fn tolerant_welding(exact: weld::ExactWeld, precision: weld::Precision) -> Weldi
 
 /// Faces that repeat another one's vertices in the same cyclic order (a duplicate: kept once) or in
 /// the reverse order (a zero-thickness wall: the pair cancels, both dropped). Returns per face whether
-/// it is dropped, and how many are.
-fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize) {
+/// it is dropped, how many extra copies were dropped and how many faces in cancelling pairs.
+fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize, usize) {
     // Each face's vertices rotated to start at the smallest index, in whichever direction reads
     // smaller, and whether that was backwards. Sorting the keys groups the copies.
     let canonical = |f: &[u32]| -> (Vec<u32>, bool) {
@@ -417,10 +421,12 @@ fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize) {
     keys.sort_unstable();
     others.sort_unstable();
     let mut dropped = vec![false; faces.len()];
-    let mut count = 0;
+    let (mut repeated, mut cancelled) = (0, 0);
     let mut drop_group = |members: &[(bool, u32)]| {
         let ahead = members.iter().filter(|m| !m.0).count();
         let back = members.len() - ahead;
+        cancelled += 2 * ahead.min(back);
+        repeated += (ahead.max(back) - ahead.min(back)).saturating_sub(1);
         // Keep one face of the majority direction (none when the directions balance).
         let keep_dir = back > ahead;
         let mut keep = usize::from(ahead != back);
@@ -429,7 +435,6 @@ fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize) {
                 keep -= 1;
             } else {
                 dropped[i as usize] = true;
-                count += 1;
             }
         }
     };
@@ -441,7 +446,7 @@ fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize) {
         let members: Vec<(bool, u32)> = group.iter().map(|m| (m.1, m.2)).collect();
         drop_group(&members);
     }
-    (dropped, count)
+    (dropped, repeated, cancelled)
 }
 
 /// Shared by the rungs: where the mesh came from and what has been said about it.
@@ -650,8 +655,14 @@ pub fn make_solid_stored_as(
     let te = edges(&w.topology);
     if w.duplicates > 0 {
         ladder.warnings.push(format!(
-            "{} duplicated faces dropped (a face stored twice, or a face and its reverse, adds nothing to a solid)",
+            "{} faces stored more than once dropped (the copies would count their volume twice)",
             w.duplicates
+        ));
+    }
+    if w.cancelled > 0 {
+        ladder.notes.push(format!(
+            "{} faces dropped in pairs, each a face and its reverse (a wall of no thickness; they cancel)",
+            w.cancelled
         ));
     }
     if w.collapsed > 0 {
