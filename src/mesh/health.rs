@@ -229,7 +229,17 @@ impl Edges {
     }
 }
 
+/// The edge structure of `faces`. A closed, consistently wound surface (the common case) is proven so
+/// by [`closed_consistent_pairs`], which builds only the face pairs; anything else gets the full
+/// analysis below (a sort of every half-edge by its undirected key), whose boundary edges come in key
+/// order.
 fn edges(faces: &Polygons) -> Edges {
+    if let Some(pairs) = closed_consistent_pairs(faces) {
+        return Edges {
+            pairs,
+            ..Edges::default()
+        };
+    }
     let mut rec: Vec<(u64, u32, bool)> = Vec::with_capacity(faces.indices.len());
     for (fi, face) in faces.iter().enumerate() {
         for k in 0..face.len() {
@@ -271,6 +281,92 @@ fn edges(faces: &Polygons) -> Edges {
         i = j;
     }
     e
+}
+
+/// The faces sharing each edge when every directed edge `u → v` of `faces` has exactly one twin
+/// `v → u` (then each undirected edge has one half-edge each way: closed, edge-manifold, consistently
+/// wound); `None` otherwise. Half-edges are bucketed by their start vertex (a counting sort), so the
+/// check costs a few linear passes instead of a sort; pairs come in order of their smaller vertex.
+fn closed_consistent_pairs(faces: &Polygons) -> Option<Vec<(u32, u32, bool)>> {
+    let idx = &faces.indices;
+    let n = *idx.iter().max()? as usize + 1;
+    let triangles = faces.all_triangles();
+    // The face of each corner, when faces are not all triangles (else corner / 3).
+    let face_of: Vec<u32> = if triangles {
+        Vec::new()
+    } else {
+        let mut f = vec![0u32; idx.len()];
+        for i in 0..faces.len() {
+            let (a, b) = (faces.starts[i] as usize, faces.starts[i + 1] as usize);
+            f[a..b].fill(i as u32);
+        }
+        f
+    };
+    let face = |c: usize| -> u32 {
+        if triangles {
+            (c / 3) as u32
+        } else {
+            face_of[c]
+        }
+    };
+    let next = |c: usize| -> usize {
+        if triangles {
+            if c % 3 == 2 {
+                c - 2
+            } else {
+                c + 1
+            }
+        } else {
+            let f = face_of[c] as usize;
+            if c + 1 == faces.starts[f + 1] as usize {
+                faces.starts[f] as usize
+            } else {
+                c + 1
+            }
+        }
+    };
+    // Out-going half-edges of each vertex: their corners and end vertices.
+    let mut start = vec![0u32; n + 1];
+    for &u in idx {
+        start[u as usize + 1] += 1;
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut corner = vec![0u32; idx.len()];
+    let mut end = vec![0u32; idx.len()];
+    for c in 0..idx.len() {
+        let u = idx[c] as usize;
+        let s = fill[u] as usize;
+        corner[s] = c as u32;
+        end[s] = idx[next(c)];
+        fill[u] += 1;
+    }
+    drop(fill);
+    let mut pairs = Vec::with_capacity(idx.len() / 2);
+    for u in 0..n {
+        for s in start[u] as usize..start[u + 1] as usize {
+            let v = end[s] as usize;
+            if v == u {
+                return None;
+            }
+            let mut twin = None;
+            for t in start[v] as usize..start[v + 1] as usize {
+                if end[t] as usize == u {
+                    if twin.is_some() {
+                        return None;
+                    }
+                    twin = Some(t);
+                }
+            }
+            let t = twin?;
+            if u < v {
+                pairs.push((face(corner[s] as usize), face(corner[t] as usize), false));
+            }
+        }
+    }
+    Some(pairs)
 }
 
 /// A consistent orientation of each connected component (over manifold edges): per-face flips,
