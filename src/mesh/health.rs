@@ -290,42 +290,8 @@ fn edges(faces: &Polygons) -> Edges {
 fn closed_consistent_pairs(faces: &Polygons) -> Option<Vec<(u32, u32, bool)>> {
     let idx = &faces.indices;
     let n = *idx.iter().max()? as usize + 1;
-    let triangles = faces.all_triangles();
-    // The face of each corner, when faces are not all triangles (else corner / 3).
-    let face_of: Vec<u32> = if triangles {
-        Vec::new()
-    } else {
-        let mut f = vec![0u32; idx.len()];
-        for i in 0..faces.len() {
-            let (a, b) = (faces.starts[i] as usize, faces.starts[i + 1] as usize);
-            f[a..b].fill(i as u32);
-        }
-        f
-    };
-    let face = |c: usize| -> u32 {
-        if triangles {
-            (c / 3) as u32
-        } else {
-            face_of[c]
-        }
-    };
-    let next = |c: usize| -> usize {
-        if triangles {
-            if c % 3 == 2 {
-                c - 2
-            } else {
-                c + 1
-            }
-        } else {
-            let f = face_of[c] as usize;
-            if c + 1 == faces.starts[f + 1] as usize {
-                faces.starts[f] as usize
-            } else {
-                c + 1
-            }
-        }
-    };
-    // Out-going half-edges of each vertex: their corners and end vertices.
+    let h = idx.len();
+    // Out-going half-edges of each vertex, `start[u]..start[u + 1]`: end vertex and face.
     let mut start = vec![0u32; n + 1];
     for &u in idx {
         start[u as usize + 1] += 1;
@@ -333,40 +299,55 @@ fn closed_consistent_pairs(faces: &Polygons) -> Option<Vec<(u32, u32, bool)>> {
     for i in 0..n {
         start[i + 1] += start[i];
     }
-    let mut fill = start.clone();
-    let mut corner = vec![0u32; idx.len()];
-    let mut end = vec![0u32; idx.len()];
-    for c in 0..idx.len() {
-        let u = idx[c] as usize;
-        let s = fill[u] as usize;
-        corner[s] = c as u32;
-        end[s] = idx[next(c)];
-        fill[u] += 1;
-    }
-    drop(fill);
-    let mut pairs = Vec::with_capacity(idx.len() / 2);
-    for u in 0..n {
-        for s in start[u] as usize..start[u + 1] as usize {
-            let v = end[s] as usize;
-            if v == u {
-                return None;
-            }
-            let mut twin = None;
-            for t in start[v] as usize..start[v + 1] as usize {
-                if end[t] as usize == u {
-                    if twin.is_some() {
-                        return None;
-                    }
-                    twin = Some(t);
-                }
-            }
-            let t = twin?;
-            if u < v {
-                pairs.push((face(corner[s] as usize), face(corner[t] as usize), false));
+    let mut fill = start[..n].to_vec();
+    let mut end = vec![0u32; h];
+    let mut face = vec![0u32; h];
+    let mut put = |u: u32, v: u32, f: u32| {
+        let s = fill[u as usize] as usize;
+        fill[u as usize] += 1;
+        end[s] = v;
+        face[s] = f;
+    };
+    if faces.all_triangles() {
+        for (f, t) in idx.chunks_exact(3).enumerate() {
+            put(t[0], t[1], f as u32);
+            put(t[1], t[2], f as u32);
+            put(t[2], t[0], f as u32);
+        }
+    } else {
+        for (f, p) in faces.iter().enumerate() {
+            for k in 0..p.len() {
+                put(p[k], p[(k + 1) % p.len()], f as u32);
             }
         }
     }
-    Some(pairs)
+    drop(fill);
+    // Each half-edge u → v with u < v must be alone in u's list and find exactly one v → u; when
+    // those pairs account for every half-edge, no half-edge v → u is left without its twin.
+    let mut pairs = Vec::with_capacity(h / 2);
+    for u in 0..n {
+        let out = start[u] as usize..start[u + 1] as usize;
+        for s in out.clone() {
+            let v = end[s] as usize;
+            if v <= u {
+                if v == u {
+                    return None;
+                }
+                continue;
+            }
+            if end[out.start..s].contains(&(v as u32)) {
+                return None;
+            }
+            let back = &end[start[v] as usize..start[v + 1] as usize];
+            let mut twins = back.iter().enumerate().filter(|(_, &w)| w as usize == u);
+            let (t, _) = twins.next()?;
+            if twins.next().is_some() {
+                return None;
+            }
+            pairs.push((face[s], face[start[v] as usize + t], false));
+        }
+    }
+    (2 * pairs.len() == h).then_some(pairs)
 }
 
 /// A consistent orientation of each connected component (over manifold edges): per-face flips,
