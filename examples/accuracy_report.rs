@@ -4,7 +4,9 @@
 //! the `cmeel.prefix/share` directory of example-robot-data (as `validation/run.sh` installs it), it also
 //! times filling every URDF of the corpus and loading every collision mesh once. With `PEERS_PYTHON` set to
 //! a Python that has coal and trimesh (e.g. `validation/.venv/bin/python` plus `pip install trimesh`), it
-//! runs them on the same meshes through `validation/peers.py`.
+//! runs them on the same meshes through `validation/peers.py`, and on the 1.3 M-face STL of the pipeline
+//! section (loading included). The pipeline section runs the `urdf-inertia` binary next to this example
+//! (`cargo build --release` first); `URDF_INERTIA_REPORT_HUGE=1` adds a 5.2 M-face sphere to its table.
 //!
 //! Every error is against exact rational arithmetic on the stored mesh (tests/common's reference).
 
@@ -614,6 +616,7 @@ fn main() -> std::io::Result<()> {
             writeln!(md, "\nSet `EXAMPLE_ROBOT_DATA_SHARE` to time the example-robot-data corpus end to end.").ok();
         }
     }
+    pipeline_section(&mut md)?;
     let share = std::env::var("EXAMPLE_ROBOT_DATA_SHARE").ok();
     ladder::section(&mut md, share.as_deref().map(std::path::Path::new));
     std::fs::write("docs/accuracy.md", md)?;
@@ -816,4 +819,246 @@ fn svg(points: &[(usize, f64, f64)]) -> String {
     );
     s += &format!("<text x=\"15\" y=\"{}\" transform=\"rotate(-90 15 {})\" text-anchor=\"middle\">relative error, central inertia</text>\n</svg>\n", (t + h - b) / 2.0, (t + h - b) / 2.0);
     s
+}
+
+/// A binary STL of the icosphere `level` (radius 0.1 m, moved off the origin as real parts are).
+fn pipeline_stl(level: u32) -> (Vec<u8>, usize) {
+    let (v, f) = icosphere(level);
+    let v: Vec<[f64; 3]> = v
+        .iter()
+        .map(|p| [0.1 * p[0] + 0.3, 0.1 * p[1] - 0.1, 0.1 * p[2] + 0.05])
+        .collect();
+    (
+        urdf_inertia::mesh::stl::write_binary(b"pipeline", &v, &f),
+        f.len(),
+    )
+}
+
+/// The mesh pipeline per stage and size on one core, the whole `urdf-inertia mesh` process on 1 and
+/// 2 threads with its peak memory, and coal and trimesh loading and integrating the same file.
+fn pipeline_section(md: &mut String) -> std::io::Result<()> {
+    use std::path::Path;
+    use urdf_inertia::mesh::{health, solid_from_raw, stl, weld};
+    let path = Path::new("pipeline.stl");
+    writeln!(md, "\n## The mesh pipeline per face\n").ok();
+    writeln!(md, "Binary STL spheres (icosphere levels 4 to 9) read from memory and turned into a solid on one core (a one-thread rayon pool): medians of repeated runs. read: bytes to a mesh, corners welded as they are read; weld: the health step's exact weld; integrate: one evaluation of the ten integrals (a clean mesh takes three: sign, value, and the round-off estimate about a second reference point); edges + ladder: heal less weld and three integrations (the edge analysis and the ladder's own passes); heal: all of `make_solid`; end to end: read + heal. Linear time is a flat column.\n").ok();
+    writeln!(md, "| faces | file MB | read | weld | integrate | edges + ladder | heal | end to end | end to end, 2 threads |\n|---|---|---|---|---|---|---|---|---|").ok();
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("pool");
+    let two = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .expect("pool");
+    let mut levels = vec![4u32, 5, 6, 7, 8, 9];
+    if std::env::var_os("URDF_INERTIA_REPORT_HUGE").is_some() {
+        levels.push(10);
+    }
+    let mut e2e_per_face: Vec<(usize, f64)> = Vec::new();
+    for level in levels {
+        let (bytes, n) = pipeline_stl(level);
+        let budget = if level >= 8 { 3.0 } else { 0.5 };
+        let per = |secs: f64| secs * 1e9 / n as f64;
+        let raw = stl::parse(&bytes, path).expect("parse");
+        let (read, weld_t, integrate, heal, e2e) = one.install(|| {
+            let read = time(budget, || stl::parse(&bytes, path).map(|m| m.faces.len()));
+            let weld_t = time(budget, || {
+                weld::exact(&raw.vertices, &raw.faces).faces.len()
+            });
+            let w = weld::exact(&raw.vertices, &raw.faces);
+            let integrate = time(budget, || {
+                volume_integrals(&w.vertices, &w.faces, &IntegrationOptions::accurate())
+            });
+            let heal = time(budget, || {
+                health::make_solid_stored_as(&raw, path, Default::default(), || {
+                    weld::Precision::F32
+                })
+                .map(|s| s.unit.mass)
+            });
+            let e2e = time(budget, || {
+                stl::parse(&bytes, path)
+                    .and_then(|m| solid_from_raw(&m, [1.0; 3], path, Default::default()))
+                    .map(|s| s.unit.mass)
+            });
+            (read, weld_t, integrate, heal, e2e)
+        });
+        let e2e2 = two.install(|| {
+            time(budget, || {
+                stl::parse(&bytes, path)
+                    .and_then(|m| solid_from_raw(&m, [1.0; 3], path, Default::default()))
+                    .map(|s| s.unit.mass)
+            })
+        });
+        writeln!(
+            md,
+            "| {n} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |",
+            bytes.len() as f64 / 1e6,
+            per(read),
+            per(weld_t),
+            per(integrate),
+            per(heal - weld_t - 3.0 * integrate),
+            per(heal),
+            per(e2e),
+            per(e2e2)
+        )
+        .ok();
+        e2e_per_face.push((n, per(e2e)));
+        eprintln!("pipeline level {level} done");
+    }
+    let load = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|l| l.split_whitespace().next().map(str::to_string))
+        .unwrap_or_else(|| "?".into());
+    if let (Some(first), Some(last)) = (e2e_per_face.first(), e2e_per_face.last()) {
+        writeln!(md, "\nAll figures in ns per face. From {} to {} faces the end-to-end cost per face grows {:.1}×: not linear yet, most likely because the working set (vertex table, edge buckets) outgrows the caches (not profiled per size). Load average at the end of these runs: {load} (timings on a shared machine are noisy; callgrind instruction counts in the commit messages are not).", first.0, last.0, last.1 / first.1).ok();
+    }
+
+    // The whole process on the 1.3 M-face file, and the peers on the same file.
+    let (bytes, n) = pipeline_stl(9);
+    let file =
+        std::env::temp_dir().join(format!("urdf-inertia-pipeline-{}.stl", std::process::id()));
+    std::fs::write(&file, &bytes)?;
+    let exe = std::env::current_exe()?
+        .parent()
+        .and_then(|p| p.parent())
+        .map(|p| p.join("urdf-inertia"));
+    writeln!(
+        md,
+        "\n### `urdf-inertia mesh` on a {n}-face binary STL ({:.1} MB)\n",
+        bytes.len() as f64 / 1e6
+    )
+    .ok();
+    match exe.filter(|e| e.exists()) {
+        Some(exe) if Path::new("/usr/bin/time").exists() => {
+            writeln!(md, "The whole process (start, read the file, heal, integrate, print JSON), page cache warm; wall time and peak resident memory from `/usr/bin/time -v`, median of 5 runs.\n").ok();
+            writeln!(md, "| threads | wall s | ns/face | peak MB | peak / file size |\n|---|---|---|---|---|").ok();
+            for threads in [1, 2] {
+                let mut runs: Vec<(f64, f64)> = Vec::new();
+                for _ in 0..5 {
+                    let out = std::process::Command::new("/usr/bin/time")
+                        .arg("-v")
+                        .arg(&exe)
+                        .args(["mesh", "--format", "json"])
+                        .arg(&file)
+                        .env("RAYON_NUM_THREADS", threads.to_string())
+                        .output()?;
+                    let err = String::from_utf8_lossy(&out.stderr);
+                    let field = |name: &str| {
+                        err.lines()
+                            .find_map(|l| l.trim().strip_prefix(name))
+                            .map(|v| v.trim().to_string())
+                    };
+                    let wall = field("Elapsed (wall clock) time (h:mm:ss or m:ss):")
+                        .map(|t| {
+                            t.split(':')
+                                .fold(0.0, |acc, x| acc * 60.0 + x.parse::<f64>().unwrap_or(0.0))
+                        })
+                        .unwrap_or(f64::NAN);
+                    let kb = field("Maximum resident set size (kbytes):")
+                        .and_then(|k| k.parse::<f64>().ok())
+                        .unwrap_or(f64::NAN);
+                    runs.push((wall, kb * 1024.0));
+                }
+                runs.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let (wall, peak) = runs[runs.len() / 2];
+                writeln!(
+                    md,
+                    "| {threads} | {wall:.2} | {:.0} | {:.0} | {:.2} |",
+                    wall * 1e9 / n as f64,
+                    peak / 1e6,
+                    peak / bytes.len() as f64
+                )
+                .ok();
+            }
+        }
+        _ => {
+            writeln!(md, "Build the binary (`cargo build --release`) and install GNU time to measure the whole process.").ok();
+        }
+    }
+    if let Ok(python) = std::env::var("PEERS_PYTHON") {
+        // Exact rationals of the stored (f32) mesh, and ours through the pipeline.
+        let raw = urdf_inertia::mesh::stl::parse(&bytes, path).expect("parse");
+        let tris: Vec<[u32; 3]> = raw.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
+        let exact = exact_mass(&exact_integrals(&raw.vertices, &tris));
+        let t0 = Instant::now();
+        let ours =
+            urdf_inertia::mesh::load_solid(&file, [1.0; 3], Default::default()).expect("solid");
+        let ours_secs = t0.elapsed().as_secs_f64();
+        let script = r#"
+import json, sys, time
+import numpy as np
+path = sys.argv[1]
+out = {}
+try:
+    import coal
+    t = time.perf_counter(); m = coal.MeshLoader().load(path); load = time.perf_counter() - t
+    t = time.perf_counter(); m.computeVolume(); m.computeCOM(); i = m.computeMomentofInertiaRelatedToCOM(); comp = time.perf_counter() - t
+    out["coal " + coal.__version__] = {"load": load, "compute": comp, "inertia": np.asarray(i).tolist()}
+except Exception as e:
+    out["coal"] = {"error": str(e)}
+try:
+    import trimesh
+    t = time.perf_counter(); m = trimesh.load(path, force="mesh"); load = time.perf_counter() - t
+    t = time.perf_counter(); mp = trimesh.triangles.mass_properties(m.triangles, density=1.0, skip_inertia=False); comp = time.perf_counter() - t
+    out["trimesh " + trimesh.__version__] = {"load": load, "compute": comp, "inertia": np.asarray(mp["inertia"]).tolist()}
+except Exception as e:
+    out["trimesh"] = {"error": str(e)}
+print(json.dumps(out))
+"#;
+        let out = std::process::Command::new(python)
+            .args(["-c", script])
+            .arg(&file)
+            .output()?;
+        writeln!(md, "\nPeers on the same file in the same run, loading included (one run each; coal loads through assimp and builds its BVH). Error: relative Frobenius error of the central inertia against exact rationals on the stored mesh.\n").ok();
+        writeln!(
+            md,
+            "| tool | load s | mass properties s | total ns/face | error |\n|---|---|---|---|---|"
+        )
+        .ok();
+        writeln!(
+            md,
+            "| urdf-inertia (load_solid, all threads) | - | - | {:.0} | {} |",
+            ours_secs * 1e9 / n as f64,
+            e(inertia_error(&ours.unit.inertia, &exact.inertia))
+        )
+        .ok();
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_default();
+        if let Some(tools) = v.as_object() {
+            for (tool, r) in tools {
+                if let Some(err) = r.get("error") {
+                    writeln!(
+                        md,
+                        "| {tool} | fails: {} | | | |",
+                        err.as_str().unwrap_or("?")
+                    )
+                    .ok();
+                    continue;
+                }
+                let load = r["load"].as_f64().unwrap_or(f64::NAN);
+                let comp = r["compute"].as_f64().unwrap_or(f64::NAN);
+                let mut i = [[f64::NAN; 3]; 3];
+                if let Some(rows) = r["inertia"].as_array() {
+                    for (a, row) in rows.iter().enumerate().take(3) {
+                        for (b, x) in row.as_array().into_iter().flatten().enumerate().take(3) {
+                            i[a][b] = x.as_f64().unwrap_or(f64::NAN);
+                        }
+                    }
+                }
+                let err = if i.iter().flatten().all(|x| x.is_finite()) {
+                    e(inertia_error(&i, &exact.inertia))
+                } else {
+                    "inf".into()
+                };
+                writeln!(
+                    md,
+                    "| {tool} | {load:.2} | {comp:.3} | {:.0} | {err} |",
+                    (load + comp) * 1e9 / n as f64
+                )
+                .ok();
+            }
+        }
+    }
+    let _ = std::fs::remove_file(&file);
+    Ok(())
 }

@@ -225,6 +225,36 @@ impl Accumulator {
         }
     }
 
+    /// Adds the first `len` lanes of a batch, lane by lane: the same additions in the same order as
+    /// `len` calls of [`Accumulator::add`]. A batch never straddles a block (it is one).
+    #[inline(always)]
+    fn add_batch(&mut self, t: &[[f64; LANES]; 10], len: usize) {
+        match self.summation {
+            Summation::Plain => {
+                for k in 0..10 {
+                    let mut s = self.sum[k];
+                    for x in &t[k][..len] {
+                        s += x;
+                    }
+                    self.sum[k] = s;
+                }
+            }
+            Summation::Compensated => {
+                for k in 0..10 {
+                    let mut s = self.block[k];
+                    for x in &t[k][..len] {
+                        s += x;
+                    }
+                    self.block[k] = s;
+                }
+                self.in_block += len as u32;
+                if self.in_block == BLOCK {
+                    self.flush();
+                }
+            }
+        }
+    }
+
     #[inline(always)]
     fn flush(&mut self) {
         for k in 0..10 {
@@ -345,53 +375,111 @@ pub fn triangle_integrals(
     // Shift every vertex once (a vertex is shared by about six triangles).
     let shifted: Vec<[f64; 3]> = vertices.iter().map(|&v| sub(v, reference)).collect();
     let mut acc = Accumulator::new(options.summation);
+    let mut batch = Batch::new();
     for t in triangles {
-        let a = &shifted[t[0] as usize];
-        let b = &shifted[t[1] as usize];
-        let c = &shifted[t[2] as usize];
-        acc.add(&triangle_terms(a, b, c, options.accurate_faces));
+        batch.push(
+            shifted[t[0] as usize],
+            shifted[t[1] as usize],
+            shifted[t[2] as usize],
+        );
+        if batch.len == LANES {
+            acc.add_batch(&batch.terms(options.accurate_faces), LANES);
+            batch.len = 0;
+        }
+    }
+    if batch.len > 0 {
+        acc.add_batch(&batch.terms(options.accurate_faces), batch.len);
     }
     finish(acc.total(), reference, [6.0, 24.0, 120.0, 120.0])
 }
 
-/// The raw (unscaled) contributions of one triangle, relative to the reference point.
-#[inline(always)]
-fn triangle_terms(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3], accurate: bool) -> [f64; 10] {
-    let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    let n = [
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
-    ];
-    let mut d = a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
-    if accurate {
-        // The rounding error of d is about eps·|a|·|e1|·|e2|: large against d when the plane passes
-        // near the reference point (a thin plate's big faces) or when the edges are nearly parallel
-        // (its long side faces, a needle). Then d is re-evaluated from a, b, c with error-free
-        // products. 2^-12 keeps the plain evaluation within ~4096 eps of d, near-ulp for the sum;
-        // well-shaped faces of a mesh around its centre never take the slow path.
-        let aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-        let ee = (e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2])
-            * (e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
-        if d * d * 16_777_216.0 < aa * ee {
-            d = accurate_triple(a, b, c);
+/// Triangles gathered for one block of the compensated sum, as lanes (structure of arrays) so that the
+/// per-triangle arithmetic runs on all of them at once and the compiler vectorises it. The lanes are
+/// summed in order, so the results are bit for bit those of one triangle at a time.
+struct Batch {
+    /// Corner coordinates relative to the reference point: `p[corner][axis][lane]`.
+    p: [[[f64; LANES]; 3]; 3],
+    len: usize,
+}
+
+/// Triangles per batch: the compensated block.
+const LANES: usize = BLOCK as usize;
+
+impl Batch {
+    fn new() -> Self {
+        Batch {
+            p: [[[0.0; LANES]; 3]; 3],
+            len: 0,
         }
     }
-    let s = [a[0] + b[0] + c[0], a[1] + b[1] + c[1], a[2] + b[2] + c[2]];
-    let q = |i: usize, j: usize| a[i] * a[j] + b[i] * b[j] + c[i] * c[j];
-    [
-        d,
-        d * s[0],
-        d * s[1],
-        d * s[2],
-        d * (q(0, 0) + s[0] * s[0]),
-        d * (q(1, 1) + s[1] * s[1]),
-        d * (q(2, 2) + s[2] * s[2]),
-        d * (q(0, 1) + s[0] * s[1]),
-        d * (q(1, 2) + s[1] * s[2]),
-        d * (q(2, 0) + s[2] * s[0]),
-    ]
+
+    #[inline(always)]
+    fn push(&mut self, a: [f64; 3], b: [f64; 3], c: [f64; 3]) {
+        let l = self.len;
+        for k in 0..3 {
+            self.p[0][k][l] = a[k];
+            self.p[1][k][l] = b[k];
+            self.p[2][k][l] = c[k];
+        }
+        self.len += 1;
+    }
+
+    /// The raw contributions of the batch's triangles, `terms[integral][lane]` (lanes past `len` are
+    /// zero triangles and contribute 0).
+    #[inline(always)]
+    fn terms(&self, accurate: bool) -> [[f64; LANES]; 10] {
+        let [a, b, c] = &self.p;
+        let mut d = [0.0; LANES];
+        let mut slow = [false; LANES];
+        for l in 0..LANES {
+            let e1 = [b[0][l] - a[0][l], b[1][l] - a[1][l], b[2][l] - a[2][l]];
+            let e2 = [c[0][l] - a[0][l], c[1][l] - a[1][l], c[2][l] - a[2][l]];
+            let n = [
+                e1[1] * e2[2] - e1[2] * e2[1],
+                e1[2] * e2[0] - e1[0] * e2[2],
+                e1[0] * e2[1] - e1[1] * e2[0],
+            ];
+            d[l] = a[0][l] * n[0] + a[1][l] * n[1] + a[2][l] * n[2];
+            // The rounding error of d is about eps·|a|·|e1|·|e2|: large against d when the plane
+            // passes near the reference point (a thin plate's big faces) or when the edges are nearly
+            // parallel (its long side faces, a needle). Then d is re-evaluated from a, b, c with
+            // error-free products. 2^-12 keeps the plain evaluation within ~4096 eps of d, near-ulp
+            // for the sum; well-shaped faces of a mesh around its centre never take the slow path.
+            let aa = a[0][l] * a[0][l] + a[1][l] * a[1][l] + a[2][l] * a[2][l];
+            let ee = (e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2])
+                * (e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
+            slow[l] = d[l] * d[l] * 16_777_216.0 < aa * ee;
+        }
+        if accurate {
+            for l in 0..self.len {
+                if slow[l] {
+                    let g = |p: &[[f64; LANES]; 3]| [p[0][l], p[1][l], p[2][l]];
+                    d[l] = accurate_triple(&g(a), &g(b), &g(c));
+                }
+            }
+        }
+        let mut out = [[0.0; LANES]; 10];
+        for l in 0..LANES {
+            let s = [
+                a[0][l] + b[0][l] + c[0][l],
+                a[1][l] + b[1][l] + c[1][l],
+                a[2][l] + b[2][l] + c[2][l],
+            ];
+            let q = |i: usize, j: usize| a[i][l] * a[j][l] + b[i][l] * b[j][l] + c[i][l] * c[j][l];
+            let dl = d[l];
+            out[0][l] = dl;
+            out[1][l] = dl * s[0];
+            out[2][l] = dl * s[1];
+            out[3][l] = dl * s[2];
+            out[4][l] = dl * (q(0, 0) + s[0] * s[0]);
+            out[5][l] = dl * (q(1, 1) + s[1] * s[1]);
+            out[6][l] = dl * (q(2, 2) + s[2] * s[2]);
+            out[7][l] = dl * (q(0, 1) + s[0] * s[1]);
+            out[8][l] = dl * (q(1, 2) + s[1] * s[2]);
+            out[9][l] = dl * (q(2, 0) + s[2] * s[0]);
+        }
+        out
+    }
 }
 
 /// The paper's algorithm (Figures 4–6) over planar polygons, about the options' reference point.
@@ -590,8 +678,47 @@ pub fn volume_integrals(
     options: &IntegrationOptions,
 ) -> VolumeIntegrals {
     let reference = options.reference_for(vertices);
+    let n = faces.len();
+    let raw = if options.summation == Summation::Compensated && n > CHUNK {
+        // Fixed chunks, whatever the number of threads, each summed with compensation and combined
+        // in chunk order as double-doubles: the same bits for any thread count.
+        use rayon::prelude::*;
+        let chunks: Vec<([f64; 10], [f64; 10])> = (0..n.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let range = c * CHUNK..((c + 1) * CHUNK).min(n);
+                fan_sums(vertices, range.map(|i| faces.face(i)), reference, options)
+            })
+            .collect();
+        let mut hi = [0.0; 10];
+        let mut lo = [0.0; 10];
+        for (h, l) in chunks {
+            for k in 0..10 {
+                let (s, e) = two_sum(hi[k], h[k]);
+                hi[k] = s;
+                lo[k] += e + l[k];
+            }
+        }
+        (hi, lo)
+    } else {
+        fan_sums(vertices, faces.iter(), reference, options)
+    };
+    finish(raw, reference, [6.0, 24.0, 120.0, 120.0])
+}
+
+/// Faces per chunk of a parallel integration (meshes up to this size are summed in one sequence).
+const CHUNK: usize = 1 << 15;
+
+/// The sums of [`volume_integrals`] over `faces`, each fanned into triangles (as double-doubles).
+fn fan_sums<'a>(
+    vertices: &[[f64; 3]],
+    faces: impl Iterator<Item = &'a [u32]>,
+    reference: [f64; 3],
+    options: &IntegrationOptions,
+) -> ([f64; 10], [f64; 10]) {
     let mut acc = Accumulator::new(options.summation);
-    for face in faces.iter() {
+    let mut batch = Batch::new();
+    for face in faces {
         if face.len() < 3 {
             continue;
         }
@@ -599,10 +726,17 @@ pub fn volume_integrals(
         for k in 1..face.len() - 1 {
             let b = sub(vertices[face[k] as usize], reference);
             let c = sub(vertices[face[k + 1] as usize], reference);
-            acc.add(&triangle_terms(&a, &b, &c, options.accurate_faces));
+            batch.push(a, b, c);
+            if batch.len == LANES {
+                acc.add_batch(&batch.terms(options.accurate_faces), LANES);
+                batch.len = 0;
+            }
         }
     }
-    finish(acc.total(), reference, [6.0, 24.0, 120.0, 120.0])
+    if batch.len > 0 {
+        acc.add_batch(&batch.terms(options.accurate_faces), batch.len);
+    }
+    acc.total()
 }
 
 impl VolumeIntegrals {
@@ -806,6 +940,53 @@ mod tests {
         assert_eq!(t.to_array(), [0.0; 10]);
         let t = triangle_integrals(&v, &[[0, 1, 2], [1, 1, 1]], &IntegrationOptions::accurate());
         assert_eq!(t.to_array(), [0.0; 10]);
+    }
+
+    /// Issue 14: a mesh integrated in parallel chunks gives the same bits on any number of threads.
+    #[test]
+    fn parallel_chunks_are_deterministic() {
+        // A (non-closed, it does not matter here) grid of 2 · 200² triangles, above one chunk.
+        let n = 201u32;
+        let v: Vec<[f64; 3]> = (0..n * n)
+            .map(|i| {
+                let (x, y) = (f64::from(i % n), f64::from(i / n));
+                [
+                    x * 0.01 + 3.0,
+                    y * 0.01 - 1.0,
+                    (x * 0.3).sin() * (y * 0.2).cos(),
+                ]
+            })
+            .collect();
+        let mut tris = Vec::new();
+        for y in 0..n - 1 {
+            for x in 0..n - 1 {
+                let i = y * n + x;
+                tris.push([i, i + 1, i + n]);
+                tris.push([i + 1, i + n + 1, i + n]);
+            }
+        }
+        let faces = Polygons::from_triangles(&tris);
+        assert!(faces.len() > CHUNK);
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("pool");
+            let t = pool.install(|| volume_integrals(&v, &faces, &IntegrationOptions::accurate()));
+            (t.to_array().map(f64::to_bits), t.low.map(f64::to_bits))
+        };
+        let one = run(1);
+        assert_eq!(one, run(2));
+        assert_eq!(one, run(3));
+        // And the chunked sum agrees with one sequential triangle sum to round-off.
+        let seq = triangle_integrals(&v, &tris, &IntegrationOptions::accurate()).to_array();
+        for k in 0..10 {
+            let par = f64::from_bits(one.0[k]);
+            assert!(
+                (par - seq[k]).abs() <= 1e-15 * seq[k].abs().max(1e-300),
+                "T[{k}]"
+            );
+        }
     }
 
     #[test]

@@ -234,7 +234,17 @@ impl Edges {
     }
 }
 
+/// The edge structure of `faces`. A closed, consistently wound surface (the common case) is proven so
+/// by [`closed_consistent_pairs`], which builds only the face pairs; anything else gets the full
+/// analysis below (a sort of every half-edge by its undirected key), whose boundary edges come in key
+/// order.
 fn edges(faces: &Polygons) -> Edges {
+    if let Some(pairs) = closed_consistent_pairs(faces) {
+        return Edges {
+            pairs,
+            ..Edges::default()
+        };
+    }
     let mut rec: Vec<(u64, u32, bool)> = Vec::with_capacity(faces.indices.len());
     for (fi, face) in faces.iter().enumerate() {
         for k in 0..face.len() {
@@ -276,6 +286,91 @@ fn edges(faces: &Polygons) -> Edges {
         i = j;
     }
     e
+}
+
+/// The faces sharing each edge when every directed edge `u → v` of `faces` has exactly one twin
+/// `v → u` (then each undirected edge has one half-edge each way: closed, edge-manifold, consistently
+/// wound); `None` otherwise. Half-edges are bucketed by their start vertex (a counting sort of the
+/// corners), so the check costs a few linear passes instead of a sort; pairs come in order of their
+/// smaller vertex.
+fn closed_consistent_pairs(faces: &Polygons) -> Option<Vec<(u32, u32, bool)>> {
+    let idx = &faces.indices;
+    let n = *idx.iter().max()? as usize + 1;
+    if faces.all_triangles() {
+        let next = |c: usize| if c % 3 == 2 { c - 2 } else { c + 1 };
+        return twin_pairs(idx, n, |c| idx[next(c)], |c| (c / 3) as u32);
+    }
+    let mut face_of = vec![0u32; idx.len()];
+    for i in 0..faces.len() {
+        let (a, b) = (faces.starts[i] as usize, faces.starts[i + 1] as usize);
+        face_of[a..b].fill(i as u32);
+    }
+    let next = |c: usize| {
+        let f = face_of[c] as usize;
+        if c + 1 == faces.starts[f + 1] as usize {
+            faces.starts[f] as usize
+        } else {
+            c + 1
+        }
+    };
+    twin_pairs(idx, n, |c| idx[next(c)], |c| face_of[c])
+}
+
+/// [`closed_consistent_pairs`] over the corners `idx` of `n` vertices, given each corner's half-edge
+/// end and face. Only the corners are bucketed (4 bytes per half-edge): the ends are read back through
+/// `end`, which for a mesh in any spatially coherent order stays in cache.
+fn twin_pairs(
+    idx: &[u32],
+    n: usize,
+    end: impl Fn(usize) -> u32,
+    face: impl Fn(usize) -> u32,
+) -> Option<Vec<(u32, u32, bool)>> {
+    let h = idx.len();
+    // Corners starting at vertex u: `corner[start[u]..start[u + 1]]`.
+    let mut start = vec![0u32; n + 1];
+    for &u in idx {
+        start[u as usize + 1] += 1;
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start[..n].to_vec();
+    let mut corner = vec![0u32; h];
+    for (c, &u) in idx.iter().enumerate() {
+        let s = &mut fill[u as usize];
+        corner[*s as usize] = c as u32;
+        *s += 1;
+    }
+    drop(fill);
+    // Each half-edge u → v with u < v must be alone in u's list and find exactly one v → u; when
+    // those pairs account for every half-edge, no half-edge v → u is left without its twin.
+    let mut pairs = Vec::with_capacity(h / 2);
+    let mut ends: Vec<u32> = Vec::new();
+    for u in 0..n {
+        let out = &corner[start[u] as usize..start[u + 1] as usize];
+        ends.clear();
+        ends.extend(out.iter().map(|&c| end(c as usize)));
+        for (i, &v) in ends.iter().enumerate() {
+            let v = v as usize;
+            if v <= u {
+                if v == u {
+                    return None;
+                }
+                continue;
+            }
+            if ends[..i].contains(&(v as u32)) {
+                return None;
+            }
+            let back = &corner[start[v] as usize..start[v + 1] as usize];
+            let mut twins = back.iter().filter(|&&c| end(c as usize) as usize == u);
+            let &t = twins.next()?;
+            if twins.next().is_some() {
+                return None;
+            }
+            pairs.push((face(out[i] as usize), face(t as usize), false));
+        }
+    }
+    (2 * pairs.len() == h).then_some(pairs)
 }
 
 /// A consistent orientation of each connected component (over manifold edges): per-face flips,

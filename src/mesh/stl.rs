@@ -11,11 +11,15 @@
 //! while reading, and the health step welds anyway), gives ASCII errors a line number, and reports a
 //! truncated or miscounted binary file with the numbers a user needs.
 
+use super::weld::VertexTable;
 use super::{parse_f64, MeshError, MeshErrorKind, RawMesh};
 use crate::mass::Polygons;
 use std::path::Path;
 
-/// Parses STL bytes (binary or ASCII). Vertices are not welded: each triangle has its own three.
+/// Parses STL bytes (binary or ASCII). Corners with bit-identical coordinates share one vertex, in
+/// order of first appearance: the exact weld the health step does anyway, done while reading so that
+/// three vertices per triangle are never stored. Faces are kept as the file has them (a triangle with
+/// two equal corners included; the health step drops and counts it).
 pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     let looks_ascii = {
         let start = bytes
@@ -79,18 +83,18 @@ fn is_text(bytes: &[u8]) -> bool {
 }
 
 fn binary(bytes: &[u8], n: usize, header_count: Option<usize>) -> RawMesh {
-    let mut vertices = Vec::with_capacity(3 * n);
+    // A closed triangle mesh has about half as many vertices as faces.
+    let mut table = VertexTable::with_capacity(n / 2 + 16);
     let mut indices = Vec::with_capacity(3 * n);
-    let f =
-        |o: usize| f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]) as f64;
-    for t in 0..n {
-        let base = 84 + 50 * t + 12; // skip the normal
-        for k in 0..3 {
-            let o = base + 12 * k;
-            vertices.push([f(o), f(o + 4), f(o + 8)]);
-            indices.push((3 * t + k) as u32);
+    let records = bytes[84..84 + 50 * n].chunks_exact(50);
+    for r in records {
+        let f = |o: usize| f64::from(f32::from_le_bytes([r[o], r[o + 1], r[o + 2], r[o + 3]]));
+        // Skip the normal (bytes 0..12); the corners follow.
+        for o in [12, 24, 36] {
+            indices.push(table.insert([f(o), f(o + 4), f(o + 8)]));
         }
     }
+    let vertices = table.into_vertices();
     let starts = (0..=n as u32).map(|i| 3 * i).collect();
     let mut notes = Vec::new();
     if let Some(h) = header_count {
@@ -117,7 +121,7 @@ fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
             )),
         )
     })?;
-    let mut vertices: Vec<[f64; 3]> = Vec::new();
+    let mut vertices = VertexTable::with_capacity(bytes.len() / 512 + 16);
     let mut faces = Polygons::new();
     let mut current: Vec<u32> = Vec::new();
     let mut in_loop = false;
@@ -154,8 +158,7 @@ fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
                         return Err(MeshError::new(path, Some(lineno), MeshErrorKind::NotFinite));
                     }
                 }
-                current.push(vertices.len() as u32);
-                vertices.push(p);
+                current.push(vertices.insert(p));
             }
             "outer" => {
                 in_loop = true;
@@ -190,7 +193,7 @@ fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         ));
     }
     Ok(RawMesh {
-        vertices,
+        vertices: vertices.into_vertices(),
         faces,
         notes: Vec::new(),
         warnings: Vec::new(),

@@ -45,26 +45,119 @@ pub struct ExactWeld {
     pub dropped: usize,
 }
 
+/// Distinct vertices keyed by their bit patterns: an open-addressing table of vertex indices (with a
+/// 32-bit tag of the hash beside each) over the vertex list itself, so a vertex is stored once and a
+/// lookup touches one 8-byte slot and, on a tag match, the vertex. Indices are given in order of first
+/// appearance, which makes the result independent of the table's size and growth.
+///
+/// It replaces a `FxHashMap<[u64; 3], u32>` (32-byte buckets and a second copy of every vertex): on a
+/// 1.3 M-face binary STL that map alone took 128 MiB, and its misses dominated the weld.
+#[derive(Debug, Clone, Default)]
+pub struct VertexTable {
+    vertices: Vec<[f64; 3]>,
+    /// 0: empty; else `tag << 32 | (index + 1)`.
+    slots: Vec<u64>,
+    /// 64 − log2(slots.len()): the slot is the top bits of the hash.
+    shift: u32,
+}
+
+impl VertexTable {
+    /// A table sized for about `expected` distinct vertices (it grows as needed).
+    pub fn with_capacity(expected: usize) -> Self {
+        let mut t = VertexTable {
+            vertices: Vec::with_capacity(expected),
+            slots: Vec::new(),
+            shift: 64,
+        };
+        t.resize((2 * expected).max(16).next_power_of_two());
+        t
+    }
+
+    fn resize(&mut self, size: usize) {
+        self.slots = vec![0; size];
+        self.shift = 64 - size.trailing_zeros();
+        let mask = size - 1;
+        for (i, v) in self.vertices.iter().enumerate() {
+            let h = hash(&v.map(f64::to_bits));
+            let mut s = (h >> self.shift) as usize;
+            while self.slots[s] != 0 {
+                s = (s + 1) & mask;
+            }
+            self.slots[s] = (h << 32) | (i as u64 + 1);
+        }
+    }
+
+    /// The index of the vertex with exactly the bits of `p`, added if new.
+    #[inline]
+    pub fn insert(&mut self, p: [f64; 3]) -> u32 {
+        let bits = p.map(f64::to_bits);
+        let h = hash(&bits);
+        let tag = h << 32;
+        let mask = self.slots.len() - 1;
+        let mut s = (h >> self.shift) as usize;
+        loop {
+            let slot = self.slots[s];
+            if slot == 0 {
+                break;
+            }
+            if slot & 0xffff_ffff_0000_0000 == tag {
+                let i = (slot as u32 - 1) as usize;
+                if self.vertices[i].map(f64::to_bits) == bits {
+                    return i as u32;
+                }
+            }
+            s = (s + 1) & mask;
+        }
+        let i = self.vertices.len();
+        self.vertices.push(p);
+        self.slots[s] = tag | (i as u64 + 1);
+        if 2 * self.vertices.len() > self.slots.len() {
+            self.resize(2 * self.slots.len());
+        }
+        i as u32
+    }
+
+    /// Number of distinct vertices.
+    pub fn len(&self) -> usize {
+        self.vertices.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.vertices.is_empty()
+    }
+
+    /// The distinct vertices, in order of first appearance.
+    pub fn into_vertices(self) -> Vec<[f64; 3]> {
+        self.vertices
+    }
+}
+
+/// Multiplicative hash of three coordinates' bits: the slot is its top bits and the tag its low half,
+/// both depending on every input bit (binary STL's f32 values have 29 zero low bits as f64).
+#[inline(always)]
+fn hash(b: &[u64; 3]) -> u64 {
+    const K: u64 = 0x9e37_79b9_7f4a_7c15;
+    let h = (b[0].wrapping_mul(K) ^ b[1]).wrapping_mul(K) ^ b[2];
+    // Folding the high half down before the last product mixes every bit into the low half too,
+    // which becomes the tag.
+    (h ^ (h >> 29)).wrapping_mul(K)
+}
+
 /// Welds bit-identical vertices and drops faces that collapse to fewer than three distinct vertices.
 pub fn exact(vertices: &[[f64; 3]], faces: &Polygons) -> ExactWeld {
-    let mut map: FxHashMap<[u64; 3], u32> =
-        FxHashMap::with_capacity_and_hasher(vertices.len() / 2, Default::default());
-    let mut out = Vec::new();
+    // Readers that weld as they read (STL) hand over distinct vertices already; raw triangle soups
+    // have about one distinct vertex in six. The table grows either way.
+    let mut table = VertexTable::with_capacity(vertices.len() / 4 + 16);
     let remap: Vec<u32> = vertices
         .iter()
-        .map(|p| {
-            // +0.0 folds -0.0 into 0.0 so that both weld.
-            let q = [p[0] + 0.0, p[1] + 0.0, p[2] + 0.0];
-            *map.entry(q.map(f64::to_bits)).or_insert_with(|| {
-                out.push(q);
-                (out.len() - 1) as u32
-            })
-        })
+        // +0.0 folds -0.0 into 0.0 so that both weld.
+        .map(|p| table.insert([p[0] + 0.0, p[1] + 0.0, p[2] + 0.0]))
         .collect();
+    drop(table.slots);
     let (faces, kept) = remap_faces(faces, &remap);
     let dropped = kept.iter().filter(|k| !**k).count();
     ExactWeld {
-        vertices: out,
+        vertices: table.vertices,
         faces,
         dropped,
     }
@@ -73,11 +166,26 @@ pub fn exact(vertices: &[[f64; 3]], faces: &Polygons) -> ExactWeld {
 /// Faces through a vertex map: runs of a repeated vertex are folded, and faces left with fewer than
 /// three distinct vertices are dropped. Returns the faces kept and, per input face, whether it was kept.
 pub fn remap_faces(faces: &Polygons, remap: &[u32]) -> (Polygons, Vec<bool>) {
-    let mut out = Polygons::new();
+    let mut out = Polygons {
+        indices: Vec::with_capacity(faces.indices.len()),
+        starts: Vec::with_capacity(faces.starts.len().max(1)),
+    };
+    out.starts.push(0);
     let mut kept = Vec::with_capacity(faces.len());
     let mut f: Vec<u32> = Vec::new();
     let mut distinct: Vec<u32> = Vec::new();
     for face in faces.iter() {
+        if let &[a, b, c] = face {
+            // Triangles, the common case: no folding to do unless two corners meet.
+            let (a, b, c) = (remap[a as usize], remap[b as usize], remap[c as usize]);
+            let ok = a != b && b != c && a != c;
+            if ok {
+                out.indices.extend_from_slice(&[a, b, c]);
+                out.starts.push(out.indices.len() as u32);
+            }
+            kept.push(ok);
+            continue;
+        }
         f.clear();
         for &i in face {
             let j = remap[i as usize];
@@ -334,6 +442,21 @@ mod tests {
             tolerance(&v, Precision::F64).base,
             16.0 * f64::EPSILON * (1e3 + 1e-3)
         );
+    }
+
+    #[test]
+    fn vertex_table_numbers_by_first_appearance_through_growth() {
+        let mut t = VertexTable::with_capacity(1);
+        let pts: Vec<[f64; 3]> = (0..1000)
+            .map(|i| [f64::from(i % 37), 0.5, -f64::from(i % 37)])
+            .collect();
+        let ids: Vec<u32> = pts.iter().map(|&p| t.insert(p)).collect();
+        assert_eq!(t.len(), 37);
+        assert!(ids.iter().enumerate().all(|(i, &id)| id == (i % 37) as u32));
+        // -0.0 and 0.0 are different bits to the table; `exact` folds them first.
+        assert_ne!(t.insert([-0.0, 0.5, 0.0]), t.insert([0.0, 0.5, 0.0]));
+        let w = exact(&[[-0.0, 0.0, 0.0], [0.0, 0.0, 0.0]], &Polygons::new());
+        assert_eq!(w.vertices, vec![[0.0, 0.0, 0.0]]);
     }
 
     #[test]
