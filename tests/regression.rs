@@ -1,6 +1,10 @@
 //! Regression tests for issue 13 ("Hardening"), each named after what it covers. The real binary runs in
 //! a temp dir on inputs generated here; nothing depends on timing, and everything holds when run as root.
 
+mod common;
+#[path = "common/gltf_gen.rs"]
+mod gltf_gen;
+
 use std::io::{BufRead, BufReader, Read, Write};
 use std::os::unix::fs::{FileTypeExt, MetadataExt, PermissionsExt};
 use std::path::{Path, PathBuf};
@@ -787,6 +791,278 @@ fn density_map_with_thousands_of_rules() {
     text.push_str("bad = \"unobtainium\"\n");
     let e = DensityMap::parse(&text, Path::new("d.toml")).unwrap_err();
     assert_eq!(e.line, Some(n + 2));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Overlap of a link's parts: bounded work and memory, and a sum over every part.
+
+/// A link `a` whose collisions are `shapes` (`(origin xyz, geometry element)`).
+fn one_link(shapes: &[(String, String)]) -> String {
+    let mut s = String::from("<robot name=\"r\">\n  <link name=\"a\">\n");
+    for (xyz, g) in shapes {
+        s.push_str(&format!(
+            "    <collision><origin xyz=\"{xyz}\"/><geometry>{g}</geometry></collision>\n"
+        ));
+    }
+    s.push_str("  </link>\n</robot>\n");
+    s
+}
+
+/// Issue 13: 200 coincident boxes in one link took 8.6 s (every pair sampled) and the warning named the
+/// largest pair, 0.5% of the volume, where 199 of the 200 copies (99.5%) are counted in excess.
+#[test]
+fn overlap_of_coincident_boxes_is_summed_over_every_part() {
+    let shapes: Vec<(String, String)> = (0..200)
+        .map(|_| ("0 0 0".to_string(), "<box size=\"1 1 1\"/>".to_string()))
+        .collect();
+    let (_tmp, urdf) = urdf_in_tmp(&one_link(&shapes));
+    let out = run(&["fill", s(&urdf), "--density", "1000"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("parts 1, 2, 3, 4, 5 and 195 others overlap: about 1.990e2 m³ (99.5% of the link's volume) is counted more than once (up to 200 times)"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+/// Issue 13: sphere-decomposed collision models have thousands of parts. 2000 disjoint spheres give no
+/// warning; 2000 spheres in a chain, each overlapping the next, give the sum of their 1999 lenses
+/// (exact: π(4r + d)(2r − d)²/12 each).
+#[test]
+fn overlap_of_2000_spheres_completes() {
+    let disjoint: Vec<(String, String)> = (0..2000)
+        .map(|i| {
+            (
+                format!("{} {} {}", i % 20, i / 20 % 10, i / 200),
+                "<sphere radius=\"0.25\"/>".to_string(),
+            )
+        })
+        .collect();
+    let (_tmp, urdf) = urdf_in_tmp(&one_link(&disjoint));
+    let out = run(&["fill", s(&urdf), "--density", "1000"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("overlap"), "{}", stderr(&out));
+
+    let (r, d) = (0.25, 0.375);
+    let chain: Vec<(String, String)> = (0..2000)
+        .map(|i| {
+            (
+                format!("{} 0 0", d * i as f64),
+                format!("<sphere radius=\"{r}\"/>"),
+            )
+        })
+        .collect();
+    let (_tmp, urdf) = urdf_in_tmp(&one_link(&chain));
+    let out = run(&["fill", s(&urdf), "--density", "1000"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    let at = err.find("overlap: about ").expect("an overlap warning") + "overlap: about ".len();
+    let got: f64 = err[at..].split(' ').next().unwrap().parse().unwrap();
+    let lens = std::f64::consts::PI * (4.0 * r + d) * (2.0 * r - d) * (2.0 * r - d) / 12.0;
+    let exact = 1999.0 * lens;
+    assert!((got / exact - 1.0).abs() < 0.05, "{got} against {exact}");
+    assert!(err.contains("is counted twice"), "{err}");
+}
+
+/// Peak resident memory of this process (VmHWM), bytes.
+fn peak_rss() -> u64 {
+    let status = std::fs::read_to_string("/proc/self/status").expect("/proc/self/status");
+    let kb: u64 = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+        .expect("VmHWM");
+    kb * 1024
+}
+
+/// A cone along +x (base of radius 1 at x = 0, apex at x = 1) with `n` segments: 2n sliver triangles
+/// from the axis to the rim, as seen along x.
+fn cone(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let mut v = vec![[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]];
+    for i in 0..n {
+        let a = 2.0 * std::f64::consts::PI * i as f64 / n as f64;
+        v.push([0.0, a.cos(), a.sin()]);
+    }
+    let mut f = Vec::new();
+    for i in 0..n {
+        let (p, q) = (2 + i, 2 + (i + 1) % n);
+        f.push([0, p, q]);
+        f.push([1, q, p]);
+    }
+    (v, f)
+}
+
+/// Issue 13: a 131k-face cone and a box once took 6.7 GB (every sliver triangle in every bucket of its
+/// bounding box) and aborted. The buckets hold what the triangles' projections meet, within a budget;
+/// the box lies inside the cone, so the volume counted twice is the box's.
+#[test]
+fn overlap_of_a_sliver_cone_and_a_box_has_bounded_memory() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (v, f) = cone(65536);
+    assert_eq!(f.len(), 131072);
+    std::fs::write(
+        tmp.path().join("cone.stl"),
+        urdf_inertia::mesh::stl::write_binary(b"cone", &v, &f),
+    )
+    .unwrap();
+    let text = one_link(&[
+        ("0 0 0".into(), "<mesh filename=\"cone.stl\"/>".into()),
+        ("0.3 0 0".into(), "<box size=\"0.2 0.2 0.2\"/>".into()),
+    ]);
+    let path = tmp.path().join("r.urdf");
+    std::fs::write(&path, &text).unwrap();
+    let before = peak_rss();
+    let robot = urdf_inertia::urdf::scan(text, &path).unwrap();
+    let report = urdf_inertia::fill::compute(
+        &robot,
+        &urdf_inertia::density::DensityMap::uniform(1000.0),
+        &urdf_inertia::urdf::resolve::PackageResolver::new(&[]),
+        &Default::default(),
+    );
+    let grown = peak_rss().saturating_sub(before);
+    assert!(report.failures.is_empty(), "{:?}", report.failures);
+    let (excess, which, _) = report.links[0].overlap.clone().expect("an overlap");
+    assert_eq!(which, "1 and 2");
+    assert!((excess / 0.008 - 1.0).abs() < 1e-9, "{excess}");
+    // The old bucket grid alone needed 6.7 GB; mesh, healing and buckets now need far less than 1 GiB.
+    assert!(grown < 1 << 30, "peak memory grew by {grown} bytes");
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Fuzzing seeds (fuzz/seeds/TARGET): regenerate with
+//   cargo test --release --test regression -- --ignored write_fuzz_seeds
+
+/// Small valid files of every format, from the tests' generators and the demo robot, for `fuzz/run.sh`.
+#[test]
+#[ignore = "writes fuzz/seeds; run on purpose"]
+fn write_fuzz_seeds() {
+    use gltf_gen::*;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let demo = root.join("robots/demo_arm_description");
+    let seeds = root.join("fuzz/seeds");
+    let put = |target: &str, name: &str, bytes: &[u8]| {
+        let dir = seeds.join(target);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join(name), bytes).unwrap();
+    };
+    let read = |p: &str| std::fs::read(demo.join(p)).unwrap();
+    // STL: the generators' box (binary and ASCII), a small sphere, the demo meshes.
+    let (bv, bf) = common::box_mesh([1.0, 2.0, 3.0]);
+    put(
+        "stl",
+        "box_binary.stl",
+        &urdf_inertia::mesh::stl::write_binary(b"solid box", &bv, &bf),
+    );
+    put(
+        "stl",
+        "box_ascii.stl",
+        urdf_inertia::mesh::stl::write_ascii(&bv, &bf).as_bytes(),
+    );
+    let (sv, sf) = common::icosphere(1);
+    put(
+        "stl",
+        "sphere.stl",
+        &urdf_inertia::mesh::stl::write_binary(b"", &sv, &sf),
+    );
+    let (cv, cf) = cone(8);
+    put(
+        "stl",
+        "cone_ascii.stl",
+        urdf_inertia::mesh::stl::write_ascii(&cv, &cf).as_bytes(),
+    );
+    for m in ["shoulder.STL", "battery.stl", "wrist_wedge.stl"] {
+        put("stl", &m.to_lowercase(), &read(&format!("meshes/{m}")));
+    }
+    // OBJ: the demo mesh; objects, negative and slashed indices, continuation lines, a quad and a
+    // two-vertex face.
+    put("obj", "upper_arm.obj", &read("meshes/upper_arm.obj"));
+    put("obj", "features.obj", b"# a box\nmtllib x.mtl\no a\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nvn 0 0 1\nvt 0 0\ng side\nf 1/1/1 4/1/1 3/1/1 2/1/1\nf 5 6 7 8\no b\nf -8 -7 -3 -4\nf 2 3 \\\n 7 6\nf 3 4 8 7\nf 4 1 5 8\nf 1 2\n");
+    let ico: String = sv
+        .iter()
+        .map(|p| format!("v {} {} {}\n", p[0], p[1], p[2]))
+        .chain(
+            sf.iter()
+                .map(|t| format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1)),
+        )
+        .collect();
+    put("obj", "sphere.obj", ico.as_bytes());
+    // COLLADA: the demo mesh and the regression generator's boxes in every primitive and scene form.
+    put("collada", "forearm.dae", &read("meshes/forearm.dae"));
+    let good = dae_box(Some("g"), 1.0, 0.0);
+    let lib = |g: &str| dae(&format!("<library_geometries>{g}</library_geometries>\n"));
+    put("collada", "triangles.dae", lib(&good).as_bytes());
+    let poly = good
+        .replace("<triangles count=\"12\">", "<polylist count=\"12\">")
+        .replace("</triangles>", "</polylist>")
+        .replace("<p>", "<vcount>3 3 3 3 3 3 3 3 3 3 3 3</vcount><p>");
+    put("collada", "polylist.dae", lib(&poly).as_bytes());
+    let polygons = good
+        .replace("<triangles count=\"12\">", "<polygons count=\"1\">")
+        .replace("</triangles>", "</polygons>")
+        .replace("<p>0 2 3 ", "<p>0 2 3</p><ph><p>1</p><h>2</h></ph><p>");
+    put("collada", "polygons.dae", lib(&polygons).as_bytes());
+    put(
+        "collada",
+        "two_without_id.dae",
+        lib(&(dae_box(None, 1.0, 0.0) + &dae_box(None, 2.0, 5.0))).as_bytes(),
+    );
+    put("collada", "scene.dae", dae(&format!(
+        "<asset><unit meter=\"0.01\"/><up_axis>Y_UP</up_axis></asset>\n<library_geometries>{good}</library_geometries>\n<library_nodes><node id=\"n1\"><rotate>0 0 1 90</rotate><scale>1 -1 1</scale><instance_geometry url=\"#g\"/></node></library_nodes>\n<library_visual_scenes><visual_scene id=\"s\"><node><matrix>1 0 0 1 0 1 0 2 0 0 1 3 0 0 0 1</matrix><translate>1 2 3</translate><instance_node url=\"#n1\"/><node><instance_geometry url=\"#g\"/></node></node></visual_scene></library_visual_scenes>\n<scene><instance_visual_scene url=\"#s\"/></scene>\n"
+    )).as_bytes());
+    // glTF: the glTF tests' generator, binary and JSON with a data URI.
+    let (size, centre) = ([0.5, 0.25, 0.125], [1.0, 2.0, 3.0]);
+    let matrix = serde_json::json!({"matrix": [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.25, 0.0, -0.5, 1.0]});
+    put(
+        "gltf",
+        "box.glb",
+        &box_builder(size, centre, serde_json::json!({})).glb(),
+    );
+    put(
+        "gltf",
+        "box_matrix.gltf",
+        box_builder(size, centre, matrix).gltf_data_uri().as_bytes(),
+    );
+    put(
+        "gltf",
+        "strip_fan.glb",
+        &box_strip_fan(size, centre, true).glb(),
+    );
+    put(
+        "gltf",
+        "two_primitives.glb",
+        &box_two_primitives(size, centre).glb(),
+    );
+    put(
+        "gltf",
+        "unindexed.gltf",
+        box_unindexed(size, centre).gltf_data_uri().as_bytes(),
+    );
+    let trs = serde_json::json!({"translation": [0.5, -1.0, 2.0], "rotation": [0.0, 0.0, 0.38268343, 0.9238795], "scale": [1.0, -2.0, 1.0]});
+    put(
+        "gltf",
+        "trs_mirrored.glb",
+        &box_builder(size, centre, trs).glb(),
+    );
+    // URDF: the demo robot, the generators' robots, UTF-16 and Latin-1 encodings.
+    let demo_urdf = read("urdf/demo_arm.urdf");
+    put("urdf", "demo_arm.urdf", &demo_urdf);
+    put("urdf", "boxes.urdf", one_box().as_bytes());
+    put("urdf", "failing.urdf", with_a_failing_link().as_bytes());
+    put("urdf", "shapes.urdf", one_link(&[
+        ("0 0 0".into(), "<cylinder radius=\"0.1\" length=\"0.5\"/>".into()),
+        ("0 0 1".into(), "<capsule radius=\"0.1\" length=\"0.2\"/>".into()),
+        ("1 0 0".into(), "<sphere radius=\"0.2\"/>".into()),
+        ("0 1 0".into(), "<mesh filename=\"package://p/m.stl\" scale=\"1 -1 1\"/>".into()),
+    ]).replace("<link name=\"a\">", "<link name=\"a\">\n    <inertial><origin xyz=\"0 0 0\" rpy=\"0 0 0\"/><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial>").as_bytes());
+    let mut utf16 = vec![0xFF, 0xFE];
+    for u in one_box().encode_utf16() {
+        utf16.extend(u.to_le_bytes());
+    }
+    put("urdf", "utf16.urdf", &utf16);
+    put("urdf", "latin1.urdf", b"<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?>\n<robot name=\"r\xe9\">\n  <link name=\"a\"><collision><geometry><box size=\"1 1 1\"/></geometry></collision></link>\n</robot>\n");
+    // Density maps: the demo's and one with every kind of rule.
+    put("density", "demo.toml", &read("densities.toml"));
+    put("density", "rules.toml", b"default = 1000.0\ntotal_mass = 12.5\n[materials]\nmy_alloy = 2810.0\n[links]\nbase_link = \"aluminum\"\n\"*_finger*\" = { mass = 0.05 }\n\"wrist_*\" = { density = 1200.0 }\n[meshes]\n\"*battery*\" = { density = 2500.0 }\n\"meshes/*.stl\" = \"my_alloy\"\n");
 }
 
 // ---------------------------------------------------------------------------------------------------
