@@ -8,7 +8,7 @@
 use crate::density::{DensityMap, Spec};
 use crate::mass::{mat_vec, primitives, rpy_matrix, validity, MassProperties};
 use crate::mesh::health::{ErrorEstimate, HealthOptions, ModelError, Solid, ROUND_OFF_FLOOR};
-use crate::mesh::{self, MeshError, RawMesh};
+use crate::mesh::{self, MeshError};
 use crate::overlap::{self, Overlap, PartShape, PlacedPart};
 use crate::urdf::resolve::PackageResolver;
 use crate::urdf::{Geometry, Inertial, Link, Robot};
@@ -109,10 +109,12 @@ pub struct FillReport {
     pub timing: Timing,
 }
 
-/// Reads each file once and heals each (file, scale) once.
+/// Reads each file once and heals each (file, scale) once. A raw mesh lives only until its scales are
+/// healed: the cache keeps the solids, and of each file read only whether it failed (a file asked for
+/// again with a new scale, by a later call sharing the cache, is read again).
 #[derive(Debug, Default)]
 pub struct MeshCache {
-    raw: HashMap<PathBuf, Result<Arc<RawMesh>, MeshError>>,
+    read: HashMap<PathBuf, Option<MeshError>>,
     solids: HashMap<(PathBuf, [u64; 3]), Result<Arc<Solid>, MeshError>>,
     pub load_time: Duration,
     pub integrate_time: Duration,
@@ -130,11 +132,11 @@ impl MeshCache {
             return r.clone();
         }
         let t0 = Instant::now();
-        let raw = match self.raw.get(path) {
-            Some(r) => r.clone(),
-            None => {
-                let r = mesh::read(path).map(Arc::new);
-                self.raw.insert(path.clone(), r.clone());
+        let raw = match self.read.get(path) {
+            Some(Some(e)) => Err(e.clone()),
+            _ => {
+                let r = mesh::read(path);
+                self.read.insert(path.clone(), r.as_ref().err().cloned());
                 r
             }
         };
@@ -169,7 +171,7 @@ impl MeshCache {
         }
         type Loaded = (
             PathBuf,
-            Result<Arc<RawMesh>, MeshError>,
+            Option<MeshError>,
             Vec<([f64; 3], Result<Arc<Solid>, MeshError>)>,
             Duration,
             Duration,
@@ -179,20 +181,20 @@ impl MeshCache {
             .into_par_iter()
             .map(|(path, scales)| {
                 let t0 = Instant::now();
-                let raw = mesh::read(path).map(Arc::new);
+                let raw = mesh::read(path);
                 let t1 = Instant::now();
                 let solids = scales
                     .into_iter()
                     .map(|scale| {
-                        (
-                            scale,
-                            raw.clone()
-                                .and_then(|r| mesh::solid_from_raw(&r, scale, path, options))
-                                .map(Arc::new),
-                        )
+                        let solid = match &raw {
+                            Ok(r) => mesh::solid_from_raw(r, scale, path, options).map(Arc::new),
+                            Err(e) => Err(e.clone()),
+                        };
+                        (scale, solid)
                     })
                     .collect();
-                (path.clone(), raw, solids, t1 - t0, t1.elapsed())
+                // The raw mesh ends here, before the next file of this thread is read.
+                (path.clone(), raw.err(), solids, t1 - t0, t1.elapsed())
             })
             .collect();
         for (path, raw, solids, load, integrate) in loaded {
@@ -202,13 +204,13 @@ impl MeshCache {
                 self.solids
                     .insert((path.clone(), scale.map(f64::to_bits)), solid);
             }
-            self.raw.insert(path, raw);
+            self.read.insert(path, raw);
         }
     }
 
     /// Number of distinct files read.
     pub fn files(&self) -> usize {
-        self.raw.len()
+        self.read.len()
     }
 }
 
