@@ -246,7 +246,12 @@ pub fn solid_from_raw(
     options: health::HealthOptions,
 ) -> Result<health::Solid, MeshError> {
     catching_panics(path, || {
-        let scaled = apply_scale(raw, scale, path)?;
+        // The usual scale 1 heals the mesh as read, without a copy of it.
+        let scaled = if scale == [1.0; 3] {
+            std::borrow::Cow::Borrowed(raw)
+        } else {
+            std::borrow::Cow::Owned(apply_scale(raw, scale, path)?)
+        };
         // The precision of the file's own numbers, before the scale multiplies them; the largest
         // coordinate scales with them, so the tolerance in ulps of it stays right.
         health::make_solid_stored_as(&scaled, path, options, || {
