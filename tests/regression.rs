@@ -1099,6 +1099,266 @@ fn what_it_says(out: &Output, tmp: &Path) -> String {
     line.replace('|', "\\|")
 }
 
+/// The binary under GNU time (peak memory and wall time into `d/.time`), where /usr/bin/time exists.
+/// `URDF_INERTIA_BIN` runs another build instead (an older one, to compare; the doc is then not theirs).
+fn timed(d: &Path) -> Command {
+    let exe = std::env::var_os("URDF_INERTIA_BIN")
+        .unwrap_or_else(|| env!("CARGO_BIN_EXE_urdf-inertia").into());
+    if Path::new("/usr/bin/time").exists() {
+        let mut c = Command::new("/usr/bin/time");
+        c.args(["-f", "%M %e", "-o"]).arg(d.join(".time")).arg(exe);
+        c
+    } else {
+        Command::new(exe)
+    }
+}
+
+/// One row of docs/reliability.md.
+struct Row {
+    what: String,
+    out: Output,
+    /// The largest input file named in the arguments, bytes.
+    size: u64,
+    peak: Option<u64>,
+    seconds: Option<f64>,
+    /// A row of the large-input table.
+    large: bool,
+}
+
+impl Row {
+    fn new(what: &str, args: &[String], out: Output, d: &Path) -> Row {
+        let size = args
+            .iter()
+            .filter_map(|a| std::fs::metadata(d.join(a)).ok())
+            .filter(|m| m.is_file())
+            .map(|m| m.len())
+            .max()
+            .unwrap_or(0);
+        let time = std::fs::read_to_string(d.join(".time")).unwrap_or_default();
+        let _ = std::fs::remove_file(d.join(".time"));
+        // GNU time prints "Command exited with non-zero status N" first when the status is not 0.
+        let last = time.lines().last().unwrap_or("");
+        let mut f = last.split_whitespace();
+        let peak = f
+            .next()
+            .and_then(|k| k.parse::<u64>().ok())
+            .map(|k| k * 1024);
+        let seconds = f.next().and_then(|t| t.parse::<f64>().ok());
+        Row {
+            what: what.trim_start_matches("large: ").to_string(),
+            out,
+            size,
+            peak,
+            seconds,
+            large: what.starts_with("large: "),
+        }
+    }
+
+    fn markdown(&self, d: &Path) -> String {
+        let code = self
+            .out
+            .status
+            .code()
+            .map_or("signal".to_string(), |c| c.to_string());
+        format!(
+            "| {} | {} | {} | {code} | {} | {} |\n",
+            self.what,
+            if self.size == 0 {
+                "—".into()
+            } else {
+                mib(self.size)
+            },
+            what_it_says(&self.out, d),
+            self.peak.map_or("—".into(), mib),
+            self.seconds.map_or("—".into(), |t| format!("{t:.2} s"))
+        )
+    }
+}
+
+fn mib(bytes: u64) -> String {
+    if bytes < 1 << 20 {
+        format!("{:.1} KiB", bytes as f64 / 1024.0)
+    } else {
+        format!("{:.1} MiB", bytes as f64 / (1 << 20) as f64)
+    }
+}
+
+/// A closed torus about z (radii 1 and 0.3) of `2 n m` outward triangles.
+fn torus(n: u32, m: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let tau = 2.0 * std::f64::consts::PI;
+    let mut v = Vec::with_capacity((n * m) as usize);
+    for i in 0..n {
+        let u = tau * i as f64 / n as f64;
+        for j in 0..m {
+            let w = tau * j as f64 / m as f64;
+            let r = 1.0 + 0.3 * w.cos();
+            v.push([r * u.cos(), r * u.sin(), 0.3 * w.sin()]);
+        }
+    }
+    let at = |i: u32, j: u32| (i % n) * m + j % m;
+    let mut f = Vec::with_capacity(2 * (n * m) as usize);
+    for i in 0..n {
+        for j in 0..m {
+            f.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            f.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    (v, f)
+}
+
+/// Rows for large files of every format, and links whose parts overlap many times over.
+fn large_inputs(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)) {
+    let (v, f) = torus(1000, 500);
+    let a = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let mut put = |name: &str, bytes: &[u8], what: &str| {
+        std::fs::write(d.join(name), bytes).unwrap();
+        add(what, a(&["mesh", name]), None);
+        std::fs::remove_file(d.join(name)).unwrap();
+    };
+    put(
+        "torus.stl",
+        &urdf_inertia::mesh::stl::write_binary(b"torus", &v, &f),
+        "large: binary STL",
+    );
+    put(
+        "torus_ascii.stl",
+        urdf_inertia::mesh::stl::write_ascii(&v, &f).as_bytes(),
+        "large: ASCII STL",
+    );
+    let mut obj = String::new();
+    for p in &v {
+        obj.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2]));
+    }
+    for t in &f {
+        obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+    }
+    put("torus.obj", obj.as_bytes(), "large: OBJ");
+    drop(obj);
+    let mut pos = String::new();
+    for p in &v {
+        pos.push_str(&format!("{} {} {} ", p[0], p[1], p[2]));
+    }
+    let mut idx = String::new();
+    for t in &f {
+        idx.push_str(&format!("{} {} {} ", t[0], t[1], t[2]));
+    }
+    let geometry = format!(
+        "<geometry id=\"t\"><mesh>\n<source id=\"pos\"><float_array id=\"pa\" count=\"{}\">{pos}</float_array>\n<technique_common><accessor source=\"#pa\" count=\"{}\" stride=\"3\"/></technique_common></source>\n<vertices id=\"vx\"><input semantic=\"POSITION\" source=\"#pos\"/></vertices>\n<triangles count=\"{}\"><input semantic=\"VERTEX\" source=\"#vx\" offset=\"0\"/><p>{idx}</p></triangles>\n</mesh></geometry>\n",
+        3 * v.len(),
+        v.len(),
+        f.len()
+    );
+    drop((pos, idx));
+    put(
+        "torus.dae",
+        dae(&format!(
+            "<library_geometries>{geometry}</library_geometries>\n"
+        ))
+        .as_bytes(),
+        "large: COLLADA",
+    );
+    drop(geometry);
+    // As exporters write it: a normal per face and a texture coordinate per vertex, three inputs a
+    // corner.
+    let mut normals = String::new();
+    for t in &f {
+        let [a, b, c] = t.map(|i| v[i as usize]);
+        let n = [
+            (b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]),
+            (b[2] - a[2]) * (c[0] - a[0]) - (b[0] - a[0]) * (c[2] - a[2]),
+            (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]),
+        ];
+        let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        normals.push_str(&format!("{} {} {} ", n[0] / l, n[1] / l, n[2] / l));
+    }
+    let mut uv = String::new();
+    for i in 0..v.len() {
+        uv.push_str(&format!(
+            "{} {} ",
+            (i / 500) as f64 / 1000.0,
+            (i % 500) as f64 / 500.0
+        ));
+    }
+    let mut pos = String::new();
+    for p in &v {
+        pos.push_str(&format!("{} {} {} ", p[0], p[1], p[2]));
+    }
+    let mut idx = String::new();
+    for (k, t) in f.iter().enumerate() {
+        for i in t {
+            idx.push_str(&format!("{i} {k} {i} "));
+        }
+    }
+    let geometry = format!(
+        "<geometry id=\"t\"><mesh>\n<source id=\"pos\"><float_array id=\"pa\" count=\"{}\">{pos}</float_array>\n<technique_common><accessor source=\"#pa\" count=\"{}\" stride=\"3\"/></technique_common></source>\n<source id=\"nrm\"><float_array id=\"na\" count=\"{}\">{normals}</float_array>\n<technique_common><accessor source=\"#na\" count=\"{}\" stride=\"3\"/></technique_common></source>\n<source id=\"uv\"><float_array id=\"ua\" count=\"{}\">{uv}</float_array>\n<technique_common><accessor source=\"#ua\" count=\"{}\" stride=\"2\"/></technique_common></source>\n<vertices id=\"vx\"><input semantic=\"POSITION\" source=\"#pos\"/></vertices>\n<triangles count=\"{}\"><input semantic=\"VERTEX\" source=\"#vx\" offset=\"0\"/><input semantic=\"NORMAL\" source=\"#nrm\" offset=\"1\"/><input semantic=\"TEXCOORD\" source=\"#uv\" offset=\"2\" set=\"0\"/><p>{idx}</p></triangles>\n</mesh></geometry>\n",
+        3 * v.len(),
+        v.len(),
+        3 * f.len(),
+        f.len(),
+        2 * v.len(),
+        v.len(),
+        f.len()
+    );
+    drop((pos, idx, normals, uv));
+    put(
+        "torus_exported.dae",
+        dae(&format!(
+            "<library_geometries>{geometry}</library_geometries>\n"
+        ))
+        .as_bytes(),
+        "large: COLLADA with a normal per face and texture coordinates (3 inputs a corner)",
+    );
+    let mut b = gltf_gen::GltfBuilder::new();
+    let points: Vec<[f32; 3]> = v.iter().map(|p| p.map(|x| x as f32)).collect();
+    let pa = b.positions(&points);
+    let flat: Vec<u32> = f.iter().flatten().copied().collect();
+    let ia = b.indices(&flat, gltf_gen::U32);
+    let mesh = b.mesh(&[(pa, Some(ia), gltf_gen::TRIANGLES)]);
+    let node = b.node(serde_json::json!({ "mesh": mesh }));
+    let scene = b.add_scene(&[node]);
+    b.scene = Some(scene);
+    put("torus.glb", &b.glb(), "large: glTF (.glb)");
+
+    // Links whose parts overlap: every pair once took O(parts²) samples, and slivers O(cells²) memory.
+    let mut link = |name: &str, what: &str, shapes: Vec<(String, String)>| {
+        std::fs::write(d.join(name), one_link(&shapes)).unwrap();
+        add(what, a(&["fill", name, "--density", "1000"]), None);
+    };
+    link(
+        "boxes200.urdf",
+        "200 coincident boxes in one link",
+        (0..200)
+            .map(|_| ("0 0 0".into(), "<box size=\"1 1 1\"/>".into()))
+            .collect(),
+    );
+    link(
+        "spheres2000.urdf",
+        "2000 spheres in one link, each overlapping the next",
+        (0..2000)
+            .map(|i| {
+                (
+                    format!("{} 0 0", 0.375 * i as f64),
+                    "<sphere radius=\"0.25\"/>".into(),
+                )
+            })
+            .collect(),
+    );
+    let (cv, cf) = cone(65536);
+    std::fs::write(
+        d.join("cone.stl"),
+        urdf_inertia::mesh::stl::write_binary(b"cone", &cv, &cf),
+    )
+    .unwrap();
+    link(
+        "cone.urdf",
+        "a 131k-face sliver cone and a box inside it",
+        vec![
+            ("0 0 0".into(), "<mesh filename=\"cone.stl\"/>".into()),
+            ("0.3 0 0".into(), "<box size=\"0.2 0.2 0.2\"/>".into()),
+        ],
+    );
+}
+
 #[test]
 #[ignore = "writes docs/reliability.md; run on purpose"]
 fn write_reliability_table() {
@@ -1116,14 +1376,15 @@ fn write_reliability_table() {
             &format!("<robot name=\"r\">\n  <link name=\"a\">\n    <collision><geometry><mesh filename=\"{mesh}\"/></geometry></collision>\n  </link>\n</robot>\n"),
         )
     };
-    let mut rows: Vec<(String, Output)> = Vec::new();
+    let mut rows: Vec<Row> = Vec::new();
     let mut add = |what: &str, args: Vec<String>, stdout: Option<Stdio>| {
-        let mut c = bin();
+        let mut c = timed(d);
         c.args(&args).current_dir(d).stdin(Stdio::null());
         if let Some(s) = stdout {
             c.stdout(s);
         }
-        rows.push((what.to_string(), c.output().unwrap()));
+        let out = c.output().unwrap();
+        rows.push(Row::new(what, &args, out, d));
     };
     let a = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
     add(
@@ -1261,8 +1522,9 @@ fn write_reliability_table() {
         a(&["fill", "r.urdf", "--density", "1000"]),
         full(),
     );
+    large_inputs(d, &mut add);
     // A broken pipe: the reader is gone before the first write.
-    let mut child = bin()
+    let mut child = timed(d)
         .args(["diff", "r.urdf", "--density", "1000"])
         .current_dir(d)
         .stdout(Stdio::piped())
@@ -1270,23 +1532,30 @@ fn write_reliability_table() {
         .spawn()
         .unwrap();
     drop(child.stdout.take());
-    rows.push((
-        "`diff … \\| head` (broken pipe)".into(),
-        child.wait_with_output().unwrap(),
+    let out = child.wait_with_output().unwrap();
+    rows.push(Row::new(
+        "`diff … \\| head` (broken pipe)",
+        &["diff".into(), "r.urdf".into()],
+        out,
+        d,
     ));
     std::fs::set_permissions(d.join("rodir"), std::fs::Permissions::from_mode(0o755)).unwrap();
 
-    let mut md = String::from("# Reliability: hostile input, what urdf-inertia does, exit code\n\nGenerated by `cargo test --release --test regression -- --ignored write_reliability_table` (every input is made by the test in a temp dir; file names are relative to it). Exit codes: 0 ok, 1 `check` found problems, 2 error. Each row has a regression test in `tests/regression.rs`. SIGINT/SIGTERM during a write removes the temporary file and exits 130 (`temp_file_has_the_targets_mode_and_is_removed_on_sigterm`).\n\n| hostile input | what the tool does (first error line, or first line of stderr) | exit |\n| --- | --- | --- |\n");
-    for (what, out) in &rows {
-        let code = out
-            .status
-            .code()
-            .map_or("signal".to_string(), |c| c.to_string());
-        md.push_str(&format!("| {what} | {} | {code} |\n", what_it_says(out, d)));
+    let mut md = String::from("# Reliability: hostile input, what urdf-inertia does, exit code, memory and time\n\nGenerated by `cargo test --release --test regression -- --ignored write_reliability_table` (every input is made by the test in a temp dir; file names are relative to it), on purpose: CI does not run it. Exit codes: 0 ok, 1 `check` found problems, 2 error. Each row has a regression test in `tests/regression.rs`. SIGINT/SIGTERM during a write removes the temporary file and exits 130 (`temp_file_has_the_targets_mode_and_is_removed_on_sigterm`). Peak memory (maximum resident set) and wall time are GNU time's (`/usr/bin/time -f '%M %e'`) for the whole process, on the machine that generated this file (2 cores shared with other work); input size is the largest file named on the command line (for `fill`, the URDF, not its meshes); the program itself takes a few MB.\n\n| hostile input | input size | what the tool does (first error line, or first line of stderr) | exit | peak memory | time |\n| --- | --- | --- | --- | --- | --- |\n");
+    for row in rows.iter().filter(|r| !r.large) {
+        md.push_str(&row.markdown(d));
+    }
+    md.push_str("\n## Large inputs: peak memory against file size\n\n`urdf-inertia mesh FILE` on one closed torus of 1,000,000 triangles (500,000 vertices) written in each format by the same generator: read, weld, heal and integrate. Peak memory is about k × the file size, with k in the last column: what stays is the mesh as read (f64 coordinates) and the welded, healed solid, about 140 to 190 MiB per million triangles whatever the format, plus the file's bytes while it is parsed. So k is largest for compact binary files (glTF's f32 positions and shared vertices) and smallest for verbose text (ASCII STL, whose bytes dominate). `URDF_INERTIA_BIN=OTHER_BUILD` runs the same rows with another build, to compare.\n\n| input | input size | what the tool does | exit | peak memory | time | peak / size |\n| --- | --- | --- | --- | --- | --- | --- |\n");
+    for row in rows.iter().filter(|r| r.large) {
+        md.push_str(&format!(
+            "{} {:.2} |\n",
+            row.markdown(d).trim_end(),
+            row.peak.map_or(f64::NAN, |p| p as f64 / row.size as f64)
+        ));
     }
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/reliability.md");
     std::fs::write(&path, md).unwrap();
-    for (what, out) in &rows {
-        assert_ne!(out.status.code(), Some(101), "{what} panicked");
+    for row in &rows {
+        assert_ne!(row.out.status.code(), Some(101), "{} panicked", row.what);
     }
 }
