@@ -929,6 +929,109 @@ fn overlap_of_a_sliver_cone_and_a_box_has_bounded_memory() {
 }
 
 // ---------------------------------------------------------------------------------------------------
+// Fuzzing: what fuzz/fuzz_targets do with one input, without the instrumentation, so that seeds and a
+// corpus grown by `bash fuzz/run.sh` can be replayed by any build.
+
+/// Runs one input through the fuzz target `target`; an error is fine, a panic or an internal error
+/// (a panic the library caught) is not.
+fn fuzz_one(target: &str, data: &[u8]) -> Result<(), String> {
+    use urdf_inertia::mesh::{self, MeshErrorKind};
+    let heal = |r: Result<mesh::RawMesh, mesh::MeshError>, path: &Path| -> Result<(), String> {
+        let raw = match r {
+            Ok(raw) => raw,
+            Err(e) if e.to_string().contains("the glTF reader failed") => return Err(e.to_string()),
+            Err(_) => return Ok(()),
+        };
+        if mesh::validate(&raw, path).is_err() {
+            return Ok(());
+        }
+        for scale in [[1.0; 3], [1.0, -1.0, 1.0]] {
+            if let Err(e) = mesh::solid_from_raw(&raw, scale, path, Default::default()) {
+                if matches!(e.kind, MeshErrorKind::Internal(_)) {
+                    return Err(e.to_string());
+                }
+            }
+        }
+        Ok(())
+    };
+    let dir = Path::new("/nonexistent-fuzz-dir");
+    match target {
+        "stl" => heal(
+            mesh::stl::parse(data, &dir.join("f.stl")),
+            &dir.join("f.stl"),
+        ),
+        "obj" => heal(
+            mesh::obj::parse(data, &dir.join("f.obj")),
+            &dir.join("f.obj"),
+        ),
+        "collada" => heal(
+            mesh::collada::parse(data, &dir.join("f.dae")),
+            &dir.join("f.dae"),
+        ),
+        "gltf" => heal(
+            mesh::gltf::parse(data, &dir.join("f.gltf")),
+            &dir.join("f.gltf"),
+        ),
+        "urdf" => {
+            let path = dir.join("f.urdf");
+            let Ok(robot) = urdf_inertia::urdf::scan_bytes(data.to_vec(), &path) else {
+                return Ok(());
+            };
+            let updates: Vec<_> = (0..robot.links.len())
+                .map(|i| (i, urdf_inertia::mass::primitives::sphere(0.1, 1000.0)))
+                .collect();
+            let out = urdf_inertia::urdf::write::splice(&robot, &updates, &Default::default());
+            urdf_inertia::urdf::scan(out, &path)
+                .map(drop)
+                .map_err(|e| format!("what was spliced does not read back: {e:?}"))
+        }
+        "density" => {
+            if let Ok(text) = std::str::from_utf8(data) {
+                let _ = urdf_inertia::density::DensityMap::parse(text, Path::new("d.toml"));
+            }
+            Ok(())
+        }
+        _ => Err(format!("no fuzz target `{target}`")),
+    }
+}
+
+/// Replays every file of `root/TARGET/` through [`fuzz_one`]; returns how many.
+fn replay(root: &Path) -> usize {
+    let mut n = 0;
+    for target in ["stl", "obj", "collada", "gltf", "urdf", "density"] {
+        let Ok(dir) = std::fs::read_dir(root.join(target)) else {
+            continue;
+        };
+        for entry in dir.flatten() {
+            let data = std::fs::read(entry.path()).unwrap();
+            let outcome = std::panic::catch_unwind(|| fuzz_one(target, &data));
+            match outcome {
+                Ok(Ok(())) => {}
+                Ok(Err(e)) => panic!("{}: {e}", entry.path().display()),
+                Err(_) => panic!("{}: panicked", entry.path().display()),
+            }
+            n += 1;
+        }
+    }
+    n
+}
+
+/// The fuzzing seeds (valid files of every format) go through every reader, healing and splicing.
+#[test]
+fn fuzz_seeds_replay() {
+    let n = replay(&Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds"));
+    assert!(n >= 30, "{n} seeds");
+}
+
+/// A corpus grown by `bash fuzz/run.sh` (fuzz/corpus, not committed), replayed without instrumentation.
+#[test]
+#[ignore = "replays fuzz/corpus after a fuzzing run"]
+fn fuzz_corpus_replay() {
+    let n = replay(&Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus"));
+    eprintln!("{n} inputs replayed");
+}
+
+// ---------------------------------------------------------------------------------------------------
 // Fuzzing seeds (fuzz/seeds/TARGET): regenerate with
 //   cargo test --release --test regression -- --ignored write_fuzz_seeds
 
