@@ -8,7 +8,8 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let Ok(map) = urdf_inertia::density::DensityMap::parse(text, Path::new("densities.toml")) else {
+    let Ok(map) = urdf_inertia::density::DensityMap::parse(text, Path::new("densities.toml"))
+    else {
         return;
     };
     for name in ["base_link", "wrist_1", "left_finger_tip", ""] {
