@@ -10,6 +10,8 @@
 
 #[path = "../tests/common/mod.rs"]
 mod common;
+#[path = "report/ladder.rs"]
+mod ladder;
 
 use common::*;
 use num_rational::BigRational;
@@ -612,6 +614,8 @@ fn main() -> std::io::Result<()> {
             writeln!(md, "\nSet `EXAMPLE_ROBOT_DATA_SHARE` to time the example-robot-data corpus end to end.").ok();
         }
     }
+    let share = std::env::var("EXAMPLE_ROBOT_DATA_SHARE").ok();
+    ladder::section(&mut md, share.as_deref().map(std::path::Path::new));
     std::fs::write("docs/accuracy.md", md)?;
     println!("wrote docs/accuracy.md and docs/accuracy.svg");
     Ok(())
@@ -655,8 +659,9 @@ fn corpus(md: &mut String, share: &std::path::Path) {
         let mut cache = MeshCache::default();
         let report = compute_with(&robot, &map, &resolver, &FillOptions::default(), &mut cache);
         let t1 = Instant::now();
-        let updates: Vec<_> = report.links.iter().map(|l| (l.index, l.computed)).collect();
-        let out = urdf_inertia::urdf::write::splice(&robot, &updates, &Default::default());
+        let updates: Vec<_> = report.links.iter().map(|l| l.update()).collect();
+        let out = urdf_inertia::urdf::write::splice(&robot, &updates, &Default::default())
+            .unwrap_or_default();
         std::hint::black_box(out.len());
         let write = t1.elapsed().as_secs_f64();
         let total = t0.elapsed().as_secs_f64();

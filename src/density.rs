@@ -230,6 +230,7 @@ impl DensityMap {
             entries
                 .into_iter()
                 .map(|(k, v)| {
+                    glob(k).map_err(|m| err(Some(v.span()), format!("[{section}] {m}")))?;
                     spec(v.get_ref(), true, &format!("[{section}] `{k}`"))
                         .map(|s| (k.clone(), s))
                         .map_err(|m| err(Some(v.span()), m))
@@ -288,32 +289,20 @@ fn check_positive(x: f64, what: &str) -> Result<(), String> {
     }
 }
 
-/// Glob matching with `*` (any run, including empty) and `?` (one character).
+/// A glob pattern, compiled with the `globset` crate: `*` and `?` (which also match `/`), `[abc]`,
+/// `[!a-z]`, `{a,b}` and `**`. Used by `--only`, `--skip` and the density map's keys.
+pub fn glob(pattern: &str) -> Result<globset::GlobMatcher, String> {
+    globset::GlobBuilder::new(pattern)
+        .backslash_escape(true)
+        .build()
+        .map(|g| g.compile_matcher())
+        .map_err(|e| format!("`{pattern}` is not a valid glob: {}", e.kind()))
+}
+
+/// Whether `name` matches the glob `pattern` (an invalid pattern matches nothing; patterns from the
+/// user are checked with [`glob`] when they are read).
 pub fn glob_match(pattern: &str, name: &str) -> bool {
-    let p: Vec<char> = pattern.chars().collect();
-    let n: Vec<char> = name.chars().collect();
-    let (mut pi, mut ni) = (0usize, 0usize);
-    let (mut star, mut mark) = (None, 0usize);
-    while ni < n.len() {
-        if pi < p.len() && (p[pi] == '?' || p[pi] == n[ni]) {
-            pi += 1;
-            ni += 1;
-        } else if pi < p.len() && p[pi] == '*' {
-            star = Some(pi);
-            mark = ni;
-            pi += 1;
-        } else if let Some(s) = star {
-            pi = s + 1;
-            mark += 1;
-            ni = mark;
-        } else {
-            return false;
-        }
-    }
-    while pi < p.len() && p[pi] == '*' {
-        pi += 1;
-    }
-    pi == p.len()
+    glob(pattern).is_ok_and(|g| g.is_match(name))
 }
 
 #[cfg(test)]
@@ -394,5 +383,12 @@ base_link = "aluminum"
         assert!(!glob_match("a?c", "ac"));
         assert!(glob_match("*", ""));
         assert!(!glob_match("wrist_*", "base"));
+        // The full syntax: classes, alternatives.
+        assert!(glob_match("link_[0-9]", "link_7"));
+        assert!(!glob_match("link_[!0-9]", "link_7"));
+        assert!(glob_match("{left,right}_finger", "right_finger"));
+        let e = DensityMap::parse("[links]\n\"a[\" = 1000\n", Path::new("d.toml")).unwrap_err();
+        assert_eq!(e.line, Some(2), "{e}");
+        assert!(e.message.contains("not a valid glob"), "{e}");
     }
 }

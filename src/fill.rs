@@ -7,15 +7,13 @@
 
 use crate::density::{DensityMap, Spec};
 use crate::mass::{mat_vec, primitives, rpy_matrix, validity, MassProperties};
-use crate::mesh::health::{ErrorEstimate, HealthOptions, ModelError, Solid, ROUND_OFF_FLOOR};
-use crate::mesh::{self, MeshError};
+pub use crate::mesh::cache::MeshCache;
+use crate::mesh::health::{ErrorEstimate, HealthOptions, ModelError, ROUND_OFF_FLOOR};
 use crate::overlap::{self, Overlap, PartShape, PlacedPart};
 use crate::urdf::resolve::PackageResolver;
 use crate::urdf::{Geometry, Inertial, Link, Robot};
-use std::collections::HashMap;
 use std::path::PathBuf;
-use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// A collision mesh larger than this (bounding-box diagonal, m) is almost surely in millimetres.
 const MILLIMETRE_SLIP: f64 = 10.0;
@@ -25,6 +23,7 @@ const PRIMITIVE_ERROR: ErrorEstimate = ErrorEstimate {
     round_off: ROUND_OFF_FLOOR,
     model: 0.0,
     source: ModelError::None,
+    com: 0.0,
 };
 
 /// What to compute.
@@ -80,6 +79,26 @@ pub struct LinkReport {
     pub warnings: Vec<String>,
 }
 
+impl LinkReport {
+    /// The link's relative error bound: the largest of its parts' (the round-off floor at least).
+    pub fn error_estimate(&self) -> f64 {
+        self.parts
+            .iter()
+            .map(|p| p.error_estimate)
+            .fold(ROUND_OFF_FLOOR, f64::max)
+    }
+
+    /// What the splice writes for this link.
+    pub fn update(&self) -> crate::urdf::write::LinkUpdate {
+        crate::urdf::write::LinkUpdate {
+            index: self.index,
+            props: self.computed,
+            error: self.error_estimate(),
+            size: self.size,
+        }
+    }
+}
+
 /// A link that could not be computed.
 #[derive(Debug, Clone)]
 pub struct LinkFailure {
@@ -107,111 +126,6 @@ pub struct FillReport {
     pub mesh_files: usize,
     pub faces: usize,
     pub timing: Timing,
-}
-
-/// Reads each file once and heals each (file, scale) once. A raw mesh lives only until its scales are
-/// healed: the cache keeps the solids, and of each file read only whether it failed (a file asked for
-/// again with a new scale, by a later call sharing the cache, is read again).
-#[derive(Debug, Default)]
-pub struct MeshCache {
-    read: HashMap<PathBuf, Option<MeshError>>,
-    solids: HashMap<(PathBuf, [u64; 3]), Result<Arc<Solid>, MeshError>>,
-    pub load_time: Duration,
-    pub integrate_time: Duration,
-}
-
-impl MeshCache {
-    pub fn solid(
-        &mut self,
-        path: &PathBuf,
-        scale: [f64; 3],
-        options: HealthOptions,
-    ) -> Result<Arc<Solid>, MeshError> {
-        let key = (path.clone(), scale.map(f64::to_bits));
-        if let Some(r) = self.solids.get(&key) {
-            return r.clone();
-        }
-        let t0 = Instant::now();
-        let raw = match self.read.get(path) {
-            Some(Some(e)) => Err(e.clone()),
-            _ => {
-                let r = mesh::read(path);
-                self.read.insert(path.clone(), r.as_ref().err().cloned());
-                r
-            }
-        };
-        let t1 = Instant::now();
-        self.load_time += t1 - t0;
-        let solid = raw
-            .and_then(|raw| mesh::solid_from_raw(&raw, scale, path, options))
-            .map(Arc::new);
-        self.integrate_time += t1.elapsed();
-        self.solids.insert(key, solid.clone());
-        solid
-    }
-
-    /// Reads and heals every not yet cached (file, scale) pair on all cores: each file once, then each
-    /// of its scales. Times are summed over threads (CPU time).
-    pub fn preload(&mut self, items: &[(PathBuf, [f64; 3])], options: HealthOptions) {
-        use rayon::prelude::*;
-        let mut by_file: HashMap<&PathBuf, Vec<[f64; 3]>> = HashMap::new();
-        for (path, scale) in items {
-            if !self
-                .solids
-                .contains_key(&(path.clone(), scale.map(f64::to_bits)))
-            {
-                let scales = by_file.entry(path).or_default();
-                if !scales
-                    .iter()
-                    .any(|s| s.map(f64::to_bits) == scale.map(f64::to_bits))
-                {
-                    scales.push(*scale);
-                }
-            }
-        }
-        type Loaded = (
-            PathBuf,
-            Option<MeshError>,
-            Vec<([f64; 3], Result<Arc<Solid>, MeshError>)>,
-            Duration,
-            Duration,
-        );
-        let work: Vec<(&PathBuf, Vec<[f64; 3]>)> = by_file.into_iter().collect();
-        let loaded: Vec<Loaded> = work
-            .into_par_iter()
-            .map(|(path, scales)| {
-                let t0 = Instant::now();
-                let raw = mesh::read(path);
-                let t1 = Instant::now();
-                let solids = scales
-                    .into_iter()
-                    .map(|scale| {
-                        let solid = match &raw {
-                            Ok(r) => mesh::solid_from_raw(r, scale, path, options).map(Arc::new),
-                            Err(e) => Err(e.clone()),
-                        };
-                        (scale, solid)
-                    })
-                    .collect();
-                // The raw mesh ends here, before the next file of this thread is read.
-                (path.clone(), raw.err(), solids, t1 - t0, t1.elapsed())
-            })
-            .collect();
-        for (path, raw, solids, load, integrate) in loaded {
-            self.load_time += load;
-            self.integrate_time += integrate;
-            for (scale, solid) in solids {
-                self.solids
-                    .insert((path.clone(), scale.map(f64::to_bits)), solid);
-            }
-            self.read.insert(path, raw);
-        }
-    }
-
-    /// Number of distinct files read.
-    pub fn files(&self) -> usize {
-        self.read.len()
-    }
 }
 
 /// Whether `fill` computes this link (it must also have collision geometry): selected by the globs and,
@@ -830,7 +744,8 @@ fn overlap_estimate(parts: &mut [Part]) -> (Option<(f64, String, usize)>, Option
         format!("is counted more than once (up to {} times)", e.most)
     };
     let message = format!(
-        "parts {which} overlap: about {v:.3e} m³ ({:.1}% of the link's volume) {how}; the parts' volumes less their union's, estimated on a {n}³ grid per part",
+        "parts {which} overlap: about {} m³ ({:.1}% of the link's volume) {how}; the parts' volumes less their union's, estimated on a {n}³ grid per part",
+        crate::text::significant(v, 4),
         100.0 * v / total
     );
     (Some((v, which, n)), Some(message))
@@ -838,5 +753,6 @@ fn overlap_estimate(parts: &mut [Part]) -> (Option<(f64, String, usize)>, Option
 
 /// Whether a mesh rung is below "exact".
 pub fn repaired(provenance: &str) -> bool {
-    provenance != "exact" && provenance != "primitive"
+    // A welded mesh is integrated as stored: not a repair.
+    provenance != "exact" && provenance != "welded" && provenance != "primitive"
 }

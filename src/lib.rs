@@ -6,12 +6,11 @@
 //! per-link composition ([`fill`]) → splice `<inertial>` into the original bytes ([`urdf::write`]).
 #![forbid(unsafe_code)]
 
-pub mod cli;
 pub mod density;
 pub mod fill;
 pub mod input;
 pub mod mass;
 pub mod mesh;
 pub mod overlap;
-mod text;
+pub mod text;
 pub mod urdf;

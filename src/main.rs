@@ -1,5 +1,11 @@
-//! The `urdf-inertia` binary: everything lives in the library's `cli` module.
+//! The `urdf-inertia` binary: the command line (`cli`) over the library's one-way pipeline.
+//!
+//! The command line is the binary's own: the library never depends on it (a test in
+//! `tests/layering.rs` keeps it so).
+#![forbid(unsafe_code)]
+
+mod cli;
 
 fn main() {
-    std::process::exit(urdf_inertia::cli::main());
+    std::process::exit(cli::main());
 }

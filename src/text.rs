@@ -1,4 +1,21 @@
-//! Line numbers for byte offsets, shared by the XML readers.
+//! Text helpers shared by the readers, the splice and the commands: line numbers for byte offsets, and
+//! the one number formatter every output uses (URDF, tables, JSON).
+//!
+//! Numbers are written as a person would: `13.11`, not `13.109999999999998`. A computed value is only
+//! known to within its error estimate, so any decimal within that distance of it is an equally honest
+//! answer; the formatter writes the shortest one. The distance is absolute, `relative error × scale`,
+//! where the scale is the size of what the number belongs to (the tensor's largest entry for products of
+//! inertia, the link's size for the centre of mass), so a product of inertia of 1e-19 beside moments of
+//! 1e-2 is written as `0`.
+//!
+//! ```
+//! use urdf_inertia::text::{shortest, shortest_within, significant};
+//! assert_eq!(shortest(13.109999999999998), "13.109999999999998");
+//! assert_eq!(shortest_within(13.109999999999998, 13.11 * 8.9e-16), "13.11");
+//! assert_eq!(shortest_within(-3.0e-19, 0.026 * 8.9e-16), "0");
+//! assert_eq!(significant(8.4412, 4), "8.441");
+//! assert_eq!(shortest(-0.0), "0");
+//! ```
 
 /// Line numbers (1-based) for byte positions, counted in one pass when positions increase (elements come
 /// in document order); an earlier position is counted from the start.
@@ -41,9 +58,113 @@ pub(crate) fn line_of(bytes: &[u8], pos: usize) -> usize {
         .count()
 }
 
+/// How many digits the URDF and JSON numbers get.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Digits {
+    /// The shortest decimal within the value's own error estimate (see the module docs).
+    #[default]
+    Auto,
+    /// The shortest text that reads back as the same f64 (every bit kept).
+    Full,
+    /// This many significant digits (3 to 17); a rounded tensor is re-checked for validity.
+    Fixed(u32),
+}
+
+impl std::str::FromStr for Digits {
+    type Err = String;
+
+    /// `auto`, `full`, or a number of significant digits from 3 to 17.
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "auto" => Ok(Digits::Auto),
+            "full" => Ok(Digits::Full),
+            _ => match s.parse::<u32>() {
+                Ok(n) if (3..=17).contains(&n) => Ok(Digits::Fixed(n)),
+                _ => Err(format!(
+                    "`{s}`: expected `auto`, `full` or a number of significant digits from 3 to 17"
+                )),
+            },
+        }
+    }
+}
+
+/// The shortest text that reads back as the same f64: plain notation for ordinary magnitudes,
+/// scientific for very small or large ones; `-0` is written `0`.
+pub fn shortest(x: f64) -> String {
+    if x == 0.0 {
+        return "0".into();
+    }
+    let a = x.abs();
+    if (1e-4..1e9).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// `x` rounded to `digits` significant digits (at least 1), as an f64.
+pub fn round_significant(x: f64, digits: u32) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return if x == 0.0 { 0.0 } else { x };
+    }
+    let precision = usize::try_from(digits.max(1) - 1).unwrap_or(0);
+    format!("{x:.precision$e}").parse().unwrap_or(x)
+}
+
+/// `x` with `digits` significant digits, written shortest (`1.50000e0` is `1.5`).
+pub fn significant(x: f64, digits: u32) -> String {
+    shortest(round_significant(x, digits))
+}
+
+/// The decimal with the fewest significant digits within `delta` (absolute) of `x`, as an f64: `0` when
+/// `|x| ≤ delta`, `x` itself when `delta` is not a positive finite number.
+pub fn within(x: f64, delta: f64) -> f64 {
+    if !(x.is_finite() && delta > 0.0 && delta.is_finite()) {
+        return if x == 0.0 { 0.0 } else { x };
+    }
+    if x.abs() <= delta {
+        return 0.0;
+    }
+    // Rounding to p significant digits gives the nearest p-digit decimal, so the first p that lands
+    // within delta gives the shortest decimal there is.
+    (1..=17)
+        .map(|p| round_significant(x, p))
+        .find(|y| (y - x).abs() <= delta)
+        .unwrap_or(x)
+}
+
+/// [`within`], written with [`shortest`].
+pub fn shortest_within(x: f64, delta: f64) -> String {
+    shortest(within(x, delta))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_drop_round_off_and_nothing_else() {
+        // Each noisy value is within 4 ulps of the decimal a person would write.
+        let e = 4.0 * f64::EPSILON;
+        assert_eq!(shortest_within(13.109999999999998, 13.11 * e), "13.11");
+        assert_eq!(shortest_within(0.0007999999999999999, 0.0008 * e), "0.0008");
+        assert_eq!(shortest_within(3.4560000000000004, 3.456 * e), "3.456");
+        // A real f32 coordinate is not noise: its digits stay.
+        assert_eq!(
+            shortest_within(0.019999999552965164, 0.02 * e),
+            "0.01999999955296516"
+        );
+        // Below the scale's round-off: zero, and never "-0".
+        assert_eq!(shortest_within(-1.9e-18, 0.3 * e), "0");
+        assert_eq!(shortest_within(-0.0, 0.0), "0");
+        assert_eq!(shortest_within(0.1 + 0.2, 0.0), "0.30000000000000004");
+        assert_eq!(shortest(1.5e-9), "1.5e-9");
+        assert_eq!(significant(0.123456789, 4), "0.1235");
+        assert_eq!(significant(8.4412, 4), "8.441");
+        assert_eq!("full".parse(), Ok(Digits::Full));
+        assert_eq!("6".parse(), Ok(Digits::Fixed(6)));
+        assert!("2".parse::<Digits>().is_err());
+    }
 
     #[test]
     fn counts_forward_and_back() {

@@ -439,13 +439,17 @@ fn diff_names_unit_slips() {
     let path = tmp.path().join("r.urdf");
     std::fs::write(&path, text).unwrap();
     let out = run(&["diff", path.to_str().unwrap(), "--density", "1000"]);
-    assert!(
-        out.status.success(),
+    // Differs beyond the tolerance: exit 1, as `ruff format --diff` does.
+    assert_eq!(
+        out.status.code(),
+        Some(1),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("mass off by 1e3"), "{stdout}");
+    // Products are all zero: no mirror can be seen, none is named.
+    assert!(!stdout.contains("mirrored"), "{stdout}");
     let out = run(&[
         "diff",
         path.to_str().unwrap(),
@@ -943,8 +947,8 @@ fn diff_names_origin_and_mirror_mistakes() {
     let (_, _, i) = inertial_of(&filled, "a").unwrap();
     assert!(i[1].abs() > 1.0);
     let mirrored = filled.replacen(
-        &format!("ixy=\"{}\"", urdf_inertia::cli::shortest(i[1])),
-        &format!("ixy=\"{}\"", urdf_inertia::cli::shortest(-i[1])),
+        &format!("ixy=\"{}\"", urdf_inertia::text::shortest(i[1])),
+        &format!("ixy=\"{}\"", urdf_inertia::text::shortest(-i[1])),
         1,
     );
     assert_ne!(mirrored, filled);
@@ -993,6 +997,6 @@ fn overlapping_parts_are_reported_with_the_doubly_counted_volume() {
     std::fs::write(&path, text).unwrap();
     let out = run(&["fill", path.to_str().unwrap(), "--density", "1000"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("link `cubes`: parts 1 and 2 overlap: about 5.000e-1 m³ (25.0% of the link's volume) is counted twice"), "{stderr}");
+    assert!(stderr.contains("link `cubes`: parts 1 and 2 overlap: about 0.5 m³ (25.0% of the link's volume) is counted twice"), "{stderr}");
     assert!(!stderr.contains("link `ball`: parts"), "{stderr}");
 }

@@ -682,7 +682,8 @@ fn robot_with_a_finding() -> (tempfile::TempDir, PathBuf) {
 fn broken_pipe_ends_quietly_with_the_earned_status() {
     let (_tmp, urdf) = robot_with_a_finding();
     for (args, code) in [
-        (vec!["diff", s(&urdf), "--density", "1000"], 0),
+        // Links without <inertial> differ from the computed values: diff exits 1 (issue 12).
+        (vec!["diff", s(&urdf), "--density", "1000"], 1),
         (vec!["check", s(&urdf)], 1),
         (vec!["fill", s(&urdf), "--density", "1000"], 0),
         (vec!["mesh", "/nonexistent.stl"], 2),
@@ -819,7 +820,7 @@ fn overlap_of_coincident_boxes_is_summed_over_every_part() {
     let out = run(&["fill", s(&urdf), "--density", "1000"]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(
-        stderr(&out).contains("parts 1, 2, 3, 4, 5 and 195 others overlap: about 1.990e2 m³ (99.5% of the link's volume) is counted more than once (up to 200 times)"),
+        stderr(&out).contains("parts 1, 2, 3, 4, 5 and 195 others overlap: about 199 m³ (99.5% of the link's volume) is counted more than once (up to 200 times)"),
         "{}",
         stderr(&out)
     );
@@ -978,9 +979,13 @@ fn fuzz_one(target: &str, data: &[u8]) -> Result<(), String> {
                 return Ok(());
             };
             let updates: Vec<_> = (0..robot.links.len())
-                .map(|i| (i, urdf_inertia::mass::primitives::sphere(0.1, 1000.0)))
+                .map(|i| (i, urdf_inertia::mass::primitives::sphere(0.1, 1000.0)).into())
                 .collect();
-            let out = urdf_inertia::urdf::write::splice(&robot, &updates, &Default::default());
+            // A text that would not re-encode to the same bytes is refused, not written.
+            let Ok(out) = urdf_inertia::urdf::write::splice(&robot, &updates, &Default::default())
+            else {
+                return Ok(());
+            };
             urdf_inertia::urdf::scan(out, &path)
                 .map(drop)
                 .map_err(|e| format!("what was spliced does not read back: {e:?}"))

@@ -37,7 +37,7 @@ TOL = 1e-6
 
 
 def ours(binary, path):
-    out = subprocess.run([binary, "mesh", str(path), "--format", "json"], capture_output=True, text=True)
+    out = subprocess.run([binary, "mesh", str(path), "--format", "json", "--digits", "full"], capture_output=True, text=True)
     if out.returncode != 0:
         raise RuntimeError(f"{path.name}: urdf-inertia failed: {out.stderr.strip()}")
     j = json.loads(out.stdout)

@@ -80,9 +80,12 @@ pub struct FillArgs {
     /// Only links whose <inertial> is absent or invalid.
     #[arg(long)]
     pub missing_only: bool,
-    /// Significant digits to write (default: shortest round-trip representation).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(3..=17))]
-    pub digits: Option<u32>,
+    /// Digits of the written numbers: `auto` (default: the shortest decimal within each value's error
+    /// estimate, so no round-off noise), `full` (every bit: the shortest text that reads back as the
+    /// same f64), or N significant digits (3 to 17; the rounded tensor is re-checked, and a link it
+    /// cannot keep valid is an error).
+    #[arg(long, value_name = "auto|full|N", default_value = "auto")]
+    pub digits: urdf_inertia::text::Digits,
     /// Write the principal frame's rpy and a diagonal tensor instead of the tensor in link axes.
     #[arg(long)]
     pub principal: bool,
@@ -97,6 +100,10 @@ pub struct DiffArgs {
     pub urdf: PathBuf,
     #[command(flatten)]
     pub source: SourceArgs,
+    /// Relative tolerance: a link whose existing mass, COM or inertia is off by more than this makes
+    /// the exit status 1 (the same threshold `check` applies).
+    #[arg(long, value_name = "REL", default_value_t = 0.05)]
+    pub tolerance: f64,
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
 }
@@ -135,6 +142,11 @@ pub struct MeshArgs {
     pub strict: bool,
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
+    /// Digits of the numbers: `auto` (default: the shortest decimal within the solid's error
+    /// estimate), `full` (every bit: the shortest text that reads back as the same f64), or N
+    /// significant digits (3 to 17).
+    #[arg(long, value_name = "auto|full|N", default_value = "auto")]
+    pub digits: urdf_inertia::text::Digits,
     /// Largest mesh file read: bytes or K/M/G; default 1G, or URDF_INERTIA_MAX_FILE_SIZE.
     #[arg(long, value_name = "SIZE")]
     pub max_file_size: Option<String>,

@@ -1,9 +1,11 @@
 //! `urdf-inertia mesh FILE`: the mass properties of one mesh, with its health.
 
 use super::args::{Format, MeshArgs};
-use super::{shortest, ExitStatus};
-use crate::mesh::{self, health::HealthOptions};
+use super::ExitStatus;
 use serde_json::json;
+use urdf_inertia::mass::{MassProperties, Principal};
+use urdf_inertia::mesh::{self, health::HealthOptions};
+use urdf_inertia::text::{round_significant, shortest, within, Digits};
 
 pub fn run(args: &MeshArgs) -> ExitStatus {
     let scale = match args.scale.as_deref() {
@@ -39,11 +41,38 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         (None, None) => 1.0,
     };
     let mp = solid.unit.scaled(density);
-    if let Some(why) = crate::fill::unrepresentable(&mp) {
+    if let Some(why) = urdf_inertia::fill::unrepresentable(&mp) {
         errln!("error: {}: {why}", args.file.display());
         return ExitStatus::Error;
     }
+    // Written within the solid's own error estimate (see `text`), like every other number; with
+    // `--digits full` every bit, with N digits rounded to N significant digits.
+    let round = |x: f64, delta: f64| match args.digits {
+        Digits::Auto => within(x, delta),
+        Digits::Full => x,
+        Digits::Fixed(n) => round_significant(x, n),
+    };
+    let err = solid.error_estimate;
+    let volume = round(volume, err * volume);
+    let length = mp.com.iter().fold(
+        solid
+            .vertices
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, x| m.max(x.abs())),
+        |m, x| m.max(x.abs()),
+    );
     let pr = mp.principal();
+    let largest = pr.moments[2].abs();
+    let mp = MassProperties {
+        mass: round(mp.mass, err * mp.mass),
+        com: mp.com.map(|x| round(x, err * length)),
+        inertia: mp.inertia.map(|r| r.map(|x| round(x, err * largest))),
+    };
+    let pr = Principal {
+        moments: pr.moments.map(|x| round(x, err * largest)),
+        axes: pr.axes,
+    };
     let elapsed = start.elapsed();
     match args.format {
         Format::Json => {
@@ -68,6 +97,7 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
                 "error_round_off": solid.error.round_off,
                 "error_model": solid.error.model,
                 "error_model_source": solid.error.source.name(),
+                "error_center_of_mass": solid.error.com,
                 "warnings": solid.warnings,
                 "notes": solid.notes,
             });

@@ -12,6 +12,7 @@ macro_rules! errln {
 }
 
 mod args;
+mod compare;
 mod mesh_cmd;
 pub mod output;
 mod robot_cmd;
@@ -53,13 +54,13 @@ pub fn main() -> i32 {
         Command::Diff(d) => d.source.max_file_size.clone(),
         Command::Check(c) => c.source.max_file_size.clone(),
     };
-    let from_env = std::env::var(crate::input::MAX_FILE_SIZE_ENV).ok();
+    let from_env = std::env::var(urdf_inertia::input::MAX_FILE_SIZE_ENV).ok();
     if let Some((what, s)) = max_size
         .map(|s| ("--max-file-size", s))
-        .or(from_env.map(|s| (crate::input::MAX_FILE_SIZE_ENV, s)))
+        .or(from_env.map(|s| (urdf_inertia::input::MAX_FILE_SIZE_ENV, s)))
     {
-        match crate::input::parse_size(&s) {
-            Ok(n) => crate::input::set_max_file_size(n),
+        match urdf_inertia::input::parse_size(&s) {
+            Ok(n) => urdf_inertia::input::set_max_file_size(n),
             Err(e) => {
                 errln!("error: {what}: {e}");
                 return ExitStatus::Error as i32;
@@ -76,18 +77,4 @@ pub fn main() -> i32 {
         return ExitStatus::Error as i32;
     }
     status as i32
-}
-
-/// Formats a number with the shortest representation that reads back to the same f64, in plain notation
-/// for ordinary magnitudes and scientific notation for very small or large ones.
-pub fn shortest(x: f64) -> String {
-    if x == 0.0 {
-        return "0".into();
-    }
-    let a = x.abs();
-    if (1e-4..1e9).contains(&a) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
 }

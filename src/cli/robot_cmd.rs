@@ -1,16 +1,21 @@
 //! `fill`, `diff` and `check`: the commands that work on a URDF.
 
 use super::args::{CheckArgs, DiffArgs, FillArgs, Format, SourceArgs};
-use super::{output, shortest, write, ExitStatus};
-use crate::density::DensityMap;
-use crate::fill::{self, existing_problems, existing_props, FillOptions, FillReport, LinkReport};
-use crate::mass::{frobenius, MassProperties};
-use crate::urdf::resolve::PackageResolver;
-use crate::urdf::write::{splice, WriteOptions};
-use crate::urdf::{scan_bytes, Geometry, NoteLevel, Robot};
+use super::compare::{compare, Comparison};
+use super::{output, write, ExitStatus};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use urdf_inertia::density::DensityMap;
+use urdf_inertia::fill::{
+    self, existing_problems, existing_props, FillOptions, FillReport, LinkReport, MeshCache,
+};
+use urdf_inertia::mass::MassProperties;
+use urdf_inertia::text::shortest;
+use urdf_inertia::text::{self, significant, Digits};
+use urdf_inertia::urdf::resolve::PackageResolver;
+use urdf_inertia::urdf::write::{splice, tidy, tidy_moments, LinkUpdate, WriteOptions};
+use urdf_inertia::urdf::{scan_bytes, Geometry, NoteLevel, Robot};
 
 /// Validated sources: densities (if any), package paths, link selection.
 struct Sources {
@@ -31,6 +36,9 @@ fn sources(s: &SourceArgs) -> Result<Sources, String> {
         (None, None) if s.keep_mass => Some(DensityMap::default()),
         (None, None) => None,
     };
+    for g in s.only.iter().chain(&s.skip) {
+        urdf_inertia::density::glob(g).map_err(|e| format!("--only/--skip: {e}"))?;
+    }
     let mut pkgs = Vec::new();
     for p in &s.package_path {
         pkgs.push(PackageResolver::parse_package_arg(p)?);
@@ -69,7 +77,7 @@ fn prepare(
 
 /// Reads, decodes and scans a URDF, printing the scan's warnings and notes to stderr.
 fn read_robot(path: &Path) -> Result<Robot, String> {
-    let bytes = crate::input::read_file(path)
+    let bytes = urdf_inertia::input::read_file(path)
         .map_err(|e| format!("{}: cannot read the URDF: {e}", path.display()))?;
     let robot = scan_bytes(bytes, path).map_err(|e| e.to_string())?;
     for note in &robot.notes {
@@ -118,18 +126,24 @@ fn part_lines(l: &LinkReport) -> Vec<String> {
     out
 }
 
-fn summary_json(robot: &Robot, report: &FillReport, seconds: f64) -> serde_json::Value {
+fn summary_json(
+    robot: &Robot,
+    report: &FillReport,
+    digits: Digits,
+    seconds: f64,
+) -> serde_json::Value {
     let links: Vec<serde_json::Value> = report
         .links
         .iter()
         .map(|l| {
+            let written = tidy(&l.update(), digits);
             json!({
                 "link": l.name,
                 "line": l.line,
-                "mass": l.computed.mass,
-                "center_of_mass": l.computed.com,
-                "inertia": l.computed.inertia,
-                "principal_moments": l.computed.principal().moments,
+                "mass": written.mass,
+                "center_of_mass": written.com,
+                "inertia": written.inertia,
+                "principal_moments": tidy_moments(l.computed.principal().moments, l.error_estimate(), digits),
                 "size": l.size,
                 "warnings": l.warnings,
                 "parts": l.parts.iter().map(|p| json!({
@@ -138,14 +152,15 @@ fn summary_json(robot: &Robot, report: &FillReport, seconds: f64) -> serde_json:
                     "file": p.file.as_ref().map(|f| f.display().to_string()),
                     "provenance": p.provenance,
                     "faces": p.faces,
-                    "volume": p.volume,
-                    "mass": p.mass,
+                    "volume": text::within(p.volume, p.error_estimate * p.volume),
+                    "mass": text::within(p.mass, p.error_estimate * p.mass),
                     "density": p.density,
                     "density_source": p.density_source,
                     "error_estimate": p.error_estimate,
                     "error_round_off": p.error.round_off,
                     "error_model": p.error.model,
                     "error_model_source": p.error.source.name(),
+                    "error_center_of_mass": p.error.com,
                     "warnings": p.warnings,
                     "notes": p.notes,
                 })).collect::<Vec<_>>(),
@@ -184,16 +199,31 @@ pub fn fill(a: &FillArgs) -> ExitStatus {
     let report = fill::compute(&robot, &map, &src.resolver, &src.options);
     print_failures(&robot, &report);
     let t_write = Instant::now();
-    let updates: Vec<(usize, MassProperties)> =
-        report.links.iter().map(|l| (l.index, l.computed)).collect();
-    let text = splice(
+    let updates: Vec<LinkUpdate> = report.links.iter().map(LinkReport::update).collect();
+    let text = match splice(
         &robot,
         &updates,
         &WriteOptions {
             digits: a.digits,
             principal: a.principal,
         },
-    );
+    ) {
+        Ok(t) => t,
+        Err(errors) => {
+            for e in errors {
+                let link = &robot.links[e.index];
+                errln!(
+                    "error: {}:{}: link `{}`: {}",
+                    robot.path.display(),
+                    link.line,
+                    link.name,
+                    e.message
+                );
+            }
+            errln!("error: nothing written");
+            return ExitStatus::Error;
+        }
+    };
     // Written back in the file's own encoding (UTF-16 and declared single-byte files included).
     let text = match robot.encoding.encode(&text) {
         Ok(bytes) => bytes,
@@ -238,7 +268,7 @@ pub fn fill(a: &FillArgs) -> ExitStatus {
     if a.format == Format::Json && target.is_some() {
         outln!(
             "{}",
-            serde_json::to_string_pretty(&summary_json(&robot, &report, seconds))
+            serde_json::to_string_pretty(&summary_json(&robot, &report, a.digits, seconds))
                 .unwrap_or_default()
         );
     } else {
@@ -297,179 +327,268 @@ pub fn fill(a: &FillArgs) -> ExitStatus {
     }
 }
 
-/// Existing against computed, for one link.
-struct Comparison {
-    mass_ratio: f64,
-    com_distance: f64,
-    inertia_difference: f64,
-    notes: Vec<String>,
+/// One existing `<inertial>` against the computed one.
+struct Row<'a> {
+    link: &'a LinkReport,
+    existing: Option<MassProperties>,
+    comparison: Option<Comparison>,
 }
 
-fn near_power(r: f64) -> Option<i32> {
-    if !(r > 0.0 && r.is_finite()) {
-        return None;
+impl Row<'_> {
+    /// Whether `fill` would change this link beyond `tolerance` (or its values are invalid).
+    fn differs(&self, tolerance: f64) -> bool {
+        self.comparison
+            .as_ref()
+            .is_none_or(|c| c.differs(tolerance))
     }
-    let e = r.log10();
-    let k = (e / 3.0).round() as i32 * 3;
-    if k != 0 && (e - k as f64).abs() < 0.15 {
-        Some(k)
+}
+
+/// Compare once: every computed link against its existing `<inertial>`.
+fn compare_all<'a>(robot: &Robot, report: &'a FillReport) -> Vec<Row<'a>> {
+    report
+        .links
+        .iter()
+        .map(|l| {
+            let existing = robot.links[l.index]
+                .inertial
+                .as_ref()
+                .and_then(|s| existing_props(&s.value));
+            let comparison = existing.as_ref().map(|e| compare(e, &l.computed, l.size));
+            Row {
+                link: l,
+                existing,
+                comparison,
+            }
+        })
+        .collect()
+}
+
+fn validated_tolerance(tolerance: f64) -> Result<f64, ExitStatus> {
+    if tolerance > 0.0 && tolerance.is_finite() {
+        Ok(tolerance)
     } else {
-        None
+        errln!("error: --tolerance {tolerance} must be a positive number");
+        Err(ExitStatus::Error)
     }
 }
 
-fn compare(existing: &MassProperties, computed: &MassProperties, size: f64) -> Comparison {
-    let rel = |a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]| {
-        let mut d = [[0.0; 3]; 3];
-        for i in 0..3 {
-            for j in 0..3 {
-                d[i][j] = a[i][j] - b[i][j];
-            }
-        }
-        frobenius(&d) / frobenius(b).max(f64::MIN_POSITIVE)
-    };
-    let mass_ratio = existing.mass / computed.mass;
-    let dc = [0, 1, 2].map(|k| existing.com[k] - computed.com[k]);
-    let com_distance =
-        (dc[0] * dc[0] + dc[1] * dc[1] + dc[2] * dc[2]).sqrt() / size.max(f64::MIN_POSITIVE);
-    let inertia_difference = rel(&existing.inertia, &computed.inertia);
-    let mut notes = Vec::new();
-    if let Some(k) = near_power(mass_ratio) {
-        notes.push(format!("mass off by 1e{k} (unit slip?)"));
-    }
-    let norm_ratio =
-        frobenius(&existing.inertia) / frobenius(&computed.inertia).max(f64::MIN_POSITIVE);
-    if let Some(k) = near_power(norm_ratio) {
-        notes.push(format!("inertia off by 1e{k} (unit slip: mm² or g?)"));
-    }
-    // Scaled to the same mass, do the values look like the tensor about the link origin?
-    let scaled = existing.scaled(1.0 / mass_ratio.max(f64::MIN_POSITIVE));
-    let about_origin = computed.inertia_about([0.0; 3]);
-    if inertia_difference > 0.05
-        && rel(&scaled.inertia, &about_origin) < 0.5 * rel(&scaled.inertia, &computed.inertia)
-        && rel(&scaled.inertia, &about_origin) < 0.05
-    {
-        notes.push("inertia looks like it is about the link origin, not the COM".into());
-    }
-    for (axis, name) in [(0usize, "x"), (1, "y"), (2, "z")] {
-        let mut m = computed.inertia;
-        for j in 0..3 {
-            if j != axis {
-                m[axis][j] = -m[axis][j];
-                m[j][axis] = -m[j][axis];
-            }
-        }
-        if inertia_difference > 0.05 && rel(&scaled.inertia, &m) < 0.05 {
-            notes.push(format!(
-                "products of inertia look mirrored in {name} (mesh mirrored, or scale sign lost?)"
-            ));
-        }
-    }
-    let problems = crate::mass::validity::check(existing, crate::mass::validity::DEFAULT_TOLERANCE);
-    for p in problems {
-        notes.push(format!("existing is invalid: {p}"));
-    }
-    Comparison {
-        mass_ratio,
-        com_distance,
-        inertia_difference,
-        notes,
+/// Reported principal moments (rounded like the rest of the output).
+fn moments(mp: &MassProperties, error: f64) -> [f64; 3] {
+    tidy_moments(mp.principal().moments, error, Digits::Auto)
+}
+
+fn props_json(mp: &MassProperties, error: f64) -> serde_json::Value {
+    json!({"mass": mp.mass, "center_of_mass": mp.com, "inertia": mp.inertia, "principal_moments": moments(mp, error)})
+}
+
+fn diff_json(rows: &[Row], tolerance: f64) -> serde_json::Value {
+    let v: Vec<serde_json::Value> = rows
+        .iter()
+        .map(|r| {
+            let l = r.link;
+            let c = r.comparison.as_ref();
+            let existing = r.existing.map(|e| tidy(&(l.index, e).into(), Digits::Full));
+            json!({
+                "link": l.name,
+                "line": l.line,
+                "computed": props_json(&tidy(&l.update(), Digits::Auto), l.error_estimate()),
+                "existing": existing.map(|e| props_json(&e, 0.0)),
+                "mass_ratio": c.map(|c| c.mass_ratio),
+                "com_distance_relative": c.map(|c| c.com_distance),
+                "inertia_difference_relative": c.map(|c| c.inertia_difference),
+                "differs": r.differs(tolerance),
+                "notes": c.map_or_else(|| vec!["no existing <inertial>".to_string()], |c| {
+                    c.causes.iter().cloned().chain(c.invalid.iter().map(|p| format!("existing is invalid: {p}"))).collect()
+                }),
+                "provenance": l.parts.iter().map(|p| p.provenance.clone()).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    serde_json::Value::Array(v)
+}
+
+fn diff_text(rows: &[Row]) {
+    outln!(
+        "{:<28} {:>12} {:>12} {:>9} {:>10} {:>10}  notes",
+        "link",
+        "existing kg",
+        "computed kg",
+        "ratio",
+        "COM Δ/size",
+        "inertia Δ"
+    );
+    for r in rows {
+        let l = r.link;
+        let computed = tidy(&l.update(), Digits::Auto);
+        let (Some(e), Some(c)) = (&r.existing, &r.comparison) else {
+            outln!(
+                "{:<28} {:>12} {:>12} {:>9} {:>10} {:>10}  no existing <inertial>",
+                l.name,
+                "-",
+                significant(computed.mass, 6),
+                "-",
+                "-",
+                "-"
+            );
+            continue;
+        };
+        let notes: Vec<String> = c
+            .causes
+            .iter()
+            .cloned()
+            .chain(
+                c.invalid
+                    .iter()
+                    .map(|p| format!("existing is invalid: {p}")),
+            )
+            .collect();
+        outln!(
+            "{:<28} {:>12} {:>12} {:>9} {:>10} {:>10}  {}",
+            l.name,
+            significant(e.mass, 6),
+            significant(computed.mass, 6),
+            significant(c.mass_ratio, 4),
+            significant(text::within(c.com_distance, l.error_estimate()), 4),
+            significant(text::within(c.inertia_difference, l.error_estimate()), 4),
+            notes.join("; ")
+        );
+        let pe = moments(e, 0.0).map(|x| significant(x, 7));
+        let pc = moments(&l.computed, l.error_estimate()).map(shortest);
+        outln!(
+            "{:<28} principal moments existing {} {} {}, computed {} {} {}",
+            "",
+            pe[0],
+            pe[1],
+            pe[2],
+            pc[0],
+            pc[1],
+            pc[2]
+        );
     }
 }
 
+/// `diff`: the comparison as a table (or JSON); exit 1 when a link differs beyond `--tolerance` or
+/// its existing values are invalid (as `ruff format --diff` exits 1 when a file would change).
 pub fn diff(a: &DiffArgs) -> ExitStatus {
+    let tolerance = match validated_tolerance(a.tolerance) {
+        Ok(t) => t,
+        Err(status) => return status,
+    };
     let (src, map, robot) = match prepare(&a.source, &a.urdf, "diff") {
         Ok(p) => p,
         Err(status) => return status,
     };
     let report = fill::compute(&robot, &map, &src.resolver, &src.options);
     print_failures(&robot, &report);
-    let mut rows = Vec::new();
-    for l in &report.links {
-        let link = &robot.links[l.index];
-        let existing = link
-            .inertial
-            .as_ref()
-            .and_then(|s| existing_props(&s.value));
-        let cmp = existing.as_ref().map(|e| compare(e, &l.computed, l.size));
-        rows.push((l, existing, cmp));
-    }
+    let rows = compare_all(&robot, &report);
     match a.format {
-        Format::Json => {
-            let v: Vec<serde_json::Value> = rows
-                .iter()
-                .map(|(l, e, c)| {
-                    json!({
-                        "link": l.name,
-                        "line": l.line,
-                        "computed": {"mass": l.computed.mass, "center_of_mass": l.computed.com, "inertia": l.computed.inertia, "principal_moments": l.computed.principal().moments},
-                        "existing": e.map(|e| json!({"mass": e.mass, "center_of_mass": e.com, "inertia": e.inertia, "principal_moments": e.principal().moments})),
-                        "mass_ratio": c.as_ref().map(|c| c.mass_ratio),
-                        "com_distance_relative": c.as_ref().map(|c| c.com_distance),
-                        "inertia_difference_relative": c.as_ref().map(|c| c.inertia_difference),
-                        "notes": c.as_ref().map(|c| c.notes.clone()).unwrap_or_else(|| vec!["no existing <inertial>".to_string()]),
-                        "provenance": l.parts.iter().map(|p| p.provenance.clone()).collect::<Vec<_>>(),
-                    })
-                })
-                .collect();
-            outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
-        }
-        Format::Text => {
-            outln!(
-                "{:<28} {:>12} {:>12} {:>9} {:>10} {:>10}  notes",
-                "link",
-                "existing kg",
-                "computed kg",
-                "ratio",
-                "COM Δ/size",
-                "inertia Δ"
-            );
-            for (l, e, c) in &rows {
-                match (e, c) {
-                    (Some(e), Some(c)) => {
-                        outln!(
-                            "{:<28} {:>12.5} {:>12.5} {:>9.4} {:>10.3e} {:>10.3e}  {}",
-                            l.name,
-                            e.mass,
-                            l.computed.mass,
-                            c.mass_ratio,
-                            c.com_distance,
-                            c.inertia_difference,
-                            c.notes.join("; ")
-                        );
-                        let pe = e.principal().moments;
-                        let pc = l.computed.principal().moments;
-                        outln!(
-                            "{:<28} principal moments existing {} {} {}, computed {} {} {}",
-                            "",
-                            shortest(pe[0]),
-                            shortest(pe[1]),
-                            shortest(pe[2]),
-                            shortest(pc[0]),
-                            shortest(pc[1]),
-                            shortest(pc[2])
-                        );
-                    }
-                    _ => outln!(
-                        "{:<28} {:>12} {:>12.5} {:>9} {:>10} {:>10}  no existing <inertial>",
-                        l.name,
-                        "-",
-                        l.computed.mass,
-                        "-",
-                        "-",
-                        "-"
-                    ),
-                }
-            }
-        }
+        Format::Json => outln!(
+            "{}",
+            serde_json::to_string_pretty(&diff_json(&rows, tolerance)).unwrap_or_default()
+        ),
+        Format::Text => diff_text(&rows),
     }
-    if report.failures.is_empty() {
-        ExitStatus::Success
-    } else {
+    if !report.failures.is_empty() {
         ExitStatus::Error
+    } else if rows.iter().any(|r| r.differs(tolerance)) {
+        ExitStatus::Problems
+    } else {
+        ExitStatus::Success
     }
 }
 
+/// What `check` found in one URDF.
+#[derive(Default)]
+struct Found {
+    problems: usize,
+    errors: usize,
+}
+
+/// Problems of the existing `<inertial>` elements themselves (no computation needed).
+fn check_existing(robot: &Robot, src: &Sources, all_links: bool, found: &mut Found) {
+    let path = robot.path.display();
+    for link in robot
+        .links
+        .iter()
+        .filter(|l| fill::selected(&l.name, &src.options))
+    {
+        let Some(span) = &link.inertial else {
+            if link.has_collision_geometry() {
+                outln!(
+                    "{path}:{}: link `{}`: has collision geometry but no <inertial>",
+                    link.line,
+                    link.name
+                );
+                found.problems += 1;
+            }
+            continue;
+        };
+        // Several <inertial> elements are a problem whatever the link: the file says two things.
+        let duplicates = fill::duplicate_inertials(link);
+        for p in existing_problems(link) {
+            if !link.has_collision_geometry() && !all_links && duplicates.as_ref() != Some(&p) {
+                errln!("note: {path}:{}: link `{}` (no collision geometry, so fill cannot compute it): {p}", span.line, link.name);
+            } else {
+                outln!("{path}:{}: link `{}`: {p}", span.line, link.name);
+                found.problems += 1;
+            }
+        }
+    }
+}
+
+/// Without densities nothing is computed, but a collision that cannot be is still an error.
+fn check_collisions(robot: &Robot, src: &Sources, found: &mut Found) {
+    for link in robot
+        .links
+        .iter()
+        .filter(|l| fill::selected(&l.name, &src.options))
+    {
+        for c in &link.collisions {
+            if let Geometry::Invalid { line, message } = &c.geometry {
+                errln!(
+                    "error: {}:{}: link `{}`: collision {} (line {line}): {message}",
+                    robot.path.display(),
+                    link.line,
+                    link.name,
+                    c.index
+                );
+                found.errors += 1;
+            }
+        }
+    }
+}
+
+/// Existing against computed, beyond the tolerance (invalid values are reported by `check_existing`).
+fn check_against_computed(robot: &Robot, report: &FillReport, tolerance: f64, found: &mut Found) {
+    for r in compare_all(robot, report) {
+        let (Some(e), Some(c)) = (&r.existing, &r.comparison) else {
+            continue;
+        };
+        let off = c.beyond(e, &r.link.computed, tolerance);
+        if off.is_empty() {
+            continue;
+        }
+        let causes = if c.causes.is_empty() {
+            String::new()
+        } else {
+            format!(" [{}]", c.causes.join("; "))
+        };
+        let line = robot.links[r.link.index]
+            .inertial
+            .as_ref()
+            .map_or(r.link.line, |s| s.line);
+        outln!(
+            "{}:{line}: link `{}`: {}{causes} (tolerance {tolerance})",
+            robot.path.display(),
+            r.link.name,
+            off.join("; ")
+        );
+        found.problems += 1;
+    }
+}
+
+/// `check`: exit 1 when an `<inertial>` is invalid, missing or (with densities) off by more than the
+/// tolerance. Several URDFs (what pre-commit passes) share one mesh cache: a mesh is read once.
 pub fn check(a: &CheckArgs) -> ExitStatus {
     let src = match sources(&a.source) {
         Ok(s) => s,
@@ -478,133 +597,35 @@ pub fn check(a: &CheckArgs) -> ExitStatus {
             return ExitStatus::Error;
         }
     };
-    if !(a.tolerance > 0.0 && a.tolerance.is_finite()) {
-        errln!(
-            "error: --tolerance {} must be a positive number",
-            a.tolerance
-        );
-        return ExitStatus::Error;
-    }
-    let mut findings = 0usize;
-    let mut errors = 0usize;
+    let tolerance = match validated_tolerance(a.tolerance) {
+        Ok(t) => t,
+        Err(status) => return status,
+    };
+    let mut cache = MeshCache::default();
+    let mut found = Found::default();
     for path in &a.urdf {
         let robot = match read_robot(path) {
             Ok(r) => r,
             Err(e) => {
                 errln!("error: {e}");
-                errors += 1;
+                found.errors += 1;
                 continue;
             }
         };
-        let mut report_line = |line: usize, link: &str, msg: &str| {
-            outln!("{}:{line}: link `{link}`: {msg}", path.display());
-            findings += 1;
+        check_existing(&robot, &src, a.all_links, &mut found);
+        let Some(map) = &src.map else {
+            check_collisions(&robot, &src, &mut found);
+            continue;
         };
-        for link in &robot.links {
-            if !fill::selected(&link.name, &src.options) {
-                continue;
-            }
-            if link.inertial.is_none() {
-                if link.has_collision_geometry() {
-                    report_line(
-                        link.line,
-                        &link.name,
-                        "has collision geometry but no <inertial>",
-                    );
-                }
-                continue;
-            }
-            let line = link.inertial.as_ref().map(|s| s.line).unwrap_or(link.line);
-            // Several <inertial> elements are a problem whatever the link: the file says two things.
-            let duplicates = fill::duplicate_inertials(link);
-            for p in existing_problems(link) {
-                if !link.has_collision_geometry() && !a.all_links && duplicates.as_ref() != Some(&p)
-                {
-                    errln!("note: {}:{line}: link `{}` (no collision geometry, so fill cannot compute it): {p}", path.display(), link.name);
-                } else {
-                    report_line(line, &link.name, &p);
-                }
-            }
-        }
-        if src.map.is_none() {
-            // Without densities nothing is computed, but a collision that cannot be is still an error.
-            for link in robot
-                .links
-                .iter()
-                .filter(|l| fill::selected(&l.name, &src.options))
-            {
-                for c in &link.collisions {
-                    if let Geometry::Invalid { line, message } = &c.geometry {
-                        errln!(
-                            "error: {}:{}: link `{}`: collision {} (line {line}): {message}",
-                            path.display(),
-                            link.line,
-                            link.name,
-                            c.index
-                        );
-                        errors += 1;
-                    }
-                }
-            }
-        }
-        if let Some(map) = &src.map {
-            let report = fill::compute(&robot, map, &src.resolver, &src.options);
-            print_failures(&robot, &report);
-            errors += report.failures.len();
-            for l in &report.links {
-                let link = &robot.links[l.index];
-                let Some(span) = &link.inertial else { continue };
-                let Some(e) = existing_props(&span.value) else {
-                    continue;
-                };
-                let c = compare(&e, &l.computed, l.size);
-                let tol = a.tolerance;
-                let mut off = Vec::new();
-                if (c.mass_ratio - 1.0).abs() > tol {
-                    off.push(format!(
-                        "mass {} kg, computed {} kg (ratio {:.4})",
-                        shortest(e.mass),
-                        shortest(l.computed.mass),
-                        c.mass_ratio
-                    ));
-                }
-                if c.com_distance > tol {
-                    off.push(format!(
-                        "centre of mass {:.3e} of the link's size from the computed one",
-                        c.com_distance
-                    ));
-                }
-                if c.inertia_difference > tol {
-                    off.push(format!(
-                        "inertia differs from the computed one by {:.3e} (relative)",
-                        c.inertia_difference
-                    ));
-                }
-                if !off.is_empty() {
-                    let notes = c
-                        .notes
-                        .iter()
-                        .filter(|n| !n.starts_with("existing is invalid"))
-                        .cloned()
-                        .collect::<Vec<_>>();
-                    let notes = if notes.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" [{}]", notes.join("; "))
-                    };
-                    report_line(
-                        span.line,
-                        &link.name,
-                        &format!("{}{notes} (tolerance {tol})", off.join("; ")),
-                    );
-                }
-            }
-        }
+        let report = fill::compute_with(&robot, map, &src.resolver, &src.options, &mut cache);
+        print_failures(&robot, &report);
+        found.errors += report.failures.len();
+        check_against_computed(&robot, &report, tolerance, &mut found);
     }
-    if errors > 0 {
+    if found.errors > 0 {
         ExitStatus::Error
-    } else if findings > 0 {
-        errln!("urdf-inertia check: {findings} problem(s) found; `urdf-inertia fill -i FILE --density-map …` computes correct values");
+    } else if found.problems > 0 {
+        errln!("urdf-inertia check: {} problem(s) found; `urdf-inertia fill -i FILE --density-map …` computes correct values", found.problems);
         ExitStatus::Problems
     } else {
         ExitStatus::Success

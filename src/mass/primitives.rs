@@ -55,8 +55,3 @@ pub fn capsule(radius: f64, length: f64, density: f64) -> MassProperties {
     let izz = mc * r2 / 2.0 + ms * 0.4 * r2;
     diagonal(mc + ms, [ixx, ixx, izz])
 }
-
-/// Volume of each primitive (for the density-to-mass step when a part is given a mass).
-pub fn capsule_volume(radius: f64, length: f64) -> f64 {
-    PI * radius * radius * (length + 4.0 / 3.0 * radius)
-}

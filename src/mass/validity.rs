@@ -4,6 +4,7 @@
 //! 1e-5 or 1e-15 on the moments would break.
 
 use super::{jacobi, MassProperties};
+use crate::text::significant as sig;
 
 /// One way in which mass properties cannot belong to a physical body.
 #[derive(Debug, Clone, PartialEq)]
@@ -26,17 +27,17 @@ impl std::fmt::Display for Violation {
             Violation::NotFinite => write!(f, "a value is NaN or infinite"),
             Violation::NonPositiveMass(m) => write!(f, "mass {m} is not positive"),
             Violation::NotSymmetric { asymmetry } => {
-                write!(f, "inertia tensor is not symmetric (relative asymmetry {asymmetry:.3e})")
+                write!(f, "inertia tensor is not symmetric (relative asymmetry {})", sig(*asymmetry, 4))
             }
             Violation::NotPositiveDefinite { moments } => write!(
                 f,
-                "inertia tensor is not positive definite (principal moments {:.6e}, {:.6e}, {:.6e})",
-                moments[0], moments[1], moments[2]
+                "inertia tensor is not positive definite (principal moments {}, {}, {})",
+                sig(moments[0], 7), sig(moments[1], 7), sig(moments[2], 7)
             ),
             Violation::TriangleInequality { moments, excess } => write!(
                 f,
-                "principal moments {:.6e}, {:.6e}, {:.6e} break the triangle inequality (largest exceeds the sum of the others by {:.3e} of it)",
-                moments[0], moments[1], moments[2], excess
+                "principal moments {}, {}, {} break the triangle inequality (largest exceeds the sum of the others by {} of it)",
+                sig(moments[0], 7), sig(moments[1], 7), sig(moments[2], 7), sig(*excess, 4)
             ),
         }
     }

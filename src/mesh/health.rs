@@ -12,10 +12,11 @@
 //!    component is made consistent, then turned outward by its signed volume.
 //! 4. [`Rung::Inverted`]: closed and consistent but wound inward (negative volume): flipped.
 //! 5. Open (boundary edges) or non-manifold, after orienting what the manifold edges allow:
-//!    * [`Rung::Capped`]: each boundary loop is closed by a fan from its centroid. When the caps'
-//!      uncertainty (below) is under 1e-3 of the volume, the capped mesh is used. When it is below
-//!      1e-12 (the "holes" are slivers), the triangles are integrated as stored and the rung is
-//!      [`Rung::Welded`].
+//!    * [`Rung::Capped`]: each boundary loop is closed by a fan from its centroid. When the bound
+//!      the caps leave on volume and inertia (below) is under 1e-3, the capped mesh is used; above
+//!      that, the convex hull is built too and the one with the smaller bound wins. When the caps'
+//!      bound is below 1e-12 (the "holes" are slivers), the triangles are integrated as stored and
+//!      the rung is [`Rung::Welded`].
 //!    * [`Rung::NonManifold`]: no boundary edges but edges shared by three or more faces: the surface
 //!      still bounds a region, integrated as it is (a region enclosed twice counts twice).
 //!    * [`Rung::ConvexHull`] otherwise: the convex hull of its vertices.
@@ -93,7 +94,8 @@ impl Rung {
 pub enum ModelError {
     /// The solid is the stored surface: no model error.
     None,
-    /// Float-noise cracks left after welding (their area times the mesh's size).
+    /// A surface closed only up to cracks: the volume that moves with the reference point
+    /// (|vector area| × diagonal / 6).
     Cracks,
     /// Re-oriented components, any of which could be a cavity (their volumes).
     Orientation,
@@ -127,6 +129,9 @@ pub struct ErrorEstimate {
     pub model: f64,
     /// What the model error is made of (the largest term).
     pub source: ModelError,
+    /// Bound on the error of the centre of mass, m: the relative bound times the solid's reach (its
+    /// farthest vertex from the centre of mass), plus the round-off of the centre's own coordinates.
+    pub com: f64,
 }
 
 impl ErrorEstimate {
@@ -183,7 +188,7 @@ pub struct HealthOptions {
 /// A solid's volume below this many f64 round-offs of its faces' contributions counts as empty.
 const ZERO_VOLUME_ROUNDOFFS: f64 = 1e3;
 
-/// Largest relative volume uncertainty of the caps for which a capped mesh is used.
+/// Largest relative bound of the caps for which a capped mesh is used without trying the hull.
 const CAPPED: f64 = 1e-3;
 
 /// Caps whose uncertainty is below this (relative) close slivers, not holes: integrate as stored.
@@ -323,7 +328,7 @@ fn orient(nfaces: usize, pairs: &[(u32, u32, bool)]) -> Option<Orientation> {
 /// topology the tolerant weld gives them.
 struct Welding {
     vertices: Vec<[f64; 3]>,
-    /// All faces as stored (bit-exact welded).
+    /// All faces as stored (bit-exact welded), less duplicates.
     stored: Polygons,
     /// The stored faces that survive the tolerant weld, in stored vertex indices.
     kept: Polygons,
@@ -332,52 +337,115 @@ struct Welding {
     tolerant: weld::TolerantWeld,
     /// Faces that collapsed under the tolerant weld.
     collapsed: usize,
-    /// Bound on the area of the cracks the tolerant weld closed, plus the collapsed faces' area, m².
-    crack_area: f64,
+    /// Faces dropped as duplicates (or as cancelling pairs).
+    duplicates: usize,
 }
 
-fn tolerant_welding(
-    exact: weld::ExactWeld,
-    exact_edges: &Edges,
-    precision: weld::Precision,
-) -> Welding {
+fn tolerant_welding(exact: weld::ExactWeld, precision: weld::Precision) -> Welding {
     let tol = weld::tolerance(&exact.vertices, precision);
     let tolerant = weld::tolerant(&exact.vertices, tol);
-    let (topology, kept_mask) = weld::remap_faces(&exact.faces, &tolerant.representative);
+    let (all_topology, kept_mask) = weld::remap_faces(&exact.faces, &tolerant.representative);
+    let (dropped, duplicates) = duplicate_faces(&all_topology);
+    let mut stored = Polygons::new();
     let mut kept = Polygons::new();
-    let mut crack_area = 0.0;
+    let mut topology = Polygons::new();
+    let mut t = 0;
     for (i, face) in exact.faces.iter().enumerate() {
-        if kept_mask[i] {
+        if !kept_mask[i] {
+            stored.push(face);
+            continue;
+        }
+        if !dropped[t] {
+            stored.push(face);
             kept.push(face);
-        } else {
-            crack_area += polygon_area(&exact.vertices, face);
+            topology.push(all_topology.face(t));
         }
-    }
-    let rep = &tolerant.representative;
-    let disp = |i: u32| {
-        dist(
-            exact.vertices[i as usize],
-            exact.vertices[rep[i as usize] as usize],
-        )
-    };
-    for &(u, v) in &exact_edges.boundary_half_edges {
-        let (du, dv) = (disp(u), disp(v));
-        if du > 0.0 || dv > 0.0 {
-            crack_area += dist(exact.vertices[u as usize], exact.vertices[v as usize]) * (du + dv);
-        }
+        t += 1;
     }
     Welding {
         collapsed: kept_mask.iter().filter(|k| !**k).count(),
+        duplicates,
         vertices: exact.vertices,
-        stored: exact.faces,
+        stored,
         kept,
         topology,
         tolerant,
-        crack_area,
     }
 }
 
+/// Faces that repeat another one's vertices in the same cyclic order (a duplicate: kept once) or in
+/// the reverse order (a zero-thickness wall: the pair cancels, both dropped). Returns per face whether
+/// it is dropped, and how many are.
+fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize) {
+    // Each face's vertices rotated to start at the smallest index, in whichever direction reads
+    // smaller, and whether that was backwards. Sorting the keys groups the copies.
+    let canonical = |f: &[u32]| -> (Vec<u32>, bool) {
+        let k = (0..f.len()).min_by_key(|&i| f[i]).unwrap_or(0);
+        let forward: Vec<u32> = (0..f.len()).map(|i| f[(k + i) % f.len()]).collect();
+        let backward: Vec<u32> = (0..f.len())
+            .map(|i| f[(k + f.len() - i) % f.len()])
+            .collect();
+        if forward <= backward {
+            (forward, false)
+        } else {
+            (backward, true)
+        }
+    };
+    // Triangles (nearly every face) without allocating: the key is the rotated triple.
+    let mut keys: Vec<([u32; 3], bool, u32)> = Vec::with_capacity(faces.len());
+    let mut others: Vec<(Vec<u32>, bool, u32)> = Vec::new();
+    for (i, f) in faces.iter().enumerate() {
+        if let [a, b, c] = *f {
+            let (x, y, z) = if a < b && a < c {
+                (a, b, c)
+            } else if b < c {
+                (b, c, a)
+            } else {
+                (c, a, b)
+            };
+            let key = if y <= z {
+                ([x, y, z], false)
+            } else {
+                ([x, z, y], true)
+            };
+            keys.push((key.0, key.1, i as u32));
+        } else {
+            let (key, reversed) = canonical(f);
+            others.push((key, reversed, i as u32));
+        }
+    }
+    keys.sort_unstable();
+    others.sort_unstable();
+    let mut dropped = vec![false; faces.len()];
+    let mut count = 0;
+    let mut drop_group = |members: &[(bool, u32)]| {
+        let ahead = members.iter().filter(|m| !m.0).count();
+        let back = members.len() - ahead;
+        // Keep one face of the majority direction (none when the directions balance).
+        let keep_dir = back > ahead;
+        let mut keep = usize::from(ahead != back);
+        for &(reversed, i) in members {
+            if reversed == keep_dir && keep > 0 {
+                keep -= 1;
+            } else {
+                dropped[i as usize] = true;
+                count += 1;
+            }
+        }
+    };
+    for group in keys.chunk_by(|a, b| a.0 == b.0).filter(|g| g.len() > 1) {
+        let members: Vec<(bool, u32)> = group.iter().map(|m| (m.1, m.2)).collect();
+        drop_group(&members);
+    }
+    for group in others.chunk_by(|a, b| a.0 == b.0).filter(|g| g.len() > 1) {
+        let members: Vec<(bool, u32)> = group.iter().map(|m| (m.1, m.2)).collect();
+        drop_group(&members);
+    }
+    (dropped, count)
+}
+
 /// Shared by the rungs: where the mesh came from and what has been said about it.
+#[derive(Clone)]
 struct Ladder<'a> {
     path: &'a Path,
     options: HealthOptions,
@@ -407,14 +475,16 @@ impl Ladder<'_> {
         vertices: Vec<[f64; 3]>,
         faces: Polygons,
         rung: Rung,
-        model: (f64, ModelError),
+        model: impl Into<Model>,
         message: impl FnOnce(f64) -> Option<String>,
     ) -> Result<Solid, MeshError> {
         let unit = unit_props(&vertices, &faces, None);
         check_volume(&vertices, &faces, unit.mass, self.path)?;
         let round_off = round_off(&vertices, &faces, &unit);
-        let (delta, source) = model;
-        let model_error = relative_model(delta, &unit, &vertices);
+        let model = model.into();
+        let source = model.source;
+        let bound = model.bound(&unit, &vertices);
+        let model_error = bound.relative;
         if let Some(m) = message(model_error) {
             self.warnings.push(m);
         }
@@ -426,9 +496,14 @@ impl Ladder<'_> {
         {
             *relative_uncertainty = model_error;
         }
+        // Round-off shifts the centre by the relative round-off of the first moments, about the
+        // reference point.
+        let com =
+            bound.com + round_off * (reach(&unit, &vertices) + dot(unit.com, unit.com).sqrt());
         let error = ErrorEstimate {
             round_off,
             model: model_error,
+            com,
             source: if model_error > 0.0 {
                 source
             } else {
@@ -449,33 +524,84 @@ impl Ladder<'_> {
     }
 }
 
-/// The relative error that a volume `delta` (m³) moved, added or removed anywhere within the solid's
-/// reach can cause, against the true value (which is at least the computed one less the change):
-/// for the volume δ/(V − δ); for the central inertia 3·δ·R²/(‖I‖ − 3·δ·R²), R the largest distance
-/// of a vertex from the centre of mass (a point mass δ at distance R changes the tensor by at most
-/// √2·δ·R², and the centre of mass it moves by as much again). Unbounded when the change could be
-/// as large as the value itself.
-fn relative_model(delta: f64, unit: &MassProperties, vertices: &[[f64; 3]]) -> f64 {
-    if delta == 0.0 {
-        return 0.0;
-    }
-    let reach2 = vertices
-        .iter()
-        .map(|v| {
-            let d = sub(*v, unit.com);
-            dot(d, d)
-        })
-        .fold(0.0, f64::max);
-    let bounded = |change: f64, value: f64| {
-        if change < value {
-            change / (value - change)
-        } else {
-            f64::INFINITY
+/// Where the volume of a model error may sit: anywhere in the solid, or near given points (the
+/// loops a cap closes).
+enum Lever {
+    Anywhere,
+    Near(Vec<[f64; 3]>),
+}
+
+/// A model error: volumes (m³) by which the solid can differ from the stored surface, each with where
+/// it sits, and what the largest is made of.
+struct Model {
+    terms: Vec<(f64, Lever)>,
+    source: ModelError,
+}
+
+impl From<(f64, ModelError)> for Model {
+    fn from((delta, source): (f64, ModelError)) -> Model {
+        Model {
+            terms: vec![(delta, Lever::Anywhere)],
+            source,
         }
-    };
-    let volume = bounded(delta, unit.mass);
-    let inertia = bounded(3.0 * delta * reach2, frobenius(&unit.inertia));
-    volume.max(inertia)
+    }
+}
+
+/// A model error as relative bounds.
+struct Bound {
+    /// On volume and central inertia.
+    relative: f64,
+    /// On the centre of mass, m.
+    com: f64,
+}
+
+impl Model {
+    /// The relative error that volumes δᵢ moved, added or removed at distances up to Rᵢ from the
+    /// centre of mass can cause, against the true value (at least the computed one less the change):
+    /// for the volume Σδ/(V − Σδ); for the central inertia 3·Σδ·R²/(‖I‖ − 3·Σδ·R²) (a point mass δ at
+    /// distance R changes the tensor by at most √2·δ·R², and the centre of mass it moves by as much
+    /// again); for the centre of mass Σδ·R/(V − Σδ). Unbounded when the change could be as large as
+    /// the value itself.
+    fn bound(&self, unit: &MassProperties, vertices: &[[f64; 3]]) -> Bound {
+        let (mut volume, mut inertia, mut moment) = (0.0, 0.0, 0.0);
+        for (delta, lever) in &self.terms {
+            if *delta == 0.0 {
+                continue;
+            }
+            let r = match lever {
+                Lever::Anywhere => reach(unit, vertices),
+                Lever::Near(points) => reach(unit, points),
+            };
+            volume += delta;
+            inertia += 3.0 * delta * r * r;
+            moment += delta * r;
+        }
+        if volume == 0.0 {
+            return Bound {
+                relative: 0.0,
+                com: 0.0,
+            };
+        }
+        let bounded = |change: f64, value: f64| {
+            if change < value {
+                change / (value - change)
+            } else {
+                f64::INFINITY
+            }
+        };
+        Bound {
+            relative: bounded(volume, unit.mass).max(bounded(inertia, frobenius(&unit.inertia))),
+            com: bounded(moment, unit.mass - volume + moment),
+        }
+    }
+}
+
+/// The largest distance of a vertex from the centre of mass.
+fn reach(unit: &MassProperties, vertices: &[[f64; 3]]) -> f64 {
+    vertices
+        .iter()
+        .map(|v| dist(*v, unit.com))
+        .fold(0.0, f64::max)
 }
 
 /// Turns a scaled mesh into a solid by the ladder in the module docs, its coordinates taken as f64
@@ -518,13 +644,18 @@ pub fn make_solid_stored_as(
             None,
             &e.pairs,
             Rung::Exact,
-            0.0,
         );
     }
-    let w = tolerant_welding(exact, &e, precision());
+    let w = tolerant_welding(exact, precision());
     let te = edges(&w.topology);
-    if w.collapsed > 0 {
+    if w.duplicates > 0 {
         ladder.warnings.push(format!(
+            "{} duplicated faces dropped (a face stored twice, or a face and its reverse, adds nothing to a solid)",
+            w.duplicates
+        ));
+    }
+    if w.collapsed > 0 {
+        ladder.notes.push(format!(
             "{} sliver faces collapse when corners within {:.1e} m are welded; left out of the topology",
             w.collapsed, w.tolerant.tolerance.largest
         ));
@@ -535,16 +666,7 @@ pub fn make_solid_stored_as(
             widest_crack: w.tolerant.widest,
             tolerance: w.tolerant.tolerance.largest,
         };
-        let cracks = w.crack_area;
-        return consistent_closed(
-            ladder,
-            w.vertices,
-            w.stored,
-            Some(w.kept),
-            &te.pairs,
-            rung,
-            cracks,
-        );
+        return consistent_closed(ladder, w.vertices, w.stored, Some(w.kept), &te.pairs, rung);
     }
     if te.closed() {
         if let Some(o) = orient(w.topology.len(), &te.pairs) {
@@ -565,8 +687,9 @@ fn consistent_closed(
     kept: Option<Polygons>,
     pairs: &[(u32, u32, bool)],
     rung: Rung,
-    crack_area: f64,
 ) -> Result<Solid, MeshError> {
+    // Closed only once welded within tolerance: the stored surface's vector area is not exactly 0.
+    let welded = kept.is_some();
     let t = volume_integrals(&vertices, &stored, &IntegrationOptions::accurate());
     let inverted = t.t1 < 0.0;
     let mut faces = stored;
@@ -600,7 +723,7 @@ fn consistent_closed(
             ladder.warnings.push(format!(
                 "{turned} of {ncomp} closed components wound inward although no other component encloses them (a cavity must lie inside a solid); {flipped} faces flipped"
             ));
-            let model = crack_volume(crack_area, &vertices);
+            let model = open_volume(&vertices, &out);
             let rung = Rung::Reoriented {
                 faces_flipped: flipped,
                 components: ncomp,
@@ -618,7 +741,11 @@ fn consistent_closed(
             "closed once {merged_vertices} corners stored up to {widest_crack:.1e} m apart are welded (tolerance {tolerance:.1e} m); integrated as stored"
         ));
     }
-    let model = crack_volume(crack_area, &vertices);
+    let model = if welded {
+        open_volume(&vertices, &faces)
+    } else {
+        0.0
+    };
     ladder.finish(vertices, faces, rung, (model, ModelError::Cracks), |_| None)
 }
 
@@ -683,14 +810,12 @@ fn misoriented(vertices: &[[f64; 3]], faces: &Polygons, comp: &[u32], ncomp: usi
         .collect()
 }
 
-/// Volume that cracks of total area `area` can hold: the flux of the integrands through them is at
-/// most area × (diagonal).
-fn crack_volume(area: f64, vertices: &[[f64; 3]]) -> f64 {
-    if area == 0.0 {
-        return 0.0;
-    }
+/// The volume that moves with the reference point, over reference points in the bounding box, for a
+/// surface that is closed only up to cracks: |vector area| × diagonal / 6 (the signed volume about
+/// r is V(0) − r·A/3). Zero for a closed surface; its round-off for one closed bit for bit.
+fn open_volume(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
     let (lo, hi) = bbox(vertices);
-    area * dist(lo, hi)
+    vector_area(vertices, faces) * dist(lo, hi) / 6.0
 }
 
 /// Closed after the tolerant weld but wound inconsistently: each component made consistent and outward.
@@ -721,7 +846,7 @@ fn reoriented(
         faces_flipped: flipped,
         components: o.ncomp,
     };
-    let model = crack_volume(w.crack_area, &w.vertices) + nested;
+    let model = open_volume(&w.vertices, &faces) + nested;
     let source = if nested > 0.0 {
         ModelError::Orientation
     } else {
@@ -772,118 +897,223 @@ fn apply(faces: &mut Polygons, reversed: &[bool]) {
     }
 }
 
-/// Open or non-manifold: caps, integration as it is, or the convex hull.
-fn open_or_nonmanifold(mut ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result<Solid, MeshError> {
-    let what = te.describe();
-    // Orient what the manifold edges allow, each component outward; failing that (contradicting
-    // edges, or open sheets whose sign is meaningless), the winding as the file gives it.
-    let mut candidates: Vec<(Polygons, Polygons, usize, f64)> = Vec::new();
-    if let Some(o) = orient(w.topology.len(), &te.pairs) {
-        let out = outward(&w.vertices, &w.kept, &o);
-        if out.flipped > 0 {
-            let (mut kept, mut topology) = (w.kept.clone(), w.topology.clone());
-            apply(&mut kept, &out.reversed);
-            apply(&mut topology, &out.reversed);
-            candidates.push((kept, topology, out.flipped, out.nested));
-        }
-    }
-    candidates.push((w.kept.clone(), w.topology.clone(), 0, 0.0));
-    for (faces, topology, flipped, nested) in candidates {
-        let flips = if flipped > 0 {
-            format!(", {flipped} faces re-oriented")
+/// One way to wind an open or non-manifold mesh: the stored faces kept by the weld and their
+/// topology, both with the same faces reversed.
+struct Winding {
+    faces: Polygons,
+    topology: Polygons,
+    flipped: usize,
+    /// Volume of components re-oriented inside another's bounding box (m³).
+    nested: f64,
+}
+
+impl Winding {
+    fn flips(&self) -> String {
+        if self.flipped > 0 {
+            format!(", {} faces re-oriented", self.flipped)
         } else {
             String::new()
-        };
+        }
+    }
+}
+
+/// Orient what the manifold edges allow, each component outward; failing that (contradicting edges,
+/// or open sheets whose sign is meaningless), the winding as the file gives it.
+fn windings(w: &Welding, te: &Edges) -> Vec<Winding> {
+    let mut out = Vec::new();
+    if let Some(o) = orient(w.topology.len(), &te.pairs) {
+        let turned = outward(&w.vertices, &w.kept, &o);
+        if turned.flipped > 0 {
+            let (mut faces, mut topology) = (w.kept.clone(), w.topology.clone());
+            apply(&mut faces, &turned.reversed);
+            apply(&mut topology, &turned.reversed);
+            out.push(Winding {
+                faces,
+                topology,
+                flipped: turned.flipped,
+                nested: turned.nested,
+            });
+        }
+    }
+    out.push(Winding {
+        faces: w.kept.clone(),
+        topology: w.topology.clone(),
+        flipped: 0,
+        nested: 0.0,
+    });
+    out
+}
+
+/// Open or non-manifold: integration as it is, caps, or the convex hull.
+fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result<Solid, MeshError> {
+    let what = te.describe();
+    let mut fallback: Option<(f64, Winding, CappedSolid)> = None;
+    for winding in windings(&w, te) {
         if te.boundary == 0 {
-            let volume = signed_volume(&w.vertices, &faces);
-            if volume > 0.0 {
-                ladder.strict(&format!("mesh is {what}"))?;
-                ladder.warnings.push(format!("mesh is {what} but has no holes: integrated as it is{flips} (a region enclosed by two overlapping shells would count twice)"));
-                // Integrated as stored (up to the faces re-oriented): a region that two shells
-                // enclose counts twice here exactly as in the stored surface, which the warning says.
-                let model = crack_volume(w.crack_area, &w.vertices) + nested;
-                let rung = Rung::NonManifold {
-                    nonmanifold_edges: te.nonmanifold,
-                    faces_flipped: flipped,
-                };
-                let source = if nested > 0.0 {
-                    ModelError::Orientation
-                } else {
-                    ModelError::Cracks
-                };
-                return ladder.finish(w.vertices, faces, rung, (model, source), |_| None);
+            if signed_volume(&w.vertices, &winding.faces) > 0.0 {
+                return non_manifold(ladder, w, te, winding, &what);
             }
             continue;
         }
-        let Some(caps) = cap_holes(&w.vertices, &topology) else {
+        let Some(caps) = cap_holes(&w.vertices, &winding.topology) else {
             continue;
         };
         let mut vertices = w.vertices.clone();
         vertices.extend_from_slice(&caps.centroids);
-        let mut capped = faces.clone();
+        let mut capped = winding.faces.clone();
         for f in caps.faces.iter() {
             capped.push(f);
         }
         let volume = signed_volume(&vertices, &capped);
-        let uncertainty = caps.bound / volume.abs();
-        if !(volume > 0.0 && uncertainty <= CAPPED) {
+        let cracks = open_volume(&vertices, &capped);
+        // The caps are used when the bound they leave on volume and inertia is small enough.
+        let relative = caps_model(&caps, cracks, winding.nested)
+            .bound(&unit_props(&vertices, &capped, None), &vertices)
+            .relative;
+        if !(volume > 0.0 && relative.is_finite()) {
             continue;
         }
-        let cracks = crack_volume(w.crack_area, &w.vertices);
-        // Whatever surface really spans the loops, its contribution is at most (its area) × diagonal.
-        let (lo, hi) = bbox(&w.vertices);
-        let spans = caps.area * dist(lo, hi);
-        if (spans + caps.bound + cracks) / volume <= SLIVERS && flipped == 0 {
-            // The "holes" are slivers: the stored triangles are closed up to round-off.
-            ladder.notes.push(format!(
-                "closed up to slivers once corners within {:.1e} m are welded ({} boundary edges bound {:.1e} m² in all); integrated as stored",
-                w.tolerant.tolerance.largest, te.boundary, caps.area
-            ));
-            let rung = Rung::Welded {
-                merged_vertices: w.tolerant.merged,
-                widest_crack: w.tolerant.widest,
-                tolerance: w.tolerant.tolerance.largest,
-            };
-            let model = spans + caps.bound + cracks;
-            return ladder.finish(
-                w.vertices,
-                w.stored,
-                rung,
-                (model, ModelError::Cracks),
-                |_| None,
-            );
-        }
-        ladder.strict(&format!("mesh is {what}"))?;
-        let mut done = Vec::new();
-        if caps.holes > 0 {
-            done.push(format!("closed its {} hole(s) with flat caps", caps.holes));
-        }
-        if caps.cracks > 0 {
-            done.push(format!(
-                "left {} edge(s) of cracks or T-junctions open",
-                caps.cracks
-            ));
-        }
-        let model = caps.bound + cracks + nested;
-        let rung = Rung::Capped {
-            holes: caps.holes,
-            boundary_edges: te.boundary,
-            nonmanifold_edges: te.nonmanifold,
-            faces_flipped: flipped,
-            relative_uncertainty: 0.0,
+        let plan = CappedSolid {
+            cracks,
+            vertices,
+            faces: capped,
+            volume,
+            caps,
         };
-        let done = done.join(", ");
-        return ladder.finish(vertices, capped, rung, (model, ModelError::Caps), |m| {
-            Some(format!(
-                "mesh is {what}: {done}{flips}; its volume {volume:.6e} m³ and inertia are uncertain by at most {m:.1e} (relative) because of them"
-            ))
-        });
+        if relative <= CAPPED {
+            return with_caps(ladder, w, te, winding, plan, &what);
+        }
+        if fallback.as_ref().is_none_or(|f| relative < f.0) {
+            fallback = Some((relative, winding, plan));
+        }
     }
-    convex_hull(ladder, w, te, &what)
+    // Caps too uncertain to trust outright: the convex hull, unless its own bound is worse.
+    let Some((relative, winding, plan)) = fallback else {
+        return convex_hull(ladder, &w, te, &what);
+    };
+    match convex_hull(ladder.clone(), &w, te, &what) {
+        Ok(hull) if hull.error_estimate < relative => Ok(hull),
+        _ => with_caps(ladder, w, te, winding, plan, &what),
+    }
+}
+
+/// No boundary edges but edges shared by three or more faces: integrated as stored (up to the faces
+/// re-oriented). A region that two shells enclose counts twice here exactly as in the stored surface,
+/// which the warning says.
+fn non_manifold(
+    mut ladder: Ladder<'_>,
+    w: Welding,
+    te: &Edges,
+    winding: Winding,
+    what: &str,
+) -> Result<Solid, MeshError> {
+    ladder.strict(&format!("mesh is {what}"))?;
+    ladder.warnings.push(format!("mesh is {what} but has no holes: integrated as it is{} (a region enclosed by two overlapping shells would count twice)", winding.flips()));
+    let model = open_volume(&w.vertices, &winding.faces) + winding.nested;
+    let rung = Rung::NonManifold {
+        nonmanifold_edges: te.nonmanifold,
+        faces_flipped: winding.flipped,
+    };
+    let source = if winding.nested > 0.0 {
+        ModelError::Orientation
+    } else {
+        ModelError::Cracks
+    };
+    ladder.finish(w.vertices, winding.faces, rung, (model, source), |_| None)
+}
+
+/// The model error of caps: their bound near the loops they close, cracks left open and components
+/// re-oriented anywhere.
+fn caps_model(caps: &Caps, cracks: f64, nested: f64) -> Model {
+    Model {
+        terms: vec![
+            (caps.bound, Lever::Near(caps.points.clone())),
+            (cracks, Lever::Anywhere),
+            (nested, Lever::Anywhere),
+        ],
+        source: ModelError::Caps,
+    }
+}
+
+/// A mesh with its holes capped, ready to integrate.
+struct CappedSolid {
+    vertices: Vec<[f64; 3]>,
+    faces: Polygons,
+    volume: f64,
+    caps: Caps,
+    /// Volume that moves with the reference point after capping (cracks left open), m³.
+    cracks: f64,
+}
+
+/// The capped solid, or, when the "holes" are slivers whose caps change nothing measurable, the
+/// stored triangles as they are (rung welded).
+fn with_caps(
+    mut ladder: Ladder<'_>,
+    w: Welding,
+    te: &Edges,
+    winding: Winding,
+    plan: CappedSolid,
+    what: &str,
+) -> Result<Solid, MeshError> {
+    let caps = &plan.caps;
+    // Whatever surface really spans the loops, its contribution is at most (its area) × diagonal.
+    let (lo, hi) = bbox(&w.vertices);
+    let spans = caps.area * dist(lo, hi);
+    if (spans + caps.bound + plan.cracks) / plan.volume <= SLIVERS && winding.flipped == 0 {
+        ladder.notes.push(format!(
+            "closed up to slivers once corners within {:.1e} m are welded ({} boundary edges bound {:.1e} m² in all); integrated as stored",
+            w.tolerant.tolerance.largest, te.boundary, caps.area
+        ));
+        let rung = Rung::Welded {
+            merged_vertices: w.tolerant.merged,
+            widest_crack: w.tolerant.widest,
+            tolerance: w.tolerant.tolerance.largest,
+        };
+        let model = spans + caps.bound + plan.cracks;
+        return ladder.finish(
+            w.vertices,
+            w.stored,
+            rung,
+            (model, ModelError::Cracks),
+            |_| None,
+        );
+    }
+    ladder.strict(&format!("mesh is {what}"))?;
+    let mut done = Vec::new();
+    if caps.holes > 0 {
+        done.push(format!("closed its {} hole(s) with flat caps", caps.holes));
+    }
+    if caps.cracks > 0 {
+        done.push(format!(
+            "left {} edge(s) of cracks or T-junctions open",
+            caps.cracks
+        ));
+    }
+    let model = caps_model(caps, plan.cracks, winding.nested);
+    let rung = Rung::Capped {
+        holes: caps.holes,
+        boundary_edges: te.boundary,
+        nonmanifold_edges: te.nonmanifold,
+        faces_flipped: winding.flipped,
+        relative_uncertainty: 0.0,
+    };
+    let done = done.join(", ");
+    let flips = winding.flips();
+    let volume = plan.volume;
+    ladder.finish(plan.vertices, plan.faces, rung, model, |m| {
+        Some(format!(
+            "mesh is {what}: {done}{flips}; its volume {volume:.6e} m³ and inertia are uncertain by at most {m:.1e} (relative) because of them"
+        ))
+    })
 }
 
 /// The convex hull of the vertices, with the numbers that say how far that is from the mesh.
-fn convex_hull(ladder: Ladder<'_>, w: Welding, te: &Edges, what: &str) -> Result<Solid, MeshError> {
+fn convex_hull(
+    ladder: Ladder<'_>,
+    w: &Welding,
+    te: &Edges,
+    what: &str,
+) -> Result<Solid, MeshError> {
     let (lo, hi) = bbox(&w.vertices);
     let diag = dist(lo, hi);
     // The stored surface's signed volume, and how much it moves over reference points in the box.
@@ -1074,6 +1304,8 @@ struct Caps {
     bound: f64,
     /// Total area of the caps, m².
     area: f64,
+    /// The vertices of the loops closed and the caps' centres: where the caps' uncertainty sits.
+    points: Vec<[f64; 3]>,
 }
 
 /// Closes every boundary loop of `faces` with a fan from the loop's centroid, wound against the loop's
@@ -1104,6 +1336,7 @@ fn cap_holes(vertices: &[[f64; 3]], faces: &Polygons) -> Option<Caps> {
         cracks: 0,
         bound: 0.0,
         area: 0.0,
+        points: Vec::new(),
     };
     for start in 0..half.len() {
         if used[start] {
@@ -1133,44 +1366,44 @@ fn cap_holes(vertices: &[[f64; 3]], faces: &Polygons) -> Option<Caps> {
             caps.cracks += steps.len();
             continue;
         }
-        let lp: Vec<u32> = steps.iter().map(|s| s.0).collect();
-        caps.holes += 1;
-        let n = lp.len() as f64;
-        let c = [0, 1, 2].map(|k| lp.iter().map(|&i| vertices[i as usize][k]).sum::<f64>() / n);
-        let ci = base + caps.centroids.len() as u32;
-        caps.centroids.push(c);
+        caps.close(vertices, base, &steps);
+    }
+    // What cracks leave open is accounted for by the caller: the capped surface's vector area.
+    Some(caps)
+}
+
+impl Caps {
+    /// Closes one boundary loop, given as (vertex, edge a → b as directed in the mesh) steps, with a
+    /// fan from its centroid (numbered `base` + the centroids so far), and adds its bound.
+    fn close(&mut self, vertices: &[[f64; 3]], base: u32, steps: &[(u32, u32, u32)]) {
+        self.holes += 1;
+        let n = steps.len() as f64;
+        let c = [0, 1, 2].map(|k| steps.iter().map(|s| vertices[s.0 as usize][k]).sum::<f64>() / n);
+        let ci = base + self.centroids.len() as u32;
+        self.centroids.push(c);
+        self.points.push(c);
+        self.points
+            .extend(steps.iter().map(|s| vertices[s.0 as usize]));
         let mut area = [0.0f64; 3];
-        for &(_, a, b) in &steps {
+        for &(_, a, b) in steps {
             // The mesh has a → b on its boundary; the cap runs b → a.
-            caps.faces.push(&[ci, b, a]);
+            self.faces.push(&[ci, b, a]);
             let x = cross(sub(vertices[b as usize], c), sub(vertices[a as usize], c));
             for k in 0..3 {
                 area[k] += 0.5 * x[k];
             }
         }
         let len = dot(area, area).sqrt();
-        caps.area += len;
+        self.area += len;
         if len > 0.0 {
             let nrm = area.map(|x| x / len);
-            let dev = lp
+            let dev = steps
                 .iter()
-                .map(|&i| dot(sub(vertices[i as usize], c), nrm).abs())
+                .map(|s| dot(sub(vertices[s.0 as usize], c), nrm).abs())
                 .fold(0.0, f64::max);
-            caps.bound += 2.0 * dev * len;
+            self.bound += 2.0 * dev * len;
         }
     }
-    if caps.cracks > 0 {
-        // What is left open makes the result depend on the reference point by at most |A|·diag/6.
-        let (lo, hi) = bbox(vertices);
-        let mut all = vertices.to_vec();
-        all.extend_from_slice(&caps.centroids);
-        let mut f = faces.clone();
-        for face in caps.faces.iter() {
-            f.push(face);
-        }
-        caps.bound += vector_area(&all, &f) * dist(lo, hi) / 6.0;
-    }
-    Some(caps)
 }
 
 /// The length of the surface's vector area `Σ N/2` (zero for a closed surface).
@@ -1226,4 +1459,80 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     let d = sub(a, b);
     dot(d, d).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit cube without its top face, one top corner raised 1e-3, beside a closed 1 cm
+    /// tetrahedron `far` metres away: the caps' uncertainty sits at the hole, not at the far part.
+    fn open_cube_and_far_tetrahedron(far: f64) -> RawMesh {
+        let mut v: Vec<[f64; 3]> = (0..8)
+            .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+            .collect();
+        v[7][2] += 1e-3;
+        let quads = [
+            [0, 2, 3, 1],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        let mut tris: Vec<[u32; 3]> = quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect();
+        let t = 0.01;
+        v.extend([
+            [far, 0.0, 0.0],
+            [far + t, 0.0, 0.0],
+            [far, t, 0.0],
+            [far, 0.0, t],
+        ]);
+        tris.extend([[8, 10, 9], [8, 9, 11], [8, 11, 10], [9, 10, 11]]);
+        RawMesh {
+            vertices: v,
+            faces: Polygons::from_triangles(&tris),
+            ..Default::default()
+        }
+    }
+
+    // Corpus finding: a capped mesh reported an unbounded estimate when a small part lay far away.
+    #[test]
+    fn caps_bound_does_not_grow_with_far_parts() {
+        for far in [10.0, 30.0, 1000.0] {
+            let s = make_solid(
+                &open_cube_and_far_tetrahedron(far),
+                Path::new("t"),
+                HealthOptions::default(),
+            )
+            .expect("solid");
+            assert_eq!(s.rung.name(), "capped", "{far}");
+            // The cap over the raised corner: 2 × 5e-4 (deviation) × 1 (area) = 1e-3 m³ of volume
+            // at most 1.5 m from the cube's centre, against 1 m³ and the cube's inertia.
+            assert!(s.error_estimate < 2e-2, "{far}: {}", s.error_estimate);
+            assert!(s.error.com < 2e-2, "{far}: {}", s.error.com);
+        }
+    }
+
+    #[test]
+    fn duplicated_faces_are_dropped() {
+        // A tetrahedron with one face stored twice.
+        let v = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        let f = Polygons::from_triangles(&[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3], [0, 1, 3]]);
+        let raw = RawMesh {
+            vertices: v,
+            faces: f,
+            ..Default::default()
+        };
+        let s = make_solid(&raw, Path::new("t"), HealthOptions::default()).expect("solid");
+        assert_eq!(s.rung.name(), "welded", "{:?}", s.warnings);
+        assert!((s.unit.mass - 1.0 / 6.0).abs() < 1e-15, "{}", s.unit.mass);
+    }
 }

@@ -5,6 +5,7 @@
 //! lines. Polygons stay polygons. Coordinates are read as f64 (binary STL's and glTF's f32 values convert
 //! exactly).
 
+pub mod cache;
 pub mod collada;
 pub mod gltf;
 pub mod health;
@@ -116,7 +117,9 @@ impl fmt::Display for MeshError {
             MeshErrorKind::Empty => write!(f, "the mesh has no faces"),
             MeshErrorKind::ZeroVolume { volume, bbox_volume } => write!(
                 f,
-                "the mesh encloses no volume ({volume:.3e} m³ against a bounding box of {bbox_volume:.3e} m³): it is flat or degenerate; give the link a primitive collision shape or a closed mesh"
+                "the mesh encloses no volume ({} m³ against a bounding box of {} m³): it is flat or degenerate; give the link a primitive collision shape or a closed mesh",
+                crate::text::significant(*volume, 4),
+                crate::text::significant(*bbox_volume, 4)
             ),
             MeshErrorKind::Strict(msg) => write!(f, "{msg} (an error under --strict)"),
             MeshErrorKind::Hull(msg) => write!(f, "{msg}; close the mesh or give the link a primitive collision shape"),

@@ -235,8 +235,10 @@ pub fn tolerant(vertices: &[[f64; 3]], tol: Tolerance) -> TolerantWeld {
     let cell = |p: &[f64; 3]| -> [i64; 3] {
         [0, 1, 2].map(|k| ((p[k] - origin[k]) / cell_size).floor() as i64)
     };
-    let mut grid: FxHashMap<[i64; 3], Vec<u32>> =
+    // Representatives per cell as linked lists: the first in `head`, the rest through `next`.
+    let mut head: FxHashMap<[i64; 3], u32> =
         FxHashMap::with_capacity_and_hasher(n, Default::default());
+    let mut next: Vec<u32> = vec![u32::MAX; n];
     let mut merged = 0;
     let mut widest = 0.0f64;
     for i in 0..n {
@@ -252,8 +254,8 @@ pub fn tolerant(vertices: &[[f64; 3]], tol: Tolerance) -> TolerantWeld {
                         c[1].saturating_add(dy),
                         c[2].saturating_add(dz),
                     ];
-                    let Some(reps) = grid.get(&key) else { continue };
-                    for &r in reps {
+                    let mut r = head.get(&key).copied().unwrap_or(u32::MAX);
+                    while r != u32::MAX {
                         let q = &vertices[r as usize];
                         let d =
                             ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2))
@@ -261,6 +263,7 @@ pub fn tolerant(vertices: &[[f64; 3]], tol: Tolerance) -> TolerantWeld {
                         if d <= tp.max(tol.at(q)) && found.is_none_or(|(_, best)| d < best) {
                             found = Some((r, d));
                         }
+                        r = next[r as usize];
                     }
                 }
             }
@@ -271,7 +274,11 @@ pub fn tolerant(vertices: &[[f64; 3]], tol: Tolerance) -> TolerantWeld {
                 merged += 1;
                 widest = widest.max(d);
             }
-            None => grid.entry(c).or_default().push(i as u32),
+            None => {
+                let slot = head.entry(c).or_insert(u32::MAX);
+                next[i] = *slot;
+                *slot = i as u32;
+            }
         }
     }
     TolerantWeld {

@@ -210,6 +210,12 @@ fn is_package(dir: &Path, pkg: &str) -> bool {
 }
 
 fn walk_up(base: &Path, pkg: &str) -> Option<PathBuf> {
+    // `robot.urdf` given relative to the working directory: its folder is "", which is ".".
+    let base = if base.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        base
+    };
     let start = std::fs::canonicalize(base).unwrap_or_else(|_| base.to_path_buf());
     let mut dir = Some(start.as_path());
     while let Some(d) = dir {

@@ -584,7 +584,7 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
 
 /// A short description of a geometry for messages: `box 1 2 3`, `sphere radius 0`.
 pub fn describe(g: &Geometry) -> String {
-    let n = crate::cli::shortest;
+    let n = crate::text::shortest;
     match g {
         Geometry::Mesh { filename, .. } => format!("mesh {filename}"),
         Geometry::Box { size } => format!("box size {} {} {}", n(size[0]), n(size[1]), n(size[2])),

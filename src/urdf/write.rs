@@ -1,50 +1,97 @@
 //! Writing `<inertial>` back: splice new text into the original bytes; everything else stays identical.
 
 use super::scan::{Link, Robot};
-use crate::mass::{matrix_rpy, MassProperties};
+use crate::mass::{matrix_rpy, validity, MassProperties};
+use crate::text::{self, Digits};
 
 /// How numbers and frames are written.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct WriteOptions {
-    /// Significant digits; `None` writes the shortest text that reads back as the same f64.
-    pub digits: Option<u32>,
+    /// How many digits (default: the shortest decimal within each value's error estimate).
+    pub digits: Digits,
     /// Write the principal frame (`rpy` of the principal axes, diagonal tensor).
     pub principal: bool,
 }
 
-/// Formats a number: shortest round-trip text, or `digits` significant digits.
-pub fn number(x: f64, digits: Option<u32>) -> String {
-    let x = if x == 0.0 { 0.0 } else { x }; // no "-0"
-    match digits {
-        None => crate::cli::shortest(x),
-        Some(d) => {
-            if x == 0.0 {
-                return "0".into();
-            }
-            let s = format!("{:.*e}", (d.max(1) - 1) as usize, x);
-            // Parse back and print shortest, so 1.50000e0 becomes 1.5.
-            let y: f64 = s.parse().unwrap_or(x);
-            crate::cli::shortest(y)
+/// One link's new `<inertial>`: the mass properties in link coordinates and how well they are known.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinkUpdate {
+    /// Index into `Robot::links`.
+    pub index: usize,
+    pub props: MassProperties,
+    /// Relative error bound of the values (volume and inertia), at least the round-off floor.
+    pub error: f64,
+    /// The link's size (m): the scale of its centre of mass.
+    pub size: f64,
+}
+
+impl From<(usize, MassProperties)> for LinkUpdate {
+    /// Values known to round-off, the centre of mass on the scale of its own coordinates.
+    fn from((index, props): (usize, MassProperties)) -> Self {
+        LinkUpdate {
+            index,
+            props,
+            error: ROUND_OFF_FLOOR,
+            size: 0.0,
         }
     }
 }
 
+/// A link whose `<inertial>` cannot be written as asked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WriteError {
+    /// Index into `Robot::links`.
+    pub index: usize,
+    pub message: String,
+}
+
+/// Relative round-off of one f64 operation chain: the least any error estimate is.
+const ROUND_OFF_FLOOR: f64 = 4.0 * f64::EPSILON;
+
+/// Most nudges of the diagonal `--digits N` tries before it gives up.
+const MAX_NUDGES: usize = 16;
+
+/// The numbers of one `<inertial>`, ready to write.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Written {
+    com: [f64; 3],
+    rpy: [f64; 3],
+    mass: f64,
+    tensor: [[f64; 3]; 3],
+}
+
+/// Whether a tensor would pass `check` (the validity tolerance `check` applies to existing values).
+fn tensor_valid(tensor: &[[f64; 3]; 3]) -> bool {
+    let mp = MassProperties {
+        mass: 1.0,
+        com: [0.0; 3],
+        inertia: *tensor,
+    };
+    validity::check(&mp, validity::DEFAULT_TOLERANCE).is_empty()
+}
+
+fn largest_entry(tensor: &[[f64; 3]; 3]) -> f64 {
+    tensor.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
 /// Rounds the tensor entries to `digits` significant digits, then nudges the diagonal minimally (relative
-/// to the largest moment, in steps of the last written digit) until the rounded tensor is valid again.
-pub fn rounded_tensor(i: &[[f64; 3]; 3], digits: u32) -> [[f64; 3]; 3] {
-    let r = |x: f64| number(x, Some(digits)).parse::<f64>().unwrap_or(x);
+/// to the largest moment, in steps of the last written digit) until the rounded tensor is valid again
+/// (judged as `check` judges it); an error when [`MAX_NUDGES`] steps do not suffice.
+pub fn rounded_tensor(i: &[[f64; 3]; 3], digits: u32) -> Result<[[f64; 3]; 3], String> {
+    round_and_nudge(i, digits, MAX_NUDGES)
+}
+
+fn round_and_nudge(
+    i: &[[f64; 3]; 3],
+    digits: u32,
+    max_nudges: usize,
+) -> Result<[[f64; 3]; 3], String> {
+    let r = |x: f64| text::round_significant(x, digits);
     let mut out = i.map(|row| row.map(r));
-    let largest = i.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-    let step = largest * 10f64.powi(1 - digits as i32);
-    for _ in 0..16 {
-        let mp = MassProperties {
-            mass: 1.0,
-            com: [0.0; 3],
-            inertia: out,
-        };
-        let bad = crate::mass::validity::check(&mp, 0.0);
-        if bad.is_empty() {
-            break;
+    let step = largest_entry(i) * 10f64.powi(1 - i32::try_from(digits).unwrap_or(17));
+    for _ in 0..max_nudges {
+        if tensor_valid(&out) {
+            return Ok(out);
         }
         // Raising every diagonal entry by one step restores positive definiteness and the triangle
         // inequality (I_a + step ≤ I_b + I_c + 2 step) while moving the tensor by one written digit.
@@ -52,18 +99,34 @@ pub fn rounded_tensor(i: &[[f64; 3]; 3], digits: u32) -> [[f64; 3]; 3] {
             out[k][k] = r(out[k][k] + step);
         }
     }
-    out
+    if tensor_valid(&out) {
+        Ok(out)
+    } else {
+        Err(format!(
+            "with {digits} significant digits the inertia tensor is not valid (not positive definite or breaking the triangle inequality) even after {max_nudges} nudges of its diagonal; write more digits (--digits 17 or --digits full)"
+        ))
+    }
 }
 
-/// The text of an `<inertial>` element for `mp` (in link coordinates), indented for its place.
-pub fn inertial_text(
-    mp: &MassProperties,
-    opts: &WriteOptions,
-    indent: &str,
-    unit: &str,
-    nl: &str,
-) -> String {
-    let n = |x: f64| number(x, opts.digits);
+/// The tensor written as the shortest decimals within `error` (relative to its largest entry); when that
+/// breaks validity (a plate on the triangle boundary with a loose error estimate), with a tighter
+/// tolerance, down to every bit.
+fn tidy_tensor(tensor: &[[f64; 3]; 3], error: f64) -> [[f64; 3]; 3] {
+    let scale = largest_entry(tensor);
+    let mut rel = error;
+    while rel >= f64::EPSILON / 4.0 {
+        let out = tensor.map(|row| row.map(|x| text::within(x, rel * scale)));
+        if tensor_valid(&out) {
+            return out;
+        }
+        rel /= 10.0;
+    }
+    tensor.map(|row| row.map(|x| text::within(x, 0.0)))
+}
+
+/// The values to write for `update`, rounded as `opts` says.
+fn written(update: &LinkUpdate, opts: &WriteOptions) -> Result<Written, String> {
+    let mp = &update.props;
     let (rpy, tensor) = if opts.principal {
         let p = mp.principal();
         let d = [
@@ -75,27 +138,100 @@ pub fn inertial_text(
     } else {
         ([0.0; 3], mp.inertia)
     };
-    let tensor = match opts.digits {
-        Some(d) => rounded_tensor(&tensor, d),
-        None => tensor,
+    let error = update.error.max(ROUND_OFF_FLOOR);
+    // The COM is known relative to the link's size or to its own coordinates, whichever is larger.
+    let length = mp.com.iter().fold(update.size, |m, x| m.max(x.abs()));
+    let floor = |x: f64, scale: f64| text::within(x, ROUND_OFF_FLOOR * scale);
+    Ok(match opts.digits {
+        Digits::Full => Written {
+            com: mp.com.map(|x| text::within(x, 0.0)),
+            rpy: rpy.map(|x| text::within(x, 0.0)),
+            mass: mp.mass,
+            tensor,
+        },
+        Digits::Auto => Written {
+            com: mp.com.map(|x| text::within(x, error * length)),
+            rpy: rpy.map(|x| text::within(x, error * std::f64::consts::PI)),
+            mass: text::within(mp.mass, error * mp.mass),
+            tensor: tidy_tensor(&tensor, error),
+        },
+        Digits::Fixed(d) => {
+            let scale = largest_entry(&tensor);
+            let cleaned = tensor.map(|row| row.map(|x| floor(x, scale)));
+            Written {
+                com: mp.com.map(|x| text::round_significant(floor(x, length), d)),
+                rpy: rpy.map(|x| text::round_significant(floor(x, 1.0), d)),
+                mass: text::round_significant(mp.mass, d),
+                tensor: rounded_tensor(&cleaned, d)?,
+            }
+        }
+    })
+}
+
+/// The mass properties as written (in link axes), for reports: rounded as `digits` says, or every bit
+/// when `--digits N` cannot keep the tensor valid.
+pub fn tidy(update: &LinkUpdate, digits: Digits) -> MassProperties {
+    let opts = WriteOptions {
+        digits,
+        principal: false,
     };
+    let w = written(update, &opts).or_else(|_| {
+        written(
+            update,
+            &WriteOptions {
+                digits: Digits::Full,
+                principal: false,
+            },
+        )
+    });
+    match w {
+        Ok(w) => MassProperties {
+            mass: w.mass,
+            com: w.com,
+            inertia: w.tensor,
+        },
+        Err(_) => update.props,
+    }
+}
+
+/// Principal moments as reports write them: within `error` of the largest, `-0` as `0`.
+pub fn tidy_moments(moments: [f64; 3], error: f64, digits: Digits) -> [f64; 3] {
+    let largest = moments.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    match digits {
+        Digits::Full => moments.map(|x| text::within(x, 0.0)),
+        Digits::Auto => moments.map(|x| text::within(x, error.max(ROUND_OFF_FLOOR) * largest)),
+        Digits::Fixed(d) => moments.map(|x| text::round_significant(x, d)),
+    }
+}
+
+/// The text of an `<inertial>` element for `update`, indented for its place.
+pub fn inertial_text(
+    update: &LinkUpdate,
+    opts: &WriteOptions,
+    indent: &str,
+    unit: &str,
+    nl: &str,
+) -> Result<String, String> {
+    let w = written(update, opts)?;
+    let n = |x: f64| text::shortest(x);
+    let t = &w.tensor;
     let inner = format!("{indent}{unit}");
-    format!(
+    Ok(format!(
         "<inertial>{nl}{inner}<origin xyz=\"{} {} {}\" rpy=\"{} {} {}\"/>{nl}{inner}<mass value=\"{}\"/>{nl}{inner}<inertia ixx=\"{}\" ixy=\"{}\" ixz=\"{}\" iyy=\"{}\" iyz=\"{}\" izz=\"{}\"/>{nl}{indent}</inertial>",
-        n(mp.com[0]),
-        n(mp.com[1]),
-        n(mp.com[2]),
-        n(rpy[0]),
-        n(rpy[1]),
-        n(rpy[2]),
-        n(mp.mass),
-        n(tensor[0][0]),
-        n(tensor[0][1]),
-        n(tensor[0][2]),
-        n(tensor[1][1]),
-        n(tensor[1][2]),
-        n(tensor[2][2]),
-    )
+        n(w.com[0]),
+        n(w.com[1]),
+        n(w.com[2]),
+        n(w.rpy[0]),
+        n(w.rpy[1]),
+        n(w.rpy[2]),
+        n(w.mass),
+        n(t[0][0]),
+        n(t[0][1]),
+        n(t[0][2]),
+        n(t[1][1]),
+        n(t[1][2]),
+        n(t[2][2]),
+    ))
 }
 
 /// The indentation unit of a link: the difference between its children's indent and its own, or two
@@ -136,42 +272,27 @@ fn removal_span(text: &str, start: usize, end: usize) -> (usize, usize) {
 
 /// The URDF text with the given links' `<inertial>` replaced or inserted; every other byte unchanged.
 /// A link's further `<inertial>` elements (which urdfdom ignores) are removed, so exactly one remains.
-pub fn splice(robot: &Robot, updates: &[(usize, MassProperties)], opts: &WriteOptions) -> String {
+///
+/// An error lists every link whose values cannot be written as asked (`--digits N` too few to keep
+/// the tensor valid).
+pub fn splice(
+    robot: &Robot,
+    updates: &[LinkUpdate],
+    opts: &WriteOptions,
+) -> Result<String, Vec<WriteError>> {
     let mut edits: Vec<(usize, usize, String)> = Vec::new();
-    for (li, mp) in updates {
-        let link = &robot.links[*li];
-        let unit = indent_unit(link);
-        let child_indent = link
-            .child_indent
-            .clone()
-            .unwrap_or_else(|| format!("{}{unit}", link.indent));
-        let text = inertial_text(mp, opts, &child_indent, &unit, robot.newline);
-        match &link.inertial {
-            Some(span) => {
-                // Replace the element itself; its leading indentation stays where it is.
-                let own_indent = robot.text[..span.start].rsplit('\n').next().unwrap_or("");
-                let text = if own_indent.chars().all(|c| c == ' ' || c == '\t')
-                    && own_indent != child_indent
-                {
-                    inertial_text(mp, opts, own_indent, &unit, robot.newline)
-                } else {
-                    text
-                };
-                edits.push((span.start, span.end, text));
-                for extra in &link.extra_inertials {
-                    let (start, end) = removal_span(&robot.text, extra.start, extra.end);
-                    edits.push((start, end, String::new()));
-                }
-            }
-            None => {
-                // Insert as the link's first child, on its own line after the start tag.
-                edits.push((
-                    link.open_end,
-                    link.open_end,
-                    format!("{}{child_indent}{text}", robot.newline),
-                ));
-            }
+    let mut errors = Vec::new();
+    for update in updates {
+        match link_edits(robot, update, opts) {
+            Ok(e) => edits.extend(e),
+            Err(message) => errors.push(WriteError {
+                index: update.index,
+                message,
+            }),
         }
+    }
+    if !errors.is_empty() {
+        return Err(errors);
     }
     edits.sort_by_key(|e| e.0);
     let mut out = String::with_capacity(robot.text.len() + 256 * edits.len());
@@ -185,36 +306,84 @@ pub fn splice(robot: &Robot, updates: &[(usize, MassProperties)], opts: &WriteOp
         at = end;
     }
     out.push_str(&robot.text[at..]);
-    out
+    Ok(out)
+}
+
+/// The edits (byte range, new text) that give one link its new `<inertial>`.
+fn link_edits(
+    robot: &Robot,
+    update: &LinkUpdate,
+    opts: &WriteOptions,
+) -> Result<Vec<(usize, usize, String)>, String> {
+    let link = &robot.links[update.index];
+    let unit = indent_unit(link);
+    let child_indent = link
+        .child_indent
+        .clone()
+        .unwrap_or_else(|| format!("{}{unit}", link.indent));
+    let Some(span) = &link.inertial else {
+        // Insert as the link's first child, on its own line after the start tag.
+        let text = inertial_text(update, opts, &child_indent, &unit, robot.newline)?;
+        return Ok(vec![(
+            link.open_end,
+            link.open_end,
+            format!("{}{child_indent}{text}", robot.newline),
+        )]);
+    };
+    // Replace the element itself; its leading indentation stays where it is.
+    let own_indent = robot.text[..span.start].rsplit('\n').next().unwrap_or("");
+    let indent = if own_indent.chars().all(|c| c == ' ' || c == '\t') {
+        own_indent
+    } else {
+        &child_indent
+    };
+    let text = inertial_text(update, opts, indent, &unit, robot.newline)?;
+    let mut edits = vec![(span.start, span.end, text)];
+    for extra in &link.extra_inertials {
+        let (start, end) = removal_span(&robot.text, extra.start, extra.end);
+        edits.push((start, end, String::new()));
+    }
+    Ok(edits)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    fn valid(t: &[[f64; 3]; 3]) -> bool {
+        tensor_valid(t)
+    }
+
     #[test]
     fn digits_and_nudging() {
-        assert_eq!(number(0.123456789, Some(4)), "0.1235");
-        assert_eq!(number(1.5e-9, None), "1.5e-9");
-        assert_eq!(number(-0.0, None), "0");
         // Valid (1.0054 ≤ 1.0045 + 0.001), but 3 digits give 1.01 > 1.00 + 0.001.
         let t = [[1.0045, 0.0, 0.0], [0.0, 1.0054, 0.0], [0.0, 0.0, 0.001]];
-        let plain = t.map(|r| r.map(|x| number(x, Some(3)).parse::<f64>().unwrap()));
-        assert!(!crate::mass::validity::check(
-            &MassProperties {
-                mass: 1.0,
-                com: [0.0; 3],
-                inertia: plain
-            },
-            0.0
-        )
-        .is_empty());
-        let r = rounded_tensor(&t, 3);
-        let mp = MassProperties {
-            mass: 1.0,
-            com: [0.0; 3],
-            inertia: r,
-        };
-        assert!(crate::mass::validity::check(&mp, 0.0).is_empty(), "{r:?}");
+        let plain = t.map(|r| r.map(|x| text::round_significant(x, 3)));
+        assert!(!valid(&plain));
+        let r = rounded_tensor(&t, 3).expect("nudged");
+        assert!(valid(&r), "{r:?}");
+    }
+
+    #[test]
+    fn too_few_digits_is_an_error_not_an_invalid_tensor() {
+        // The tensor of `digits_and_nudging`, allowed no nudge: reported, never written invalid.
+        let t = [[1.0045, 0.0, 0.0], [0.0, 1.0054, 0.0], [0.0, 0.0, 0.001]];
+        let e = round_and_nudge(&t, 3, 0).expect_err("invalid after rounding");
+        assert!(e.contains("--digits"), "{e}");
+        assert!(round_and_nudge(&t, 3, 1).is_ok());
+    }
+
+    #[test]
+    fn auto_digits_keep_plates_valid() {
+        // A thin plate: Izz exceeds Ixx + Iyy by nothing but the thickness term (1e-10 relative),
+        // a loose error estimate (1e-3) must not round it across the boundary.
+        let (a, b, c) = (1.0f64, 1.0f64, 1e-5f64);
+        let t = [
+            [(b * b + c * c) / 12.0, 0.0, 0.0],
+            [0.0, (a * a + c * c) / 12.0, 0.0],
+            [0.0, 0.0, (a * a + b * b) / 12.0],
+        ];
+        let r = tidy_tensor(&t, 1e-3);
+        assert!(valid(&r), "{r:?}");
     }
 }

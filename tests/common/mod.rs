@@ -10,6 +10,8 @@ use num_rational::BigRational;
 use num_traits::{ToPrimitive, Zero};
 use std::collections::HashMap;
 
+pub mod wild;
+
 pub type Mesh = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 
 /// Decomposes a finite f64 into (mantissa, exponent) with value = mantissa · 2^exponent.
@@ -31,14 +33,30 @@ fn decompose(x: f64) -> (i64, i32) {
 
 /// The exact integrals `[T1, Tx, Ty, Tz, Tx², Ty², Tz², Txy, Tyz, Tzx]` of a closed triangle mesh about the origin.
 pub fn exact_integrals(v: &[[f64; 3]], tris: &[[u32; 3]]) -> [BigRational; 10] {
-    let emin = v
+    exact_integrals_with(v, tris, false)
+}
+
+/// The same integrals with every coordinate taken relative to the exact centre of the vertices'
+/// bounding box. For a surface that is closed only up to round-off (cracks, slivers), this is its
+/// "as stored" value, independent of where the mesh sits; for a closed surface the central inertia
+/// is the same either way.
+pub fn exact_integrals_about_centre(v: &[[f64; 3]], tris: &[[u32; 3]]) -> [BigRational; 10] {
+    exact_integrals_with(v, tris, true)
+}
+
+fn exact_integrals_with(v: &[[f64; 3]], tris: &[[u32; 3]], centred: bool) -> [BigRational; 10] {
+    let mut emin = v
         .iter()
         .flatten()
         .filter(|x| **x != 0.0)
         .map(|&x| decompose(x).1)
         .min()
         .unwrap_or(0);
-    let ints: Vec<[BigInt; 3]> = v
+    if centred {
+        // One more bit: the centre (lo + hi) / 2 is then an integer too.
+        emin -= 1;
+    }
+    let mut ints: Vec<[BigInt; 3]> = v
         .iter()
         .map(|p| {
             p.map(|x| {
@@ -47,6 +65,26 @@ pub fn exact_integrals(v: &[[f64; 3]], tris: &[[u32; 3]]) -> [BigRational; 10] {
             })
         })
         .collect();
+    if centred && !ints.is_empty() {
+        for k in 0..3 {
+            let lo = ints
+                .iter()
+                .map(|p| &p[k])
+                .min()
+                .cloned()
+                .unwrap_or_default();
+            let hi = ints
+                .iter()
+                .map(|p| &p[k])
+                .max()
+                .cloned()
+                .unwrap_or_default();
+            let c: BigInt = (lo + hi) >> 1usize;
+            for p in ints.iter_mut() {
+                p[k] -= &c;
+            }
+        }
+    }
     let mut acc: [BigInt; 10] = std::array::from_fn(|_| BigInt::zero());
     for t in tris {
         let a = &ints[t[0] as usize];

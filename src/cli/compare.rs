@@ -1,0 +1,177 @@
+//! Existing `<inertial>` against computed: one comparison, one set of thresholds, shared by `check` and
+//! `diff`.
+
+use urdf_inertia::mass::{frobenius, validity, MassProperties, Mat3};
+use urdf_inertia::text::significant;
+
+/// Existing against computed, for one link.
+#[derive(Debug, Clone)]
+pub struct Comparison {
+    /// Existing mass over computed mass.
+    pub mass_ratio: f64,
+    /// Distance of the centres of mass over the link's size.
+    pub com_distance: f64,
+    /// Frobenius norm of the tensor difference over the computed tensor's (both about their COM).
+    pub inertia_difference: f64,
+    /// Likely causes of a difference (unit slips, tensor about the origin, mirrored products).
+    pub causes: Vec<String>,
+    /// Why the existing values cannot belong to a body, if they cannot.
+    pub invalid: Vec<String>,
+}
+
+impl Comparison {
+    /// What differs by more than `tolerance` (relative), each as a sentence; empty when nothing does.
+    pub fn beyond(
+        &self,
+        existing: &MassProperties,
+        computed: &MassProperties,
+        tolerance: f64,
+    ) -> Vec<String> {
+        let mut off = Vec::new();
+        if (self.mass_ratio - 1.0).abs() > tolerance {
+            off.push(format!(
+                "mass {} kg, computed {} kg (ratio {})",
+                significant(existing.mass, 7),
+                significant(computed.mass, 7),
+                significant(self.mass_ratio, 4)
+            ));
+        }
+        if self.com_distance > tolerance {
+            off.push(format!(
+                "centre of mass {} of the link's size from the computed one",
+                significant(self.com_distance, 4)
+            ));
+        }
+        if self.inertia_difference > tolerance {
+            off.push(format!(
+                "inertia differs from the computed one by {} (relative)",
+                significant(self.inertia_difference, 4)
+            ));
+        }
+        off
+    }
+
+    /// Whether the link differs beyond `tolerance` or its existing values are invalid.
+    pub fn differs(&self, tolerance: f64) -> bool {
+        !self.invalid.is_empty()
+            || (self.mass_ratio - 1.0).abs() > tolerance
+            || self.com_distance > tolerance
+            || self.inertia_difference > tolerance
+    }
+}
+
+/// The decade (a multiple of 3) a ratio sits near, if it is a unit slip (1e3, 1e6, 1e9).
+fn near_power(r: f64) -> Option<i32> {
+    if !(r > 0.0 && r.is_finite()) {
+        return None;
+    }
+    let e = r.log10();
+    let k = (e / 3.0).round() * 3.0;
+    if k != 0.0 && (e - k).abs() < 0.15 {
+        // |k| ≤ 308 + 3: always an i32.
+        #[allow(clippy::cast_possible_truncation)]
+        Some(k as i32)
+    } else {
+        None
+    }
+}
+
+/// Frobenius norm of `a − b` relative to `b`'s.
+fn relative(a: &Mat3, b: &Mat3) -> f64 {
+    let d = [0, 1, 2].map(|i| [0, 1, 2].map(|j| a[i][j] - b[i][j]));
+    frobenius(&d) / frobenius(b).max(f64::MIN_POSITIVE)
+}
+
+/// Whether the tensor has products of inertia worth mirroring (above round-off of its size).
+fn has_products(t: &Mat3) -> bool {
+    let scale = frobenius(t);
+    [(0, 1), (0, 2), (1, 2)]
+        .iter()
+        .any(|&(i, j)| t[i][j].abs() > 1e-9 * scale)
+}
+
+/// Likely causes of a difference, named for the user.
+fn causes(
+    existing: &MassProperties,
+    computed: &MassProperties,
+    mass_ratio: f64,
+    difference: f64,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    if let Some(k) = near_power(mass_ratio) {
+        out.push(format!("mass off by 1e{k} (unit slip?)"));
+    }
+    let norm_ratio =
+        frobenius(&existing.inertia) / frobenius(&computed.inertia).max(f64::MIN_POSITIVE);
+    if let Some(k) = near_power(norm_ratio) {
+        out.push(format!("inertia off by 1e{k} (unit slip: mm² or g?)"));
+    }
+    if difference <= 0.05 {
+        return out;
+    }
+    // Scaled to the same mass, do the values look like the tensor about the link origin?
+    let scaled = existing.scaled(1.0 / mass_ratio.max(f64::MIN_POSITIVE));
+    let about_origin = computed.inertia_about([0.0; 3]);
+    let to_origin = relative(&scaled.inertia, &about_origin);
+    if to_origin < 0.5 * relative(&scaled.inertia, &computed.inertia) && to_origin < 0.05 {
+        out.push("inertia looks like it is about the link origin, not the COM".into());
+    }
+    // Mirrored products only mean something when there are products: two diagonal tensors cannot be
+    // told apart from their mirror images.
+    if !has_products(&computed.inertia) {
+        return out;
+    }
+    for (axis, name) in [(0usize, "x"), (1, "y"), (2, "z")] {
+        let mut m = computed.inertia;
+        for j in (0..3).filter(|&j| j != axis) {
+            m[axis][j] = -m[axis][j];
+            m[j][axis] = -m[j][axis];
+        }
+        if relative(&scaled.inertia, &m) < 0.05 {
+            out.push(format!(
+                "products of inertia look mirrored in {name} (mesh mirrored, or scale sign lost?)"
+            ));
+        }
+    }
+    out
+}
+
+/// Compares existing mass properties with computed ones of a link of diagonal `size`.
+pub fn compare(existing: &MassProperties, computed: &MassProperties, size: f64) -> Comparison {
+    let mass_ratio = existing.mass / computed.mass;
+    let dc = [0, 1, 2].map(|k| existing.com[k] - computed.com[k]);
+    let com_distance =
+        (dc[0] * dc[0] + dc[1] * dc[1] + dc[2] * dc[2]).sqrt() / size.max(f64::MIN_POSITIVE);
+    let inertia_difference = relative(&existing.inertia, &computed.inertia);
+    Comparison {
+        mass_ratio,
+        com_distance,
+        inertia_difference,
+        causes: causes(existing, computed, mass_ratio, inertia_difference),
+        invalid: validity::check(existing, validity::DEFAULT_TOLERANCE)
+            .iter()
+            .map(ToString::to_string)
+            .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use urdf_inertia::mass::primitives;
+
+    #[test]
+    fn diagonal_tensors_are_never_called_mirrored() {
+        // A box and the same box 10 % heavier: products are zero in both, so no mirror can be seen.
+        let computed = primitives::cuboid([0.1, 0.2, 0.3], 1000.0);
+        let existing = computed.scaled(1.5);
+        let c = compare(&existing, &computed, 0.37);
+        assert!(
+            c.causes.iter().all(|n| !n.contains("mirrored")),
+            "{:?}",
+            c.causes
+        );
+        assert!(c.differs(0.05));
+        assert!(!compare(&computed, &computed, 0.37).differs(0.05));
+    }
+}

@@ -1,0 +1,114 @@
+//! The mesh cache: each file read once and each (file, scale) healed and integrated once, across the
+//! links of a robot and across robots (`check a.urdf b.urdf`, a corpus).
+
+use super::health::{HealthOptions, Solid};
+use super::{read, solid_from_raw, MeshError};
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Reads each file once and heals each (file, scale) once. A raw mesh lives only until its scales are
+/// healed: the cache keeps the solids, and of each file read only whether it failed (a file asked for
+/// again with a new scale, by a later call sharing the cache, is read again).
+#[derive(Debug, Default)]
+pub struct MeshCache {
+    read: HashMap<PathBuf, Option<MeshError>>,
+    solids: HashMap<(PathBuf, [u64; 3]), Result<Arc<Solid>, MeshError>>,
+    pub load_time: Duration,
+    pub integrate_time: Duration,
+}
+
+impl MeshCache {
+    pub fn solid(
+        &mut self,
+        path: &PathBuf,
+        scale: [f64; 3],
+        options: HealthOptions,
+    ) -> Result<Arc<Solid>, MeshError> {
+        let key = (path.clone(), scale.map(f64::to_bits));
+        if let Some(r) = self.solids.get(&key) {
+            return r.clone();
+        }
+        let t0 = Instant::now();
+        let raw = match self.read.get(path) {
+            Some(Some(e)) => Err(e.clone()),
+            _ => {
+                let r = read(path);
+                self.read.insert(path.clone(), r.as_ref().err().cloned());
+                r
+            }
+        };
+        let t1 = Instant::now();
+        self.load_time += t1 - t0;
+        let solid = raw
+            .and_then(|raw| solid_from_raw(&raw, scale, path, options))
+            .map(Arc::new);
+        self.integrate_time += t1.elapsed();
+        self.solids.insert(key, solid.clone());
+        solid
+    }
+
+    /// Reads and heals every not yet cached (file, scale) pair on all cores: each file once, then each
+    /// of its scales. Times are summed over threads (CPU time).
+    pub fn preload(&mut self, items: &[(PathBuf, [f64; 3])], options: HealthOptions) {
+        use rayon::prelude::*;
+        let mut by_file: HashMap<&PathBuf, Vec<[f64; 3]>> = HashMap::new();
+        for (path, scale) in items {
+            if !self
+                .solids
+                .contains_key(&(path.clone(), scale.map(f64::to_bits)))
+            {
+                let scales = by_file.entry(path).or_default();
+                if !scales
+                    .iter()
+                    .any(|s| s.map(f64::to_bits) == scale.map(f64::to_bits))
+                {
+                    scales.push(*scale);
+                }
+            }
+        }
+        type Loaded = (
+            PathBuf,
+            Option<MeshError>,
+            Vec<([f64; 3], Result<Arc<Solid>, MeshError>)>,
+            Duration,
+            Duration,
+        );
+        let work: Vec<(&PathBuf, Vec<[f64; 3]>)> = by_file.into_iter().collect();
+        let loaded: Vec<Loaded> = work
+            .into_par_iter()
+            .map(|(path, scales)| {
+                let t0 = Instant::now();
+                let raw = read(path);
+                let t1 = Instant::now();
+                let solids = scales
+                    .into_iter()
+                    .map(|scale| {
+                        let solid = match &raw {
+                            Ok(r) => solid_from_raw(r, scale, path, options).map(Arc::new),
+                            Err(e) => Err(e.clone()),
+                        };
+                        (scale, solid)
+                    })
+                    .collect();
+                // The raw mesh ends here, before the next file of this thread is read.
+                (path.clone(), raw.err(), solids, t1 - t0, t1.elapsed())
+            })
+            .collect();
+        for (path, raw, solids, load, integrate) in loaded {
+            self.load_time += load;
+            self.integrate_time += integrate;
+            for (scale, solid) in solids {
+                self.solids
+                    .insert((path.clone(), scale.map(f64::to_bits)), solid);
+            }
+            self.read.insert(path, raw);
+        }
+    }
+
+    /// Number of distinct files read.
+    pub fn files(&self) -> usize {
+        self.read.len()
+    }
+}
