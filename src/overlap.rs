@@ -93,8 +93,8 @@ fn z_extent_in_band(p: &[[f64; 2]; 3], y0: f64, y1: f64) -> Option<(f64, f64)> {
 }
 
 impl MeshLocator {
-    /// Buckets `solid`'s triangles within [`LOCATOR_ENTRIES`]; `None` when even one bucket would hold
-    /// more (a mesh of more triangles than that).
+    /// Buckets `solid`'s triangles within [`LOCATOR_ENTRIES`] references; a mesh of more triangles than
+    /// that gets one bucket holding them all.
     pub fn new(solid: &Solid) -> Self {
         Self::with_budget(solid, LOCATOR_ENTRIES).unwrap_or_else(|| Self::with_grid(solid, 1))
     }
@@ -667,6 +667,66 @@ mod tests {
         assert!(
             matches!(estimate(&mut parts), Overlap::Skipped(m) if m.contains("pairs of parts"))
         );
+    }
+
+    /// A cone along +x (base radius 1 at x = 0, apex at x = 1) of `2 n` sliver triangles seen along x.
+    fn cone(n: u32) -> Solid {
+        let mut v = vec![[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]];
+        for i in 0..n {
+            let a = 2.0 * std::f64::consts::PI * i as f64 / n as f64;
+            v.push([0.0, a.cos(), a.sin()]);
+        }
+        let mut f = Vec::new();
+        for i in 0..n {
+            let (p, q) = (2 + i, 2 + (i + 1) % n);
+            f.push([0, p, q]);
+            f.push([1, q, p]);
+        }
+        let raw = crate::mesh::RawMesh {
+            vertices: v,
+            faces: crate::mass::Polygons::from_triangles(&f),
+            ..Default::default()
+        };
+        crate::mesh::health::make_solid(&raw, std::path::Path::new("cone"), Default::default())
+            .expect("solid")
+    }
+
+    /// Issue 13: slivers go only into the cells their projection meets, the references stay within the
+    /// budget (a coarser grid otherwise), and points are still located right, those level with the
+    /// slivers' shared edges included.
+    #[test]
+    fn sliver_buckets_stay_within_the_budget() {
+        let solid = cone(4096);
+        let fine = MeshLocator::with_budget(&solid, LOCATOR_ENTRIES).expect("fits");
+        // 8192 slivers from the axis to the rim of a 46-cell grid: each crosses at most the 23 rows and
+        // 23 columns it spans, 46 cells and a few for the slack (its bounding box of cells is up to
+        // 23 × 23 = 529).
+        assert_eq!(fine.grid(), 46);
+        assert!(fine.entries() <= 8192 * 49, "{}", fine.entries());
+        let coarse = MeshLocator::with_budget(&solid, 60_000).expect("fits when coarser");
+        assert!(coarse.grid() < 46 && coarse.entries() <= 60_000);
+        assert!(MeshLocator::with_budget(&solid, 8000).is_none());
+        for l in [&fine, &coarse] {
+            for a in 0..12 {
+                for b in 0..12 {
+                    for c in 0..12 {
+                        let q = [
+                            0.05 + 0.9 * a as f64 / 11.0,
+                            -1.0 + 2.0 * b as f64 / 11.0 + 1e-3,
+                            -1.0 + 2.0 * c as f64 / 11.0 + 1e-3,
+                        ];
+                        let r = (q[1] * q[1] + q[2] * q[2]).sqrt();
+                        let inside = r < 0.99 * (1.0 - q[0]);
+                        let outside = r > 1.01 * (1.0 - q[0]);
+                        if inside || outside {
+                            assert_eq!(l.contains(q), inside, "{q:?}");
+                        }
+                    }
+                }
+            }
+            // On the diagonal, level with shared edges (vertex 512 is at 45°).
+            assert!(l.contains([0.3, 0.1, 0.1]) && l.contains([0.3, -0.2, -0.2]));
+        }
     }
 
     #[test]
