@@ -9,7 +9,7 @@ use crate::density::{DensityMap, Spec};
 use crate::mass::{mat_vec, primitives, rpy_matrix, validity, MassProperties};
 pub use crate::mesh::cache::MeshCache;
 use crate::mesh::health::{ErrorEstimate, HealthOptions, ModelError, ROUND_OFF_FLOOR};
-use crate::overlap::{overlap_volume, PartShape, PlacedPart};
+use crate::overlap::{self, Overlap, PartShape, PlacedPart};
 use crate::urdf::resolve::PackageResolver;
 use crate::urdf::{Geometry, Inertial, Link, Robot};
 use std::path::PathBuf;
@@ -71,7 +71,8 @@ pub struct LinkReport {
     pub line: usize,
     pub computed: MassProperties,
     pub parts: Vec<PartReport>,
-    /// Estimated volume counted twice by overlapping parts (m³), which parts, and the sampling grid size.
+    /// Estimated volume counted more than once by overlapping parts (m³: their volumes less their
+    /// union's), which parts, and the sampling grid size.
     pub overlap: Option<(f64, String, usize)>,
     /// Diagonal of the link's collision geometry's bounding box (link frame), m.
     pub size: f64,
@@ -590,15 +591,8 @@ pub fn compute_with(
         );
         let size =
             ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
-        let overlap = overlap_estimate(&mut parts);
-        if let Some((v, pair, n)) = &overlap {
-            let total: f64 = parts.iter().map(|p| p.unit.mass).sum();
-            warnings.push(format!(
-                "parts {pair} overlap: about {} m³ ({:.1}% of the link's volume) is counted twice (estimated on a {n}³ grid)",
-                crate::text::significant(*v, 4),
-                100.0 * v / total
-            ));
-        }
+        let (overlap, message) = overlap_estimate(&mut parts);
+        warnings.extend(message);
         if matches!(link_spec, Some((_, Spec::Density(_)))) && own.iter().all(|o| o.is_none()) {
             density_links.push(report.links.len());
         }
@@ -715,36 +709,46 @@ fn reject_unrepresentable(report: &mut FillReport) {
     }
 }
 
-/// The largest pairwise overlap of the parts' bounding boxes, capped by the smaller part's volume, when it
-/// exceeds 1% of that volume: an upper estimate of the volume counted twice.
-fn overlap_estimate(parts: &mut [Part]) -> Option<(f64, String, usize)> {
-    let mut best: Option<(f64, String, usize)> = None;
-    for i in 0..parts.len() {
-        for j in i + 1..parts.len() {
-            let (a, b) = (&parts[i].placed, &parts[j].placed);
-            let smaller = a.volume.min(b.volume);
-            // Bounding boxes first: no sampling where they cannot hold 1% of the smaller part.
-            let boxes: f64 = (0..3)
-                .map(|k| (a.bbox.1[k].min(b.bbox.1[k]) - a.bbox.0[k].max(b.bbox.0[k])).max(0.0))
-                .product();
-            if boxes <= 0.01 * smaller {
-                continue;
-            }
-            parts[i].placed.prepare();
-            parts[j].placed.prepare();
-            let Some((v, n)) = overlap_volume(&parts[i].placed, &parts[j].placed) else {
-                continue;
-            };
-            if v > 0.01 * smaller && best.as_ref().is_none_or(|b| v > b.0) {
-                best = Some((
-                    v,
-                    format!("{} and {}", parts[i].collision, parts[j].collision),
-                    n,
-                ));
-            }
+/// The volume the link's parts count more than once (their volumes less their union's, estimated by
+/// [`overlap::estimate`]), which parts and the grid, with the warning that says so; or only a warning
+/// when the estimate was skipped.
+fn overlap_estimate(parts: &mut [Part]) -> (Option<(f64, String, usize)>, Option<String>) {
+    let mut placed: Vec<PlacedPart> = parts.iter().map(|p| p.placed.clone()).collect();
+    let e = match overlap::estimate(&mut placed) {
+        Overlap::None => return (None, None),
+        Overlap::Skipped(why) => {
+            return (
+                None,
+                Some(format!("the overlap of the parts was not estimated ({why}): any volume they share is counted more than once")),
+            )
         }
-    }
-    best
+        Overlap::Estimated(e) => e,
+    };
+    let names: Vec<String> = e
+        .parts
+        .iter()
+        .map(|&i| parts[i].collision.to_string())
+        .collect();
+    let which = match names.len() {
+        0..=6 => match names.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+            _ => names.join(""),
+        },
+        n => format!("{} and {} others", names[..5].join(", "), n - 5),
+    };
+    let total: f64 = parts.iter().map(|p| p.unit.mass).sum();
+    let (v, n) = (e.excess, e.grid);
+    let how = if e.most <= 2 {
+        "is counted twice".to_string()
+    } else {
+        format!("is counted more than once (up to {} times)", e.most)
+    };
+    let message = format!(
+        "parts {which} overlap: about {} m³ ({:.1}% of the link's volume) {how}; the parts' volumes less their union's, estimated on a {n}³ grid per part",
+        crate::text::significant(v, 4),
+        100.0 * v / total
+    );
+    (Some((v, which, n)), Some(message))
 }
 
 /// Whether a mesh rung is below "exact".

@@ -1,15 +1,37 @@
-//! How much of a link's volume its parts count twice.
+//! How much of a link's volume its parts count more than once.
 //!
-//! A link's parts are integrated as a disjoint union (Problem 1). Where two parts overlap, the overlap is
-//! counted twice. The estimate samples a grid over the intersection of the two parts' bounding boxes and
-//! tests each point against both solids: analytically for primitives, and for meshes by the parity of a
-//! ray along +x, with the mesh's triangles bucketed on a (y, z) grid so that a point meets only the few
-//! triangles above and below it. (A mesh here is a healed, closed solid; [`winding_number`] is the slower,
-//! exact reference the tests compare with.)
+//! A link's parts are integrated as a disjoint union (Problem 1). Where parts overlap, the overlap is
+//! counted once per part covering it: the excess is the parts' volumes less the volume of their union,
+//! `Σ vᵢ − |∪ Pᵢ| = Σᵢ ∫_{Pᵢ} (1 − 1/k(x)) dx` with `k(x)` the number of parts covering `x`. The estimate
+//! samples that integral on a grid per part, over the region where the part's bounding box meets its
+//! neighbours' (candidate pairs come from a sweep over the bounding boxes, so disjoint parts cost
+//! nothing), and tests each point against the solids: analytically for primitives, and for meshes by the
+//! parity of a ray along +x, with the mesh's triangles bucketed on a (y, z) grid so that a point meets
+//! only the few triangles above and below it. (A mesh here is a healed, closed solid; [`winding_number`]
+//! is the slower, exact reference the tests compare with.)
+//!
+//! Bounded work and memory: a triangle is put only in the buckets its projection meets (a sliver
+//! crosses a row of cells, not its bounding box of cells), the buckets hold at most
+//! [`LOCATOR_ENTRIES`] triangle references (fewer, larger buckets otherwise), the samples per part
+//! shrink so that all point tests stay near [`POINT_TEST_BUDGET`], and more than [`MAX_PAIRS`]
+//! overlapping pairs skip the estimate with a reason.
 
 use crate::mass::{mat_vec, transpose, Mat3};
 use crate::mesh::health::Solid;
 use std::sync::Arc;
+
+/// Most triangle references a mesh's bucket grid may hold (4 bytes each: 64 MiB).
+pub const LOCATOR_ENTRIES: usize = 1 << 24;
+
+/// Point tests (in units of one primitive test) the sampling of one link aims at.
+pub const POINT_TEST_BUDGET: usize = 1 << 25;
+
+/// Pairs of parts whose bounding boxes overlap beyond which the estimate is skipped.
+pub const MAX_PAIRS: usize = 1 << 20;
+
+/// Samples per axis of a part's grid: at most, and at least.
+const GRID: usize = 24;
+const MIN_GRID: usize = 4;
 
 /// A part's solid in its own frame.
 #[derive(Debug, Clone)]
@@ -25,6 +47,9 @@ pub enum PartShape {
 }
 
 /// A closed triangle mesh bucketed on a (y, z) grid for point-in-solid tests by ray parity.
+///
+/// The buckets are one flat list (`entries`, bucket `c` is `entries[starts[c]..starts[c + 1]]`), so the
+/// memory is the references themselves and nothing per bucket but an offset.
 #[derive(Debug)]
 pub struct MeshLocator {
     vertices: Vec<[f64; 3]>,
@@ -32,62 +57,192 @@ pub struct MeshLocator {
     lo: [f64; 2],
     cell: [f64; 2],
     grid: usize,
-    buckets: Vec<Vec<u32>>,
+    starts: Vec<usize>,
+    entries: Vec<u32>,
+}
+
+/// The range of cells a closed interval `[a, b]` meets along axis `k` of a grid.
+fn cells(a: f64, b: f64, lo: f64, cell: f64, grid: usize) -> (usize, usize) {
+    let index = |x: f64| (((x - lo) / cell).floor().max(0.0) as usize).min(grid - 1);
+    // A little slack: a point on a cell border goes to the upper cell, and rounding must not lose it.
+    let pad = 1e-7 * cell;
+    (index(a - pad), index(b + pad))
+}
+
+/// The z extent of a triangle projected on (y, z), cut to the band `y0 ≤ y ≤ y1`.
+fn z_extent_in_band(p: &[[f64; 2]; 3], y0: f64, y1: f64) -> Option<(f64, f64)> {
+    let mut lo = f64::INFINITY;
+    let mut hi = f64::NEG_INFINITY;
+    for v in p {
+        if v[0] >= y0 && v[0] <= y1 {
+            lo = lo.min(v[1]);
+            hi = hi.max(v[1]);
+        }
+    }
+    for e in 0..3 {
+        let (a, b) = (p[e], p[(e + 1) % 3]);
+        for y in [y0, y1] {
+            if (a[0] - y) * (b[0] - y) < 0.0 {
+                let z = a[1] + (y - a[0]) / (b[0] - a[0]) * (b[1] - a[1]);
+                lo = lo.min(z);
+                hi = hi.max(z);
+            }
+        }
+    }
+    (lo <= hi).then_some((lo, hi))
 }
 
 impl MeshLocator {
+    /// Buckets `solid`'s triangles within [`LOCATOR_ENTRIES`] references; a mesh of more triangles than
+    /// that gets one bucket holding them all.
     pub fn new(solid: &Solid) -> Self {
+        Self::with_budget(solid, LOCATOR_ENTRIES).unwrap_or_else(|| Self::with_grid(solid, 1))
+    }
+
+    /// Buckets `solid`'s triangles on the finest grid (at most 256 × 256, about four triangles per
+    /// cell) whose buckets hold at most `entries` references in all; `None` if none does.
+    pub fn with_budget(solid: &Solid, entries: usize) -> Option<Self> {
         let triangles = solid.faces.triangles();
-        let vertices = solid.vertices.clone();
+        if triangles.len() > entries {
+            return None;
+        }
+        let mut grid = ((triangles.len() as f64 / 4.0).sqrt().ceil() as usize).clamp(1, 256);
+        loop {
+            let (lo, cell) = Self::frame(&solid.vertices, grid);
+            let mut count = 0usize;
+            for tri in &triangles {
+                Self::rows(&solid.vertices, tri, lo, cell, grid, |_, b0, b1| {
+                    count += b1 - b0 + 1
+                });
+                if count > entries {
+                    break;
+                }
+            }
+            if count <= entries || grid == 1 {
+                return (count <= entries).then(|| Self::build(solid, triangles, grid));
+            }
+            grid /= 2;
+        }
+    }
+
+    /// Buckets on a `grid` × `grid` grid, whatever the memory.
+    fn with_grid(solid: &Solid, grid: usize) -> Self {
+        Self::build(solid, solid.faces.triangles(), grid.max(1))
+    }
+
+    /// The grid's origin and cell size over the vertices' (y, z) extent.
+    fn frame(vertices: &[[f64; 3]], grid: usize) -> ([f64; 2], [f64; 2]) {
         let mut lo = [f64::INFINITY; 2];
         let mut hi = [f64::NEG_INFINITY; 2];
-        for v in &vertices {
+        for v in vertices {
             for k in 0..2 {
                 lo[k] = lo[k].min(v[k + 1]);
                 hi[k] = hi[k].max(v[k + 1]);
             }
         }
-        let grid = ((triangles.len() as f64 / 4.0).sqrt().ceil() as usize).clamp(1, 256);
+        if vertices.is_empty() {
+            lo = [0.0; 2];
+            hi = [0.0; 2];
+        }
         let cell = [0, 1].map(|k| ((hi[k] - lo[k]) / grid as f64).max(f64::MIN_POSITIVE));
-        let mut buckets = vec![Vec::new(); grid * grid];
-        let index =
-            |x: f64, k: usize| (((x - lo[k]) / cell[k]).floor().max(0.0) as usize).min(grid - 1);
-        for (t, tri) in triangles.iter().enumerate() {
-            let ys = tri.map(|i| vertices[i as usize][1]);
-            let zs = tri.map(|i| vertices[i as usize][2]);
-            let (y0, y1) = (
-                index(ys.iter().cloned().fold(f64::INFINITY, f64::min), 0),
-                index(ys.iter().cloned().fold(f64::NEG_INFINITY, f64::max), 0),
-            );
-            let (z0, z1) = (
-                index(zs.iter().cloned().fold(f64::INFINITY, f64::min), 1),
-                index(zs.iter().cloned().fold(f64::NEG_INFINITY, f64::max), 1),
-            );
-            for a in y0..=y1 {
-                for b in z0..=z1 {
-                    buckets[a * grid + b].push(t as u32);
+        (lo, cell)
+    }
+
+    /// Calls `f(row, first column, last column)` for each row of cells the triangle's projection meets.
+    fn rows(
+        vertices: &[[f64; 3]],
+        tri: &[u32; 3],
+        lo: [f64; 2],
+        cell: [f64; 2],
+        grid: usize,
+        mut f: impl FnMut(usize, usize, usize),
+    ) {
+        let p = tri.map(|i| {
+            let v = vertices[i as usize];
+            [v[1], v[2]]
+        });
+        let ymin = p[0][0].min(p[1][0]).min(p[2][0]);
+        let ymax = p[0][0].max(p[1][0]).max(p[2][0]);
+        let zmin = p[0][1].min(p[1][1]).min(p[2][1]);
+        let zmax = p[0][1].max(p[1][1]).max(p[2][1]);
+        let (a0, a1) = cells(ymin, ymax, lo[0], cell[0], grid);
+        for a in a0..=a1 {
+            let pad = 1e-7 * cell[0];
+            let y0 = lo[0] + a as f64 * cell[0] - pad;
+            let y1 = lo[0] + (a + 1) as f64 * cell[0] + pad;
+            // The first and last rows reach to the grid's border (points there are clamped into them).
+            let y0 = if a == 0 { f64::NEG_INFINITY } else { y0 };
+            let y1 = if a == grid - 1 { f64::INFINITY } else { y1 };
+            let (z0, z1) = z_extent_in_band(&p, y0, y1).unwrap_or((zmin, zmax));
+            let (b0, b1) = cells(z0.max(zmin), z1.min(zmax), lo[1], cell[1], grid);
+            f(a, b0, b1);
+        }
+    }
+
+    fn build(solid: &Solid, triangles: Vec<[u32; 3]>, grid: usize) -> Self {
+        let vertices = &solid.vertices;
+        let (lo, cell) = Self::frame(vertices, grid);
+        let mut starts = vec![0usize; grid * grid + 1];
+        for tri in &triangles {
+            Self::rows(vertices, tri, lo, cell, grid, |a, b0, b1| {
+                for b in b0..=b1 {
+                    starts[a * grid + b + 1] += 1;
                 }
-            }
+            });
+        }
+        for c in 0..grid * grid {
+            starts[c + 1] += starts[c];
+        }
+        let mut fill = starts.clone();
+        let mut entries = vec![0u32; starts[grid * grid]];
+        for (t, tri) in triangles.iter().enumerate() {
+            Self::rows(vertices, tri, lo, cell, grid, |a, b0, b1| {
+                for b in b0..=b1 {
+                    entries[fill[a * grid + b]] = t as u32;
+                    fill[a * grid + b] += 1;
+                }
+            });
         }
         MeshLocator {
-            vertices,
+            vertices: vertices.clone(),
             triangles,
             lo,
             cell,
             grid,
-            buckets,
+            starts,
+            entries,
         }
+    }
+
+    /// Cells per axis of the bucket grid.
+    pub fn grid(&self) -> usize {
+        self.grid
+    }
+
+    /// Triangle references held by all buckets.
+    pub fn entries(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// What one point test costs, in primitive tests: the triangles of an average bucket.
+    fn cost(&self) -> usize {
+        2 + self.entries.len() / (self.grid * self.grid)
     }
 
     /// Whether `q` (mesh frame) is inside: the number of triangles a ray from `q` along +x crosses is odd.
     pub fn contains(&self, q: [f64; 3]) -> bool {
         let a = ((q[1] - self.lo[0]) / self.cell[0]).floor();
         let b = ((q[2] - self.lo[1]) / self.cell[1]).floor();
-        if a < 0.0 || b < 0.0 || a >= self.grid as f64 || b >= self.grid as f64 {
+        // Points on the far border belong to the last cell.
+        let last = self.grid as f64;
+        let a = if a == last { a - 1.0 } else { a };
+        let b = if b == last { b - 1.0 } else { b };
+        if !(a >= 0.0 && b >= 0.0 && a < last && b < last) {
             return false;
         }
+        let c = a as usize * self.grid + b as usize;
         let mut crossings = 0usize;
-        for &t in &self.buckets[a as usize * self.grid + b as usize] {
+        for &t in &self.entries[self.starts[c]..self.starts[c + 1]] {
             let [i, j, k] = self.triangles[t as usize];
             let (p0, p1, p2) = (
                 self.vertices[i as usize],
@@ -113,9 +268,17 @@ impl MeshLocator {
     }
 }
 
-/// Twice the signed area of (a, b, q) projected on the (y, z) plane.
+/// Twice the signed area of (a, b, q) projected on the (y, z) plane, evaluated from the edge's own
+/// first end (by [`edge_rule`]) so that the two triangles sharing an edge get exactly opposite values:
+/// rounding must not put a point on that edge inside both or neither.
 fn orient(a: [f64; 3], b: [f64; 3], q: [f64; 3]) -> f64 {
-    (b[1] - a[1]) * (q[2] - a[2]) - (b[2] - a[2]) * (q[1] - a[1])
+    let area =
+        |a: [f64; 3], b: [f64; 3]| (b[1] - a[1]) * (q[2] - a[2]) - (b[2] - a[2]) * (q[1] - a[1]);
+    if edge_rule(a, b) {
+        area(a, b)
+    } else {
+        -area(b, a)
+    }
 }
 
 /// Tie-break for a point exactly on an edge: the edge owns it on one side only.
@@ -158,18 +321,30 @@ impl PlacedPart {
         }
     }
 
+    /// What one point test costs, in primitive tests.
     fn cost(&self) -> usize {
-        match &self.shape {
-            PartShape::Mesh(_) => 8,
+        match (&self.shape, &self.locator) {
+            (PartShape::Mesh(_), Some(l)) => l.cost(),
+            (PartShape::Mesh(_), None) => usize::MAX / 4,
             _ => 1,
         }
     }
 
-    /// Builds the mesh locator if this part is a mesh and has none yet.
-    pub fn prepare(&mut self) {
+    /// Builds the mesh locator if this part is a mesh and has none yet, within [`LOCATOR_ENTRIES`].
+    /// False when the mesh has more triangles than that (it cannot be located).
+    pub fn prepare(&mut self) -> bool {
         if let (PartShape::Mesh(solid), None) = (&self.shape, &self.locator) {
-            self.locator = Some(Arc::new(MeshLocator::new(solid)));
+            match MeshLocator::with_budget(solid, LOCATOR_ENTRIES) {
+                Some(l) => self.locator = Some(Arc::new(l)),
+                None => return false,
+            }
         }
+        true
+    }
+
+    /// Whether the link-frame point `p` is inside the part's bounding box.
+    fn in_bbox(&self, p: [f64; 3]) -> bool {
+        (0..3).all(|k| p[k] >= self.bbox.0[k] && p[k] <= self.bbox.1[k])
     }
 }
 
@@ -204,37 +379,178 @@ fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// Samples per axis of the grid over the intersection of the bounding boxes.
-const GRID: usize = 24;
+/// The volume a link's parts count more than once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OverlapEstimate {
+    /// The parts' volumes less the volume of their union (m³).
+    pub excess: f64,
+    /// The parts (indices into the slice given) found inside another part somewhere.
+    pub parts: Vec<usize>,
+    /// The most parts found covering one sample point.
+    pub most: usize,
+    /// Samples per axis of each part's grid.
+    pub grid: usize,
+}
 
-/// The estimated volume inside both parts (m³) and the grid size used, or `None` when their bounding
-/// boxes do not overlap.
-pub fn overlap_volume(a: &PlacedPart, b: &PlacedPart) -> Option<(f64, usize)> {
-    let lo = [0, 1, 2].map(|k| a.bbox.0[k].max(b.bbox.0[k]));
-    let hi = [0, 1, 2].map(|k| a.bbox.1[k].min(b.bbox.1[k]));
-    if (0..3).any(|k| hi[k] <= lo[k]) {
-        return None;
-    }
-    let box_volume = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
-    let n = GRID;
-    let mut inside = 0usize;
-    for i in 0..n {
-        for j in 0..n {
-            for k in 0..n {
-                let p = [
-                    lo[0] + (hi[0] - lo[0]) * (i as f64 + 0.5) / n as f64,
-                    lo[1] + (hi[1] - lo[1]) * (j as f64 + 0.5) / n as f64,
-                    lo[2] + (hi[2] - lo[2]) * (k as f64 + 0.5) / n as f64,
-                ];
-                // The cheap test first.
-                let (first, second) = if a.cost() <= b.cost() { (a, b) } else { (b, a) };
-                if first.contains(p) && second.contains(p) {
-                    inside += 1;
+/// What [`estimate`] found.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Overlap {
+    /// No two parts' bounding boxes share more than 1% of the smaller part's volume.
+    None,
+    Estimated(OverlapEstimate),
+    /// Not estimated, and why.
+    Skipped(String),
+}
+
+/// The volume of the intersection of two bounding boxes (0 when they do not meet).
+fn box_overlap(a: &PlacedPart, b: &PlacedPart) -> f64 {
+    (0..3)
+        .map(|k| (a.bbox.1[k].min(b.bbox.1[k]) - a.bbox.0[k].max(b.bbox.0[k])).max(0.0))
+        .product()
+}
+
+/// For each part, the parts whose bounding boxes share more than 1% of the smaller one's volume with
+/// its own: a sweep along the axis where the boxes are most spread, so that far apart parts are never
+/// compared. `None` past [`MAX_PAIRS`] pairs.
+fn neighbours(parts: &[PlacedPart]) -> Option<Vec<Vec<usize>>> {
+    let usable: Vec<usize> = (0..parts.len())
+        .filter(|&i| {
+            let p = &parts[i];
+            p.volume > 0.0 && (0..3).all(|k| p.bbox.0[k].is_finite() && p.bbox.1[k].is_finite())
+        })
+        .collect();
+    let spread = |k: usize| {
+        let (lo, hi) = usable
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| {
+                let c = 0.5 * (parts[i].bbox.0[k] + parts[i].bbox.1[k]);
+                (lo.min(c), hi.max(c))
+            });
+        let mean_size: f64 = usable
+            .iter()
+            .map(|&i| parts[i].bbox.1[k] - parts[i].bbox.0[k])
+            .sum::<f64>()
+            / usable.len().max(1) as f64;
+        (hi - lo) / mean_size.max(f64::MIN_POSITIVE)
+    };
+    let axis = (0..3)
+        .max_by(|&a, &b| spread(a).total_cmp(&spread(b)))
+        .unwrap_or(0);
+    let mut order = usable;
+    order.sort_by(|&a, &b| parts[a].bbox.0[axis].total_cmp(&parts[b].bbox.0[axis]));
+    let mut out = vec![Vec::new(); parts.len()];
+    let mut active: Vec<usize> = Vec::new();
+    let mut pairs = 0usize;
+    for &i in &order {
+        let start = parts[i].bbox.0[axis];
+        active.retain(|&j| parts[j].bbox.1[axis] > start);
+        for &j in &active {
+            let (a, b) = (&parts[i], &parts[j]);
+            if box_overlap(a, b) > 0.01 * a.volume.min(b.volume) {
+                out[i].push(j);
+                out[j].push(i);
+                pairs += 1;
+                if pairs > MAX_PAIRS {
+                    return None;
                 }
             }
         }
+        active.push(i);
     }
-    Some((box_volume * inside as f64 / (n * n * n) as f64, n))
+    Some(out)
+}
+
+/// Estimates the volume the parts count more than once (see the module docs). Builds the mesh
+/// locators it needs.
+pub fn estimate(parts: &mut [PlacedPart]) -> Overlap {
+    let Some(nb) = neighbours(parts) else {
+        return Overlap::Skipped(format!(
+            "more than {MAX_PAIRS} pairs of parts have overlapping bounding boxes"
+        ));
+    };
+    let involved: Vec<usize> = (0..parts.len()).filter(|&i| !nb[i].is_empty()).collect();
+    if involved.is_empty() {
+        return Overlap::None;
+    }
+    for &i in &involved {
+        if !parts[i].prepare() {
+            return Overlap::Skipped(format!(
+                "part {} has more than {LOCATOR_ENTRIES} triangles",
+                i + 1
+            ));
+        }
+    }
+    // One grid size for all: the point tests of every part and its neighbours within the budget.
+    let cost: usize = involved
+        .iter()
+        .map(|&i| {
+            nb[i]
+                .iter()
+                .fold(parts[i].cost(), |c, &j| c.saturating_add(parts[j].cost()))
+        })
+        .fold(0usize, usize::saturating_add);
+    let samples = POINT_TEST_BUDGET / cost.max(1);
+    let n = ((samples as f64).cbrt().floor() as usize).clamp(MIN_GRID, GRID);
+    let parts: &[PlacedPart] = parts;
+    let sample_part = |i: usize| -> (f64, bool, usize) {
+        let p = &parts[i];
+        // Only where the part's box meets a neighbour's can a point be covered twice.
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for &j in &nb[i] {
+            let q = &parts[j];
+            for k in 0..3 {
+                lo[k] = lo[k].min(p.bbox.0[k].max(q.bbox.0[k]));
+                hi[k] = hi[k].max(p.bbox.1[k].min(q.bbox.1[k]));
+            }
+        }
+        let cell_volume = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]) / (n * n * n) as f64;
+        let mut sum = 0.0;
+        let mut most = 1usize;
+        for a in 0..n {
+            for b in 0..n {
+                for c in 0..n {
+                    let x = [
+                        lo[0] + (hi[0] - lo[0]) * (a as f64 + 0.5) / n as f64,
+                        lo[1] + (hi[1] - lo[1]) * (b as f64 + 0.5) / n as f64,
+                        lo[2] + (hi[2] - lo[2]) * (c as f64 + 0.5) / n as f64,
+                    ];
+                    if !p.contains(x) {
+                        continue;
+                    }
+                    let k = 1 + nb[i]
+                        .iter()
+                        .filter(|&&j| parts[j].in_bbox(x) && parts[j].contains(x))
+                        .count();
+                    most = most.max(k);
+                    sum += 1.0 - 1.0 / k as f64;
+                }
+            }
+        }
+        (sum * cell_volume, most > 1, most)
+    };
+    use rayon::prelude::*;
+    let results: Vec<(f64, bool, usize)> = involved.par_iter().map(|&i| sample_part(i)).collect();
+    let excess: f64 = results.iter().map(|r| r.0).sum();
+    let found: Vec<usize> = involved
+        .iter()
+        .zip(&results)
+        .filter(|(_, r)| r.1)
+        .map(|(&i, _)| i)
+        .collect();
+    let smallest = found
+        .iter()
+        .map(|&i| parts[i].volume)
+        .fold(f64::INFINITY, f64::min);
+    if found.is_empty() || excess <= 0.01 * smallest {
+        return Overlap::None;
+    }
+    Overlap::Estimated(OverlapEstimate {
+        excess,
+        parts: found,
+        most: results.iter().map(|r| r.2).max().unwrap_or(1),
+        grid: n,
+    })
 }
 
 #[cfg(test)]
@@ -257,26 +573,160 @@ mod tests {
         }
     }
 
+    fn estimated(parts: &mut [PlacedPart]) -> OverlapEstimate {
+        match estimate(parts) {
+            Overlap::Estimated(e) => e,
+            other => panic!("expected an estimate, got {other:?}"),
+        }
+    }
+
     #[test]
     fn two_boxes_overlapping_by_half() {
-        let a = placed(PartShape::Box([0.5; 3]), [0.0; 3], [0.5; 3], 1.0);
-        let b = placed(PartShape::Box([0.5; 3]), [0.5, 0.0, 0.0], [0.5; 3], 1.0);
-        let (v, _) = overlap_volume(&a, &b).expect("overlap");
-        assert!((v - 0.5).abs() < 1e-12, "{v}");
+        let mut parts = [
+            placed(PartShape::Box([0.5; 3]), [0.0; 3], [0.5; 3], 1.0),
+            placed(PartShape::Box([0.5; 3]), [0.5, 0.0, 0.0], [0.5; 3], 1.0),
+        ];
+        let e = estimated(&mut parts);
+        assert!((e.excess - 0.5).abs() < 1e-12, "{e:?}");
+        assert_eq!((e.parts.clone(), e.most, e.grid), (vec![0, 1], 2, GRID));
     }
 
     #[test]
     fn boxes_overlap_but_solids_do_not() {
         // A small box in the corner of a sphere's bounding box, outside the sphere.
-        let s = placed(
-            PartShape::Sphere(1.0),
-            [0.0; 3],
-            [1.0; 3],
-            4.0 / 3.0 * std::f64::consts::PI,
+        let mut parts = [
+            placed(
+                PartShape::Sphere(1.0),
+                [0.0; 3],
+                [1.0; 3],
+                4.0 / 3.0 * std::f64::consts::PI,
+            ),
+            placed(PartShape::Box([0.1; 3]), [0.9, 0.9, 0.9], [0.1; 3], 0.008),
+        ];
+        assert_eq!(estimate(&mut parts), Overlap::None);
+    }
+
+    /// Issue 13: 200 coincident boxes count the box 200 times: 199 of 200 copies (99.5% of the summed
+    /// volume) are excess, where the largest pair showed 0.5%.
+    #[test]
+    fn coincident_boxes_sum_every_copy() {
+        let mut parts: Vec<PlacedPart> = (0..200)
+            .map(|_| placed(PartShape::Box([0.5; 3]), [0.0; 3], [0.5; 3], 1.0))
+            .collect();
+        let e = estimated(&mut parts);
+        assert!((e.excess - 199.0).abs() < 1e-9, "{e:?}");
+        assert_eq!((e.parts.len(), e.most), (200, 200));
+    }
+
+    /// Three spheres in a row, each overlapping the next: the excess is the two lens volumes (exact:
+    /// π(4r + d)(2r − d)²/12 for radius r at distance d), within the grid's resolution.
+    #[test]
+    fn a_chain_of_spheres_sums_its_lenses() {
+        let (r, d) = (1.0, 1.5);
+        let v = 4.0 / 3.0 * std::f64::consts::PI;
+        let mut parts: Vec<PlacedPart> = (0..3)
+            .map(|i| placed(PartShape::Sphere(r), [d * i as f64, 0.0, 0.0], [r; 3], v))
+            .collect();
+        let lens = std::f64::consts::PI * (4.0 * r + d) * (2.0 * r - d).powi(2) / 12.0;
+        let e = estimated(&mut parts);
+        assert!(
+            (e.excess / (2.0 * lens) - 1.0).abs() < 0.05,
+            "{e:?} against {}",
+            2.0 * lens
         );
-        let b = placed(PartShape::Box([0.1; 3]), [0.9, 0.9, 0.9], [0.1; 3], 0.008);
-        let (v, _) = overlap_volume(&s, &b).expect("boxes overlap");
-        assert_eq!(v, 0.0);
+        assert_eq!((e.parts.len(), e.most), (3, 2));
+    }
+
+    /// Issue 13: 2000 disjoint spheres cost nothing but the sweep (no pair, no sampling).
+    #[test]
+    fn disjoint_spheres_have_no_overlap() {
+        let v = 4.0 / 3.0 * std::f64::consts::PI * 0.001;
+        let mut parts: Vec<PlacedPart> = (0..2000)
+            .map(|i| {
+                let t = [
+                    (i % 20) as f64 * 0.25,
+                    (i / 20 % 10) as f64 * 0.25,
+                    (i / 200) as f64 * 0.25,
+                ];
+                placed(PartShape::Sphere(0.1), t, [0.1; 3], v)
+            })
+            .collect();
+        assert_eq!(
+            neighbours(&parts).map(|n| n.iter().map(Vec::len).sum::<usize>()),
+            Some(0)
+        );
+        assert_eq!(estimate(&mut parts), Overlap::None);
+    }
+
+    /// Too many overlapping pairs skip the estimate with the reason.
+    #[test]
+    fn too_many_pairs_are_skipped() {
+        let mut parts: Vec<PlacedPart> = (0..1500)
+            .map(|_| placed(PartShape::Sphere(1.0), [0.0; 3], [1.0; 3], 4.0))
+            .collect();
+        assert!(
+            matches!(estimate(&mut parts), Overlap::Skipped(m) if m.contains("pairs of parts"))
+        );
+    }
+
+    /// A cone along +x (base radius 1 at x = 0, apex at x = 1) of `2 n` sliver triangles seen along x.
+    fn cone(n: u32) -> Solid {
+        let mut v = vec![[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]];
+        for i in 0..n {
+            let a = 2.0 * std::f64::consts::PI * i as f64 / n as f64;
+            v.push([0.0, a.cos(), a.sin()]);
+        }
+        let mut f = Vec::new();
+        for i in 0..n {
+            let (p, q) = (2 + i, 2 + (i + 1) % n);
+            f.push([0, p, q]);
+            f.push([1, q, p]);
+        }
+        let raw = crate::mesh::RawMesh {
+            vertices: v,
+            faces: crate::mass::Polygons::from_triangles(&f),
+            ..Default::default()
+        };
+        crate::mesh::health::make_solid(&raw, std::path::Path::new("cone"), Default::default())
+            .expect("solid")
+    }
+
+    /// Issue 13: slivers go only into the cells their projection meets, the references stay within the
+    /// budget (a coarser grid otherwise), and points are still located right, those level with the
+    /// slivers' shared edges included.
+    #[test]
+    fn sliver_buckets_stay_within_the_budget() {
+        let solid = cone(4096);
+        let fine = MeshLocator::with_budget(&solid, LOCATOR_ENTRIES).expect("fits");
+        // 8192 slivers from the axis to the rim of a 46-cell grid: each crosses at most the 23 rows and
+        // 23 columns it spans, 46 cells and a few for the slack (its bounding box of cells is up to
+        // 23 × 23 = 529).
+        assert_eq!(fine.grid(), 46);
+        assert!(fine.entries() <= 8192 * 49, "{}", fine.entries());
+        let coarse = MeshLocator::with_budget(&solid, 60_000).expect("fits when coarser");
+        assert!(coarse.grid() < 46 && coarse.entries() <= 60_000);
+        assert!(MeshLocator::with_budget(&solid, 8000).is_none());
+        for l in [&fine, &coarse] {
+            for a in 0..12 {
+                for b in 0..12 {
+                    for c in 0..12 {
+                        let q = [
+                            0.05 + 0.9 * a as f64 / 11.0,
+                            -1.0 + 2.0 * b as f64 / 11.0 + 1e-3,
+                            -1.0 + 2.0 * c as f64 / 11.0 + 1e-3,
+                        ];
+                        let r = (q[1] * q[1] + q[2] * q[2]).sqrt();
+                        let inside = r < 0.99 * (1.0 - q[0]);
+                        let outside = r > 1.01 * (1.0 - q[0]);
+                        if inside || outside {
+                            assert_eq!(l.contains(q), inside, "{q:?}");
+                        }
+                    }
+                }
+            }
+            // On the diagonal, level with shared edges (vertex 512 is at 45°).
+            assert!(l.contains([0.3, 0.1, 0.1]) && l.contains([0.3, -0.2, -0.2]));
+        }
     }
 
     #[test]

@@ -2,16 +2,18 @@
 //! links of a robot and across robots (`check a.urdf b.urdf`, a corpus).
 
 use super::health::{HealthOptions, Solid};
-use super::{read, solid_from_raw, MeshError, RawMesh};
+use super::{read, solid_from_raw, MeshError};
 use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-/// Reads each file once and heals each (file, scale) once.
+/// Reads each file once and heals each (file, scale) once. A raw mesh lives only until its scales are
+/// healed: the cache keeps the solids, and of each file read only whether it failed (a file asked for
+/// again with a new scale, by a later call sharing the cache, is read again).
 #[derive(Debug, Default)]
 pub struct MeshCache {
-    raw: HashMap<PathBuf, Result<Arc<RawMesh>, MeshError>>,
+    read: HashMap<PathBuf, Option<MeshError>>,
     solids: HashMap<(PathBuf, [u64; 3]), Result<Arc<Solid>, MeshError>>,
     pub load_time: Duration,
     pub integrate_time: Duration,
@@ -29,11 +31,11 @@ impl MeshCache {
             return r.clone();
         }
         let t0 = Instant::now();
-        let raw = match self.raw.get(path) {
-            Some(r) => r.clone(),
-            None => {
-                let r = read(path).map(Arc::new);
-                self.raw.insert(path.clone(), r.clone());
+        let raw = match self.read.get(path) {
+            Some(Some(e)) => Err(e.clone()),
+            _ => {
+                let r = read(path);
+                self.read.insert(path.clone(), r.as_ref().err().cloned());
                 r
             }
         };
@@ -68,7 +70,7 @@ impl MeshCache {
         }
         type Loaded = (
             PathBuf,
-            Result<Arc<RawMesh>, MeshError>,
+            Option<MeshError>,
             Vec<([f64; 3], Result<Arc<Solid>, MeshError>)>,
             Duration,
             Duration,
@@ -78,20 +80,20 @@ impl MeshCache {
             .into_par_iter()
             .map(|(path, scales)| {
                 let t0 = Instant::now();
-                let raw = read(path).map(Arc::new);
+                let raw = read(path);
                 let t1 = Instant::now();
                 let solids = scales
                     .into_iter()
                     .map(|scale| {
-                        (
-                            scale,
-                            raw.clone()
-                                .and_then(|r| solid_from_raw(&r, scale, path, options))
-                                .map(Arc::new),
-                        )
+                        let solid = match &raw {
+                            Ok(r) => solid_from_raw(r, scale, path, options).map(Arc::new),
+                            Err(e) => Err(e.clone()),
+                        };
+                        (scale, solid)
                     })
                     .collect();
-                (path.clone(), raw, solids, t1 - t0, t1.elapsed())
+                // The raw mesh ends here, before the next file of this thread is read.
+                (path.clone(), raw.err(), solids, t1 - t0, t1.elapsed())
             })
             .collect();
         for (path, raw, solids, load, integrate) in loaded {
@@ -101,12 +103,12 @@ impl MeshCache {
                 self.solids
                     .insert((path.clone(), scale.map(f64::to_bits)), solid);
             }
-            self.raw.insert(path, raw);
+            self.read.insert(path, raw);
         }
     }
 
     /// Number of distinct files read.
     pub fn files(&self) -> usize {
-        self.raw.len()
+        self.read.len()
     }
 }

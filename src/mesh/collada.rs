@@ -21,16 +21,38 @@ use std::collections::HashMap;
 use std::path::Path;
 
 /// A minimal element tree: enough of COLLADA for geometry and scene graphs.
+///
+/// The tree holds no copy of the text: an element's text is a span of the file's bytes, parsed where
+/// it is used (a `<float_array>` or `<p>` is most of a file's size).
 #[derive(Debug, Default)]
 struct El {
     name: String,
     attrs: Vec<(String, String)>,
     children: Vec<El>,
-    text: String,
+    text: Text,
     line: usize,
 }
 
+/// An element's character data, whitespace-only pieces left out.
+#[derive(Debug, Default)]
+enum Text {
+    #[default]
+    None,
+    /// One piece: a byte range of the file.
+    Span(usize, usize),
+    /// Several pieces (text around a comment or child), joined as XML joins them.
+    Joined(String),
+}
+
 impl El {
+    /// The element's text (borrowed from the file unless it came in several pieces).
+    fn text<'a>(&'a self, bytes: &'a [u8]) -> std::borrow::Cow<'a, str> {
+        match &self.text {
+            Text::None => "".into(),
+            Text::Span(a, b) => String::from_utf8_lossy(bytes.get(*a..*b).unwrap_or_default()),
+            Text::Joined(s) => s.as_str().into(),
+        }
+    }
     fn attr(&self, key: &str) -> Option<&str> {
         self.attrs
             .iter()
@@ -133,8 +155,31 @@ fn parse_tree(bytes: &[u8], path: &Path) -> Result<El, MeshError> {
                 }
             }
             Event::Text(t) => {
+                let piece: &[u8] = t.as_ref();
                 if let Some(top) = stack.last_mut() {
-                    top.text.push_str(&String::from_utf8_lossy(t.as_ref()));
+                    if piece.iter().all(u8::is_ascii_whitespace) {
+                        // Nothing to keep, unless it separates two pieces.
+                        if !matches!(top.text, Text::None) {
+                            top.text = Text::Joined(format!("{} ", top.text(bytes)));
+                        }
+                        continue;
+                    }
+                    // The event borrows the file's bytes from `pos` on; the span is checked anyway.
+                    let span = (pos, pos + piece.len());
+                    let borrowed = bytes.get(span.0..span.1) == Some(piece);
+                    top.text = match std::mem::take(&mut top.text) {
+                        Text::None if borrowed => Text::Span(span.0, span.1),
+                        Text::None => Text::Joined(String::from_utf8_lossy(piece).into_owned()),
+                        Text::Span(a, b) => {
+                            let mut s = String::from_utf8_lossy(&bytes[a..b]).into_owned();
+                            s.push_str(&String::from_utf8_lossy(piece));
+                            Text::Joined(s)
+                        }
+                        Text::Joined(mut s) => {
+                            s.push_str(&String::from_utf8_lossy(piece));
+                            Text::Joined(s)
+                        }
+                    };
                 }
             }
             Event::Eof => break,
@@ -164,27 +209,33 @@ fn compose(a: &Affine, b: &Affine) -> Affine {
     (m, [t[0] + a.1[0], t[1] + a.1[1], t[2] + a.1[2]])
 }
 
-fn numbers(el: &El, path: &Path) -> Result<Vec<f64>, MeshError> {
-    el.text
-        .split_ascii_whitespace()
-        .map(|w| {
-            parse_f64(w).ok_or_else(|| {
-                MeshError::new(
-                    path,
-                    Some(el.line),
-                    MeshErrorKind::Syntax(format!("`{w}` is not a number in <{}>", el.name)),
-                )
-            })
+/// The numbers of an element's text, one at a time (a `<p>` of millions of indices is never a list).
+fn each_number<'a>(
+    el: &'a El,
+    text: &'a str,
+    path: &'a Path,
+) -> impl Iterator<Item = Result<f64, MeshError>> + 'a {
+    text.split_ascii_whitespace().map(move |w| {
+        parse_f64(w).ok_or_else(|| {
+            MeshError::new(
+                path,
+                Some(el.line),
+                MeshErrorKind::Syntax(format!("`{w}` is not a number in <{}>", el.name)),
+            )
         })
-        .collect()
+    })
 }
 
-fn node_transform(node: &El, path: &Path) -> Result<Affine, MeshError> {
+fn numbers(el: &El, bytes: &[u8], path: &Path) -> Result<Vec<f64>, MeshError> {
+    each_number(el, &el.text(bytes), path).collect()
+}
+
+fn node_transform(node: &El, bytes: &[u8], path: &Path) -> Result<Affine, MeshError> {
     let mut acc = IDENTITY;
     for c in &node.children {
         let step: Affine = match c.name.as_str() {
             "matrix" => {
-                let m = numbers(c, path)?;
+                let m = numbers(c, bytes, path)?;
                 if m.len() != 16 {
                     return Err(MeshError::new(
                         path,
@@ -198,7 +249,7 @@ fn node_transform(node: &El, path: &Path) -> Result<Affine, MeshError> {
                 )
             }
             "translate" => {
-                let t = numbers(c, path)?;
+                let t = numbers(c, bytes, path)?;
                 if t.len() != 3 {
                     return Err(MeshError::new(
                         path,
@@ -209,7 +260,7 @@ fn node_transform(node: &El, path: &Path) -> Result<Affine, MeshError> {
                 (IDENTITY.0, [t[0], t[1], t[2]])
             }
             "scale" => {
-                let s = numbers(c, path)?;
+                let s = numbers(c, bytes, path)?;
                 if s.len() != 3 {
                     return Err(MeshError::new(
                         path,
@@ -223,7 +274,7 @@ fn node_transform(node: &El, path: &Path) -> Result<Affine, MeshError> {
                 )
             }
             "rotate" => {
-                let r = numbers(c, path)?;
+                let r = numbers(c, bytes, path)?;
                 if r.len() != 4 {
                     return Err(MeshError::new(
                         path,
@@ -258,6 +309,7 @@ fn axis_angle(axis: [f64; 3], angle: f64) -> Mat3 {
 /// Geometry of one `<mesh>`: positions and polygons.
 fn read_geometry(
     geom: &El,
+    bytes: &[u8],
     path: &Path,
     notes: &mut Vec<String>,
 ) -> Result<(Vec<[f64; 3]>, Polygons), MeshError> {
@@ -270,14 +322,14 @@ fn read_geometry(
     };
     let err =
         |line: usize, msg: String| MeshError::new(path, Some(line), MeshErrorKind::Syntax(msg));
-    // Sources by id.
-    let mut sources: HashMap<&str, (Vec<f64>, usize, usize, usize)> = HashMap::new();
+    // Sources by id, read only when a VERTEX input asks for their positions (normals and texture
+    // coordinates are never parsed).
+    let mut sources: HashMap<&str, (&El, usize, usize, usize)> = HashMap::new();
     for src in mesh.children_named("source") {
         let Some(id) = src.attr("id") else { continue };
         let Some(arr) = src.child("float_array") else {
             continue;
         };
-        let data = numbers(arr, path)?;
         let (stride, offset, line) = src
             .child("technique_common")
             .and_then(|t| t.child("accessor"))
@@ -293,7 +345,7 @@ fn read_geometry(
                 )
             })
             .unwrap_or((3, 0, src.line));
-        sources.insert(id, (data, stride.max(1), offset, line));
+        sources.insert(id, (arr, stride.max(1), offset, line));
     }
     let positions_of = |source_ref: &str, line: usize| -> Result<Vec<[f64; 3]>, MeshError> {
         let id = source_ref.trim_start_matches('#');
@@ -310,25 +362,35 @@ fn read_geometry(
         } else {
             id
         };
-        let (data, stride, offset, accessor_line) = sources
+        let &(arr, stride, offset, accessor_line) = sources
             .get(id)
             .ok_or_else(|| err(line, format!("no <source id=\"{id}\">")))?;
-        if *stride < 3 {
+        if stride < 3 {
             return Err(err(
                 line,
                 format!("position source `{id}` has stride {stride}"),
             ));
         }
-        if offset.checked_add(3).is_none_or(|end| end > *stride) {
+        if offset.checked_add(3).is_none_or(|end| end > stride) {
             return Err(err(
-                *accessor_line,
+                accessor_line,
                 format!("<accessor> of `{id}`: offset {offset} leaves no room for x, y, z in its stride {stride}"),
             ));
         }
-        Ok(data
-            .chunks_exact(*stride)
-            .map(|c| [c[*offset], c[offset + 1], c[offset + 2]])
-            .collect())
+        // Straight from the text into points: one stride of numbers at a time.
+        let text = arr.text(bytes);
+        let mut out = Vec::new();
+        let mut record = vec![0.0; stride];
+        let mut filled = 0;
+        for x in each_number(arr, &text, path) {
+            record[filled] = x?;
+            filled += 1;
+            if filled == stride {
+                out.push([record[offset], record[offset + 1], record[offset + 2]]);
+                filled = 0;
+            }
+        }
+        Ok(out)
     };
 
     let mut vertices: Vec<[f64; 3]> = Vec::new();
@@ -394,53 +456,57 @@ fn read_geometry(
         match kind {
             "triangles" => {
                 let Some(p) = prim.child("p") else { continue };
-                let idx = numbers(p, path)?;
-                let chunk = stride.checked_mul(3).ok_or_else(|| {
-                    err(
-                        prim.line,
-                        format!("<{kind}> has an <input> offset too large"),
-                    )
-                })?;
-                for tri in idx.chunks_exact(chunk) {
-                    face.clear();
-                    for k in 0..3 {
-                        face.push(index(tri[k * stride + voff], p.line)?);
+                // One triangle's numbers at a time; only each corner's VERTEX index is kept, and a
+                // trailing incomplete triangle is ignored.
+                let text = p.text(bytes);
+                let mut corner = [0.0; 3];
+                let mut at = 0usize;
+                for x in each_number(p, &text, path) {
+                    let x = x?;
+                    if at % stride == voff {
+                        corner[at / stride] = x;
                     }
-                    faces.push(&face);
+                    at += 1;
+                    if at == 3 * stride {
+                        at = 0;
+                        face.clear();
+                        for c in corner {
+                            face.push(index(c, p.line)?);
+                        }
+                        faces.push(&face);
+                    }
                 }
             }
             "polylist" => {
                 let Some(p) = prim.child("p") else { continue };
-                let idx = numbers(p, path)?;
                 let vcount = prim
                     .child("vcount")
-                    .map(|v| numbers(v, path))
+                    .map(|v| numbers(v, bytes, path))
                     .transpose()?
                     .unwrap_or_default();
-                let mut at = 0usize;
                 let more = || {
                     err(
                         p.line,
                         "<polylist> <vcount> asks for more indices than <p> holds".into(),
                     )
                 };
+                let text = p.text(bytes);
+                let mut idx = each_number(p, &text, path);
                 for n in vcount {
-                    if !(n >= 0.0 && n.fract() == 0.0 && n <= idx.len() as f64) {
-                        return Err(more());
-                    }
-                    let n = n as usize;
-                    let end = at
-                        .checked_add(n)
-                        .and_then(|e| e.checked_mul(stride))
-                        .ok_or_else(more)?;
-                    if end > idx.len() {
+                    if !(n >= 0.0 && n.fract() == 0.0 && n <= text.len() as f64) {
                         return Err(more());
                     }
                     face.clear();
-                    for k in 0..n {
-                        face.push(index(idx[(at + k) * stride + voff], p.line)?);
+                    for _ in 0..n as usize {
+                        let mut vertex = None;
+                        for k in 0..stride {
+                            let x = idx.next().ok_or_else(more)??;
+                            if k == voff {
+                                vertex = Some(x);
+                            }
+                        }
+                        face.push(index(vertex.unwrap_or(-1.0), p.line)?);
                     }
-                    at += n;
                     if face.len() >= 3 {
                         faces.push(&face);
                     }
@@ -452,7 +518,7 @@ fn read_geometry(
                     notes.push("warning: <polygons> with holes (<ph>) skipped".into());
                 }
                 for p in prim.children_named("p") {
-                    let idx = numbers(p, path)?;
+                    let idx = numbers(p, bytes, path)?;
                     face.clear();
                     for chunk in idx.chunks_exact(stride) {
                         face.push(index(chunk[voff], p.line)?);
@@ -512,7 +578,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         let (v, f) = match geom_cache.entry(key) {
             std::collections::hash_map::Entry::Occupied(e) => &*e.into_mut(),
             std::collections::hash_map::Entry::Vacant(e) => {
-                &*e.insert(read_geometry(geom, path, notes)?)
+                &*e.insert(read_geometry(geom, bytes, path, notes)?)
             }
         };
         corners = corners.saturating_add(f.indices.len());
@@ -587,7 +653,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
                         ),
                     ));
                 }
-                let xf = compose(&parent, &node_transform(node, path)?);
+                let xf = compose(&parent, &node_transform(node, bytes, path)?);
                 for c in &node.children {
                     match c.name.as_str() {
                         "instance_geometry" => {
@@ -632,4 +698,60 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit tetrahedron whose `<p>` text is `p` and whose document has `extra` sources.
+    fn tetra(p: &str, extra: &str) -> String {
+        format!(
+            "<COLLADA><library_geometries><geometry id=\"g\"><mesh>\n<source id=\"pos\"><float_array id=\"a\">0 0 0 1 0 0 0 1 0 0 0 1</float_array><technique_common><accessor source=\"#a\" stride=\"3\"/></technique_common></source>{extra}\n<triangles count=\"4\"><input semantic=\"VERTEX\" source=\"#pos\" offset=\"0\"/><p>{p}</p></triangles>\n</mesh></geometry></library_geometries></COLLADA>"
+        )
+    }
+
+    const FACES: &str = "0 2 1 0 1 3 0 3 2 1 2 3";
+
+    #[test]
+    fn text_is_read_in_place_and_joined_across_comments() {
+        let m = parse(tetra(FACES, "").as_bytes(), Path::new("t.dae")).unwrap();
+        assert_eq!(m.vertices.len(), 4);
+        assert_eq!(m.faces.indices, [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]);
+        // XML joins the text around a comment: "1<!-- -->3" is 13 (out of range), "1 <!-- -->3" two.
+        let joined = tetra("0 2 1 0 1<!-- c -->3 0 3 2 1 2 3", "");
+        let e = parse(joined.as_bytes(), Path::new("t.dae")).unwrap_err();
+        assert!(
+            matches!(e.kind, MeshErrorKind::IndexOutOfRange { index: 13, .. }),
+            "{e}"
+        );
+        let spaced = tetra("0 2 1 0 1<!-- c --> <!-- d -->3 0 3 2 1 2 3", "");
+        let m = parse(spaced.as_bytes(), Path::new("t.dae")).unwrap();
+        assert_eq!(m.faces.indices, [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]);
+    }
+
+    /// Sources no VERTEX input names (normals, texture coordinates) are never parsed.
+    #[test]
+    fn unused_sources_are_not_parsed() {
+        let normals = "<source id=\"n\"><float_array id=\"na\">not numbers</float_array></source>";
+        let m = parse(tetra(FACES, normals).as_bytes(), Path::new("t.dae")).unwrap();
+        assert_eq!(m.faces.len(), 4);
+    }
+
+    /// A trailing incomplete triangle is ignored; a bad number anywhere in `<p>` is an error.
+    #[test]
+    fn triangles_stream_their_indices() {
+        let m = parse(
+            tetra(&format!("{FACES} 0 1"), "").as_bytes(),
+            Path::new("t.dae"),
+        )
+        .unwrap();
+        assert_eq!(m.faces.len(), 4);
+        let e = parse(
+            tetra(&format!("{FACES} x"), "").as_bytes(),
+            Path::new("t.dae"),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("`x` is not a number in <p>"), "{e}");
+    }
 }

@@ -15,7 +15,6 @@ use std::path::Path;
 
 /// Parses OBJ text.
 pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
-    let text = String::from_utf8_lossy(bytes);
     let mut vertices: Vec<[f64; 3]> = Vec::new();
     let mut faces = Polygons::new();
     let mut face: Vec<u32> = Vec::new();
@@ -27,7 +26,11 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         |line: usize, msg: String| MeshError::new(path, Some(line), MeshErrorKind::Syntax(msg));
     let mut pending = String::new();
     let mut start_line = 0;
-    for (lineno, raw) in text.lines().enumerate() {
+    // Line by line from the bytes: a stray non-UTF-8 byte (a Latin-1 comment) costs a copy of its
+    // line, not of the file.
+    for (lineno, raw) in bytes.split(|&b| b == b'\n').enumerate() {
+        let raw = String::from_utf8_lossy(raw.strip_suffix(b"\r").unwrap_or(raw));
+        let raw: &str = &raw;
         // Backslash continues a line.
         if let Some(stripped) = raw.strip_suffix('\\') {
             if pending.is_empty() {
@@ -144,5 +147,14 @@ mod tests {
                     .to_string()
             ]
         );
+    }
+
+    /// Lines end with LF or CRLF; a non-UTF-8 byte in a comment does not stop the file.
+    #[test]
+    fn crlf_and_latin1_comments() {
+        let text = b"# caf\xe9\r\nv 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nv 0 0 1\r\nf 1 3 2\r\nf 1 2 4\r\nf 1 4 \\\r\n 3\r\nf 2 3 4";
+        let m = parse(text, Path::new("t.obj")).expect("reads");
+        assert_eq!(m.vertices[3], [0.0, 0.0, 1.0]);
+        assert_eq!(m.faces.indices, [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]);
     }
 }

@@ -1,0 +1,13 @@
+//! The stl reader, then healing and integration of what it reads.
+#![no_main]
+
+#[path = "common.rs"]
+mod common;
+
+use libfuzzer_sys::fuzz_target;
+use std::path::Path;
+
+fuzz_target!(|data: &[u8]| {
+    let path = Path::new("/nonexistent-fuzz-dir/fuzz.stl");
+    common::heal(urdf_inertia::mesh::stl::parse(data, path), path);
+});
