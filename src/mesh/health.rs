@@ -27,7 +27,7 @@
 //! the solid integrated can be from the surface stored). See [`ModelError`] for each term.
 
 use super::{hull, weld, MeshError, MeshErrorKind, RawMesh};
-use crate::mass::integrals::{bounding_box_centre, volume_integrals};
+use crate::mass::integrals::{bounding_box_centre, volume_integrals, VolumeIntegrals};
 use crate::mass::{frobenius, IntegrationOptions, MassProperties, Polygons};
 use rustc_hash::FxHashMap;
 use std::path::Path;
@@ -552,6 +552,9 @@ struct Ladder<'a> {
     warnings: Vec<String>,
     notes: Vec<String>,
     faces_read: usize,
+    /// The integrals of the faces `finish` gets, when a rung already has them (a clean mesh is then
+    /// integrated twice, not three times: once here, once about a second reference point).
+    known: Option<VolumeIntegrals>,
 }
 
 impl Ladder<'_> {
@@ -578,7 +581,10 @@ impl Ladder<'_> {
         model: impl Into<Model>,
         message: impl FnOnce(f64) -> Option<String>,
     ) -> Result<Solid, MeshError> {
-        let unit = unit_props(&vertices, &faces, None);
+        let unit = match self.known.take() {
+            Some(t) => MassProperties::from_integrals(&t, 1.0),
+            None => unit_props(&vertices, &faces, None),
+        };
         check_volume(&vertices, &faces, unit.mass, self.path)?;
         let round_off = round_off(&vertices, &faces, &unit);
         let model = model.into();
@@ -724,6 +730,7 @@ pub fn make_solid_stored_as(
         warnings: mesh.warnings.clone(),
         notes: mesh.notes.clone(),
         faces_read: mesh.faces.len(),
+        known: None,
     };
     let exact = weld::exact(&mesh.vertices, &mesh.faces);
     if exact.dropped > 0 {
@@ -852,6 +859,8 @@ fn consistent_closed(
     } else {
         0.0
     };
+    // The faces are the stored ones, or all of them reversed: their integrals are known.
+    ladder.known = Some(if inverted { t.negated() } else { t });
     ladder.finish(vertices, faces, rung, (model, ModelError::Cracks), |_| None)
 }
 
