@@ -6,12 +6,16 @@
 //! once and each (file, scale) healed and integrated once.
 
 use crate::density::{DensityMap, Spec};
+use crate::diagnostic::{
+    self, Code, CollisionRef, Diagnostic, LinkError, LinkErrorKind, Location, Provenance,
+    RobotError,
+};
 use crate::mass::{mat_vec, primitives, rpy_matrix, validity, MassProperties};
 pub use crate::mesh::cache::MeshCache;
-use crate::mesh::health::{ErrorEstimate, HealthOptions, ModelError, ROUND_OFF_FLOOR};
+use crate::mesh::health::{ErrorEstimate, HealthOptions, ModelError, Solid, ROUND_OFF_FLOOR};
 use crate::overlap::{self, Overlap, PartShape, PlacedPart};
 use crate::urdf::resolve::PackageResolver;
-use crate::urdf::{Geometry, Inertial, Link, Robot};
+use crate::urdf::{Collision, Geometry, Inertial, Link, Robot};
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -46,9 +50,10 @@ pub struct PartReport {
     /// `box 0.1 0.2 0.3`, or the mesh URI.
     pub what: String,
     pub file: Option<PathBuf>,
-    /// "primitive" or the mesh rung's name.
-    pub provenance: String,
-    pub warnings: Vec<String>,
+    /// A primitive, or the mesh rung that produced the solid.
+    pub provenance: Provenance,
+    /// Warnings and notes about this part (mesh health, its reader, its size).
+    pub diagnostics: Vec<Diagnostic>,
     pub faces: usize,
     pub volume: f64,
     pub mass: f64,
@@ -58,8 +63,6 @@ pub struct PartReport {
     pub error_estimate: f64,
     /// What the error estimate is made of (round-off, model error and its source).
     pub error: ErrorEstimate,
-    /// Things worth knowing that need no action (a weld within tolerance, reader notes).
-    pub notes: Vec<String>,
 }
 
 /// A link whose inertial was computed.
@@ -76,7 +79,20 @@ pub struct LinkReport {
     pub overlap: Option<(f64, String, usize)>,
     /// Diagonal of the link's collision geometry's bounding box (link frame), m.
     pub size: f64,
-    pub warnings: Vec<String>,
+    /// Warnings and notes about the link as a whole (overlapping parts, an overridden mass rule).
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl PartReport {
+    /// The warnings (printed always).
+    pub fn warnings(&self) -> impl Iterator<Item = &Diagnostic> {
+        self.diagnostics.iter().filter(|d| d.is_warning())
+    }
+
+    /// The notes (printed with `--verbose`).
+    pub fn notes(&self) -> impl Iterator<Item = &Diagnostic> {
+        self.diagnostics.iter().filter(|d| !d.is_warning())
+    }
 }
 
 impl LinkReport {
@@ -99,14 +115,6 @@ impl LinkReport {
     }
 }
 
-/// A link that could not be computed.
-#[derive(Debug, Clone)]
-pub struct LinkFailure {
-    pub name: String,
-    pub line: usize,
-    pub message: String,
-}
-
 /// Wall time per stage.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Timing {
@@ -114,11 +122,21 @@ pub struct Timing {
     pub integrate: Duration,
 }
 
+impl FillReport {
+    /// Links that failed plus robot-wide errors: nonzero means the run failed.
+    pub fn error_count(&self) -> usize {
+        self.failures.len() + self.robot_errors.len()
+    }
+}
+
 /// Everything `fill`, `diff` and `check` need to report.
 #[derive(Debug, Clone, Default)]
 pub struct FillReport {
     pub links: Vec<LinkReport>,
-    pub failures: Vec<LinkFailure>,
+    /// Links that could not be computed.
+    pub failures: Vec<LinkError>,
+    /// What stopped the robot as a whole (no density for some links, an unreachable `total_mass`).
+    pub robot_errors: Vec<RobotError>,
     /// Links with no collision geometry (left as they are).
     pub without_geometry: usize,
     /// Links not selected (--only/--skip/--missing-only).
@@ -218,18 +236,18 @@ pub fn existing_problems(link: &Link) -> Vec<String> {
     out
 }
 
+/// One collision, resolved and integrated at density 1, in the link frame.
 struct Part {
     collision: usize,
     what: String,
     file: Option<PathBuf>,
     uri: Option<String>,
     unit: MassProperties,
-    provenance: String,
-    warnings: Vec<String>,
+    provenance: Provenance,
+    diagnostics: Vec<Diagnostic>,
     faces: usize,
     error_estimate: f64,
     error: ErrorEstimate,
-    notes: Vec<String>,
     /// The solid in the link frame (for bounding boxes and the overlap estimate).
     placed: PlacedPart,
 }
@@ -261,28 +279,56 @@ fn box_corners(h: [f64; 3]) -> impl Iterator<Item = [f64; 3]> {
     })
 }
 
-fn geometry_part(
-    c: &crate::urdf::Collision,
-    robot: &Robot,
-    resolver: &PackageResolver,
-    cache: &mut MeshCache,
-    opts: &FillOptions,
-) -> Result<Part, String> {
+/// Diagonal of a bounding box.
+fn diagonal(lo: [f64; 3], hi: [f64; 3]) -> f64 {
+    ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
+}
+
+/// Where the link's failures point: the link and one of its collisions.
+fn link_error(link: &Link, c: &Collision, kind: LinkErrorKind) -> LinkError {
+    LinkError {
+        link: link.name.clone(),
+        line: link.line,
+        collision: Some(CollisionRef {
+            index: c.index,
+            line: c.line,
+        }),
+        kind: Box::new(kind),
+    }
+}
+
+/// Where a part's diagnostics point.
+fn part_location(link: &Link, c: &Collision) -> Location {
+    Location {
+        file: None,
+        line: Some(c.line),
+        link: Some(link.name.clone()),
+        collision: Some(c.index),
+    }
+}
+
+/// A primitive collision: exact formulas.
+fn primitive_part(c: &Collision, what: String, unit: MassProperties, shape: PartShape) -> Part {
     let r = rpy_matrix(c.origin.rpy);
     let t = c.origin.xyz;
-    let fmt3 = |v: [f64; 3]| format!("{} {} {}", v[0], v[1], v[2]);
-    let primitive = |unit: MassProperties, what: String, half: [f64; 3], shape: PartShape| Part {
+    let half = match &shape {
+        PartShape::Box(h) => *h,
+        PartShape::Cylinder(radius, half) => [*radius, *radius, *half],
+        PartShape::Capsule(radius, half) => [*radius, *radius, half + radius],
+        PartShape::Sphere(radius) => [*radius; 3],
+        PartShape::Mesh(_) => [0.0; 3],
+    };
+    Part {
         collision: c.index,
         what,
         file: None,
         uri: None,
         unit: unit.transformed(&r, t),
-        provenance: "primitive".into(),
-        warnings: Vec::new(),
+        provenance: Provenance::Primitive,
+        diagnostics: Vec::new(),
         faces: 0,
         error_estimate: PRIMITIVE_ERROR.total(),
         error: PRIMITIVE_ERROR,
-        notes: Vec::new(),
         placed: PlacedPart {
             shape,
             rotation: r,
@@ -291,111 +337,136 @@ fn geometry_part(
             volume: unit.mass,
             locator: None,
         },
-    };
+    }
+}
 
+/// The warning for a mesh so large it was likely exported in millimetres, if it is.
+fn millimetre_slip(solid: &Solid, scale: [f64; 3]) -> Option<String> {
+    let (lo, hi) = solid.vertices.iter().fold(
+        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+        |(lo, hi), p| {
+            (
+                [0, 1, 2].map(|k| lo[k].min(p[k])),
+                [0, 1, 2].map(|k| hi[k].max(p[k])),
+            )
+        },
+    );
+    let extent = diagonal(lo, hi);
+    if extent <= MILLIMETRE_SLIP {
+        return None;
+    }
+    let s = if scale == [1.0; 3] {
+        String::new()
+    } else {
+        format!(" (after scale {} {} {})", scale[0], scale[1], scale[2])
+    };
+    Some(format!(
+        "the mesh is {extent:.1} m across{s}: if it was exported in millimetres, give it scale=\"0.001 0.001 0.001\""
+    ))
+}
+
+/// A mesh collision: resolved, read, healed and integrated (through the cache).
+fn mesh_part(
+    link: &Link,
+    c: &Collision,
+    (filename, scale): (&str, [f64; 3]),
+    ctx: &mut Context<'_>,
+) -> Result<Part, LinkError> {
+    let path = ctx
+        .resolver
+        .resolve(filename, &ctx.robot.path)
+        .map_err(|nf| {
+            let kind = LinkErrorKind::MeshNotFound {
+                uri: nf.uri,
+                searched: nf.searched,
+                hint: nf.hint,
+            };
+            link_error(link, c, kind)
+        })?;
+    let health = HealthOptions {
+        strict: ctx.opts.strict,
+    };
+    let solid = ctx
+        .cache
+        .solid(&path, scale, health)
+        .map_err(|e| link_error(link, c, LinkErrorKind::Mesh(e)))?;
+    let mut diagnostics = diagnostic::mesh_health(&solid);
+    if let Some(m) = millimetre_slip(&solid, scale) {
+        diagnostics.push(Diagnostic::new(Code::MeshTooLarge, m));
+    }
+    for d in &mut diagnostics {
+        d.location = Some(part_location(link, c));
+    }
+    let r = rpy_matrix(c.origin.rpy);
+    let t = c.origin.xyz;
+    Ok(Part {
+        collision: c.index,
+        what: filename.to_string(),
+        file: Some(path),
+        uri: Some(filename.to_string()),
+        unit: solid.unit.transformed(&r, t),
+        provenance: Provenance::Mesh(solid.rung.clone()),
+        diagnostics,
+        faces: solid.faces_read,
+        error_estimate: solid.error_estimate,
+        error: solid.error,
+        placed: PlacedPart {
+            bbox: transformed_bbox(solid.vertices.iter().copied(), &r, t),
+            volume: solid.unit.mass,
+            shape: PartShape::Mesh(solid),
+            rotation: r,
+            translation: t,
+            locator: None,
+        },
+    })
+}
+
+/// One collision as a part, or the link's error.
+fn geometry_part(link: &Link, c: &Collision, ctx: &mut Context<'_>) -> Result<Part, LinkError> {
+    let fmt3 = |v: [f64; 3]| format!("{} {} {}", v[0], v[1], v[2]);
     Ok(match &c.geometry {
         Geometry::Invalid { line, message } => {
-            return Err(format!("collision {} (line {line}): {message}", c.index))
+            let kind = LinkErrorKind::InvalidGeometry {
+                line: *line,
+                message: message.clone(),
+            };
+            return Err(link_error(link, c, kind));
         }
-        Geometry::Box { size } => primitive(
-            primitives::cuboid(*size, 1.0),
+        Geometry::Box { size } => primitive_part(
+            c,
             format!("box {}", fmt3(*size)),
-            size.map(|s| s / 2.0),
+            primitives::cuboid(*size, 1.0),
             PartShape::Box(size.map(|s| s / 2.0)),
         ),
-        Geometry::Cylinder { radius, length } => primitive(
-            primitives::cylinder(*radius, *length, 1.0),
+        Geometry::Cylinder { radius, length } => primitive_part(
+            c,
             format!("cylinder r={radius} l={length}"),
-            [*radius, *radius, length / 2.0],
+            primitives::cylinder(*radius, *length, 1.0),
             PartShape::Cylinder(*radius, length / 2.0),
         ),
-        Geometry::Capsule { radius, length } => primitive(
-            primitives::capsule(*radius, *length, 1.0),
+        Geometry::Capsule { radius, length } => primitive_part(
+            c,
             format!("capsule r={radius} l={length}"),
-            [*radius, *radius, length / 2.0 + radius],
+            primitives::capsule(*radius, *length, 1.0),
             PartShape::Capsule(*radius, length / 2.0),
         ),
-        Geometry::Sphere { radius } => primitive(
-            primitives::sphere(*radius, 1.0),
+        Geometry::Sphere { radius } => primitive_part(
+            c,
             format!("sphere r={radius}"),
-            [*radius; 3],
+            primitives::sphere(*radius, 1.0),
             PartShape::Sphere(*radius),
         ),
-        Geometry::Mesh { filename, scale } => {
-            let path = resolver.resolve(filename, &robot.path).map_err(|nf| {
-                let searched: Vec<String> = nf
-                    .searched
-                    .iter()
-                    .map(|p| format!("    {}", p.display()))
-                    .collect();
-                format!(
-                    "collision {} (line {}): mesh `{}` not found; searched:\n{}\n  {}",
-                    c.index,
-                    c.line,
-                    nf.uri,
-                    if searched.is_empty() {
-                        "    (nothing)".to_string()
-                    } else {
-                        searched.join("\n")
-                    },
-                    nf.hint
-                )
-            })?;
-            let solid = cache
-                .solid(
-                    &path,
-                    *scale,
-                    HealthOptions {
-                        strict: opts.strict,
-                    },
-                )
-                .map_err(|e| format!("collision {} (line {}): {e}", c.index, c.line))?;
-            let mut warnings = solid.warnings.clone();
-            let (lo, hi) = solid.vertices.iter().fold(
-                ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
-                |(lo, hi), p| {
-                    (
-                        [0, 1, 2].map(|k| lo[k].min(p[k])),
-                        [0, 1, 2].map(|k| hi[k].max(p[k])),
-                    )
-                },
-            );
-            let extent =
-                ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2))
-                    .sqrt();
-            if extent > MILLIMETRE_SLIP {
-                let s = if *scale == [1.0; 3] {
-                    String::new()
-                } else {
-                    format!(" (after scale {} {} {})", scale[0], scale[1], scale[2])
-                };
-                warnings.push(format!(
-                    "the mesh is {extent:.1} m across{s}: if it was exported in millimetres, give it scale=\"0.001 0.001 0.001\""
-                ));
-            }
-            Part {
-                collision: c.index,
-                what: filename.clone(),
-                file: Some(path),
-                uri: Some(filename.clone()),
-                unit: solid.unit.transformed(&r, t),
-                provenance: solid.rung.name().into(),
-                warnings,
-                faces: solid.faces_read,
-                error_estimate: solid.error_estimate,
-                error: solid.error,
-                notes: solid.notes.clone(),
-                placed: PlacedPart {
-                    shape: PartShape::Mesh(solid.clone()),
-                    rotation: r,
-                    translation: t,
-                    bbox: transformed_bbox(solid.vertices.iter().copied(), &r, t),
-                    volume: solid.unit.mass,
-                    locator: None,
-                },
-            }
-        }
+        Geometry::Mesh { filename, scale } => mesh_part(link, c, (filename, *scale), ctx)?,
     })
+}
+
+/// What every stage of a robot's computation reads.
+struct Context<'a> {
+    robot: &'a Robot,
+    map: &'a DensityMap,
+    resolver: &'a PackageResolver,
+    opts: &'a FillOptions,
+    cache: &'a mut MeshCache,
 }
 
 /// Computes every selected link with collision geometry.
@@ -410,6 +481,9 @@ pub fn compute(
 
 /// [`compute`] with a mesh cache shared across calls (several URDFs of one robot, or a whole corpus).
 /// The report's timing and file counts are this call's share.
+///
+/// The stages: preload the meshes → each link's parts → their densities → the link's body → the
+/// overlap estimate → `total_mass` scaling → the overflow backstop.
 pub fn compute_with(
     robot: &Robot,
     map: &DensityMap,
@@ -418,27 +492,14 @@ pub fn compute_with(
     cache: &mut MeshCache,
 ) -> FillReport {
     let (load0, integrate0, files0) = (cache.load_time, cache.integrate_time, cache.files());
-    // Every mesh the selected links need, read and healed in parallel up front (a path that does not
-    // resolve is reported by the per-link pass below).
-    let wanted: Vec<(PathBuf, [f64; 3])> = robot
-        .links
-        .iter()
-        .filter(|l| l.has_collision_geometry() && is_target(l, opts))
-        .flat_map(|l| l.collisions.iter())
-        .filter_map(|c| match &c.geometry {
-            Geometry::Mesh { filename, scale } => resolver
-                .resolve(filename, &robot.path)
-                .ok()
-                .map(|p| (p, *scale)),
-            _ => None,
-        })
-        .collect();
-    cache.preload(
-        &wanted,
-        HealthOptions {
-            strict: opts.strict,
-        },
-    );
+    let mut ctx = Context {
+        robot,
+        map,
+        resolver,
+        opts,
+        cache,
+    };
+    preload(&mut ctx);
     let mut report = FillReport::default();
     let mut missing_density: Vec<(String, usize)> = Vec::new();
     // Links whose mass follows from densities (scaled by total_mass), as indices into report.links.
@@ -454,208 +515,287 @@ pub fn compute_with(
             report.not_selected += 1;
             continue;
         }
-        let mut parts = Vec::new();
-        let mut failed = None;
-        for c in link
-            .collisions
-            .iter()
-            .filter(|c| !c.geometry.is_zero_size())
-        {
-            match geometry_part(c, robot, resolver, cache, opts) {
-                Ok(p) => parts.push(p),
-                Err(m) => {
-                    failed = Some(m);
-                    break;
+        match compute_link(li, link, &mut ctx) {
+            Ok(Some((l, density_based))) => {
+                if density_based {
+                    density_links.push(report.links.len());
                 }
+                report.faces += l.faces;
+                report.links.push(l.report);
             }
+            Ok(None) => missing_density.push((link.name.clone(), link.line)),
+            Err(e) => report.failures.push(e),
         }
-        if let Some(message) = failed {
-            report.failures.push(LinkFailure {
-                name: link.name.clone(),
-                line: link.line,
-                message,
-            });
-            continue;
-        }
-        // Densities: a part's own [meshes] rule, else the link's rule (keep-mass, [links], default).
-        let own: Vec<Option<(String, Spec)>> = parts
-            .iter()
-            .map(|p| {
-                p.uri
-                    .as_deref()
-                    .and_then(|u| map.mesh_rule(u))
-                    .map(|(k, s)| (format!("[meshes] \"{k}\""), s))
-            })
-            .collect();
-        let kept = if opts.keep_mass {
-            link.inertial
-                .as_ref()
-                .and_then(|s| s.value.mass)
-                .filter(|m| *m > 0.0 && m.is_finite())
-        } else {
-            None
-        };
-        let link_spec: Option<(String, Spec)> = match kept {
-            Some(m) => Some(("existing <mass> (--keep-mass)".into(), Spec::Mass(m))),
-            None => map
-                .link_rule(&link.name)
-                .map(|(k, s)| (format!("[links] \"{k}\""), s))
-                .or_else(|| map.default.map(|d| ("default".into(), Spec::Density(d)))),
-        };
-        let others_need = own.iter().any(|o| o.is_none());
-        let link_spec = match link_spec {
-            Some(s) => Some(s),
-            None if others_need => {
-                missing_density.push((link.name.clone(), link.line));
-                continue;
-            }
-            None => None,
-        };
-        let mut warnings = Vec::new();
-        let own_mass: f64 = parts
-            .iter()
-            .zip(&own)
-            .map(|(p, o)| match o {
-                Some((_, Spec::Density(d))) => p.unit.mass * d,
-                Some((_, Spec::Mass(m))) => *m,
-                None => 0.0,
-            })
-            .sum();
-        let other_volume: f64 = parts
-            .iter()
-            .zip(&own)
-            .filter(|(_, o)| o.is_none())
-            .map(|(p, _)| p.unit.mass)
-            .sum();
-        let shared_density = match &link_spec {
-            Some((_, Spec::Density(d))) => *d,
-            Some((src, Spec::Mass(m))) => {
-                if other_volume > 0.0 {
-                    let d = (m - own_mass) / other_volume;
-                    if d.is_nan() || d <= 0.0 {
-                        report.failures.push(LinkFailure {
-                            name: link.name.clone(),
-                            line: link.line,
-                            message: format!("{src} gives the link {m} kg, but its parts with their own [meshes] rule already weigh {own_mass} kg"),
-                        });
-                        continue;
-                    }
-                    d
-                } else {
-                    if (m - own_mass).abs() > 1e-9 * m {
-                        warnings.push(format!("{src} asks for {m} kg, but every part has its own rule ({own_mass} kg); the parts' rules win"));
-                    }
-                    0.0
-                }
-            }
-            None => 0.0,
-        };
-        let mut part_reports = Vec::new();
-        let mut bodies = Vec::new();
-        for (p, o) in parts.iter().zip(&own) {
-            let (density, source) = match o {
-                Some((src, Spec::Density(d))) => (*d, src.clone()),
-                Some((src, Spec::Mass(m))) => (m / p.unit.mass, src.clone()),
-                None => (
-                    shared_density,
-                    link_spec.as_ref().map(|l| l.0.clone()).unwrap_or_default(),
-                ),
-            };
-            let body = p.unit.scaled(density);
-            bodies.push(body);
-            part_reports.push(PartReport {
-                collision: p.collision,
-                what: p.what.clone(),
-                file: p.file.clone(),
-                provenance: p.provenance.clone(),
-                warnings: p.warnings.clone(),
-                faces: p.faces,
-                volume: p.unit.mass,
-                mass: body.mass,
-                density,
-                density_source: source,
-                error_estimate: p.error_estimate,
-                error: p.error,
-                notes: p.notes.clone(),
-            });
-        }
-        let computed: MassProperties = bodies.into_iter().sum();
-        let (lo, hi) = parts.iter().fold(
-            ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
-            |(lo, hi), p| {
-                (
-                    [0, 1, 2].map(|k| lo[k].min(p.placed.bbox.0[k])),
-                    [0, 1, 2].map(|k| hi[k].max(p.placed.bbox.1[k])),
-                )
-            },
-        );
-        let size =
-            ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
-        let (overlap, message) = overlap_estimate(&mut parts);
-        warnings.extend(message);
-        if matches!(link_spec, Some((_, Spec::Density(_)))) && own.iter().all(|o| o.is_none()) {
-            density_links.push(report.links.len());
-        }
-        report.faces += parts.iter().map(|p| p.faces).sum::<usize>();
-        report.links.push(LinkReport {
-            index: li,
-            name: link.name.clone(),
-            line: link.line,
-            computed,
-            parts: part_reports,
-            overlap,
-            size,
-            warnings,
-        });
     }
     if !missing_density.is_empty() {
-        let list: Vec<String> = missing_density
-            .iter()
-            .map(|(n, l)| format!("`{n}` (line {l})"))
-            .collect();
-        report.failures.push(LinkFailure {
-            name: String::new(),
-            line: missing_density[0].1,
-            message: format!(
-                "no density for {} link(s) with collision geometry: {}; give --density RHO, a `default` in the density map, or a [links] rule",
-                missing_density.len(),
-                list.join(", ")
-            ),
+        report.robot_errors.push(RobotError::MissingDensity {
+            links: missing_density,
         });
     }
     if let Some(total) = map.total_mass {
-        let variable: f64 = density_links
-            .iter()
-            .map(|&i| report.links[i].computed.mass)
-            .sum();
-        let fixed: f64 = report.links.iter().map(|l| l.computed.mass).sum::<f64>() - variable;
-        if variable > 0.0 && total > fixed {
-            let factor = (total - fixed) / variable;
-            for &i in &density_links {
-                let l = &mut report.links[i];
-                l.computed = l.computed.scaled(factor);
-                for p in l.parts.iter_mut() {
-                    p.mass *= factor;
-                    p.density *= factor;
-                    p.density_source =
-                        format!("{} × {factor:.6} (total_mass {total} kg)", p.density_source);
-                }
-            }
-        } else {
-            report.failures.push(LinkFailure {
-                name: String::new(),
-                line: 0,
-                message: format!("total_mass {total} kg cannot be met: links with fixed masses already weigh {fixed} kg and density-based links {variable} kg"),
-            });
-        }
+        scale_to_total_mass(&mut report, &density_links, total);
     }
     reject_unrepresentable(&mut report);
-    report.mesh_files = cache.files() - files0;
+    report.mesh_files = ctx.cache.files() - files0;
     report.timing = Timing {
-        load: cache.load_time - load0,
-        integrate: cache.integrate_time - integrate0,
+        load: ctx.cache.load_time - load0,
+        integrate: ctx.cache.integrate_time - integrate0,
     };
     report
+}
+
+/// Every mesh the selected links need, read and healed in parallel up front (a path that does not
+/// resolve is reported by the per-link pass).
+fn preload(ctx: &mut Context<'_>) {
+    let wanted: Vec<(PathBuf, [f64; 3])> = ctx
+        .robot
+        .links
+        .iter()
+        .filter(|l| l.has_collision_geometry() && is_target(l, ctx.opts))
+        .flat_map(|l| l.collisions.iter())
+        .filter_map(|c| match &c.geometry {
+            Geometry::Mesh { filename, scale } => ctx
+                .resolver
+                .resolve(filename, &ctx.robot.path)
+                .ok()
+                .map(|p| (p, *scale)),
+            _ => None,
+        })
+        .collect();
+    ctx.cache.preload(
+        &wanted,
+        HealthOptions {
+            strict: ctx.opts.strict,
+        },
+    );
+}
+
+/// A computed link and its face count.
+struct ComputedLink {
+    report: LinkReport,
+    faces: usize,
+}
+
+/// One link: its parts, their densities, the body, the overlap estimate. `Ok(None)` when the link has
+/// no density from anywhere (reported for all such links at once); the flag says whether the link's
+/// mass follows from densities alone (what `total_mass` scales).
+fn compute_link(
+    index: usize,
+    link: &Link,
+    ctx: &mut Context<'_>,
+) -> Result<Option<(ComputedLink, bool)>, LinkError> {
+    let mut parts = link
+        .collisions
+        .iter()
+        .filter(|c| !c.geometry.is_zero_size())
+        .map(|c| geometry_part(link, c, ctx))
+        .collect::<Result<Vec<Part>, LinkError>>()?;
+    let Some(densities) = densities(link, &parts, ctx.map, ctx.opts)? else {
+        return Ok(None);
+    };
+    let (computed, part_reports) = body(&parts, &densities);
+    let size = parts.iter().fold(
+        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+        |(lo, hi), p| {
+            (
+                [0, 1, 2].map(|k| lo[k].min(p.placed.bbox.0[k])),
+                [0, 1, 2].map(|k| hi[k].max(p.placed.bbox.1[k])),
+            )
+        },
+    );
+    let size = diagonal(size.0, size.1);
+    let mut diagnostics = densities.diagnostics;
+    let (overlap, message) = overlap_estimate(&mut parts);
+    if let Some(message) = message {
+        diagnostics.push(Diagnostic::new(Code::PartsOverlap, message));
+    }
+    for d in &mut diagnostics {
+        d.location = Some(Location {
+            line: Some(link.line),
+            link: Some(link.name.clone()),
+            ..Location::default()
+        });
+    }
+    let density_based = matches!(densities.link_spec, Some((_, Spec::Density(_))))
+        && densities.own.iter().all(Option::is_none);
+    let report = LinkReport {
+        index,
+        name: link.name.clone(),
+        line: link.line,
+        computed,
+        parts: part_reports,
+        overlap,
+        size,
+        diagnostics,
+    };
+    let faces = parts.iter().map(|p| p.faces).sum();
+    Ok(Some((ComputedLink { report, faces }, density_based)))
+}
+
+/// A rule and where it came from (`[links] "arm_*"`, `default`, …).
+type Rule = (String, Spec);
+
+/// The densities of a link's parts: each part's own `[meshes]` rule, else the link's rule, and the
+/// density the parts without their own rule share.
+struct Densities {
+    own: Vec<Option<Rule>>,
+    link_spec: Option<Rule>,
+    shared: f64,
+    diagnostics: Vec<Diagnostic>,
+}
+
+/// The link's rule: its kept mass (`--keep-mass`), a `[links]` rule, or the default.
+fn link_rule(link: &Link, map: &DensityMap, opts: &FillOptions) -> Option<Rule> {
+    let kept = if opts.keep_mass {
+        link.inertial
+            .as_ref()
+            .and_then(|s| s.value.mass)
+            .filter(|m| *m > 0.0 && m.is_finite())
+    } else {
+        None
+    };
+    match kept {
+        Some(m) => Some(("existing <mass> (--keep-mass)".into(), Spec::Mass(m))),
+        None => map
+            .link_rule(&link.name)
+            .map(|(k, s)| (format!("[links] \"{k}\""), s))
+            .or_else(|| map.default.map(|d| ("default".into(), Spec::Density(d)))),
+    }
+}
+
+/// Densities for a link's parts; `Ok(None)` when a part needs the link's rule and there is none.
+fn densities(
+    link: &Link,
+    parts: &[Part],
+    map: &DensityMap,
+    opts: &FillOptions,
+) -> Result<Option<Densities>, LinkError> {
+    let own: Vec<Option<Rule>> = parts
+        .iter()
+        .map(|p| {
+            p.uri
+                .as_deref()
+                .and_then(|u| map.mesh_rule(u))
+                .map(|(k, s)| (format!("[meshes] \"{k}\""), s))
+        })
+        .collect();
+    let link_spec = link_rule(link, map, opts);
+    if link_spec.is_none() && own.iter().any(Option::is_none) {
+        return Ok(None);
+    }
+    let own_mass: f64 = parts
+        .iter()
+        .zip(&own)
+        .map(|(p, o)| match o {
+            Some((_, Spec::Density(d))) => p.unit.mass * d,
+            Some((_, Spec::Mass(m))) => *m,
+            None => 0.0,
+        })
+        .sum();
+    let other_volume: f64 = parts
+        .iter()
+        .zip(&own)
+        .filter(|(_, o)| o.is_none())
+        .map(|(p, _)| p.unit.mass)
+        .sum();
+    let mut diagnostics = Vec::new();
+    let shared = match &link_spec {
+        Some((_, Spec::Density(d))) => *d,
+        Some((source, Spec::Mass(m))) if other_volume > 0.0 => {
+            let d = (m - own_mass) / other_volume;
+            if d.is_nan() || d <= 0.0 {
+                let kind = LinkErrorKind::MassTarget {
+                    source: source.clone(),
+                    mass: *m,
+                    own_mass,
+                };
+                return Err(LinkError {
+                    link: link.name.clone(),
+                    line: link.line,
+                    collision: None,
+                    kind: Box::new(kind),
+                });
+            }
+            d
+        }
+        Some((source, Spec::Mass(m))) => {
+            if (m - own_mass).abs() > 1e-9 * m {
+                diagnostics.push(Diagnostic::new(Code::DensityRuleOverridden, format!("{source} asks for {m} kg, but every part has its own rule ({own_mass} kg); the parts' rules win")));
+            }
+            0.0
+        }
+        None => 0.0,
+    };
+    Ok(Some(Densities {
+        own,
+        link_spec,
+        shared,
+        diagnostics,
+    }))
+}
+
+/// The link's body (the parts at their densities, summed) and each part's report.
+fn body(parts: &[Part], d: &Densities) -> (MassProperties, Vec<PartReport>) {
+    let mut reports = Vec::new();
+    let mut bodies = Vec::new();
+    for (p, o) in parts.iter().zip(&d.own) {
+        let (density, source) = match o {
+            Some((src, Spec::Density(rho))) => (*rho, src.clone()),
+            Some((src, Spec::Mass(m))) => (m / p.unit.mass, src.clone()),
+            None => (
+                d.shared,
+                d.link_spec
+                    .as_ref()
+                    .map(|l| l.0.clone())
+                    .unwrap_or_default(),
+            ),
+        };
+        let body = p.unit.scaled(density);
+        bodies.push(body);
+        reports.push(PartReport {
+            collision: p.collision,
+            what: p.what.clone(),
+            file: p.file.clone(),
+            provenance: p.provenance.clone(),
+            diagnostics: p.diagnostics.clone(),
+            faces: p.faces,
+            volume: p.unit.mass,
+            mass: body.mass,
+            density,
+            density_source: source,
+            error_estimate: p.error_estimate,
+            error: p.error,
+        });
+    }
+    (bodies.into_iter().sum(), reports)
+}
+
+/// Scales the density-based links so that the filled links weigh `total` kg, or reports why not.
+fn scale_to_total_mass(report: &mut FillReport, density_links: &[usize], total: f64) {
+    let variable: f64 = density_links
+        .iter()
+        .map(|&i| report.links[i].computed.mass)
+        .sum();
+    let fixed: f64 = report.links.iter().map(|l| l.computed.mass).sum::<f64>() - variable;
+    if !(variable > 0.0 && total > fixed) {
+        report.robot_errors.push(RobotError::TotalMass {
+            total,
+            fixed,
+            variable,
+        });
+        return;
+    }
+    let factor = (total - fixed) / variable;
+    for &i in density_links {
+        let l = &mut report.links[i];
+        l.computed = l.computed.scaled(factor);
+        for p in &mut l.parts {
+            p.mass *= factor;
+            p.density *= factor;
+            p.density_source =
+                format!("{} × {factor:.6} (total_mass {total} kg)", p.density_source);
+        }
+    }
 }
 
 /// Why computed mass properties cannot be written, if they cannot: every check of
@@ -700,10 +840,11 @@ fn reject_unrepresentable(report: &mut FillReport) {
     for l in links {
         match unrepresentable(&l.computed) {
             None => report.links.push(l),
-            Some(message) => report.failures.push(LinkFailure {
-                name: l.name,
+            Some(message) => report.failures.push(LinkError {
+                link: l.name,
                 line: l.line,
-                message,
+                collision: None,
+                kind: Box::new(LinkErrorKind::Unrepresentable(message)),
             }),
         }
     }
@@ -749,10 +890,4 @@ fn overlap_estimate(parts: &mut [Part]) -> (Option<(f64, String, usize)>, Option
         100.0 * v / total
     );
     (Some((v, which, n)), Some(message))
-}
-
-/// Whether a mesh rung is below "exact".
-pub fn repaired(provenance: &str) -> bool {
-    // A welded mesh is integrated as stored: not a repair.
-    provenance != "exact" && provenance != "welded" && provenance != "primitive"
 }

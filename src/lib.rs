@@ -7,6 +7,7 @@
 #![forbid(unsafe_code)]
 
 pub mod density;
+pub mod diagnostic;
 pub mod fill;
 pub mod input;
 pub mod mass;

@@ -263,7 +263,8 @@ fn zero_size_primitives_contribute_nothing() {
 </robot>
 ";
     let urdf = write(tmp.path(), "zero.urdf", text);
-    let out = run(&["fill", s(&urdf), "--density", "1000"]);
+    // Zero-size parts are notes (UI203): printed with --verbose.
+    let out = run(&["fill", s(&urdf), "--density", "1000", "--verbose"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(
@@ -476,7 +477,7 @@ fn xacro_files_get_one_note() {
     assert!(out.status.success(), "{stderr}");
     assert_eq!(stderr.matches("run `xacro").count(), 1, "{stderr}");
     assert!(
-        stderr.contains("note: ")
+        stderr.contains("warning: ")
             && stderr.contains("arm.urdf.xacro:2: this file uses xacro")
             && stderr.contains("links inside xacro macros are not seen"),
         "{stderr}"
@@ -487,7 +488,10 @@ fn xacro_files_get_one_note() {
         "expanded.urdf",
         "<robot name=\"arm\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">\n  <link name=\"base\"><collision><geometry><box size=\"1 1 1\"/></geometry></collision></link>\n</robot>\n",
     );
+    // A note (UI205): printed with --verbose only.
     let out = run(&["fill", s(&urdf), "--density", "1000"]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("xacro"));
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-v"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert_eq!(stderr.matches("run `xacro").count(), 1, "{stderr}");

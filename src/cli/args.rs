@@ -92,6 +92,10 @@ pub struct FillArgs {
     /// Summary format on stdout when the URDF is not written there (-o or -i).
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
+    /// Also print notes (things that need no action: a mesh welded within tolerance, a zero-size
+    /// part); warnings are printed always, and JSON carries both.
+    #[arg(short, long)]
+    pub verbose: bool,
 }
 
 #[derive(Debug, Clone, ClapArgs)]
@@ -106,6 +110,10 @@ pub struct DiffArgs {
     pub tolerance: f64,
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
+    /// Also print notes (things that need no action: a mesh welded within tolerance, a zero-size
+    /// part); warnings are printed always, and JSON carries both.
+    #[arg(short, long)]
+    pub verbose: bool,
 }
 
 #[derive(Debug, Clone, ClapArgs)]
@@ -122,6 +130,10 @@ pub struct CheckArgs {
     /// frames), which fill cannot compute; by default they are reported as notes only.
     #[arg(long)]
     pub all_links: bool,
+    /// Also print notes (things that need no action: a mesh welded within tolerance, a zero-size
+    /// part); warnings are printed always, and JSON carries both.
+    #[arg(short, long)]
+    pub verbose: bool,
 }
 
 #[derive(Debug, Clone, ClapArgs)]

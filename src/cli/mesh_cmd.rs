@@ -74,6 +74,7 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         axes: pr.axes,
     };
     let elapsed = start.elapsed();
+    let diagnostics = urdf_inertia::diagnostic::mesh_health(&solid);
     match args.format {
         Format::Json => {
             let axes: Vec<Vec<f64>> = (0..3)
@@ -98,8 +99,8 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
                 "error_model": solid.error.model,
                 "error_model_source": solid.error.source.name(),
                 "error_center_of_mass": solid.error.com,
-                "warnings": solid.warnings,
-                "notes": solid.notes,
+                "warnings": diagnostics.iter().filter(|d| d.is_warning()).collect::<Vec<_>>(),
+                "notes": diagnostics.iter().filter(|d| !d.is_warning()).collect::<Vec<_>>(),
             });
             outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
         }

@@ -16,6 +16,7 @@ mod compare;
 mod mesh_cmd;
 pub mod output;
 mod robot_cmd;
+mod summary;
 pub mod write;
 
 use clap::Parser;

@@ -12,7 +12,4 @@ pub mod resolve;
 pub mod scan;
 pub mod write;
 
-pub use scan::{
-    scan, scan_bytes, Collision, Geometry, Inertial, Link, NoteLevel, Pose, Robot, ScanNote,
-    UrdfError,
-};
+pub use scan::{scan, scan_bytes, Collision, Geometry, Inertial, Link, Pose, Robot, UrdfError};

@@ -8,6 +8,7 @@
 //! [`Geometry::Invalid`], the link's failure, not the file's; malformed XML and duplicate link names
 //! are the file's.
 
+use crate::diagnostic::{Code, Diagnostic, Location};
 use crate::mass::primitives;
 use crate::text::LineCounter;
 use quick_xml::events::attributes::AttrError;
@@ -133,49 +134,6 @@ impl Link {
     }
 }
 
-/// How much a scan note matters.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum NoteLevel {
-    /// Something urdfdom reads differently from what the file seems to say (an ignored duplicate).
-    Warning,
-    /// Information (a zero-size part, xacro in the file).
-    Note,
-}
-
-/// Something the scan noticed that does not stop the robot from being read.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ScanNote {
-    pub level: NoteLevel,
-    pub line: usize,
-    /// The link, if the note is about one.
-    pub link: Option<String>,
-    pub message: String,
-}
-
-impl ScanNote {
-    /// `warning: PATH:LINE: link `NAME`: MESSAGE`.
-    pub fn render(&self, path: &Path) -> String {
-        let level = match self.level {
-            NoteLevel::Warning => "warning",
-            NoteLevel::Note => "note",
-        };
-        match &self.link {
-            Some(l) => format!(
-                "{level}: {}:{}: link `{l}`: {}",
-                path.display(),
-                self.line,
-                self.message
-            ),
-            None => format!(
-                "{level}: {}:{}: {}",
-                path.display(),
-                self.line,
-                self.message
-            ),
-        }
-    }
-}
-
 /// A scanned URDF.
 #[derive(Debug, Clone)]
 pub struct Robot {
@@ -188,8 +146,8 @@ pub struct Robot {
     pub newline: &'static str,
     /// The file's encoding, to write it back in.
     pub encoding: SourceEncoding,
-    /// Warnings and notes, in file order.
-    pub notes: Vec<ScanNote>,
+    /// Warnings and notes, in file order, located in this file.
+    pub notes: Vec<Diagnostic>,
 }
 
 /// Why a URDF cannot be read.
@@ -319,13 +277,24 @@ struct InertialInProgress {
     seen: HashMap<String, usize>,
 }
 
-fn warning(line: usize, link: &Option<Link>, message: String) -> ScanNote {
-    ScanNote {
-        level: NoteLevel::Warning,
+/// A diagnostic of the scan at `line`, about `link` if any (the file is added when the scan ends).
+fn diagnostic(code: Code, line: usize, link: Option<&str>, message: String) -> Diagnostic {
+    Diagnostic::new(code, message).at(Location {
+        file: None,
+        line: Some(line),
+        link: link.map(str::to_string),
+        collision: None,
+    })
+}
+
+/// An element urdfdom ignores, in the link being read.
+fn warning(line: usize, link: &Option<Link>, message: String) -> Diagnostic {
+    diagnostic(
+        Code::UrdfIgnoredElement,
         line,
-        link: link.as_ref().map(|l| l.name.clone()),
+        link.as_ref().map(|l| l.name.as_str()),
         message,
-    }
+    )
 }
 
 /// Scans URDF text. `path` is used in messages and for resolving relative mesh paths.
@@ -355,7 +324,7 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
     let mut collision: Option<CollisionInProgress> = None;
     let mut inertial: Option<InertialInProgress> = None;
     let mut seen: HashMap<String, usize> = HashMap::new();
-    let mut notes: Vec<ScanNote> = Vec::new();
+    let mut notes: Vec<Diagnostic> = Vec::new();
     // Line of the first sign of xacro (xmlns:xacro on the root, a <xacro:…> element).
     let mut xacro: Option<usize> = None;
     // Line of the root if it declares xmlns:xacro (xacro's own output keeps the declaration).
@@ -556,20 +525,20 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
         ));
     }
     let xacro_note = match (xacro, xacro_namespace) {
-        (Some(line), _) => Some((line, "this file uses xacro (<xacro:…> elements): links inside xacro macros are not seen and ${…} expressions are not expanded; run `xacro FILE.urdf.xacro > FILE.urdf` first and give urdf-inertia the result")),
+        (Some(line), _) => Some((Code::UrdfXacro, line, "this file uses xacro (<xacro:…> elements): links inside xacro macros are not seen and ${…} expressions are not expanded; run `xacro FILE.urdf.xacro > FILE.urdf` first and give urdf-inertia the result")),
         // xacro's output keeps the declaration, so most expanded URDFs have it: a softer note.
-        (None, Some(line)) => Some((line, "the root declares xmlns:xacro: if this is a xacro source rather than xacro's output, links inside its macros are not seen; run `xacro FILE.urdf.xacro > FILE.urdf` first")),
+        (None, Some(line)) => Some((Code::UrdfXacroNamespace, line, "the root declares xmlns:xacro: if this is a xacro source rather than xacro's output, links inside its macros are not seen; run `xacro FILE.urdf.xacro > FILE.urdf` first")),
         (None, None) => None,
     };
-    if let Some((line, message)) = xacro_note {
-        notes.push(ScanNote {
-            level: NoteLevel::Note,
-            line,
-            link: None,
-            message: message.into(),
-        });
+    if let Some((code, line, message)) = xacro_note {
+        notes.push(diagnostic(code, line, None, message.into()));
     }
-    notes.sort_by_key(|n| n.line);
+    notes.sort_by_key(Diagnostic::line);
+    for n in &mut notes {
+        if let Some(l) = n.location.as_mut() {
+            l.file = Some(path.to_path_buf());
+        }
+    }
     let newline = if text.contains("\r\n") { "\r\n" } else { "\n" };
     Ok(Robot {
         path: path.to_path_buf(),
@@ -600,17 +569,14 @@ pub fn describe(g: &Geometry) -> String {
 }
 
 /// Ends a link: notes for its zero-size parts, then into the list.
-fn finish_link(link: Link, links: &mut Vec<Link>, notes: &mut Vec<ScanNote>) {
+fn finish_link(link: Link, links: &mut Vec<Link>, notes: &mut Vec<Diagnostic>) {
     let zero: Vec<&Collision> = link
         .collisions
         .iter()
         .filter(|c| c.geometry.is_zero_size())
         .collect();
-    let note = |line: usize, message: String| ScanNote {
-        level: NoteLevel::Note,
-        line,
-        link: Some(link.name.clone()),
-        message,
+    let note = |line: usize, message: String| {
+        diagnostic(Code::UrdfZeroVolume, line, Some(&link.name), message)
     };
     if !zero.is_empty() && !link.has_collision_geometry() {
         let parts: Vec<String> = zero
@@ -638,7 +604,7 @@ fn finish_link(link: Link, links: &mut Vec<Link>, notes: &mut Vec<ScanNote>) {
 fn finish_collision(
     collision: Option<CollisionInProgress>,
     current: &mut Option<Link>,
-    notes: &mut Vec<ScanNote>,
+    notes: &mut Vec<Diagnostic>,
 ) {
     let (Some(c), Some(link)) = (collision, current.as_mut()) else {
         return;
@@ -652,14 +618,12 @@ fn finish_collision(
             } else {
                 "has an empty <geometry>"
             };
-            notes.push(ScanNote {
-                level: NoteLevel::Warning,
-                line: c.line,
-                link: Some(link.name.clone()),
-                message: format!(
-                    "a collision {what}: it is ignored (urdfdom refuses such a collision)"
-                ),
-            });
+            notes.push(diagnostic(
+                Code::UrdfEmptyCollision,
+                c.line,
+                Some(&link.name),
+                format!("a collision {what}: it is ignored (urdfdom refuses such a collision)"),
+            ));
             return;
         }
     };
@@ -673,7 +637,7 @@ fn finish_collision(
 }
 
 /// Ends an `<inertial>`: the first is the link's, later ones are kept only to be removed by `fill`.
-fn finish_inertial(i: InertialInProgress, current: &mut Option<Link>, notes: &mut Vec<ScanNote>) {
+fn finish_inertial(i: InertialInProgress, current: &mut Option<Link>, notes: &mut Vec<Diagnostic>) {
     let Some(link) = current.as_mut() else {
         return;
     };
@@ -681,12 +645,12 @@ fn finish_inertial(i: InertialInProgress, current: &mut Option<Link>, notes: &mu
         link.inertial = Some(i.span);
     } else {
         let first = link.inertial.as_ref().map(|s| s.line).unwrap_or(link.line);
-        notes.push(ScanNote {
-            level: NoteLevel::Warning,
-            line: i.span.line,
-            link: Some(link.name.clone()),
-            message: format!("a second <inertial> is ignored (urdfdom reads the first, on line {first}); `fill` replaces them all with one"),
-        });
+        notes.push(diagnostic(
+            Code::UrdfIgnoredElement,
+            i.span.line,
+            Some(&link.name),
+            format!("a second <inertial> is ignored (urdfdom reads the first, on line {first}); `fill` replaces them all with one"),
+        ));
         link.extra_inertials.push(i.span);
     }
 }
@@ -953,7 +917,7 @@ mod tests {
         let notes: Vec<(usize, &str)> = r
             .notes
             .iter()
-            .map(|n| (n.line, n.message.as_str()))
+            .map(|n| (n.line().unwrap_or(0), n.message.as_str()))
             .collect();
         let has =
             |line: usize, what: &str| notes.iter().any(|(l, m)| *l == line && m.contains(what));
@@ -984,7 +948,7 @@ mod tests {
         assert!(r
             .notes
             .iter()
-            .all(|n| n.level == NoteLevel::Warning && n.link.as_deref() == Some("a")));
+            .all(|n| n.code == Code::UrdfIgnoredElement && n.link() == Some("a")));
         // An <origin> where the shape should be is what urdfdom refuses: that collision's failure.
         let r = scan("<robot name=\"r\"><link name=\"a\"><collision><geometry><origin/><box size=\"1 1 1\"/></geometry></collision></link></robot>".into(), Path::new("x.urdf")).expect("scan");
         assert!(invalid(&geometries(&r, "a")[0])
@@ -1004,12 +968,12 @@ mod tests {
         assert!(
             r.notes
                 .iter()
-                .any(|n| n.line == 2 && n.message.contains("left as it is")),
+                .any(|n| n.line() == Some(2) && n.message.contains("left as it is")),
             "{:?}",
             r.notes
         );
         assert!(
-            r.notes.iter().any(|n| n.line == 4
+            r.notes.iter().any(|n| n.line() == Some(4)
                 && n.message
                     .contains("capsule radius 0 length 1 has no volume")),
             "{:?}",
@@ -1046,13 +1010,13 @@ mod tests {
         let text = "<robot name=\"r\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">\n<xacro:macro name=\"m\"><link name=\"hidden\"/></xacro:macro>\n<xacro:m/>\n</robot>";
         let r = scan(text.into(), Path::new("x.urdf")).expect("scan");
         assert!(r.links.is_empty());
-        let xacro: Vec<&ScanNote> = r
+        let xacro: Vec<&Diagnostic> = r
             .notes
             .iter()
             .filter(|n| n.message.contains("run `xacro"))
             .collect();
         assert_eq!(xacro.len(), 1);
-        assert_eq!((xacro[0].line, xacro[0].level), (2, NoteLevel::Note));
+        assert_eq!((xacro[0].line(), xacro[0].code), (Some(2), Code::UrdfXacro));
         let r = scan(
             "<robot name=\"r\"><xacro:include filename=\"x.xacro\"/></robot>".into(),
             Path::new("x.urdf"),

@@ -1,0 +1,471 @@
+//! Typed diagnostics: the warnings and notes of a run, each with a stable [`Code`], and the errors of
+//! one link ([`LinkError`]) or of a whole robot ([`RobotError`]).
+//!
+//! A warning asks the user to look (a repaired mesh, overlapping parts, an element urdfdom ignores); a
+//! note needs no action (a mesh welded within tolerance, a zero-size part). Codes are stable: tools
+//! and people match them, never the message text. They are grouped by hundreds: mesh health (1xx),
+//! URDF reading (2xx), density (3xx), overlap (4xx), output (5xx). README's "Diagnostics" table lists
+//! them.
+
+use crate::mesh::health::{Rung, Solid};
+use crate::mesh::MeshError;
+use serde::{Serialize, Serializer};
+use std::fmt;
+use std::path::PathBuf;
+
+/// How much a diagnostic matters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Severity {
+    /// Worth knowing, needs no action; printed with `--verbose` or in JSON.
+    Note,
+    /// The user should look; always printed.
+    Warning,
+}
+
+impl Severity {
+    /// `note` or `warning`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Severity::Note => "note",
+            Severity::Warning => "warning",
+        }
+    }
+}
+
+impl Serialize for Severity {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.as_str())
+    }
+}
+
+/// A stable diagnostic code (`UI101`, …); each has one severity.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum Code {
+    /// UI101: a mesh needed a repair below `exact`/`welded` (re-oriented, inverted, capped,
+    /// non-manifold, convex hull).
+    MeshRepaired,
+    /// UI102: degenerate or duplicated faces dropped.
+    MeshFacesDropped,
+    /// UI103: closed once corners within a tolerance are welded; integrated as stored.
+    MeshWelded,
+    /// UI104: the mesh reader left something out of the solid (faces it could not use).
+    MeshReaderSkipped,
+    /// UI105: the mesh reader tolerated something that leaves the solid as the file means it.
+    MeshReaderNote,
+    /// UI106: a mesh over 10 m across (likely millimetres without `scale`).
+    MeshTooLarge,
+    /// UI201: an element urdfdom ignores (a second `<origin>`, `<geometry>`, shape, `<inertial>`).
+    UrdfIgnoredElement,
+    /// UI202: a `<collision>` without a shape, ignored.
+    UrdfEmptyCollision,
+    /// UI203: a zero-size primitive, which contributes nothing.
+    UrdfZeroVolume,
+    /// UI204: the file uses xacro elements: links inside macros are not seen.
+    UrdfXacro,
+    /// UI205: the root declares `xmlns:xacro` (xacro's output keeps it).
+    UrdfXacroNamespace,
+    /// UI206: `<robot>` has no name attribute.
+    UrdfNoRobotName,
+    /// UI207: an invalid `<inertial>` on a link without collision geometry (`check`).
+    UrdfFrameInertial,
+    /// UI301: a link's mass target is overridden by its parts' own `[meshes]` rules.
+    DensityRuleOverridden,
+    /// UI401: parts of a link overlap: their common volume is counted twice.
+    PartsOverlap,
+    /// UI501: links that failed were left as they were (`--keep-going`).
+    OutputNotWritten,
+}
+
+impl Code {
+    /// Every code, in table order.
+    pub const ALL: [Code; 16] = [
+        Code::MeshRepaired,
+        Code::MeshFacesDropped,
+        Code::MeshWelded,
+        Code::MeshReaderSkipped,
+        Code::MeshReaderNote,
+        Code::MeshTooLarge,
+        Code::UrdfIgnoredElement,
+        Code::UrdfEmptyCollision,
+        Code::UrdfZeroVolume,
+        Code::UrdfXacro,
+        Code::UrdfXacroNamespace,
+        Code::UrdfNoRobotName,
+        Code::UrdfFrameInertial,
+        Code::DensityRuleOverridden,
+        Code::PartsOverlap,
+        Code::OutputNotWritten,
+    ];
+
+    /// The stable code, `UI101` …
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Code::MeshRepaired => "UI101",
+            Code::MeshFacesDropped => "UI102",
+            Code::MeshWelded => "UI103",
+            Code::MeshReaderSkipped => "UI104",
+            Code::MeshReaderNote => "UI105",
+            Code::MeshTooLarge => "UI106",
+            Code::UrdfIgnoredElement => "UI201",
+            Code::UrdfEmptyCollision => "UI202",
+            Code::UrdfZeroVolume => "UI203",
+            Code::UrdfXacro => "UI204",
+            Code::UrdfXacroNamespace => "UI205",
+            Code::UrdfNoRobotName => "UI206",
+            Code::UrdfFrameInertial => "UI207",
+            Code::DensityRuleOverridden => "UI301",
+            Code::PartsOverlap => "UI401",
+            Code::OutputNotWritten => "UI501",
+        }
+    }
+
+    /// The code's severity.
+    pub fn severity(self) -> Severity {
+        match self {
+            Code::MeshWelded
+            | Code::MeshReaderNote
+            | Code::UrdfZeroVolume
+            | Code::UrdfXacroNamespace
+            | Code::UrdfFrameInertial => Severity::Note,
+            _ => Severity::Warning,
+        }
+    }
+}
+
+impl fmt::Display for Code {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl Serialize for Code {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.as_str())
+    }
+}
+
+/// Where a diagnostic points; every part is optional.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct Location {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub file: Option<PathBuf>,
+    /// 1-based line in `file` (the URDF, unless a mesh is named).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub line: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub link: Option<String>,
+    /// 1-based collision index in the link.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub collision: Option<usize>,
+}
+
+/// One warning or note.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Diagnostic {
+    pub severity: Severity,
+    pub code: Code,
+    /// The text for people (stable enough for humans, not for tools: match `code`).
+    pub message: String,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub location: Option<Location>,
+}
+
+impl Diagnostic {
+    /// A diagnostic with the code's severity and no location.
+    pub fn new(code: Code, message: impl Into<String>) -> Self {
+        Diagnostic {
+            severity: code.severity(),
+            code,
+            message: message.into(),
+            location: None,
+        }
+    }
+
+    /// The same, located.
+    #[must_use]
+    pub fn at(mut self, location: Location) -> Self {
+        self.location = Some(location);
+        self
+    }
+
+    pub fn is_warning(&self) -> bool {
+        self.severity == Severity::Warning
+    }
+
+    /// The URDF line, if located on one.
+    pub fn line(&self) -> Option<usize> {
+        self.location.as_ref().and_then(|l| l.line)
+    }
+
+    /// The link, if about one.
+    pub fn link(&self) -> Option<&str> {
+        self.location.as_ref().and_then(|l| l.link.as_deref())
+    }
+
+    /// `warning: PATH:LINE: link `NAME`: MESSAGE` (the parts the location has).
+    pub fn render(&self) -> String {
+        let mut s = format!("{}: ", self.severity.as_str());
+        if let Some(l) = &self.location {
+            if let Some(f) = &l.file {
+                s.push_str(&f.display().to_string());
+                if let Some(line) = l.line {
+                    s.push_str(&format!(":{line}"));
+                }
+                s.push_str(": ");
+            }
+            if let Some(link) = &l.link {
+                s.push_str(&format!("link `{link}`: "));
+            }
+        }
+        s.push_str(&self.message);
+        s
+    }
+}
+
+/// What a part's numbers were computed from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Provenance {
+    /// A box, cylinder, sphere or capsule: exact formulas.
+    Primitive,
+    /// A mesh, with the rung of the health ladder that produced its solid.
+    Mesh(Rung),
+}
+
+impl Provenance {
+    /// `primitive` or the rung's name (`exact`, `welded`, `capped`, …).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Provenance::Primitive => "primitive",
+            Provenance::Mesh(r) => r.name(),
+        }
+    }
+
+    /// Whether the solid was repaired (a rung below exact and welded, which integrate as stored).
+    pub fn is_repaired(&self) -> bool {
+        matches!(self, Provenance::Mesh(r) if !r.is_as_stored())
+    }
+}
+
+impl fmt::Display for Provenance {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Serialize for Provenance {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+/// The diagnostics of a solid's health and of its reader.
+///
+/// `mesh::health` (owned elsewhere) still says these in strings; they are typed here, at the
+/// boundary, by their wording: a reader's warning says what it *skipped*, the ladder's drops say
+/// *dropped*, every other warning is the rung's repair; a note about welding is the ladder's, the
+/// rest are the reader's. When `Solid` carries codes itself, this becomes a plain copy.
+pub fn mesh_health(solid: &Solid) -> Vec<Diagnostic> {
+    let warnings = solid.warnings.iter().map(|w| {
+        let code = if w.contains("skipped") {
+            Code::MeshReaderSkipped
+        } else if w.contains("dropped") {
+            Code::MeshFacesDropped
+        } else {
+            Code::MeshRepaired
+        };
+        Diagnostic::new(code, w.clone())
+    });
+    let notes = solid.notes.iter().map(|n| {
+        let code = if n.contains("welded") {
+            Code::MeshWelded
+        } else {
+            Code::MeshReaderNote
+        };
+        Diagnostic::new(code, n.clone())
+    });
+    warnings.chain(notes).collect()
+}
+
+/// A collision of a link: its 1-based index and line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CollisionRef {
+    pub index: usize,
+    pub line: usize,
+}
+
+/// Why one link could not be computed (the others still are).
+#[derive(Debug, Clone)]
+pub struct LinkError {
+    pub link: String,
+    /// Line of the `<link>`.
+    pub line: usize,
+    /// The collision at fault, where one is.
+    pub collision: Option<CollisionRef>,
+    /// Boxed: the error travels through every stage's `Result`.
+    pub kind: Box<LinkErrorKind>,
+}
+
+/// What went wrong with a link.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub enum LinkErrorKind {
+    /// A collision the scan could not read (unknown shape, bad vector, negative size), at `line`.
+    InvalidGeometry { line: usize, message: String },
+    /// A mesh URI that resolves to no file.
+    MeshNotFound {
+        uri: String,
+        searched: Vec<PathBuf>,
+        hint: String,
+    },
+    /// A mesh that could not become a solid.
+    Mesh(MeshError),
+    /// A mass target (`source`: `[links] "x"`, `--keep-mass`) below what the parts with their own
+    /// rules already weigh.
+    MassTarget {
+        source: String,
+        mass: f64,
+        own_mass: f64,
+    },
+    /// Values beyond f64 (overflow or underflow), with the reasons.
+    Unrepresentable(String),
+}
+
+impl LinkErrorKind {
+    /// A short stable name for JSON: `invalid-geometry`, `mesh-not-found`, `mesh`, `mass-target`,
+    /// `unrepresentable`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            LinkErrorKind::InvalidGeometry { .. } => "invalid-geometry",
+            LinkErrorKind::MeshNotFound { .. } => "mesh-not-found",
+            LinkErrorKind::Mesh(_) => "mesh",
+            LinkErrorKind::MassTarget { .. } => "mass-target",
+            LinkErrorKind::Unrepresentable(_) => "unrepresentable",
+        }
+    }
+}
+
+impl fmt::Display for LinkError {
+    /// The message after `link `NAME`: ` (the caller names the file, line and link).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let index = self.collision.map_or(0, |c| c.index);
+        let cline = self.collision.map_or(self.line, |c| c.line);
+        match &*self.kind {
+            LinkErrorKind::InvalidGeometry { line, message } => {
+                write!(f, "collision {index} (line {line}): {message}")
+            }
+            LinkErrorKind::MeshNotFound {
+                uri,
+                searched,
+                hint,
+            } => {
+                let list: Vec<String> = searched
+                    .iter()
+                    .map(|p| format!("    {}", p.display()))
+                    .collect();
+                let list = if list.is_empty() {
+                    "    (nothing)".to_string()
+                } else {
+                    list.join("\n")
+                };
+                write!(
+                    f,
+                    "collision {index} (line {cline}): mesh `{uri}` not found; searched:\n{list}\n  {hint}"
+                )
+            }
+            LinkErrorKind::Mesh(e) => write!(f, "collision {index} (line {cline}): {e}"),
+            LinkErrorKind::MassTarget {
+                source,
+                mass,
+                own_mass,
+            } => write!(
+                f,
+                "{source} gives the link {mass} kg, but its parts with their own [meshes] rule already weigh {own_mass} kg"
+            ),
+            LinkErrorKind::Unrepresentable(m) => f.write_str(m),
+        }
+    }
+}
+
+impl std::error::Error for LinkError {}
+
+/// Why the robot as a whole could not be computed (no single link is at fault).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum RobotError {
+    /// Links with collision geometry and no density from anywhere: names and lines.
+    MissingDensity { links: Vec<(String, usize)> },
+    /// The density map's `total_mass` cannot be met by scaling the density-based links.
+    TotalMass {
+        total: f64,
+        fixed: f64,
+        variable: f64,
+    },
+}
+
+impl RobotError {
+    /// A short stable name for JSON: `missing-density`, `total-mass`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            RobotError::MissingDensity { .. } => "missing-density",
+            RobotError::TotalMass { .. } => "total-mass",
+        }
+    }
+}
+
+impl fmt::Display for RobotError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            RobotError::MissingDensity { links } => {
+                let list: Vec<String> = links
+                    .iter()
+                    .map(|(n, l)| format!("`{n}` (line {l})"))
+                    .collect();
+                write!(
+                    f,
+                    "no density for {} link(s) with collision geometry: {}; give --density RHO, a `default` in the density map, or a [links] rule",
+                    links.len(),
+                    list.join(", ")
+                )
+            }
+            RobotError::TotalMass {
+                total,
+                fixed,
+                variable,
+            } => write!(
+                f,
+                "total_mass {total} kg cannot be met: links with fixed masses already weigh {fixed} kg and density-based links {variable} kg"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for RobotError {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn codes_are_unique_and_grouped() {
+        let mut seen = std::collections::HashSet::new();
+        for c in Code::ALL {
+            let s = c.as_str();
+            assert!(seen.insert(s), "{s} twice");
+            assert!(s.starts_with("UI") && s.len() == 5, "{s}");
+        }
+    }
+
+    #[test]
+    fn json_carries_severity_code_message_and_location() {
+        let d = Diagnostic::new(Code::PartsOverlap, "parts 1 and 2 overlap").at(Location {
+            link: Some("arm".into()),
+            ..Location::default()
+        });
+        let v = serde_json::to_value(&d).expect("json");
+        assert_eq!(
+            v,
+            serde_json::json!({"severity": "warning", "code": "UI401", "message": "parts 1 and 2 overlap", "link": "arm"})
+        );
+    }
+}
