@@ -17,6 +17,24 @@
 //! assert_eq!(shortest(-0.0), "0");
 //! ```
 
+/// The most that rounding may move a written value, relative: the error estimate says which digits are
+/// round-off noise, but a model error (caps, a hull) bounds how far the solid can be from the truth, not
+/// how the solid's own numbers should be written. They keep six digits at least, so a second `fill`
+/// and `check` see the solid that was computed.
+pub const MAX_ROUNDING: f64 = 1e-6;
+
+/// The relative tolerance the formatter rounds within for a value whose relative error estimate is
+/// `error`: at least the f64 round-off floor, at most [`MAX_ROUNDING`] (also for an unbounded or NaN
+/// estimate).
+pub fn rounding_tolerance(error: f64) -> f64 {
+    const FLOOR: f64 = 4.0 * f64::EPSILON;
+    if error.is_nan() {
+        MAX_ROUNDING
+    } else {
+        error.clamp(FLOOR, MAX_ROUNDING)
+    }
+}
+
 /// Line numbers (1-based) for byte positions, counted in one pass when positions increase (elements come
 /// in document order); an earlier position is counted from the start.
 #[derive(Debug)]

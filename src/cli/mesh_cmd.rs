@@ -52,7 +52,7 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         Digits::Full => x,
         Digits::Fixed(n) => round_significant(x, n),
     };
-    let err = solid.error_estimate;
+    let err = urdf_inertia::text::rounding_tolerance(solid.error_estimate);
     let volume = round(volume, err * volume);
     let length = mp.com.iter().fold(
         solid

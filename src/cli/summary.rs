@@ -269,8 +269,17 @@ fn diff_row(r: &Row) {
         significant(e.mass, 6),
         significant(computed.mass, 6),
         significant(c.mass_ratio, 4),
-        significant(text::within(c.com_distance, l.error_estimate()), 4),
-        significant(text::within(c.inertia_difference, l.error_estimate()), 4),
+        significant(
+            text::within(c.com_distance, text::rounding_tolerance(l.error_estimate())),
+            4
+        ),
+        significant(
+            text::within(
+                c.inertia_difference,
+                text::rounding_tolerance(l.error_estimate())
+            ),
+            4
+        ),
         row_notes(r).join("; ")
     );
     let pe = moments(e, 0.0).map(|x| significant(x, 7));

@@ -1216,9 +1216,15 @@ fn with_caps(
     let flips = winding.flips();
     let volume = plan.volume;
     ladder.finish(plan.vertices, plan.faces, rung, model, |m| {
-        Some(format!(
-            "mesh is {what}: {done}{flips}; its volume {volume:.6e} m³ and inertia are uncertain by at most {m:.1e} (relative) because of them"
-        ))
+        Some(if m > 0.0 {
+            format!(
+                "mesh is {what}: {done}{flips}; its volume {volume:.6e} m³ and inertia are uncertain by at most {m:.1e} (relative) because of them"
+            )
+        } else {
+            format!(
+                "mesh is {what}: {done}{flips}; the holes' edges are planar, so the caps are exact if the missing surface was flat (volume {volume:.6e} m³); if it was not, this number is off by the missing volume"
+            )
+        })
     })
 }
 

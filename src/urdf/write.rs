@@ -60,14 +60,16 @@ struct Written {
     tensor: [[f64; 3]; 3],
 }
 
-/// Whether a tensor would pass `check` (the validity tolerance `check` applies to existing values).
+/// Whether a written tensor is valid with no tolerance at all: positive definite and the triangle
+/// inequality holding exactly, as MuJoCo and Drake require (`check` allows a round-off tolerance for
+/// existing values; what we write must not need it).
 fn tensor_valid(tensor: &[[f64; 3]; 3]) -> bool {
     let mp = MassProperties {
         mass: 1.0,
         com: [0.0; 3],
         inertia: *tensor,
     };
-    validity::check(&mp, validity::DEFAULT_TOLERANCE).is_empty()
+    validity::check(&mp, 0.0).is_empty()
 }
 
 fn largest_entry(tensor: &[[f64; 3]; 3]) -> f64 {
@@ -138,7 +140,7 @@ fn written(update: &LinkUpdate, opts: &WriteOptions) -> Result<Written, String> 
     } else {
         ([0.0; 3], mp.inertia)
     };
-    let error = update.error.max(ROUND_OFF_FLOOR);
+    let error = text::rounding_tolerance(update.error);
     // The COM is known relative to the link's size or to its own coordinates, whichever is larger.
     let length = mp.com.iter().fold(update.size, |m, x| m.max(x.abs()));
     let floor = |x: f64, scale: f64| text::within(x, ROUND_OFF_FLOOR * scale);
@@ -199,7 +201,7 @@ pub fn tidy_moments(moments: [f64; 3], error: f64, digits: Digits) -> [f64; 3] {
     let largest = moments.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     match digits {
         Digits::Full => moments.map(|x| text::within(x, 0.0)),
-        Digits::Auto => moments.map(|x| text::within(x, error.max(ROUND_OFF_FLOOR) * largest)),
+        Digits::Auto => moments.map(|x| text::within(x, text::rounding_tolerance(error) * largest)),
         Digits::Fixed(d) => moments.map(|x| text::round_significant(x, d)),
     }
 }
