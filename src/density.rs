@@ -127,6 +127,7 @@ impl DensityMap {
     }
 
     /// Parses and validates density map text.
+    #[allow(clippy::too_many_lines)] // TODO(issue 12): split
     pub fn parse(text: &str, path: &Path) -> Result<Self, MapError> {
         // Line starts, once: each lookup is a binary search (a map with thousands of rules stays linear).
         let line_starts: Vec<usize> = std::iter::once(0)

@@ -462,6 +462,7 @@ fn neighbours(parts: &[PlacedPart]) -> Option<Vec<Vec<usize>>> {
 
 /// Estimates the volume the parts count more than once (see the module docs). Builds the mesh
 /// locators it needs.
+#[allow(clippy::too_many_lines)] // TODO(issue 12): split
 pub fn estimate(parts: &mut [PlacedPart]) -> Overlap {
     let Some(nb) = neighbours(parts) else {
         return Overlap::Skipped(format!(
@@ -625,7 +626,14 @@ mod tests {
         let (r, d) = (1.0, 1.5);
         let v = 4.0 / 3.0 * std::f64::consts::PI;
         let mut parts: Vec<PlacedPart> = (0..3)
-            .map(|i| placed(PartShape::Sphere(r), [d * i as f64, 0.0, 0.0], [r; 3], v))
+            .map(|i| {
+                placed(
+                    PartShape::Sphere(r),
+                    [d * f64::from(i), 0.0, 0.0],
+                    [r; 3],
+                    v,
+                )
+            })
             .collect();
         let lens = std::f64::consts::PI * (4.0 * r + d) * (2.0 * r - d).powi(2) / 12.0;
         let e = estimated(&mut parts);
@@ -644,9 +652,9 @@ mod tests {
         let mut parts: Vec<PlacedPart> = (0..2000)
             .map(|i| {
                 let t = [
-                    (i % 20) as f64 * 0.25,
-                    (i / 20 % 10) as f64 * 0.25,
-                    (i / 200) as f64 * 0.25,
+                    f64::from(i % 20) * 0.25,
+                    f64::from(i / 20 % 10) * 0.25,
+                    f64::from(i / 200) * 0.25,
                 ];
                 placed(PartShape::Sphere(0.1), t, [0.1; 3], v)
             })
@@ -673,7 +681,7 @@ mod tests {
     fn cone(n: u32) -> Solid {
         let mut v = vec![[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]];
         for i in 0..n {
-            let a = 2.0 * std::f64::consts::PI * i as f64 / n as f64;
+            let a = 2.0 * std::f64::consts::PI * f64::from(i) / f64::from(n);
             v.push([0.0, a.cos(), a.sin()]);
         }
         let mut f = Vec::new();
@@ -711,9 +719,9 @@ mod tests {
                 for b in 0..12 {
                     for c in 0..12 {
                         let q = [
-                            0.05 + 0.9 * a as f64 / 11.0,
-                            -1.0 + 2.0 * b as f64 / 11.0 + 1e-3,
-                            -1.0 + 2.0 * c as f64 / 11.0 + 1e-3,
+                            0.05 + 0.9 * f64::from(a) / 11.0,
+                            -1.0 + 2.0 * f64::from(b) / 11.0 + 1e-3,
+                            -1.0 + 2.0 * f64::from(c) / 11.0 + 1e-3,
                         ];
                         let r = (q[1] * q[1] + q[2] * q[2]).sqrt();
                         let inside = r < 0.99 * (1.0 - q[0]);
@@ -732,7 +740,13 @@ mod tests {
     #[test]
     fn winding_number_of_a_closed_box() {
         let v: Vec<[f64; 3]> = (0..8)
-            .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+            .map(|i| {
+                [
+                    f64::from(i & 1),
+                    f64::from((i >> 1) & 1),
+                    f64::from((i >> 2) & 1),
+                ]
+            })
             .collect();
         let quads = [
             [0u32, 2, 3, 1],

@@ -7,6 +7,7 @@ use urdf_inertia::mass::{MassProperties, Principal};
 use urdf_inertia::mesh::{self, health::HealthOptions};
 use urdf_inertia::text::{round_significant, shortest, within, Digits};
 
+#[allow(clippy::too_many_lines)] // TODO(issue 12): split
 pub fn run(args: &MeshArgs) -> ExitStatus {
     let scale = match args.scale.as_deref() {
         Some([x, y, z]) => [*x, *y, *z],

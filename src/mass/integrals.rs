@@ -510,6 +510,7 @@ pub fn mirtich_polygons(
 }
 
 /// One face's contribution to the (not yet halved/thirded) sums of Figure 4, or `None` for zero area.
+#[allow(clippy::too_many_lines)] // TODO(issue 12): split
 fn polygon_terms(p: &[[f64; 3]]) -> Option<[f64; 10]> {
     // Newell's normal: twice the vector area.
     let mut n = [0.0f64; 3];

@@ -110,6 +110,7 @@ fn element(e: &quick_xml::events::BytesStart<'_>, line: usize) -> El {
     el
 }
 
+#[allow(clippy::too_many_lines)] // TODO(issue 12): split
 fn parse_tree(bytes: &[u8], path: &Path) -> Result<El, MeshError> {
     let mut reader = Reader::from_reader(bytes);
     reader.config_mut().trim_text(false);
@@ -307,6 +308,7 @@ fn axis_angle(axis: [f64; 3], angle: f64) -> Mat3 {
 }
 
 /// Geometry of one `<mesh>`: positions and polygons.
+#[allow(clippy::too_many_lines)] // TODO(issue 12): split
 fn read_geometry(
     geom: &El,
     bytes: &[u8],
@@ -333,7 +335,7 @@ fn read_geometry(
         let (stride, offset, line) = src
             .child("technique_common")
             .and_then(|t| t.child("accessor"))
-            .map(|a| {
+            .map_or((3, 0, src.line), |a| {
                 (
                     a.attr("stride")
                         .and_then(|s| s.parse().ok())
@@ -343,8 +345,7 @@ fn read_geometry(
                         .unwrap_or(0usize),
                     a.line,
                 )
-            })
-            .unwrap_or((3, 0, src.line));
+            });
         sources.insert(id, (arr, stride.max(1), offset, line));
     }
     let positions_of = |source_ref: &str, line: usize| -> Result<Vec<[f64; 3]>, MeshError> {
@@ -534,6 +535,7 @@ fn read_geometry(
 }
 
 /// Parses a COLLADA document into one mesh in the file's frame (see the module docs for the convention).
+#[allow(clippy::too_many_lines)] // TODO(issue 12): split
 pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     let doc = parse_tree(bytes, path)?;
     let root = doc

@@ -282,10 +282,7 @@ fn check_accessor(
         .checked_mul(stride)
         .and_then(|n| n.checked_add(elem))
         .and_then(|n| n.checked_add(acc.offset()));
-    let buffer = buffers
-        .get(view.buffer().index())
-        .map(Vec::len)
-        .unwrap_or(0);
+    let buffer = buffers.get(view.buffer().index()).map_or(0, Vec::len);
     let view_end = view.offset().checked_add(view.length());
     match (need, view_end) {
         (Some(need), Some(view_end)) if count == 0 || (need <= view.length() && view_end <= buffer) => Ok(()),
@@ -302,6 +299,7 @@ fn check_accessor(
 }
 
 /// Positions (world frame) and triangles of one primitive, appended to `out`.
+#[allow(clippy::too_many_lines)] // TODO(issue 12): split
 fn add_primitive(
     prim: &gltf::Primitive<'_>,
     xf: &Affine,
@@ -499,6 +497,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     }
 }
 
+#[allow(clippy::too_many_lines)] // TODO(issue 12): split
 fn parse_checked(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(bytes)
         .map_err(|e| syntax(path, format!("not a valid glTF file: {e}")))?;

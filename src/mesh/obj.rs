@@ -14,6 +14,7 @@ use crate::mass::Polygons;
 use std::path::Path;
 
 /// Parses OBJ text.
+#[allow(clippy::too_many_lines)] // TODO(issue 12): split
 pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     let mut vertices: Vec<[f64; 3]> = Vec::new();
     let mut faces = Polygons::new();

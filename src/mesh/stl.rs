@@ -14,6 +14,7 @@
 use super::weld::VertexTable;
 use super::{parse_f64, MeshError, MeshErrorKind, RawMesh};
 use crate::mass::Polygons;
+use std::fmt::Write as _;
 use std::path::Path;
 
 /// Parses STL bytes (binary or ASCII). Corners with bit-identical coordinates share one vertex, in
@@ -110,6 +111,7 @@ fn binary(bytes: &[u8], n: usize, header_count: Option<usize>) -> RawMesh {
     }
 }
 
+#[allow(clippy::too_many_lines)] // TODO(issue 12): split
 fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         MeshError::new(
@@ -224,7 +226,7 @@ pub fn write_ascii(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> String {
         s.push_str("  facet normal 0 0 0\n    outer loop\n");
         for &i in t {
             let v = vertices[i as usize];
-            s.push_str(&format!("      vertex {} {} {}\n", v[0], v[1], v[2]));
+            let _ = writeln!(s, "      vertex {} {} {}", v[0], v[1], v[2]);
         }
         s.push_str("    endloop\n  endfacet\n");
     }

@@ -100,7 +100,7 @@ impl DecodeError {
             .map_or(0, |i| i + 1);
         DecodeError {
             offset,
-            line: 1 + before.iter().filter(|&&b| b == b'\n').count(),
+            line: 1 + crate::text::count_newlines(before),
             column: 1 + before.len() - line_start,
             message,
         }
@@ -129,6 +129,7 @@ fn declared_encoding(bytes: &[u8]) -> Option<&[u8]> {
 }
 
 /// Decodes a URDF file's bytes to UTF-8 text.
+#[allow(clippy::too_many_lines)] // TODO(issue 12): split
 pub fn decode(bytes: Vec<u8>) -> Result<(String, SourceEncoding), DecodeError> {
     // UTF-16: a byte-order mark, or `<?` as 16-bit units (XML 1.0 appendix F).
     let utf16 = match bytes.get(..4) {

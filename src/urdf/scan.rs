@@ -178,13 +178,12 @@ impl std::error::Error for UrdfError {}
 pub fn line_col(text: &str, pos: usize) -> (usize, usize) {
     let pos = pos.min(text.len());
     let before = &text.as_bytes()[..pos];
-    let line = 1 + before.iter().filter(|&&b| b == b'\n').count();
+    let line = 1 + crate::text::count_newlines(before);
     let col = 1 + pos
         - before
             .iter()
             .rposition(|&b| b == b'\n')
-            .map(|i| i + 1)
-            .unwrap_or(0);
+            .map_or(0, |i| i + 1);
     (line, col)
 }
 
@@ -207,17 +206,17 @@ fn attrs(e: &BytesStart<'_>) -> Result<HashMap<String, String>, (usize, String)>
             | AttrError::ExpectedQuote(at, _) => (at, format!("malformed attribute: {err}")),
         })?;
         let key = String::from_utf8_lossy(a.key.as_ref()).into_owned();
-        let v = a
-            .unescape_value()
-            .map(|v| v.into_owned())
-            .unwrap_or_else(|_| String::from_utf8_lossy(&a.value).into_owned());
+        let v = a.unescape_value().map_or_else(
+            |_| String::from_utf8_lossy(&a.value).into_owned(),
+            |v| v.into_owned(),
+        );
         m.insert(key, v);
     }
     Ok(m)
 }
 
 fn indent_before(text: &str, pos: usize) -> Option<String> {
-    let line_start = text[..pos].rfind('\n').map(|i| i + 1).unwrap_or(0);
+    let line_start = text[..pos].rfind('\n').map_or(0, |i| i + 1);
     let ws = &text[line_start..pos];
     if ws.chars().all(|c| c == ' ' || c == '\t') {
         Some(ws.to_string())
@@ -298,6 +297,7 @@ fn warning(line: usize, link: &Option<Link>, message: String) -> Diagnostic {
 }
 
 /// Scans URDF text. `path` is used in messages and for resolving relative mesh paths.
+#[allow(clippy::too_many_lines)] // TODO(issue 12): split
 pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
     let err = |pos: usize, message: String| {
         let (line, column) = line_col(&text, pos);
@@ -415,7 +415,7 @@ pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
                 }
                 match child {
                     "collision" => {
-                        let index = current.as_ref().map(|l| l.collisions.len() + 1).unwrap_or(1);
+                        let index = current.as_ref().map_or(1, |l| l.collisions.len() + 1);
                         collision = Some(CollisionInProgress {
                             index,
                             line,
@@ -644,7 +644,7 @@ fn finish_inertial(i: InertialInProgress, current: &mut Option<Link>, notes: &mu
     if i.first {
         link.inertial = Some(i.span);
     } else {
-        let first = link.inertial.as_ref().map(|s| s.line).unwrap_or(link.line);
+        let first = link.inertial.as_ref().map_or(link.line, |s| s.line);
         notes.push(diagnostic(
             Code::UrdfIgnoredElement,
             i.span.line,
