@@ -111,7 +111,7 @@ fn binary(bytes: &[u8], n: usize, header_count: Option<usize>) -> RawMesh {
     }
 }
 
-#[allow(clippy::too_many_lines)] // TODO(issue 12): split
+/// Parses ASCII STL; errors carry the line.
 fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         MeshError::new(
@@ -140,26 +140,7 @@ fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
                         MeshErrorKind::Syntax("`vertex` outside `outer loop`".into()),
                     ));
                 }
-                let mut p = [0.0; 3];
-                for c in p.iter_mut() {
-                    let w = words.next().ok_or_else(|| {
-                        MeshError::new(
-                            path,
-                            Some(lineno),
-                            MeshErrorKind::Syntax("`vertex` needs three coordinates".into()),
-                        )
-                    })?;
-                    *c = parse_f64(w).ok_or_else(|| {
-                        MeshError::new(
-                            path,
-                            Some(lineno),
-                            MeshErrorKind::Syntax(format!("`{w}` is not a number")),
-                        )
-                    })?;
-                    if !c.is_finite() {
-                        return Err(MeshError::new(path, Some(lineno), MeshErrorKind::NotFinite));
-                    }
-                }
+                let p = ascii_vertex(words, lineno, path)?;
                 current.push(vertices.insert(p));
             }
             "outer" => {
@@ -200,6 +181,35 @@ fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         notes: Vec::new(),
         warnings: Vec::new(),
     })
+}
+
+/// The three coordinates after an ASCII STL `vertex`.
+fn ascii_vertex<'a>(
+    mut words: impl Iterator<Item = &'a str>,
+    lineno: usize,
+    path: &Path,
+) -> Result<[f64; 3], MeshError> {
+    let mut p = [0.0; 3];
+    for c in p.iter_mut() {
+        let w = words.next().ok_or_else(|| {
+            MeshError::new(
+                path,
+                Some(lineno),
+                MeshErrorKind::Syntax("`vertex` needs three coordinates".into()),
+            )
+        })?;
+        *c = parse_f64(w).ok_or_else(|| {
+            MeshError::new(
+                path,
+                Some(lineno),
+                MeshErrorKind::Syntax(format!("`{w}` is not a number")),
+            )
+        })?;
+        if !c.is_finite() {
+            return Err(MeshError::new(path, Some(lineno), MeshErrorKind::NotFinite));
+        }
+    }
+    Ok(p)
 }
 
 /// Writes a binary STL (used by tests and fixture generators).
