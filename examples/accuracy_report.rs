@@ -79,7 +79,7 @@ fn integrate(
         ),
         Variant::Ours => triangle_integrals(v, f, &IntegrationOptions::accurate()),
         Variant::OursF32Input => {
-            let v32: Vec<[f64; 3]> = v.iter().map(|p| p.map(|c| c as f32 as f64)).collect();
+            let v32: Vec<[f64; 3]> = v.iter().map(|p| p.map(|c| f64::from(c as f32))).collect();
             triangle_integrals(&v32, f, &IntegrationOptions::accurate())
         }
     }
@@ -160,9 +160,7 @@ fn machine() -> String {
                 .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
         })
         .unwrap_or_else(|| "unknown CPU".into());
-    let cores = std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1);
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     format!(
         "{cpu}, {cores} cores visible, one core used; {} {}",
         std::env::consts::OS,
@@ -170,6 +168,7 @@ fn machine() -> String {
     )
 }
 
+#[allow(clippy::too_many_lines)] // a script: the report's sections in order
 fn main() -> std::io::Result<()> {
     let mut md = String::new();
     writeln!(md, "# Accuracy against run time\n").ok();
@@ -275,9 +274,7 @@ fn main() -> std::io::Result<()> {
         let secs = time(if level > 6 { 2.0 } else { 0.5 }, || {
             integrate(Variant::Ours, &v, &f, &polys)
         });
-        let growth = last
-            .map(|l: f64| format!("{:.2}", secs / l))
-            .unwrap_or_else(|| "-".into());
+        let growth = last.map_or_else(|| "-".into(), |l: f64| format!("{:.2}", secs / l));
         last = Some(secs);
         writeln!(
             md,
@@ -464,13 +461,13 @@ fn main() -> std::io::Result<()> {
     let mut header = String::from("| case | ours | parry3d-f64 |");
     let mut rule = String::from("|---|---|---|");
     for p in &peer_names {
-        header += &format!(" {p} |");
+        let _ = write!(header, " {p} |");
         rule += "---|";
     }
     header += " ours ns/face | parry3d-f64 ns/face |";
     rule += "---|---|";
     for p in &peer_names {
-        header += &format!(" {p} ns/face |");
+        let _ = write!(header, " {p} ns/face |");
         rule += "---|";
     }
     writeln!(md, "{header}\n{rule}").ok();
@@ -507,7 +504,8 @@ fn main() -> std::io::Result<()> {
                 match results.get(&(ci, tool.clone())) {
                     Some(Ok((inertia, secs))) => {
                         let finite = inertia.iter().flatten().all(|x| x.is_finite());
-                        row += &format!(
+                        let _ = write!(
+                            row,
                             " {} |",
                             if finite {
                                 e(inertia_error(inertia, &exact.inertia))
@@ -515,10 +513,11 @@ fn main() -> std::io::Result<()> {
                                 "inf".into()
                             }
                         );
-                        times += &format!(" {:.1} |", per_face(*secs));
+                        let _ = write!(times, " {:.1} |", per_face(*secs));
                     }
                     Some(Err(msg)) => {
-                        row += &format!(
+                        let _ = write!(
+                            row,
                             " fails: {} |",
                             msg.split_whitespace()
                                 .collect::<Vec<_>>()
@@ -586,9 +585,7 @@ fn main() -> std::io::Result<()> {
     let file = std::env::temp_dir().join(format!("urdf-inertia-bench-{}.stl", std::process::id()));
     std::fs::write(&file, &bytes)?;
     let secs = time(3.0, || {
-        urdf_inertia::mesh::read(&file)
-            .map(|m| m.faces.len())
-            .unwrap_or(0)
+        urdf_inertia::mesh::read(&file).map_or(0, |m| m.faces.len())
     });
     let _ = std::fs::remove_file(&file);
     writeln!(md, "Binary STL file, {} faces ({:.1} MB), read and parsed (page cache warm): {:.1} ms, {:.0} MB/s, {:.1} M faces/s.", f.len(), bytes.len() as f64 / 1e6, secs * 1e3, bytes.len() as f64 / 1e6 / secs, f.len() as f64 / 1e6 / secs).ok();
@@ -600,8 +597,7 @@ fn main() -> std::io::Result<()> {
             std::path::Path::new("bench.stl"),
             Default::default(),
         )
-        .map(|s| s.faces.len())
-        .unwrap_or(0)
+        .map_or(0, |s| s.faces.len())
     });
     writeln!(
         md,
@@ -779,23 +775,24 @@ fn svg(points: &[(usize, f64, f64)]) -> String {
     for k in (y0 as i32)..=(y1 as i32) {
         let y = py(10f64.powi(k));
         if k % 2 == 0 {
-            s += &format!("<line x1=\"{l}\" x2=\"{}\" y1=\"{y}\" y2=\"{y}\" stroke=\"#eee\"/><text x=\"{}\" y=\"{}\" text-anchor=\"end\">1e{k}</text>\n", w - r, l - 5.0, y + 4.0);
+            let _ = writeln!(s, "<line x1=\"{l}\" x2=\"{}\" y1=\"{y}\" y2=\"{y}\" stroke=\"#eee\"/><text x=\"{}\" y=\"{}\" text-anchor=\"end\">1e{k}</text>", w - r, l - 5.0, y + 4.0);
         }
     }
     for k in (x0 as i32)..=(x1 as i32) {
         let x = px(10f64.powi(k));
-        s += &format!("<line x1=\"{x}\" x2=\"{x}\" y1=\"{t}\" y2=\"{}\" stroke=\"#eee\"/><text x=\"{x}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n", h - b, h - b + 16.0, 10f64.powi(k));
+        let _ = writeln!(s, "<line x1=\"{x}\" x2=\"{x}\" y1=\"{t}\" y2=\"{}\" stroke=\"#eee\"/><text x=\"{x}\" y=\"{}\" text-anchor=\"middle\">{}</text>", h - b, h - b + 16.0, 10f64.powi(k));
     }
     for (value, label) in [
         (2f64.powi(-53), "f64 round-off of the result, 2^-53"),
         (101.0 * 2f64.powi(-53), "f64 round-off of the inputs"),
     ] {
         let y = py(value);
-        s += &format!("<line x1=\"{l}\" x2=\"{}\" y1=\"{y}\" y2=\"{y}\" stroke=\"black\" stroke-dasharray=\"5,4\"/><text x=\"{}\" y=\"{}\">{label}</text>\n", w - r, w - r + 5.0, y + 4.0);
+        let _ = writeln!(s, "<line x1=\"{l}\" x2=\"{}\" y1=\"{y}\" y2=\"{y}\" stroke=\"black\" stroke-dasharray=\"5,4\"/><text x=\"{}\" y=\"{}\">{label}</text>", w - r, w - r + 5.0, y + 4.0);
     }
     for (vi, ns, err) in points {
-        s += &format!(
-            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"4\" fill=\"{}\" fill-opacity=\"0.8\"/>\n",
+        let _ = writeln!(
+            s,
+            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"4\" fill=\"{}\" fill-opacity=\"0.8\"/>",
             px(*ns),
             py(*err),
             colours[*vi]
@@ -803,8 +800,9 @@ fn svg(points: &[(usize, f64, f64)]) -> String {
     }
     for (vi, (_, name)) in VARIANTS.iter().enumerate() {
         let y = t + 20.0 + 20.0 * vi as f64;
-        s += &format!(
-            "<circle cx=\"{}\" cy=\"{y}\" r=\"5\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}</text>\n",
+        let _ =
+            writeln!(s,
+            "<circle cx=\"{}\" cy=\"{y}\" r=\"5\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}</text>",
             w - r + 15.0,
             colours[vi],
             w - r + 25.0,
@@ -812,12 +810,13 @@ fn svg(points: &[(usize, f64, f64)]) -> String {
             name.replace('&', "and")
         );
     }
-    s += &format!(
-        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">ns per face</text>\n",
+    let _ = writeln!(
+        s,
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">ns per face</text>",
         (l + w - r) / 2.0,
         h - 10.0
     );
-    s += &format!("<text x=\"15\" y=\"{}\" transform=\"rotate(-90 15 {})\" text-anchor=\"middle\">relative error, central inertia</text>\n</svg>\n", (t + h - b) / 2.0, (t + h - b) / 2.0);
+    let _ = write!(s, "<text x=\"15\" y=\"{}\" transform=\"rotate(-90 15 {})\" text-anchor=\"middle\">relative error, central inertia</text>\n</svg>\n", (t + h - b) / 2.0, (t + h - b) / 2.0);
     s
 }
 
@@ -836,6 +835,7 @@ fn pipeline_stl(level: u32) -> (Vec<u8>, usize) {
 
 /// The mesh pipeline per stage and size on one core, the whole `urdf-inertia mesh` process on 1 and
 /// 2 threads with its peak memory, and coal and trimesh loading and integrating the same file.
+#[allow(clippy::too_many_lines)] // one report section written top to bottom, table after table
 fn pipeline_section(md: &mut String) -> std::io::Result<()> {
     use std::path::Path;
     use urdf_inertia::mesh::{health, solid_from_raw, stl, weld};
@@ -949,12 +949,13 @@ fn pipeline_section(md: &mut String) -> std::io::Result<()> {
                             .find_map(|l| l.trim().strip_prefix(name))
                             .map(|v| v.trim().to_string())
                     };
-                    let wall = field("Elapsed (wall clock) time (h:mm:ss or m:ss):")
-                        .map(|t| {
+                    let wall = field("Elapsed (wall clock) time (h:mm:ss or m:ss):").map_or(
+                        f64::NAN,
+                        |t| {
                             t.split(':')
                                 .fold(0.0, |acc, x| acc * 60.0 + x.parse::<f64>().unwrap_or(0.0))
-                        })
-                        .unwrap_or(f64::NAN);
+                        },
+                    );
                     let kb = field("Maximum resident set size (kbytes):")
                         .and_then(|k| k.parse::<f64>().ok())
                         .unwrap_or(f64::NAN);

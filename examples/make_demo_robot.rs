@@ -13,6 +13,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 use urdf_inertia::mesh::stl::{write_ascii, write_binary};
 
+#[allow(clippy::too_many_lines)] // a script writing the demo robot's files one after another
 fn main() -> std::io::Result<()> {
     let dir = Path::new("robots/demo_arm_description/meshes");
     std::fs::create_dir_all(dir)?;
@@ -33,11 +34,11 @@ fn main() -> std::io::Result<()> {
     // split into two OBJ objects (the sides, and the caps).
     let mut obj = String::from("# demo upper arm: hexagonal prism\nmtllib missing.mtl\no sides\n");
     for k in 0..6 {
-        let a = std::f64::consts::PI / 3.0 * k as f64;
+        let a = std::f64::consts::PI / 3.0 * f64::from(k);
         writeln!(obj, "v {} {} 0", 0.04 * a.cos(), 0.04 * a.sin()).ok();
     }
     for k in 0..6 {
-        let a = std::f64::consts::PI / 3.0 * k as f64;
+        let a = std::f64::consts::PI / 3.0 * f64::from(k);
         writeln!(obj, "v {} {} 0.3", 0.04 * a.cos(), 0.04 * a.sin()).ok();
     }
     obj.push_str("usemtl grey\n");

@@ -22,6 +22,7 @@
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::fmt;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
@@ -132,10 +133,10 @@ impl DensityMap {
         let line_starts: Vec<usize> = std::iter::once(0)
             .chain(text.match_indices('\n').map(|(i, _)| i + 1))
             .collect();
-        let line_of = |span: std::ops::Range<usize>| {
+        let line_of = |span: Range<usize>| {
             Some(line_starts.partition_point(|&s| s <= span.start.min(text.len())))
         };
-        let err = |span: Option<std::ops::Range<usize>>, message: String| MapError {
+        let err = |span: Option<Range<usize>>, message: String| MapError {
             path: path.into(),
             line: span.and_then(line_of),
             message,
@@ -143,102 +144,21 @@ impl DensityMap {
         let raw: RawMap =
             toml::from_str(text).map_err(|e| err(e.span(), e.message().to_string()))?;
 
-        let mut materials: BTreeMap<String, f64> =
-            MATERIALS.iter().map(|(k, v)| (k.to_string(), *v)).collect();
-        for (name, v) in &raw.materials {
-            let d = v
-                .get_ref()
-                .as_float()
-                .or_else(|| v.get_ref().as_integer().map(|i| i as f64))
-                .ok_or_else(|| {
-                    err(
-                        Some(v.span()),
-                        format!("material `{name}` must be a density in kg/m³"),
-                    )
-                })?;
-            check_positive(d, &format!("material `{name}`")).map_err(|m| err(Some(v.span()), m))?;
-            materials.insert(name.to_ascii_lowercase(), d);
-        }
-        let spec = |v: &toml::Value, allow_mass: bool, what: &str| -> Result<Spec, String> {
-            let material = |name: &str| -> Result<Spec, String> {
-                materials.get(&name.to_ascii_lowercase()).map(|d| Spec::Density(*d)).ok_or_else(|| {
-                    format!("{what}: unknown material `{name}`; add it under [materials] (built in: {})", MATERIALS.iter().map(|m| m.0).collect::<Vec<_>>().join(", "))
-                })
-            };
-            match v {
-                toml::Value::Float(d) => check_positive(*d, what).map(|_| Spec::Density(*d)),
-                toml::Value::Integer(i) => {
-                    check_positive(*i as f64, what).map(|_| Spec::Density(*i as f64))
-                }
-                toml::Value::String(s) => material(s),
-                toml::Value::Table(t) => {
-                    if t.len() != 1 {
-                        return Err(format!(
-                            "{what}: give exactly one of density, mass or material"
-                        ));
-                    }
-                    let (k, val) = t
-                        .iter()
-                        .next()
-                        .ok_or_else(|| format!("{what}: empty table"))?;
-                    let num = || {
-                        val.as_float()
-                            .or_else(|| val.as_integer().map(|i| i as f64))
-                            .ok_or_else(|| format!("{what}: `{k}` must be a number"))
-                    };
-                    match k.as_str() {
-                        "density" => {
-                            let d = num()?;
-                            check_positive(d, what).map(|_| Spec::Density(d))
-                        }
-                        "mass" if allow_mass => {
-                            let m = num()?;
-                            check_positive(m, what).map(|_| Spec::Mass(m))
-                        }
-                        "material" => material(
-                            val.as_str()
-                                .ok_or_else(|| format!("{what}: material must be a name"))?,
-                        ),
-                        other => Err(format!(
-                            "{what}: unknown key `{other}` (expected density, mass or material)"
-                        )),
-                    }
-                }
-                _ => Err(format!(
-                    "{what}: expected a density, a material name or a table"
-                )),
-            }
-        };
+        let materials = material_table(&raw.materials).map_err(|(span, m)| err(Some(span), m))?;
         let default = match &raw.default {
             None => None,
-            Some(v) => {
-                match spec(v.get_ref(), false, "default").map_err(|m| err(Some(v.span()), m))? {
-                    Spec::Density(d) => Some(d),
-                    Spec::Mass(_) => None,
-                }
-            }
+            Some(v) => match spec(&materials, v.get_ref(), false, "default")
+                .map_err(|m| err(Some(v.span()), m))?
+            {
+                Spec::Density(d) => Some(d),
+                Spec::Mass(_) => None,
+            },
         };
         if let Some(t) = &raw.total_mass {
             check_positive(*t.get_ref(), "total_mass").map_err(|m| err(Some(t.span()), m))?;
         }
-        // Rules in file order (for tie-breaking), each error on its entry's line.
-        let rules = |section: &str,
-                     table: &BTreeMap<String, Spanned<toml::Value>>|
-         -> Result<Vec<(String, Spec)>, MapError> {
-            let mut entries: Vec<(&String, &Spanned<toml::Value>)> = table.iter().collect();
-            entries.sort_by_key(|(_, v)| v.span().start);
-            entries
-                .into_iter()
-                .map(|(k, v)| {
-                    glob(k).map_err(|m| err(Some(v.span()), format!("[{section}] {m}")))?;
-                    spec(v.get_ref(), true, &format!("[{section}] `{k}`"))
-                        .map(|s| (k.clone(), s))
-                        .map_err(|m| err(Some(v.span()), m))
-                })
-                .collect()
-        };
-        let links = rules("links", &raw.links)?;
-        let meshes = rules("meshes", &raw.meshes)?;
+        let links = rules(&materials, "links", &raw.links, &err)?;
+        let meshes = rules(&materials, "meshes", &raw.meshes, &err)?;
         Ok(DensityMap {
             default,
             total_mass: raw.total_mass.map(|t| *t.get_ref()),
@@ -279,6 +199,126 @@ fn best_glob<'a, 'b>(
         }
     }
     best.map(|(k, s)| (k.as_str(), *s))
+}
+
+/// The built-in materials with the map's `[materials]` added (names compare case-insensitively). An
+/// error carries the span of the entry it concerns.
+fn material_table(
+    table: &BTreeMap<String, Spanned<toml::Value>>,
+) -> Result<BTreeMap<String, f64>, (Range<usize>, String)> {
+    let mut materials: BTreeMap<String, f64> =
+        MATERIALS.iter().map(|(k, v)| (k.to_string(), *v)).collect();
+    for (name, v) in table {
+        let d = v
+            .get_ref()
+            .as_float()
+            .or_else(|| v.get_ref().as_integer().map(|i| i as f64))
+            .ok_or_else(|| {
+                (
+                    v.span(),
+                    format!("material `{name}` must be a density in kg/m³"),
+                )
+            })?;
+        check_positive(d, &format!("material `{name}`")).map_err(|m| (v.span(), m))?;
+        materials.insert(name.to_ascii_lowercase(), d);
+    }
+    Ok(materials)
+}
+
+/// A material by name, as a density; an unknown name lists the built-in ones.
+fn material(materials: &BTreeMap<String, f64>, name: &str, what: &str) -> Result<Spec, String> {
+    materials
+        .get(&name.to_ascii_lowercase())
+        .map(|d| Spec::Density(*d))
+        .ok_or_else(|| {
+            format!(
+                "{what}: unknown material `{name}`; add it under [materials] (built in: {})",
+                MATERIALS.iter().map(|m| m.0).collect::<Vec<_>>().join(", ")
+            )
+        })
+}
+
+/// One rule's value: a density, a material name or a one-key table (`mass` only where `allow_mass`).
+/// `what` names the rule in messages.
+fn spec(
+    materials: &BTreeMap<String, f64>,
+    v: &toml::Value,
+    allow_mass: bool,
+    what: &str,
+) -> Result<Spec, String> {
+    match v {
+        toml::Value::Float(d) => check_positive(*d, what).map(|_| Spec::Density(*d)),
+        toml::Value::Integer(i) => {
+            check_positive(*i as f64, what).map(|_| Spec::Density(*i as f64))
+        }
+        toml::Value::String(s) => material(materials, s, what),
+        toml::Value::Table(t) => table_spec(materials, t, allow_mass, what),
+        _ => Err(format!(
+            "{what}: expected a density, a material name or a table"
+        )),
+    }
+}
+
+/// A rule written as a table: exactly one of `density`, `mass` (where allowed) or `material`.
+fn table_spec(
+    materials: &BTreeMap<String, f64>,
+    t: &toml::Table,
+    allow_mass: bool,
+    what: &str,
+) -> Result<Spec, String> {
+    if t.len() != 1 {
+        return Err(format!(
+            "{what}: give exactly one of density, mass or material"
+        ));
+    }
+    let (k, val) = t
+        .iter()
+        .next()
+        .ok_or_else(|| format!("{what}: empty table"))?;
+    let num = || {
+        val.as_float()
+            .or_else(|| val.as_integer().map(|i| i as f64))
+            .ok_or_else(|| format!("{what}: `{k}` must be a number"))
+    };
+    match k.as_str() {
+        "density" => {
+            let d = num()?;
+            check_positive(d, what).map(|_| Spec::Density(d))
+        }
+        "mass" if allow_mass => {
+            let m = num()?;
+            check_positive(m, what).map(|_| Spec::Mass(m))
+        }
+        "material" => material(
+            materials,
+            val.as_str()
+                .ok_or_else(|| format!("{what}: material must be a name"))?,
+            what,
+        ),
+        other => Err(format!(
+            "{what}: unknown key `{other}` (expected density, mass or material)"
+        )),
+    }
+}
+
+/// The rules of `[section]` in file order (for tie-breaking), each error on its entry's line.
+fn rules(
+    materials: &BTreeMap<String, f64>,
+    section: &str,
+    table: &BTreeMap<String, Spanned<toml::Value>>,
+    err: &impl Fn(Option<Range<usize>>, String) -> MapError,
+) -> Result<Vec<(String, Spec)>, MapError> {
+    let mut entries: Vec<(&String, &Spanned<toml::Value>)> = table.iter().collect();
+    entries.sort_by_key(|(_, v)| v.span().start);
+    entries
+        .into_iter()
+        .map(|(k, v)| {
+            glob(k).map_err(|m| err(Some(v.span()), format!("[{section}] {m}")))?;
+            spec(materials, v.get_ref(), true, &format!("[{section}] `{k}`"))
+                .map(|s| (k.clone(), s))
+                .map_err(|m| err(Some(v.span()), m))
+        })
+        .collect()
 }
 
 fn check_positive(x: f64, what: &str) -> Result<(), String> {

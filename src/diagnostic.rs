@@ -11,6 +11,7 @@ use crate::mesh::health::{Rung, Solid};
 use crate::mesh::MeshError;
 use serde::{Serialize, Serializer};
 use std::fmt;
+use std::fmt::Write as _;
 use std::path::PathBuf;
 
 /// How much a diagnostic matters.
@@ -210,12 +211,12 @@ impl Diagnostic {
             if let Some(f) = &l.file {
                 s.push_str(&f.display().to_string());
                 if let Some(line) = l.line {
-                    s.push_str(&format!(":{line}"));
+                    let _ = write!(s, ":{line}");
                 }
                 s.push_str(": ");
             }
             if let Some(link) = &l.link {
-                s.push_str(&format!("link `{link}`: "));
+                let _ = write!(s, "link `{link}`: ");
             }
         }
         s.push_str(&self.message);

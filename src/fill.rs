@@ -537,9 +537,10 @@ pub fn compute_with(
     }
     reject_unrepresentable(&mut report);
     report.mesh_files = ctx.cache.files() - files0;
+    // The cache's clocks only accumulate, so these never saturate.
     report.timing = Timing {
-        load: ctx.cache.load_time - load0,
-        integrate: ctx.cache.integrate_time - integrate0,
+        load: ctx.cache.load_time.saturating_sub(load0),
+        integrate: ctx.cache.integrate_time.saturating_sub(integrate0),
     };
     report
 }

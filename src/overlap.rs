@@ -460,6 +460,62 @@ fn neighbours(parts: &[PlacedPart]) -> Option<Vec<Vec<usize>>> {
     Some(out)
 }
 
+/// The grid size for every part: one size for all that keeps the point tests of every part and its
+/// neighbours within the budget.
+fn grid_size(parts: &[PlacedPart], nb: &[Vec<usize>], involved: &[usize]) -> usize {
+    let cost: usize = involved
+        .iter()
+        .map(|&i| {
+            nb[i]
+                .iter()
+                .fold(parts[i].cost(), |c, &j| c.saturating_add(parts[j].cost()))
+        })
+        .fold(0usize, usize::saturating_add);
+    let samples = POINT_TEST_BUDGET / cost.max(1);
+    ((samples as f64).cbrt().floor() as usize).clamp(MIN_GRID, GRID)
+}
+
+/// Samples part `i` on an `n`³ grid over where its box meets its neighbours': the volume it shares
+/// (each point covered k times counts 1 - 1/k), whether any point is shared, and the most parts
+/// covering one point.
+fn sample_part(parts: &[PlacedPart], nb: &[Vec<usize>], i: usize, n: usize) -> (f64, bool, usize) {
+    let p = &parts[i];
+    // Only where the part's box meets a neighbour's can a point be covered twice.
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for &j in &nb[i] {
+        let q = &parts[j];
+        for k in 0..3 {
+            lo[k] = lo[k].min(p.bbox.0[k].max(q.bbox.0[k]));
+            hi[k] = hi[k].max(p.bbox.1[k].min(q.bbox.1[k]));
+        }
+    }
+    let cell_volume = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]) / (n * n * n) as f64;
+    let mut sum = 0.0;
+    let mut most = 1usize;
+    for a in 0..n {
+        for b in 0..n {
+            for c in 0..n {
+                let x = [
+                    lo[0] + (hi[0] - lo[0]) * (a as f64 + 0.5) / n as f64,
+                    lo[1] + (hi[1] - lo[1]) * (b as f64 + 0.5) / n as f64,
+                    lo[2] + (hi[2] - lo[2]) * (c as f64 + 0.5) / n as f64,
+                ];
+                if !p.contains(x) {
+                    continue;
+                }
+                let k = 1 + nb[i]
+                    .iter()
+                    .filter(|&&j| parts[j].in_bbox(x) && parts[j].contains(x))
+                    .count();
+                most = most.max(k);
+                sum += 1.0 - 1.0 / k as f64;
+            }
+        }
+    }
+    (sum * cell_volume, most > 1, most)
+}
+
 /// Estimates the volume the parts count more than once (see the module docs). Builds the mesh
 /// locators it needs.
 pub fn estimate(parts: &mut [PlacedPart]) -> Overlap {
@@ -480,57 +536,13 @@ pub fn estimate(parts: &mut [PlacedPart]) -> Overlap {
             ));
         }
     }
-    // One grid size for all: the point tests of every part and its neighbours within the budget.
-    let cost: usize = involved
-        .iter()
-        .map(|&i| {
-            nb[i]
-                .iter()
-                .fold(parts[i].cost(), |c, &j| c.saturating_add(parts[j].cost()))
-        })
-        .fold(0usize, usize::saturating_add);
-    let samples = POINT_TEST_BUDGET / cost.max(1);
-    let n = ((samples as f64).cbrt().floor() as usize).clamp(MIN_GRID, GRID);
+    let n = grid_size(parts, &nb, &involved);
     let parts: &[PlacedPart] = parts;
-    let sample_part = |i: usize| -> (f64, bool, usize) {
-        let p = &parts[i];
-        // Only where the part's box meets a neighbour's can a point be covered twice.
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for &j in &nb[i] {
-            let q = &parts[j];
-            for k in 0..3 {
-                lo[k] = lo[k].min(p.bbox.0[k].max(q.bbox.0[k]));
-                hi[k] = hi[k].max(p.bbox.1[k].min(q.bbox.1[k]));
-            }
-        }
-        let cell_volume = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]) / (n * n * n) as f64;
-        let mut sum = 0.0;
-        let mut most = 1usize;
-        for a in 0..n {
-            for b in 0..n {
-                for c in 0..n {
-                    let x = [
-                        lo[0] + (hi[0] - lo[0]) * (a as f64 + 0.5) / n as f64,
-                        lo[1] + (hi[1] - lo[1]) * (b as f64 + 0.5) / n as f64,
-                        lo[2] + (hi[2] - lo[2]) * (c as f64 + 0.5) / n as f64,
-                    ];
-                    if !p.contains(x) {
-                        continue;
-                    }
-                    let k = 1 + nb[i]
-                        .iter()
-                        .filter(|&&j| parts[j].in_bbox(x) && parts[j].contains(x))
-                        .count();
-                    most = most.max(k);
-                    sum += 1.0 - 1.0 / k as f64;
-                }
-            }
-        }
-        (sum * cell_volume, most > 1, most)
-    };
     use rayon::prelude::*;
-    let results: Vec<(f64, bool, usize)> = involved.par_iter().map(|&i| sample_part(i)).collect();
+    let results: Vec<(f64, bool, usize)> = involved
+        .par_iter()
+        .map(|&i| sample_part(parts, &nb, i, n))
+        .collect();
     let excess: f64 = results.iter().map(|r| r.0).sum();
     let found: Vec<usize> = involved
         .iter()
@@ -625,7 +637,14 @@ mod tests {
         let (r, d) = (1.0, 1.5);
         let v = 4.0 / 3.0 * std::f64::consts::PI;
         let mut parts: Vec<PlacedPart> = (0..3)
-            .map(|i| placed(PartShape::Sphere(r), [d * i as f64, 0.0, 0.0], [r; 3], v))
+            .map(|i| {
+                placed(
+                    PartShape::Sphere(r),
+                    [d * f64::from(i), 0.0, 0.0],
+                    [r; 3],
+                    v,
+                )
+            })
             .collect();
         let lens = std::f64::consts::PI * (4.0 * r + d) * (2.0 * r - d).powi(2) / 12.0;
         let e = estimated(&mut parts);
@@ -644,9 +663,9 @@ mod tests {
         let mut parts: Vec<PlacedPart> = (0..2000)
             .map(|i| {
                 let t = [
-                    (i % 20) as f64 * 0.25,
-                    (i / 20 % 10) as f64 * 0.25,
-                    (i / 200) as f64 * 0.25,
+                    f64::from(i % 20) * 0.25,
+                    f64::from(i / 20 % 10) * 0.25,
+                    f64::from(i / 200) * 0.25,
                 ];
                 placed(PartShape::Sphere(0.1), t, [0.1; 3], v)
             })
@@ -673,7 +692,7 @@ mod tests {
     fn cone(n: u32) -> Solid {
         let mut v = vec![[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]];
         for i in 0..n {
-            let a = 2.0 * std::f64::consts::PI * i as f64 / n as f64;
+            let a = 2.0 * std::f64::consts::PI * f64::from(i) / f64::from(n);
             v.push([0.0, a.cos(), a.sin()]);
         }
         let mut f = Vec::new();
@@ -711,9 +730,9 @@ mod tests {
                 for b in 0..12 {
                     for c in 0..12 {
                         let q = [
-                            0.05 + 0.9 * a as f64 / 11.0,
-                            -1.0 + 2.0 * b as f64 / 11.0 + 1e-3,
-                            -1.0 + 2.0 * c as f64 / 11.0 + 1e-3,
+                            0.05 + 0.9 * f64::from(a) / 11.0,
+                            -1.0 + 2.0 * f64::from(b) / 11.0 + 1e-3,
+                            -1.0 + 2.0 * f64::from(c) / 11.0 + 1e-3,
                         ];
                         let r = (q[1] * q[1] + q[2] * q[2]).sqrt();
                         let inside = r < 0.99 * (1.0 - q[0]);
@@ -732,7 +751,13 @@ mod tests {
     #[test]
     fn winding_number_of_a_closed_box() {
         let v: Vec<[f64; 3]> = (0..8)
-            .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+            .map(|i| {
+                [
+                    f64::from(i & 1),
+                    f64::from((i >> 1) & 1),
+                    f64::from((i >> 2) & 1),
+                ]
+            })
             .collect();
         let quads = [
             [0u32, 2, 3, 1],

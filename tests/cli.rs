@@ -130,6 +130,7 @@ fn combine(parts: &[(f64, [f64; 3], [f64; 6])]) -> (f64, [f64; 3], [f64; 6]) {
 }
 
 #[test]
+#[allow(clippy::too_many_lines)] // one check per value of the demo robot, in its order
 fn fill_demo_robot_gives_analytic_values() {
     let (urdf, map) = demo();
     let out = run(&[
@@ -258,7 +259,7 @@ fn strip_inertials(text: &str) -> String {
     let mut out = String::new();
     let mut rest = text;
     while let Some(s) = rest.find("<inertial>") {
-        let line_start = rest[..s].rfind('\n').map(|i| i + 1).unwrap_or(0);
+        let line_start = rest[..s].rfind('\n').map_or(0, |i| i + 1);
         out.push_str(&rest[..line_start]);
         let e = s + rest[s..].find("</inertial>").expect("closing") + "</inertial>".len();
         rest = &rest[e..];
@@ -788,7 +789,13 @@ fn json_summary_names_repairs() {
     let tmp = tempfile::tempdir().unwrap();
     // An inside-out box mesh: the summary must say it was flipped.
     let v: Vec<[f64; 3]> = (0..8)
-        .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+        .map(|i| {
+            [
+                f64::from(i & 1),
+                f64::from((i >> 1) & 1),
+                f64::from((i >> 2) & 1),
+            ]
+        })
         .collect();
     let quads = [
         [0u32, 2, 3, 1],

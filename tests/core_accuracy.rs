@@ -137,6 +137,7 @@ struct Case {
     ours_max: f64,
 }
 
+#[allow(clippy::too_many_lines)] // a table of cases
 fn stiff_cases() -> Vec<Case> {
     let cube = box_mesh([1.0, 1.0, 1.0]);
     let sphere = icosphere(6);

@@ -31,7 +31,7 @@ fn revolve(profile: &[(f64, f64)], n: u32) -> Mesh {
     let rings = &profile[1..profile.len() - 1];
     for &(r, z) in rings {
         for i in 0..n {
-            let a = 2.0 * std::f64::consts::PI * i as f64 / n as f64;
+            let a = 2.0 * std::f64::consts::PI * f64::from(i) / f64::from(n);
             v.push([r * a.cos(), r * a.sin(), z]);
         }
     }
@@ -109,9 +109,9 @@ fn regular_prism_matches_its_exact_formula() {
     // n-gon prism, circumradius R, length L: A = n R² sin θ / 2, J = n R⁴ sin θ (2 + cos θ) / 12, θ = 2π/n.
     for n in [3u32, 6, 17, 100] {
         let (rr, l) = (0.7f64, 1.3f64);
-        let th = 2.0 * std::f64::consts::PI / n as f64;
-        let area = n as f64 * rr * rr * th.sin() / 2.0;
-        let j = n as f64 * rr.powi(4) * th.sin() * (2.0 + th.cos()) / 12.0;
+        let th = 2.0 * std::f64::consts::PI / f64::from(n);
+        let area = f64::from(n) * rr * rr * th.sin() / 2.0;
+        let j = f64::from(n) * rr.powi(4) * th.sin() * (2.0 + th.cos()) / 12.0;
         let (v, f) = cylinder_mesh(rr, l, n);
         let mp = MassProperties::from_trimesh(&v, &f, 1.0);
         assert!((mp.mass - area * l).abs() < 1e-14 * area * l);

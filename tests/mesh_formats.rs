@@ -115,6 +115,7 @@ fn dae_text(v: &[[f64; 3]], f: &[[u32; 3]], unit: f64, up: &str, matrix: &str) -
 const IDENTITY: &str = "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1";
 
 #[test]
+#[allow(clippy::too_many_lines)] // one solid written and read back in every format, format after format
 fn same_solid_through_every_reader() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let d = tmp.path();
@@ -214,6 +215,7 @@ fn same_solid_through_every_reader() {
 }
 
 #[test]
+#[allow(clippy::too_many_lines)] // a table of cases
 fn broken_meshes_take_the_documented_rung() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let d = tmp.path();
@@ -410,7 +412,7 @@ fn small_hole_is_capped_exactly() {
     let mut idx = std::collections::HashMap::new();
     let mut id = |p: [i32; 3], v: &mut Vec<[f64; 3]>| -> u32 {
         *idx.entry(p).or_insert_with(|| {
-            v.push(p.map(|c| c as f64 / n as f64));
+            v.push(p.map(|c| f64::from(c) / f64::from(n)));
             (v.len() - 1) as u32
         })
     };
@@ -501,9 +503,9 @@ fn mesh_locator_agrees_with_the_winding_number() {
         for j in 0..21 {
             for k in 0..21 {
                 let q = [
-                    -1.0 + 0.1 * i as f64,
-                    -1.0 + 0.1 * j as f64,
-                    -1.0 + 0.1 * k as f64,
+                    -1.0 + 0.1 * f64::from(i),
+                    -1.0 + 0.1 * f64::from(j),
+                    -1.0 + 0.1 * f64::from(k),
                 ];
                 let w = winding_number(&solid, q);
                 if w.abs() > 1e-6 && (w - 1.0).abs() > 1e-6 {

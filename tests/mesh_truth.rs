@@ -4,6 +4,7 @@
 mod common;
 
 use common::wild::{self, Expect};
+use std::fmt::Write as _;
 use urdf_inertia::mesh::health::HealthOptions;
 
 #[test]
@@ -98,10 +99,10 @@ fn needles_through_the_mesh_command() {
         // `{:?}` writes the shortest text that reads back as the same f64: the file is exact.
         let mut obj = String::new();
         for p in &v {
-            obj += &format!("v {:?} {:?} {:?}\n", p[0], p[1], p[2]);
+            let _ = writeln!(obj, "v {:?} {:?} {:?}", p[0], p[1], p[2]);
         }
         for t in &f {
-            obj += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+            let _ = writeln!(obj, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
         }
         let path = tmp.path().join(name);
         std::fs::write(&path, obj).expect("write");
@@ -153,7 +154,7 @@ fn large_error_estimates_do_not_round_numbers_away() {
     let mut obj = String::new();
     for i in 0..8 {
         let z = f64::from((i >> 2) & 1) + if i == 7 { 0.1 } else { 0.0 };
-        obj += &format!("v {} {} {z}\n", i & 1, (i >> 1) & 1);
+        let _ = writeln!(obj, "v {} {} {z}", i & 1, (i >> 1) & 1);
     }
     for q in [
         [0, 2, 3, 1],
@@ -162,7 +163,7 @@ fn large_error_estimates_do_not_round_numbers_away() {
         [0, 4, 6, 2],
         [1, 3, 7, 5],
     ] {
-        obj += &format!("f {} {} {} {}\n", q[0] + 1, q[1] + 1, q[2] + 1, q[3] + 1);
+        let _ = writeln!(obj, "f {} {} {} {}", q[0] + 1, q[1] + 1, q[2] + 1, q[3] + 1);
     }
     std::fs::write(tmp.path().join("open.obj"), obj).expect("write");
     let urdf = tmp.path().join("r.urdf");

@@ -5,6 +5,7 @@ mod common;
 #[path = "common/gltf_gen.rs"]
 mod gltf_gen;
 
+use std::fmt::Write as _;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::os::unix::fs::{FileTypeExt, MetadataExt, PermissionsExt};
 use std::path::{Path, PathBuf};
@@ -26,9 +27,9 @@ fn stderr(o: &Output) -> String {
 fn boxes(links: &[(&str, &str, &str)]) -> String {
     let mut s = String::from("<robot name=\"r\">\n");
     for (name, size, xyz) in links {
-        s.push_str(&format!(
+        let _ = write!(s,
             "  <link name=\"{name}\">\n    <collision><origin xyz=\"{xyz}\"/><geometry><box size=\"{size}\"/></geometry></collision>\n  </link>\n"
-        ));
+        );
     }
     s.push_str("</robot>\n");
     s
@@ -498,7 +499,7 @@ fn dae_box(id: Option<&str>, size: f64, at: f64) -> String {
     for i in 0..8 {
         for k in 0..3 {
             let c = if i >> k & 1 == 1 { size } else { 0.0 };
-            pos.push_str(&format!("{} ", at + c));
+            let _ = write!(pos, "{} ", at + c);
         }
     }
     let quads = [
@@ -594,11 +595,12 @@ fn collada_offsets_and_counts_are_checked() {
 fn collada_instance_fan_out_has_a_budget() {
     let mut nodes = String::new();
     for i in 0..40 {
-        nodes.push_str(&format!(
-            "<node id=\"n{i}\"><instance_node url=\"#n{}\"/><instance_node url=\"#n{}\"/></node>\n",
+        let _ =
+            writeln!(nodes,
+            "<node id=\"n{i}\"><instance_node url=\"#n{}\"/><instance_node url=\"#n{}\"/></node>",
             i + 1,
             i + 1
-        ));
+        );
     }
     nodes.push_str("<node id=\"n40\"><instance_geometry url=\"#g\"/></node>\n");
     let text = dae(&format!(
@@ -783,7 +785,7 @@ fn density_map_with_thousands_of_rules() {
     let n = 8000;
     let mut text = String::from("[links]\n");
     for i in (0..n).rev() {
-        text.push_str(&format!("\"link_{i}\" = {}.0\n", 1000 + i));
+        let _ = writeln!(text, "\"link_{i}\" = {}.0", 1000 + i);
     }
     let m = DensityMap::parse(&text, Path::new("d.toml")).unwrap();
     assert_eq!(m.links.len(), n);
@@ -801,9 +803,10 @@ fn density_map_with_thousands_of_rules() {
 fn one_link(shapes: &[(String, String)]) -> String {
     let mut s = String::from("<robot name=\"r\">\n  <link name=\"a\">\n");
     for (xyz, g) in shapes {
-        s.push_str(&format!(
-            "    <collision><origin xyz=\"{xyz}\"/><geometry>{g}</geometry></collision>\n"
-        ));
+        let _ = writeln!(
+            s,
+            "    <collision><origin xyz=\"{xyz}\"/><geometry>{g}</geometry></collision>"
+        );
     }
     s.push_str("  </link>\n</robot>\n");
     s
@@ -848,7 +851,7 @@ fn overlap_of_2000_spheres_completes() {
     let chain: Vec<(String, String)> = (0..2000)
         .map(|i| {
             (
-                format!("{} 0 0", d * i as f64),
+                format!("{} 0 0", d * f64::from(i)),
                 format!("<sphere radius=\"{r}\"/>"),
             )
         })
@@ -881,7 +884,7 @@ fn peak_rss() -> u64 {
 fn cone(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
     let mut v = vec![[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]];
     for i in 0..n {
-        let a = 2.0 * std::f64::consts::PI * i as f64 / n as f64;
+        let a = 2.0 * std::f64::consts::PI * f64::from(i) / f64::from(n);
         v.push([0.0, a.cos(), a.sin()]);
     }
     let mut f = Vec::new();
@@ -1043,6 +1046,7 @@ fn fuzz_corpus_replay() {
 /// Small valid files of every format, from the tests' generators and the demo robot, for `fuzz/run.sh`.
 #[test]
 #[ignore = "writes fuzz/seeds; run on purpose"]
+#[allow(clippy::too_many_lines)] // a list of seed files, format after format
 fn write_fuzz_seeds() {
     use gltf_gen::*;
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -1187,8 +1191,7 @@ fn what_it_says(out: &Output, tmp: &Path) -> String {
         .find(|l| l.starts_with("error:"))
         .or_else(|| err.lines().next())
         .or_else(|| stdout.lines().find(|l| l.contains("volume")))
-        .map(str::trim)
-        .unwrap_or("(nothing)");
+        .map_or("(nothing)", str::trim);
     let written = err
         .lines()
         .find(|l| l.contains("nothing written") || l.contains("not written (--keep-going)"))
@@ -1287,7 +1290,7 @@ fn mib(bytes: u64) -> String {
     if bytes < 1 << 20 {
         format!("{:.1} KiB", bytes as f64 / 1024.0)
     } else {
-        format!("{:.1} MiB", bytes as f64 / (1 << 20) as f64)
+        format!("{:.1} MiB", bytes as f64 / f64::from(1 << 20))
     }
 }
 
@@ -1296,9 +1299,9 @@ fn torus(n: u32, m: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
     let tau = 2.0 * std::f64::consts::PI;
     let mut v = Vec::with_capacity((n * m) as usize);
     for i in 0..n {
-        let u = tau * i as f64 / n as f64;
+        let u = tau * f64::from(i) / f64::from(n);
         for j in 0..m {
-            let w = tau * j as f64 / m as f64;
+            let w = tau * f64::from(j) / f64::from(m);
             let r = 1.0 + 0.3 * w.cos();
             v.push([r * u.cos(), r * u.sin(), 0.3 * w.sin()]);
         }
@@ -1315,6 +1318,7 @@ fn torus(n: u32, m: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
 }
 
 /// Rows for large files of every format, and links whose parts overlap many times over.
+#[allow(clippy::too_many_lines)] // a table of large inputs
 fn large_inputs(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)) {
     let (v, f) = torus(1000, 500);
     let a = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
@@ -1335,20 +1339,20 @@ fn large_inputs(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)
     );
     let mut obj = String::new();
     for p in &v {
-        obj.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2]));
+        let _ = writeln!(obj, "v {} {} {}", p[0], p[1], p[2]);
     }
     for t in &f {
-        obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+        let _ = writeln!(obj, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
     }
     put("torus.obj", obj.as_bytes(), "large: OBJ");
     drop(obj);
     let mut pos = String::new();
     for p in &v {
-        pos.push_str(&format!("{} {} {} ", p[0], p[1], p[2]));
+        let _ = write!(pos, "{} {} {} ", p[0], p[1], p[2]);
     }
     let mut idx = String::new();
     for t in &f {
-        idx.push_str(&format!("{} {} {} ", t[0], t[1], t[2]));
+        let _ = write!(idx, "{} {} {} ", t[0], t[1], t[2]);
     }
     let geometry = format!(
         "<geometry id=\"t\"><mesh>\n<source id=\"pos\"><float_array id=\"pa\" count=\"{}\">{pos}</float_array>\n<technique_common><accessor source=\"#pa\" count=\"{}\" stride=\"3\"/></technique_common></source>\n<vertices id=\"vx\"><input semantic=\"POSITION\" source=\"#pos\"/></vertices>\n<triangles count=\"{}\"><input semantic=\"VERTEX\" source=\"#vx\" offset=\"0\"/><p>{idx}</p></triangles>\n</mesh></geometry>\n",
@@ -1377,24 +1381,25 @@ fn large_inputs(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)
             (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]),
         ];
         let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        normals.push_str(&format!("{} {} {} ", n[0] / l, n[1] / l, n[2] / l));
+        let _ = write!(normals, "{} {} {} ", n[0] / l, n[1] / l, n[2] / l);
     }
     let mut uv = String::new();
     for i in 0..v.len() {
-        uv.push_str(&format!(
+        let _ = write!(
+            uv,
             "{} {} ",
             (i / 500) as f64 / 1000.0,
             (i % 500) as f64 / 500.0
-        ));
+        );
     }
     let mut pos = String::new();
     for p in &v {
-        pos.push_str(&format!("{} {} {} ", p[0], p[1], p[2]));
+        let _ = write!(pos, "{} {} {} ", p[0], p[1], p[2]);
     }
     let mut idx = String::new();
     for (k, t) in f.iter().enumerate() {
         for i in t {
-            idx.push_str(&format!("{i} {k} {i} "));
+            let _ = write!(idx, "{i} {k} {i} ");
         }
     }
     let geometry = format!(
@@ -1445,7 +1450,7 @@ fn large_inputs(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)
         (0..2000)
             .map(|i| {
                 (
-                    format!("{} 0 0", 0.375 * i as f64),
+                    format!("{} 0 0", 0.375 * f64::from(i)),
                     "<sphere radius=\"0.25\"/>".into(),
                 )
             })
@@ -1469,6 +1474,7 @@ fn large_inputs(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)
 
 #[test]
 #[ignore = "writes docs/reliability.md; run on purpose"]
+#[allow(clippy::too_many_lines)] // writes one report table, row kind after row kind
 fn write_reliability_table() {
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path();
@@ -1607,7 +1613,11 @@ fn write_reliability_table() {
     let lib = |g: &str| dae(&format!("<library_geometries>{g}</library_geometries>\n"));
     let mut fan = String::new();
     for i in 0..40 {
-        fan.push_str(&format!("<node id=\"n{i}\"><instance_node url=\"#n{0}\"/><instance_node url=\"#n{0}\"/></node>\n", i + 1));
+        let _ = writeln!(
+            fan,
+            "<node id=\"n{i}\"><instance_node url=\"#n{0}\"/><instance_node url=\"#n{0}\"/></node>",
+            i + 1
+        );
     }
     fan.push_str("<node id=\"n40\"><instance_geometry url=\"#g\"/></node>\n");
     let dae_cases = [
@@ -1655,11 +1665,12 @@ fn write_reliability_table() {
     }
     md.push_str("\n## Large inputs: peak memory against file size\n\n`urdf-inertia mesh FILE` on one closed torus of 1,000,000 triangles (500,000 vertices) written in each format by the same generator: read, weld, heal and integrate. Peak memory is about k × the file size, with k in the last column: what stays is the mesh as read (f64 coordinates) and the welded, healed solid, about 140 to 190 MiB per million triangles whatever the format, plus the file's bytes while it is parsed. So k is largest for compact binary files (glTF's f32 positions and shared vertices) and smallest for verbose text (ASCII STL, whose bytes dominate). `URDF_INERTIA_BIN=OTHER_BUILD` runs the same rows with another build, to compare.\n\n| input | input size | what the tool does | exit | peak memory | time | peak / size |\n| --- | --- | --- | --- | --- | --- | --- |\n");
     for row in rows.iter().filter(|r| r.large) {
-        md.push_str(&format!(
-            "{} {:.2} |\n",
+        let _ = writeln!(
+            md,
+            "{} {:.2} |",
             row.markdown(d).trim_end(),
             row.peak.map_or(f64::NAN, |p| p as f64 / row.size as f64)
-        ));
+        );
     }
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/reliability.md");
     std::fs::write(&path, md).unwrap();

@@ -6,6 +6,7 @@
 //! they are the demo robot's URDF, its density map and its shoulder mesh, copied under those names
 //! into the `urdf/` folder of a temporary copy of the demo package, where the commands run.
 
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -112,7 +113,7 @@ fn readme_commands() {
         let (_tmp, dir) = workspace();
         let mut text = transcript(&dir, line);
         if let Some(file) = written {
-            text.push_str(&format!("--- {file}\n"));
+            let _ = writeln!(text, "--- {file}");
             text.push_str(&std::fs::read_to_string(dir.join(file)).expect("written file"));
         }
         settings(&dir).bind(|| insta::assert_snapshot!(name, text));
@@ -137,6 +138,7 @@ fn noisy(text: &str) -> Vec<String> {
 /// Issue 12: the demo's default output has no round-off noise and no warning, filling it again changes
 /// nothing, and the rounded values pass `check` and `diff`.
 #[test]
+#[allow(clippy::too_many_lines)] // one scenario checked step by step
 fn demo_output_is_clean_idempotent_and_passes_check() {
     let (_tmp, dir) = workspace();
     let run = |args: &[&str]| {

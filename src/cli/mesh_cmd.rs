@@ -4,7 +4,7 @@ use super::args::{Format, MeshArgs};
 use super::ExitStatus;
 use serde_json::json;
 use urdf_inertia::mass::{MassProperties, Principal};
-use urdf_inertia::mesh::{self, health::HealthOptions};
+use urdf_inertia::mesh::{self, health::HealthOptions, health::Solid};
 use urdf_inertia::text::{round_significant, shortest, within, Digits};
 
 pub fn run(args: &MeshArgs) -> ExitStatus {
@@ -12,13 +12,8 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         Some([x, y, z]) => [*x, *y, *z],
         _ => [1.0; 3],
     };
-    for (name, v) in [("--density", args.density), ("--mass", args.mass)] {
-        if let Some(v) = v {
-            if !(v > 0.0 && v.is_finite()) {
-                errln!("error: {name} {v} must be a positive number");
-                return ExitStatus::Error;
-            }
-        }
+    if !options_valid(args) {
+        return ExitStatus::Error;
     }
     let start = std::time::Instant::now();
     let solid = match mesh::load_solid(
@@ -45,8 +40,45 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         errln!("error: {}: {why}", args.file.display());
         return ExitStatus::Error;
     }
-    // Written within the solid's own error estimate (see `text`), like every other number; with
-    // `--digits full` every bit, with N digits rounded to N significant digits.
+    let out = rounded(args, &solid, volume, density, &mp);
+    let elapsed = start.elapsed();
+    match args.format {
+        Format::Json => print_json(args, scale, &solid, &out),
+        Format::Text => print_text(args, scale, &solid, &out, elapsed),
+    }
+    ExitStatus::Success
+}
+
+/// Whether `--density` and `--mass`, if given, are positive numbers (an error is printed if not).
+fn options_valid(args: &MeshArgs) -> bool {
+    for (name, v) in [("--density", args.density), ("--mass", args.mass)] {
+        if let Some(v) = v {
+            if !(v > 0.0 && v.is_finite()) {
+                errln!("error: {name} {v} must be a positive number");
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// The numbers `mesh` prints, rounded.
+struct Rounded {
+    volume: f64,
+    density: f64,
+    mp: MassProperties,
+    pr: Principal,
+}
+
+/// Rounds the results within the solid's own error estimate (see `text`), like every other number;
+/// with `--digits full` every bit, with N digits to N significant digits.
+fn rounded(
+    args: &MeshArgs,
+    solid: &Solid,
+    volume: f64,
+    density: f64,
+    mp: &MassProperties,
+) -> Rounded {
     let round = |x: f64, delta: f64| match args.digits {
         Digits::Auto => within(x, delta),
         Digits::Full => x,
@@ -73,96 +105,120 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         moments: pr.moments.map(|x| round(x, err * largest)),
         axes: pr.axes,
     };
-    let elapsed = start.elapsed();
-    let diagnostics = urdf_inertia::diagnostic::mesh_health(&solid);
-    match args.format {
-        Format::Json => {
-            let axes: Vec<Vec<f64>> = (0..3)
-                .map(|c| (0..3).map(|r| pr.axes[r][c]).collect())
-                .collect();
-            let v = json!({
-                "file": args.file.display().to_string(),
-                "scale": scale,
-                "volume": volume,
-                "density": density,
-                "mass": mp.mass,
-                "center_of_mass": mp.com,
-                "inertia": mp.inertia,
-                "principal_moments": pr.moments,
-                "principal_axes": axes,
-                "provenance": solid.rung.name(),
-                "faces": solid.faces.len(),
-                "faces_read": solid.faces_read,
-                "vertices": solid.vertices.len(),
-                "error_estimate": solid.error_estimate,
-                "error_round_off": solid.error.round_off,
-                "error_model": solid.error.model,
-                "error_model_source": solid.error.source.name(),
-                "error_center_of_mass": solid.error.com,
-                "warnings": diagnostics.iter().filter(|d| d.is_warning()).collect::<Vec<_>>(),
-                "notes": diagnostics.iter().filter(|d| !d.is_warning()).collect::<Vec<_>>(),
-            });
-            outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
-        }
-        Format::Text => {
-            outln!(
-                "{}  (scale {} {} {})",
-                args.file.display(),
-                scale[0],
-                scale[1],
-                scale[2]
-            );
-            outln!(
-                "  health            {} ({} faces read; the solid has {} faces, {} vertices)",
-                solid.rung.name(),
-                solid.faces_read,
-                solid.faces.len(),
-                solid.vertices.len()
-            );
-            outln!("  volume            {} m³", shortest(volume));
-            outln!("  density           {} kg/m³", shortest(density));
-            outln!("  mass              {} kg", shortest(mp.mass));
-            outln!(
-                "  centre of mass    {} {} {} m",
-                shortest(mp.com[0]),
-                shortest(mp.com[1]),
-                shortest(mp.com[2])
-            );
-            outln!("  inertia about the COM (kg·m², mesh axes)");
-            for row in &mp.inertia {
-                outln!(
-                    "    {:>24} {:>24} {:>24}",
-                    shortest(row[0]),
-                    shortest(row[1]),
-                    shortest(row[2])
-                );
-            }
-            outln!(
-                "  principal moments {} {} {}",
-                shortest(pr.moments[0]),
-                shortest(pr.moments[1]),
-                shortest(pr.moments[2])
-            );
-            for (k, name) in ["axis 1", "axis 2", "axis 3"].iter().enumerate() {
-                outln!(
-                    "  principal {name}  {:.9} {:.9} {:.9}",
-                    pr.axes[0][k],
-                    pr.axes[1][k],
-                    pr.axes[2][k]
-                );
-            }
-            outln!(
-                "  error estimate    {} (relative bound on volume and central inertia)",
-                solid.error.describe()
-            );
-            outln!("  time              {:.3} ms", elapsed.as_secs_f64() * 1e3);
-            for w in &solid.warnings {
-                outln!("  warning: {w}");
-            }
-            for n in &solid.notes {
-                outln!("  note: {n}");
-            }
-        }
+    Rounded {
+        volume,
+        density,
+        mp,
+        pr,
     }
-    ExitStatus::Success
+}
+
+/// `--format json`: one object with the results, the solid's health and its diagnostics.
+fn print_json(args: &MeshArgs, scale: [f64; 3], solid: &Solid, out: &Rounded) {
+    let Rounded {
+        volume,
+        density,
+        ref mp,
+        ref pr,
+    } = *out;
+    let diagnostics = urdf_inertia::diagnostic::mesh_health(solid);
+    let axes: Vec<Vec<f64>> = (0..3)
+        .map(|c| (0..3).map(|r| pr.axes[r][c]).collect())
+        .collect();
+    let v = json!({
+        "file": args.file.display().to_string(),
+        "scale": scale,
+        "volume": volume,
+        "density": density,
+        "mass": mp.mass,
+        "center_of_mass": mp.com,
+        "inertia": mp.inertia,
+        "principal_moments": pr.moments,
+        "principal_axes": axes,
+        "provenance": solid.rung.name(),
+        "faces": solid.faces.len(),
+        "faces_read": solid.faces_read,
+        "vertices": solid.vertices.len(),
+        "error_estimate": solid.error_estimate,
+        "error_round_off": solid.error.round_off,
+        "error_model": solid.error.model,
+        "error_model_source": solid.error.source.name(),
+        "error_center_of_mass": solid.error.com,
+        "warnings": diagnostics.iter().filter(|d| d.is_warning()).collect::<Vec<_>>(),
+        "notes": diagnostics.iter().filter(|d| !d.is_warning()).collect::<Vec<_>>(),
+    });
+    outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+}
+
+/// `--format text`: the results one per line, for people.
+fn print_text(
+    args: &MeshArgs,
+    scale: [f64; 3],
+    solid: &Solid,
+    out: &Rounded,
+    elapsed: std::time::Duration,
+) {
+    let Rounded {
+        volume,
+        density,
+        ref mp,
+        ref pr,
+    } = *out;
+    outln!(
+        "{}  (scale {} {} {})",
+        args.file.display(),
+        scale[0],
+        scale[1],
+        scale[2]
+    );
+    outln!(
+        "  health            {} ({} faces read; the solid has {} faces, {} vertices)",
+        solid.rung.name(),
+        solid.faces_read,
+        solid.faces.len(),
+        solid.vertices.len()
+    );
+    outln!("  volume            {} m³", shortest(volume));
+    outln!("  density           {} kg/m³", shortest(density));
+    outln!("  mass              {} kg", shortest(mp.mass));
+    outln!(
+        "  centre of mass    {} {} {} m",
+        shortest(mp.com[0]),
+        shortest(mp.com[1]),
+        shortest(mp.com[2])
+    );
+    outln!("  inertia about the COM (kg·m², mesh axes)");
+    for row in &mp.inertia {
+        outln!(
+            "    {:>24} {:>24} {:>24}",
+            shortest(row[0]),
+            shortest(row[1]),
+            shortest(row[2])
+        );
+    }
+    outln!(
+        "  principal moments {} {} {}",
+        shortest(pr.moments[0]),
+        shortest(pr.moments[1]),
+        shortest(pr.moments[2])
+    );
+    for (k, name) in ["axis 1", "axis 2", "axis 3"].iter().enumerate() {
+        outln!(
+            "  principal {name}  {:.9} {:.9} {:.9}",
+            pr.axes[0][k],
+            pr.axes[1][k],
+            pr.axes[2][k]
+        );
+    }
+    outln!(
+        "  error estimate    {} (relative bound on volume and central inertia)",
+        solid.error.describe()
+    );
+    outln!("  time              {:.3} ms", elapsed.as_secs_f64() * 1e3);
+    for w in &solid.warnings {
+        outln!("  warning: {w}");
+    }
+    for n in &solid.notes {
+        outln!("  note: {n}");
+    }
 }

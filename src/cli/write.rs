@@ -145,7 +145,7 @@ fn write_direct(p: &Path, text: &[u8]) -> Result<(), String> {
     let fail = |e: io::Error| format!("{}: cannot write: {e}", p.display());
     let mut f = OpenOptions::new().write(true).open(p).map_err(fail)?;
     // `/dev/stdout` redirected to a file: start it afresh, as `>` does. Devices and FIFOs are not touched.
-    if f.metadata().map(|m| m.is_file()).unwrap_or(false) {
+    if f.metadata().is_ok_and(|m| m.is_file()) {
         f.set_len(0).map_err(fail)?;
     }
     f.write_all(text).and_then(|()| f.flush()).map_err(fail)
@@ -164,8 +164,7 @@ fn replace_through_temp(
         .unwrap_or(Path::new("."));
     let name = target
         .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "urdf".into());
+        .map_or_else(|| "urdf".into(), |n| n.to_string_lossy().into_owned());
     let tmp = dir.join(format!(
         ".{name}.urdf-inertia.{}.{}.tmp",
         std::process::id(),

@@ -509,8 +509,8 @@ pub fn mirtich_polygons(
     finish(acc.total(), reference, [1.0, 2.0, 3.0, 2.0])
 }
 
-/// One face's contribution to the (not yet halved/thirded) sums of Figure 4, or `None` for zero area.
-fn polygon_terms(p: &[[f64; 3]]) -> Option<[f64; 10]> {
+/// A face's unit normal from Newell's formula (robust for non-planar polygons), or `None` for zero area.
+fn unit_normal(p: &[[f64; 3]]) -> Option<[f64; 3]> {
     // Newell's normal: twice the vector area.
     let mut n = [0.0f64; 3];
     for i in 0..p.len() {
@@ -523,15 +523,25 @@ fn polygon_terms(p: &[[f64; 3]]) -> Option<[f64; 10]> {
     if len == 0.0 || !len.is_finite() {
         return None;
     }
-    let n = [n[0] / len, n[1] / len, n[2] / len];
-    // γ = the axis of the largest normal component; α, β follow cyclically (right-handed).
-    let (ax, bx, cx) = if n[0].abs() > n[1].abs() && n[0].abs() > n[2].abs() {
+    Some([n[0] / len, n[1] / len, n[2] / len])
+}
+
+/// Mirtich's (α, β, γ): γ is the axis of the largest normal component (the best-conditioned
+/// projection); α, β follow cyclically (right-handed).
+fn projection_axes(n: &[f64; 3]) -> (usize, usize, usize) {
+    if n[0].abs() > n[1].abs() && n[0].abs() > n[2].abs() {
         (1, 2, 0)
     } else if n[1].abs() > n[2].abs() {
         (2, 0, 1)
     } else {
         (0, 1, 2)
-    };
+    }
+}
+
+/// One face's contribution to the (not yet halved/thirded) sums of Figure 4, or `None` for zero area.
+fn polygon_terms(p: &[[f64; 3]]) -> Option<[f64; 10]> {
+    let n = unit_normal(p)?;
+    let (ax, bx, cx) = projection_axes(&n);
     let pr = projection_integrals(p, ax, bx);
     // w = -n·p for a point on the face; the mean of the vertices is the best-fit choice.
     let inv = 1.0 / p.len() as f64;

@@ -110,6 +110,8 @@ fn element(e: &quick_xml::events::BytesStart<'_>, line: usize) -> El {
     el
 }
 
+/// Reads the document into a tree of elements, with each element's text kept as a span of the file
+/// where it can be.
 fn parse_tree(bytes: &[u8], path: &Path) -> Result<El, MeshError> {
     let mut reader = Reader::from_reader(bytes);
     reader.config_mut().trim_text(false);
@@ -155,31 +157,8 @@ fn parse_tree(bytes: &[u8], path: &Path) -> Result<El, MeshError> {
                 }
             }
             Event::Text(t) => {
-                let piece: &[u8] = t.as_ref();
                 if let Some(top) = stack.last_mut() {
-                    if piece.iter().all(u8::is_ascii_whitespace) {
-                        // Nothing to keep, unless it separates two pieces.
-                        if !matches!(top.text, Text::None) {
-                            top.text = Text::Joined(format!("{} ", top.text(bytes)));
-                        }
-                        continue;
-                    }
-                    // The event borrows the file's bytes from `pos` on; the span is checked anyway.
-                    let span = (pos, pos + piece.len());
-                    let borrowed = bytes.get(span.0..span.1) == Some(piece);
-                    top.text = match std::mem::take(&mut top.text) {
-                        Text::None if borrowed => Text::Span(span.0, span.1),
-                        Text::None => Text::Joined(String::from_utf8_lossy(piece).into_owned()),
-                        Text::Span(a, b) => {
-                            let mut s = String::from_utf8_lossy(&bytes[a..b]).into_owned();
-                            s.push_str(&String::from_utf8_lossy(piece));
-                            Text::Joined(s)
-                        }
-                        Text::Joined(mut s) => {
-                            s.push_str(&String::from_utf8_lossy(piece));
-                            Text::Joined(s)
-                        }
-                    };
+                    add_text(top, t.as_ref(), pos, bytes);
                 }
             }
             Event::Eof => break,
@@ -194,6 +173,34 @@ fn parse_tree(bytes: &[u8], path: &Path) -> Result<El, MeshError> {
         ));
     }
     Ok(stack.pop().unwrap_or_default())
+}
+
+/// Adds a piece of text to `top`: a span of `bytes` while it is one piece borrowed from the file at `pos`,
+/// joined text otherwise. Whitespace only matters between two pieces.
+fn add_text(top: &mut El, piece: &[u8], pos: usize, bytes: &[u8]) {
+    if piece.iter().all(u8::is_ascii_whitespace) {
+        // Nothing to keep, unless it separates two pieces.
+        if !matches!(top.text, Text::None) {
+            top.text = Text::Joined(format!("{} ", top.text(bytes)));
+        }
+        return;
+    }
+    // The event borrows the file's bytes from `pos` on; the span is checked anyway.
+    let span = (pos, pos + piece.len());
+    let borrowed = bytes.get(span.0..span.1) == Some(piece);
+    top.text = match std::mem::take(&mut top.text) {
+        Text::None if borrowed => Text::Span(span.0, span.1),
+        Text::None => Text::Joined(String::from_utf8_lossy(piece).into_owned()),
+        Text::Span(a, b) => {
+            let mut s = String::from_utf8_lossy(&bytes[a..b]).into_owned();
+            s.push_str(&String::from_utf8_lossy(piece));
+            Text::Joined(s)
+        }
+        Text::Joined(mut s) => {
+            s.push_str(&String::from_utf8_lossy(piece));
+            Text::Joined(s)
+        }
+    };
 }
 
 type Affine = (Mat3, [f64; 3]);
@@ -306,6 +313,14 @@ fn axis_angle(axis: [f64; 3], angle: f64) -> Mat3 {
     ]
 }
 
+/// A syntax error at `line`.
+fn syntax_at(path: &Path, line: usize, msg: String) -> MeshError {
+    MeshError::new(path, Some(line), MeshErrorKind::Syntax(msg))
+}
+
+/// A position source: its `<float_array>`, the accessor's stride and offset, and the accessor's line.
+type Source<'a> = (&'a El, usize, usize, usize);
+
 /// Geometry of one `<mesh>`: positions and polygons.
 fn read_geometry(
     geom: &El,
@@ -320,79 +335,7 @@ fn read_geometry(
         ));
         return Ok((Vec::new(), Polygons::new()));
     };
-    let err =
-        |line: usize, msg: String| MeshError::new(path, Some(line), MeshErrorKind::Syntax(msg));
-    // Sources by id, read only when a VERTEX input asks for their positions (normals and texture
-    // coordinates are never parsed).
-    let mut sources: HashMap<&str, (&El, usize, usize, usize)> = HashMap::new();
-    for src in mesh.children_named("source") {
-        let Some(id) = src.attr("id") else { continue };
-        let Some(arr) = src.child("float_array") else {
-            continue;
-        };
-        let (stride, offset, line) = src
-            .child("technique_common")
-            .and_then(|t| t.child("accessor"))
-            .map(|a| {
-                (
-                    a.attr("stride")
-                        .and_then(|s| s.parse().ok())
-                        .unwrap_or(1usize),
-                    a.attr("offset")
-                        .and_then(|s| s.parse().ok())
-                        .unwrap_or(0usize),
-                    a.line,
-                )
-            })
-            .unwrap_or((3, 0, src.line));
-        sources.insert(id, (arr, stride.max(1), offset, line));
-    }
-    let positions_of = |source_ref: &str, line: usize| -> Result<Vec<[f64; 3]>, MeshError> {
-        let id = source_ref.trim_start_matches('#');
-        // A <vertices> element forwards to its POSITION input.
-        let id = if let Some(v) = mesh
-            .children_named("vertices")
-            .find(|v| v.attr("id") == Some(id))
-        {
-            v.children_named("input")
-                .find(|i| i.attr("semantic") == Some("POSITION"))
-                .and_then(|i| i.attr("source"))
-                .map(|s| s.trim_start_matches('#'))
-                .ok_or_else(|| err(v.line, "<vertices> without a POSITION input".into()))?
-        } else {
-            id
-        };
-        let &(arr, stride, offset, accessor_line) = sources
-            .get(id)
-            .ok_or_else(|| err(line, format!("no <source id=\"{id}\">")))?;
-        if stride < 3 {
-            return Err(err(
-                line,
-                format!("position source `{id}` has stride {stride}"),
-            ));
-        }
-        if offset.checked_add(3).is_none_or(|end| end > stride) {
-            return Err(err(
-                accessor_line,
-                format!("<accessor> of `{id}`: offset {offset} leaves no room for x, y, z in its stride {stride}"),
-            ));
-        }
-        // Straight from the text into points: one stride of numbers at a time.
-        let text = arr.text(bytes);
-        let mut out = Vec::new();
-        let mut record = vec![0.0; stride];
-        let mut filled = 0;
-        for x in each_number(arr, &text, path) {
-            record[filled] = x?;
-            filled += 1;
-            if filled == stride {
-                out.push([record[offset], record[offset + 1], record[offset + 2]]);
-                filled = 0;
-            }
-        }
-        Ok(out)
-    };
-
+    let sources = sources(mesh);
     let mut vertices: Vec<[f64; 3]> = Vec::new();
     let mut faces = Polygons::new();
     let mut cache: HashMap<String, (u32, usize)> = HashMap::new();
@@ -402,135 +345,288 @@ fn read_geometry(
             "triangles" | "polylist" | "polygons" => {}
             "lines" | "linestrips" | "source" | "vertices" | "extra" => continue,
             "tristrips" | "trifans" => {
-                return Err(err(
+                return Err(syntax_at(
+                    path,
                     prim.line,
                     format!("<{kind}> is not supported; re-export the mesh with triangles"),
                 ));
             }
             _ => continue,
         }
-        let inputs: Vec<&El> = prim.children_named("input").collect();
-        let stride = inputs
-            .iter()
-            .filter_map(|i| i.attr("offset").and_then(|o| o.parse::<usize>().ok()))
-            .max()
-            .unwrap_or(0)
-            .checked_add(1)
-            .ok_or_else(|| {
-                err(
-                    prim.line,
-                    format!("<{kind}> has an <input> offset too large"),
-                )
-            })?;
-        let vin = inputs
-            .iter()
-            .find(|i| i.attr("semantic") == Some("VERTEX"))
-            .ok_or_else(|| err(prim.line, format!("<{kind}> has no VERTEX input")))?;
-        let voff: usize = vin.attr("offset").and_then(|o| o.parse().ok()).unwrap_or(0);
+        let (vin, stride, voff) = vertex_input(prim, kind, path)?;
         let src = vin.attr("source").unwrap_or("");
         // Each distinct source is appended once; its indices may only reach its own vertices.
         let (base, count) = match cache.get(src) {
             Some(&bc) => bc,
             None => {
-                let pos = positions_of(src, vin.line)?;
+                let pos = positions_of(mesh, &sources, src, vin.line, bytes, path)?;
                 let bc = (vertices.len() as u32, pos.len());
                 vertices.extend(pos);
                 cache.insert(src.to_string(), bc);
                 bc
             }
         };
-        let index = |raw: f64, line: usize| -> Result<u32, MeshError> {
-            if raw < 0.0 || raw.fract() != 0.0 || raw >= count as f64 {
-                return Err(MeshError::new(
-                    path,
-                    Some(line),
-                    MeshErrorKind::IndexOutOfRange {
-                        index: raw as i64,
-                        vertices: count,
-                    },
-                ));
-            }
-            Ok(base + raw as u32)
+        let input = VertexInput {
+            stride,
+            voff,
+            base,
+            count,
         };
-        let mut face: Vec<u32> = Vec::new();
         match kind {
-            "triangles" => {
-                let Some(p) = prim.child("p") else { continue };
-                // One triangle's numbers at a time; only each corner's VERTEX index is kept, and a
-                // trailing incomplete triangle is ignored.
-                let text = p.text(bytes);
-                let mut corner = [0.0; 3];
-                let mut at = 0usize;
-                for x in each_number(p, &text, path) {
-                    let x = x?;
-                    if at % stride == voff {
-                        corner[at / stride] = x;
-                    }
-                    at += 1;
-                    if at == 3 * stride {
-                        at = 0;
-                        face.clear();
-                        for c in corner {
-                            face.push(index(c, p.line)?);
-                        }
-                        faces.push(&face);
-                    }
-                }
-            }
-            "polylist" => {
-                let Some(p) = prim.child("p") else { continue };
-                let vcount = prim
-                    .child("vcount")
-                    .map(|v| numbers(v, bytes, path))
-                    .transpose()?
-                    .unwrap_or_default();
-                let more = || {
-                    err(
-                        p.line,
-                        "<polylist> <vcount> asks for more indices than <p> holds".into(),
-                    )
-                };
-                let text = p.text(bytes);
-                let mut idx = each_number(p, &text, path);
-                for n in vcount {
-                    if !(n >= 0.0 && n.fract() == 0.0 && n <= text.len() as f64) {
-                        return Err(more());
-                    }
-                    face.clear();
-                    for _ in 0..n as usize {
-                        let mut vertex = None;
-                        for k in 0..stride {
-                            let x = idx.next().ok_or_else(more)??;
-                            if k == voff {
-                                vertex = Some(x);
-                            }
-                        }
-                        face.push(index(vertex.unwrap_or(-1.0), p.line)?);
-                    }
-                    if face.len() >= 3 {
-                        faces.push(&face);
-                    }
-                }
-            }
-            _ => {
-                // <polygons>: one <p> per polygon; <ph> (polygons with holes) are not supported.
-                if prim.child("ph").is_some() {
-                    notes.push("warning: <polygons> with holes (<ph>) skipped".into());
-                }
-                for p in prim.children_named("p") {
-                    let idx = numbers(p, bytes, path)?;
-                    face.clear();
-                    for chunk in idx.chunks_exact(stride) {
-                        face.push(index(chunk[voff], p.line)?);
-                    }
-                    if face.len() >= 3 {
-                        faces.push(&face);
-                    }
-                }
-            }
+            "triangles" => read_triangles(prim, &input, bytes, path, &mut faces)?,
+            "polylist" => read_polylist(prim, &input, bytes, path, &mut faces)?,
+            _ => read_polygons(prim, &input, bytes, path, &mut faces, notes)?,
         }
     }
     Ok((vertices, faces))
+}
+
+/// Sources by id, read only when a VERTEX input asks for their positions (normals and texture
+/// coordinates are never parsed).
+fn sources(mesh: &El) -> HashMap<&str, Source<'_>> {
+    let mut sources: HashMap<&str, Source<'_>> = HashMap::new();
+    for src in mesh.children_named("source") {
+        let Some(id) = src.attr("id") else { continue };
+        let Some(arr) = src.child("float_array") else {
+            continue;
+        };
+        let (stride, offset, line) = src
+            .child("technique_common")
+            .and_then(|t| t.child("accessor"))
+            .map_or((3, 0, src.line), |a| {
+                (
+                    a.attr("stride")
+                        .and_then(|s| s.parse().ok())
+                        .unwrap_or(1usize),
+                    a.attr("offset")
+                        .and_then(|s| s.parse().ok())
+                        .unwrap_or(0usize),
+                    a.line,
+                )
+            });
+        sources.insert(id, (arr, stride.max(1), offset, line));
+    }
+    sources
+}
+
+/// The points of the position source `source_ref` names (through a `<vertices>` element if it names
+/// one), read straight from the text.
+fn positions_of(
+    mesh: &El,
+    sources: &HashMap<&str, Source<'_>>,
+    source_ref: &str,
+    line: usize,
+    bytes: &[u8],
+    path: &Path,
+) -> Result<Vec<[f64; 3]>, MeshError> {
+    let id = source_ref.trim_start_matches('#');
+    // A <vertices> element forwards to its POSITION input.
+    let id = if let Some(v) = mesh
+        .children_named("vertices")
+        .find(|v| v.attr("id") == Some(id))
+    {
+        v.children_named("input")
+            .find(|i| i.attr("semantic") == Some("POSITION"))
+            .and_then(|i| i.attr("source"))
+            .map(|s| s.trim_start_matches('#'))
+            .ok_or_else(|| syntax_at(path, v.line, "<vertices> without a POSITION input".into()))?
+    } else {
+        id
+    };
+    let &(arr, stride, offset, accessor_line) = sources
+        .get(id)
+        .ok_or_else(|| syntax_at(path, line, format!("no <source id=\"{id}\">")))?;
+    if stride < 3 {
+        return Err(syntax_at(
+            path,
+            line,
+            format!("position source `{id}` has stride {stride}"),
+        ));
+    }
+    if offset.checked_add(3).is_none_or(|end| end > stride) {
+        return Err(syntax_at(path,
+            accessor_line,
+            format!("<accessor> of `{id}`: offset {offset} leaves no room for x, y, z in its stride {stride}"),
+        ));
+    }
+    // Straight from the text into points: one stride of numbers at a time.
+    let text = arr.text(bytes);
+    let mut out = Vec::new();
+    let mut record = vec![0.0; stride];
+    let mut filled = 0;
+    for x in each_number(arr, &text, path) {
+        record[filled] = x?;
+        filled += 1;
+        if filled == stride {
+            out.push([record[offset], record[offset + 1], record[offset + 2]]);
+            filled = 0;
+        }
+    }
+    Ok(out)
+}
+
+/// A primitive's VERTEX input, the number of interleaved inputs per corner, and the VERTEX one's offset.
+fn vertex_input<'a>(
+    prim: &'a El,
+    kind: &str,
+    path: &Path,
+) -> Result<(&'a El, usize, usize), MeshError> {
+    let inputs: Vec<&El> = prim.children_named("input").collect();
+    let stride = inputs
+        .iter()
+        .filter_map(|i| i.attr("offset").and_then(|o| o.parse::<usize>().ok()))
+        .max()
+        .unwrap_or(0)
+        .checked_add(1)
+        .ok_or_else(|| {
+            syntax_at(
+                path,
+                prim.line,
+                format!("<{kind}> has an <input> offset too large"),
+            )
+        })?;
+    let vin = inputs
+        .iter()
+        .find(|i| i.attr("semantic") == Some("VERTEX"))
+        .ok_or_else(|| syntax_at(path, prim.line, format!("<{kind}> has no VERTEX input")))?;
+    let voff: usize = vin.attr("offset").and_then(|o| o.parse().ok()).unwrap_or(0);
+    Ok((vin, stride, voff))
+}
+
+/// Where a primitive's VERTEX indices are among its interleaved inputs, and where the vertices they
+/// reach are in the geometry's list.
+struct VertexInput {
+    stride: usize,
+    voff: usize,
+    base: u32,
+    count: usize,
+}
+
+impl VertexInput {
+    /// The geometry vertex of a raw VERTEX index, which must be a whole number below the source's count.
+    fn index(&self, raw: f64, line: usize, path: &Path) -> Result<u32, MeshError> {
+        if raw < 0.0 || raw.fract() != 0.0 || raw >= self.count as f64 {
+            return Err(MeshError::new(
+                path,
+                Some(line),
+                MeshErrorKind::IndexOutOfRange {
+                    index: raw as i64,
+                    vertices: self.count,
+                },
+            ));
+        }
+        Ok(self.base + raw as u32)
+    }
+}
+
+/// `<triangles>`: one triangle's numbers at a time from its `<p>`.
+fn read_triangles(
+    prim: &El,
+    input: &VertexInput,
+    bytes: &[u8],
+    path: &Path,
+    faces: &mut Polygons,
+) -> Result<(), MeshError> {
+    let mut face: Vec<u32> = Vec::new();
+    let Some(p) = prim.child("p") else {
+        return Ok(());
+    };
+    // One triangle's numbers at a time; only each corner's VERTEX index is kept, and a
+    // trailing incomplete triangle is ignored.
+    let text = p.text(bytes);
+    let mut corner = [0.0; 3];
+    let mut at = 0usize;
+    for x in each_number(p, &text, path) {
+        let x = x?;
+        if at % input.stride == input.voff {
+            corner[at / input.stride] = x;
+        }
+        at += 1;
+        if at == 3 * input.stride {
+            at = 0;
+            face.clear();
+            for c in corner {
+                face.push(input.index(c, p.line, path)?);
+            }
+            faces.push(&face);
+        }
+    }
+    Ok(())
+}
+
+/// `<polylist>`: polygons of `<vcount>` corners each from one `<p>`.
+fn read_polylist(
+    prim: &El,
+    input: &VertexInput,
+    bytes: &[u8],
+    path: &Path,
+    faces: &mut Polygons,
+) -> Result<(), MeshError> {
+    let mut face: Vec<u32> = Vec::new();
+    let Some(p) = prim.child("p") else {
+        return Ok(());
+    };
+    let vcount = prim
+        .child("vcount")
+        .map(|v| numbers(v, bytes, path))
+        .transpose()?
+        .unwrap_or_default();
+    let more = || {
+        syntax_at(
+            path,
+            p.line,
+            "<polylist> <vcount> asks for more indices than <p> holds".into(),
+        )
+    };
+    let text = p.text(bytes);
+    let mut idx = each_number(p, &text, path);
+    for n in vcount {
+        if !(n >= 0.0 && n.fract() == 0.0 && n <= text.len() as f64) {
+            return Err(more());
+        }
+        face.clear();
+        for _ in 0..n as usize {
+            let mut vertex = None;
+            for k in 0..input.stride {
+                let x = idx.next().ok_or_else(more)??;
+                if k == input.voff {
+                    vertex = Some(x);
+                }
+            }
+            face.push(input.index(vertex.unwrap_or(-1.0), p.line, path)?);
+        }
+        if face.len() >= 3 {
+            faces.push(&face);
+        }
+    }
+    Ok(())
+}
+
+/// `<polygons>`: one `<p>` per polygon.
+fn read_polygons(
+    prim: &El,
+    input: &VertexInput,
+    bytes: &[u8],
+    path: &Path,
+    faces: &mut Polygons,
+    notes: &mut Vec<String>,
+) -> Result<(), MeshError> {
+    let mut face: Vec<u32> = Vec::new();
+    // <polygons>: one <p> per polygon; <ph> (polygons with holes) are not supported.
+    if prim.child("ph").is_some() {
+        notes.push("warning: <polygons> with holes (<ph>) skipped".into());
+    }
+    for p in prim.children_named("p") {
+        let idx = numbers(p, bytes, path)?;
+        face.clear();
+        for chunk in idx.chunks_exact(input.stride) {
+            face.push(input.index(chunk[input.voff], p.line, path)?);
+        }
+        if face.len() >= 3 {
+            faces.push(&face);
+        }
+    }
+    Ok(())
 }
 
 /// Parses a COLLADA document into one mesh in the file's frame (see the module docs for the convention).
@@ -547,7 +643,6 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
                 MeshErrorKind::Syntax("no <COLLADA> root element".into()),
             )
         })?;
-    let mut notes = Vec::new();
     let unit = root
         .child("asset")
         .and_then(|a| a.child("unit"))
@@ -562,44 +657,95 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         .filter_map(|e| e.attr("id").map(|id| (id, *e)))
         .collect();
 
-    // Keyed by element, not by id: id-less geometries are each their own.
-    let mut geom_cache: HashMap<*const El, (Vec<[f64; 3]>, Polygons)> = HashMap::new();
-    let mut corners = 0usize;
-    let mut out = RawMesh {
-        faces: Polygons::new(),
-        ..Default::default()
+    let mut inst = Instancer {
+        bytes,
+        path,
+        unit,
+        geom_cache: HashMap::new(),
+        corners: 0,
+        out: RawMesh {
+            faces: Polygons::new(),
+            ..Default::default()
+        },
+        notes: Vec::new(),
     };
-    let mut add = |geom: &El,
-                   xf: &Affine,
-                   out: &mut RawMesh,
-                   notes: &mut Vec<String>|
-     -> Result<(), MeshError> {
+    let scene = root
+        .child("scene")
+        .and_then(|s| s.child("instance_visual_scene"))
+        .and_then(|i| i.attr("url"))
+        .and_then(|u| by_id.get(u.trim_start_matches('#')).copied())
+        .or_else(|| {
+            root.child("library_visual_scenes")
+                .and_then(|l| l.child("visual_scene"))
+        });
+    match scene {
+        Some(scene) => add_scene(scene, &by_id, &mut inst)?,
+        None => {
+            if let Some(lib) = root.child("library_geometries") {
+                for g in lib.children_named("geometry") {
+                    inst.add(g, &IDENTITY)?;
+                }
+            }
+            inst.notes
+                .push("no visual scene: every geometry counted once, untransformed".into());
+        }
+    }
+    let Instancer { mut out, notes, .. } = inst;
+    // Reader messages that say something was left out are warnings; the rest are notes.
+    for n in notes {
+        match n.strip_prefix("warning: ") {
+            Some(w) => out.warnings.push(w.to_string()),
+            None => out.notes.push(n),
+        }
+    }
+    Ok(out)
+}
+
+/// Places geometries into one mesh, each read once however often the scene instances it, within the
+/// instancing budget.
+struct Instancer<'a> {
+    bytes: &'a [u8],
+    path: &'a Path,
+    /// Metres per unit of the file.
+    unit: f64,
+    /// Keyed by element, not by id: id-less geometries are each their own.
+    geom_cache: HashMap<*const El, (Vec<[f64; 3]>, Polygons)>,
+    /// Polygon corners instanced so far.
+    corners: usize,
+    out: RawMesh,
+    /// Reader messages; those starting `warning: ` become warnings.
+    notes: Vec<String>,
+}
+
+impl Instancer<'_> {
+    /// Adds one instance of `geom` transformed by `xf` (faces reversed if `xf` mirrors).
+    fn add(&mut self, geom: &El, xf: &Affine) -> Result<(), MeshError> {
         let key: *const El = geom;
-        let (v, f) = match geom_cache.entry(key) {
+        let (v, f) = match self.geom_cache.entry(key) {
             std::collections::hash_map::Entry::Occupied(e) => &*e.into_mut(),
             std::collections::hash_map::Entry::Vacant(e) => {
-                &*e.insert(read_geometry(geom, bytes, path, notes)?)
+                &*e.insert(read_geometry(geom, self.bytes, self.path, &mut self.notes)?)
             }
         };
-        corners = corners.saturating_add(f.indices.len());
-        if out.vertices.len().saturating_add(v.len()) > MAX_INSTANCED_VERTICES
-            || corners > MAX_INSTANCED_CORNERS
+        self.corners = self.corners.saturating_add(f.indices.len());
+        if self.out.vertices.len().saturating_add(v.len()) > MAX_INSTANCED_VERTICES
+            || self.corners > MAX_INSTANCED_CORNERS
         {
             return Err(MeshError::new(
-                path,
+                self.path,
                 Some(geom.line),
                 MeshErrorKind::Syntax(format!(
                     "the scene instances more than {MAX_INSTANCED_VERTICES} vertices or {MAX_INSTANCED_CORNERS} polygon corners (nested <instance_node> multiply their geometry); simplify the collision mesh"
                 )),
             ));
         }
-        let base = out.vertices.len() as u32;
+        let base = self.out.vertices.len() as u32;
         for p in v {
             let q = crate::mass::mat_vec(&xf.0, *p);
-            out.vertices.push([
-                (q[0] + xf.1[0]) * unit,
-                (q[1] + xf.1[1]) * unit,
-                (q[2] + xf.1[2]) * unit,
+            self.out.vertices.push([
+                (q[0] + xf.1[0]) * self.unit,
+                (q[1] + xf.1[1]) * self.unit,
+                (q[2] + xf.1[2]) * self.unit,
             ]);
         }
         // A mirroring node transform reverses the faces' orientation.
@@ -612,92 +758,72 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
             if det < 0.0 {
                 g.reverse();
             }
-            out.faces.push(&g);
+            self.out.faces.push(&g);
         }
         Ok(())
-    };
+    }
+}
 
-    let scene = root
-        .child("scene")
-        .and_then(|s| s.child("instance_visual_scene"))
-        .and_then(|i| i.attr("url"))
-        .and_then(|u| by_id.get(u.trim_start_matches('#')).copied())
-        .or_else(|| {
-            root.child("library_visual_scenes")
-                .and_then(|l| l.child("visual_scene"))
-        });
-    match scene {
-        Some(scene) => {
-            let mut stack: Vec<(&El, Affine, usize)> = scene
-                .children_named("node")
-                .map(|n| (n, IDENTITY, 0))
-                .collect();
-            let mut visits = 0usize;
-            while let Some((node, parent, depth)) = stack.pop() {
-                visits += 1;
-                if visits > MAX_NODE_VISITS {
-                    return Err(MeshError::new(
-                        path,
-                        Some(node.line),
-                        MeshErrorKind::Syntax(format!(
-                            "the scene instances more than {MAX_NODE_VISITS} nodes (nested <instance_node> multiply); simplify the collision mesh"
-                        )),
-                    ));
+/// Every geometry a visual scene's node hierarchy instances, with its node transforms (depth and node
+/// visits bounded: a cycle of `<instance_node>` is an error, not a hang).
+fn add_scene<'a>(
+    scene: &'a El,
+    by_id: &HashMap<&str, &'a El>,
+    inst: &mut Instancer<'_>,
+) -> Result<(), MeshError> {
+    let mut stack: Vec<(&El, Affine, usize)> = scene
+        .children_named("node")
+        .map(|n| (n, IDENTITY, 0))
+        .collect();
+    let mut visits = 0usize;
+    while let Some((node, parent, depth)) = stack.pop() {
+        visits += 1;
+        if visits > MAX_NODE_VISITS {
+            return Err(MeshError::new(
+                inst.path,
+                Some(node.line),
+                MeshErrorKind::Syntax(format!(
+                    "the scene instances more than {MAX_NODE_VISITS} nodes (nested <instance_node> multiply); simplify the collision mesh"
+                )),
+            ));
+        }
+        if depth > 64 {
+            return Err(MeshError::new(
+                inst.path,
+                Some(node.line),
+                MeshErrorKind::Syntax(
+                    "node hierarchy deeper than 64 (a cycle of <instance_node>?)".into(),
+                ),
+            ));
+        }
+        let xf = compose(&parent, &node_transform(node, inst.bytes, inst.path)?);
+        for c in &node.children {
+            match c.name.as_str() {
+                "instance_geometry" => {
+                    let url = c.attr("url").unwrap_or("").trim_start_matches('#');
+                    let geom = by_id.get(url).ok_or_else(|| {
+                        MeshError::new(
+                            inst.path,
+                            Some(c.line),
+                            MeshErrorKind::Syntax(format!(
+                                "<instance_geometry url=\"#{url}\"> names no geometry"
+                            )),
+                        )
+                    })?;
+                    inst.add(geom, &xf)?;
                 }
-                if depth > 64 {
-                    return Err(MeshError::new(
-                        path,
-                        Some(node.line),
-                        MeshErrorKind::Syntax(
-                            "node hierarchy deeper than 64 (a cycle of <instance_node>?)".into(),
-                        ),
-                    ));
-                }
-                let xf = compose(&parent, &node_transform(node, bytes, path)?);
-                for c in &node.children {
-                    match c.name.as_str() {
-                        "instance_geometry" => {
-                            let url = c.attr("url").unwrap_or("").trim_start_matches('#');
-                            let geom = by_id.get(url).ok_or_else(|| {
-                                MeshError::new(
-                                    path,
-                                    Some(c.line),
-                                    MeshErrorKind::Syntax(format!(
-                                        "<instance_geometry url=\"#{url}\"> names no geometry"
-                                    )),
-                                )
-                            })?;
-                            add(geom, &xf, &mut out, &mut notes)?;
-                        }
-                        "node" => stack.push((c, xf, depth + 1)),
-                        "instance_node" => {
-                            let url = c.attr("url").unwrap_or("").trim_start_matches('#');
-                            if let Some(n) = by_id.get(url) {
-                                stack.push((n, xf, depth + 1));
-                            }
-                        }
-                        _ => {}
+                "node" => stack.push((c, xf, depth + 1)),
+                "instance_node" => {
+                    let url = c.attr("url").unwrap_or("").trim_start_matches('#');
+                    if let Some(n) = by_id.get(url) {
+                        stack.push((n, xf, depth + 1));
                     }
                 }
+                _ => {}
             }
         }
-        None => {
-            if let Some(lib) = root.child("library_geometries") {
-                for g in lib.children_named("geometry") {
-                    add(g, &IDENTITY, &mut out, &mut notes)?;
-                }
-            }
-            notes.push("no visual scene: every geometry counted once, untransformed".into());
-        }
     }
-    // Reader messages that say something was left out are warnings; the rest are notes.
-    for n in notes {
-        match n.strip_prefix("warning: ") {
-            Some(w) => out.warnings.push(w.to_string()),
-            None => out.notes.push(n),
-        }
-    }
-    Ok(out)
+    Ok(())
 }
 
 #[cfg(test)]

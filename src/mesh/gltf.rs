@@ -282,10 +282,7 @@ fn check_accessor(
         .checked_mul(stride)
         .and_then(|n| n.checked_add(elem))
         .and_then(|n| n.checked_add(acc.offset()));
-    let buffer = buffers
-        .get(view.buffer().index())
-        .map(Vec::len)
-        .unwrap_or(0);
+    let buffer = buffers.get(view.buffer().index()).map_or(0, Vec::len);
     let view_end = view.offset().checked_add(view.length());
     match (need, view_end) {
         (Some(need), Some(view_end)) if count == 0 || (need <= view.length() && view_end <= buffer) => Ok(()),
@@ -324,6 +321,30 @@ fn add_primitive(
             .push("a primitive without POSITION (skipped)".into());
         return Ok(());
     };
+    check_primitive_accessors(prim, &pos, buffers, path, draco_used)?;
+    if pos.count() == 0 {
+        return Ok(());
+    }
+    let (positions, indices) = read_primitive(prim, &pos, buffers, path)?;
+    let base = out.vertices.len() as u32;
+    for p in &positions {
+        let q = crate::mass::mat_vec(&xf.0, p.map(f64::from));
+        out.vertices
+            .push([q[0] + xf.1[0], q[1] + xf.1[1], q[2] + xf.1[2]]);
+    }
+    push_triangles(mode, &indices, base, det(&xf.0) < 0.0, out);
+    Ok(())
+}
+
+/// Checks a primitive's POSITION accessor (float VEC3) and its index accessor (unsigned scalars) before
+/// anything is read through them.
+fn check_primitive_accessors(
+    prim: &gltf::Primitive<'_>,
+    pos: &gltf::Accessor<'_>,
+    buffers: &[Vec<u8>],
+    path: &Path,
+    draco_used: bool,
+) -> Result<(), MeshError> {
     if pos.data_type() != DataType::F32 || pos.dimensions() != Dimensions::Vec3 {
         return Err(unsupported(
             path,
@@ -335,9 +356,8 @@ fn add_primitive(
             ),
         ));
     }
-    check_accessor(&pos, buffers, path, "POSITION", draco_used)?;
-    let index_acc = prim.indices();
-    if let Some(acc) = &index_acc {
+    check_accessor(pos, buffers, path, "POSITION", draco_used)?;
+    if let Some(acc) = &prim.indices() {
         if acc.dimensions() != Dimensions::Scalar
             || !matches!(
                 acc.data_type(),
@@ -354,9 +374,17 @@ fn add_primitive(
         }
         check_accessor(acc, buffers, path, "index", draco_used)?;
     }
-    if pos.count() == 0 {
-        return Ok(());
-    }
+    Ok(())
+}
+
+/// A primitive's positions and vertex indices (`0..n` without an index accessor), each index checked
+/// against the positions.
+fn read_primitive(
+    prim: &gltf::Primitive<'_>,
+    pos: &gltf::Accessor<'_>,
+    buffers: &[Vec<u8>],
+    path: &Path,
+) -> Result<(Vec<[f32; 3]>, Vec<u32>), MeshError> {
     let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
     let positions: Vec<[f32; 3]> =
         reader
@@ -368,7 +396,7 @@ fn add_primitive(
                     format!("POSITION accessor {} cannot be read", pos.index()),
                 )
             })?;
-    let indices: Vec<u32> = match &index_acc {
+    let indices: Vec<u32> = match &prim.indices() {
         Some(acc) if acc.count() == 0 => Vec::new(),
         Some(acc) => reader
             .read_indices()
@@ -392,13 +420,12 @@ fn add_primitive(
             },
         ));
     }
-    let base = out.vertices.len() as u32;
-    for p in &positions {
-        let q = crate::mass::mat_vec(&xf.0, p.map(f64::from));
-        out.vertices
-            .push([q[0] + xf.1[0], q[1] + xf.1[1], q[2] + xf.1[2]]);
-    }
-    let mirrored = det(&xf.0) < 0.0;
+    Ok((positions, indices))
+}
+
+/// The triangles of a primitive's `indices` (offset by `base`) in its `mode`, reversed if the node's
+/// transform mirrors.
+fn push_triangles(mode: Mode, indices: &[u32], base: u32, mirrored: bool, out: &mut RawMesh) {
     let mut push = |a: u32, b: u32, c: u32| {
         let tri = if mirrored {
             [base + a, base + c, base + b]
@@ -445,7 +472,6 @@ fn add_primitive(
             }
         }
     }
-    Ok(())
 }
 
 /// Checks the GLB container header before the crate parses it (the crate assumes a sane length).
@@ -499,10 +525,43 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     }
 }
 
+/// Parses a glTF document whose GLB header was checked; may panic inside the crate (see [`parse`]).
 fn parse_checked(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(bytes)
         .map_err(|e| syntax(path, format!("not a valid glTF file: {e}")))?;
     let mut root = document.into_json();
+    let (draco_used, meshopt_used) = check_json(&root, path)?;
+    // Material-only required extensions are accepted above; the crate's validation would refuse them.
+    root.extensions_required.clear();
+    let doc = gltf::Document::from_json(root).map_err(|e| syntax(path, format!("{e}")))?;
+    let buffers = load_buffers(&doc, blob.as_deref(), path, meshopt_used)?;
+
+    let mut out = RawMesh {
+        faces: Polygons::new(),
+        ..Default::default()
+    };
+    let scene = doc.default_scene().or_else(|| doc.scenes().next());
+    match scene {
+        Some(scene) => add_scene(&scene, &buffers, path, draco_used, &mut out)?,
+        None => {
+            for mesh in doc.meshes() {
+                for prim in mesh.primitives() {
+                    add_primitive(&prim, &IDENTITY, &buffers, path, draco_used, &mut out)?;
+                }
+            }
+            if doc.meshes().len() > 0 {
+                out.notes
+                    .push("no scene: every mesh counted once, untransformed".into());
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Checks the document's JSON before the crate validates it: required extensions, Draco accessors
+/// and accessor indices the crate's validation would trip on. Returns whether Draco and meshopt
+/// compression are used.
+fn check_json(root: &gltf::json::Root, path: &Path) -> Result<(bool, bool), MeshError> {
     if let Some(name) = root.extensions_required.iter().find(|name| {
         !GEOMETRY_NEUTRAL_PREFIXES
             .iter()
@@ -552,57 +611,44 @@ fn parse_checked(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
             }
         }
     }
-    // Material-only required extensions are accepted above; the crate's validation would refuse them.
-    root.extensions_required.clear();
-    let doc = gltf::Document::from_json(root).map_err(|e| syntax(path, format!("{e}")))?;
-    let buffers = load_buffers(&doc, blob.as_deref(), path, meshopt_used)?;
+    Ok((draco_used, meshopt_used))
+}
 
-    let mut out = RawMesh {
-        faces: Polygons::new(),
-        ..Default::default()
-    };
-    let scene = doc.default_scene().or_else(|| doc.scenes().next());
-    match scene {
-        Some(scene) => {
-            let mut visits = 0usize;
-            let mut stack: Vec<(gltf::Node<'_>, Affine, usize)> =
-                scene.nodes().map(|n| (n, IDENTITY, 0)).collect();
-            while let Some((node, parent, depth)) = stack.pop() {
-                visits += 1;
-                if depth > MAX_DEPTH || visits > MAX_VISITS {
-                    return Err(syntax(
-                        path,
-                        format!("the node hierarchy is deeper than {MAX_DEPTH} or reaches more than {MAX_VISITS} nodes (a cycle?)"),
-                    ));
-                }
-                let xf = compose(&parent, &node_transform(&node, path)?);
-                if let Some(mesh) = node.mesh() {
-                    if node.skin().is_some() {
-                        out.notes.push(format!(
-                            "mesh {} is skinned: its bind pose is used",
-                            mesh.index()
-                        ));
-                    }
-                    for prim in mesh.primitives() {
-                        add_primitive(&prim, &xf, &buffers, path, draco_used, &mut out)?;
-                    }
-                }
-                for child in node.children() {
-                    stack.push((child, xf, depth + 1));
-                }
+/// Every primitive of the meshes a scene's node hierarchy reaches, in the world frame (depth and
+/// visits are bounded: a cycle is an error, not a hang).
+fn add_scene(
+    scene: &gltf::Scene<'_>,
+    buffers: &[Vec<u8>],
+    path: &Path,
+    draco_used: bool,
+    out: &mut RawMesh,
+) -> Result<(), MeshError> {
+    let mut visits = 0usize;
+    let mut stack: Vec<(gltf::Node<'_>, Affine, usize)> =
+        scene.nodes().map(|n| (n, IDENTITY, 0)).collect();
+    while let Some((node, parent, depth)) = stack.pop() {
+        visits += 1;
+        if depth > MAX_DEPTH || visits > MAX_VISITS {
+            return Err(syntax(
+                path,
+                format!("the node hierarchy is deeper than {MAX_DEPTH} or reaches more than {MAX_VISITS} nodes (a cycle?)"),
+            ));
+        }
+        let xf = compose(&parent, &node_transform(&node, path)?);
+        if let Some(mesh) = node.mesh() {
+            if node.skin().is_some() {
+                out.notes.push(format!(
+                    "mesh {} is skinned: its bind pose is used",
+                    mesh.index()
+                ));
+            }
+            for prim in mesh.primitives() {
+                add_primitive(&prim, &xf, buffers, path, draco_used, out)?;
             }
         }
-        None => {
-            for mesh in doc.meshes() {
-                for prim in mesh.primitives() {
-                    add_primitive(&prim, &IDENTITY, &buffers, path, draco_used, &mut out)?;
-                }
-            }
-            if doc.meshes().len() > 0 {
-                out.notes
-                    .push("no scene: every mesh counted once, untransformed".into());
-            }
+        for child in node.children() {
+            stack.push((child, xf, depth + 1));
         }
     }
-    Ok(out)
+    Ok(())
 }

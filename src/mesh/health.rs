@@ -1590,7 +1590,13 @@ mod tests {
     /// tetrahedron `far` metres away: the caps' uncertainty sits at the hole, not at the far part.
     fn open_cube_and_far_tetrahedron(far: f64) -> RawMesh {
         let mut v: Vec<[f64; 3]> = (0..8)
-            .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+            .map(|i| {
+                [
+                    f64::from(i & 1),
+                    f64::from((i >> 1) & 1),
+                    f64::from((i >> 2) & 1),
+                ]
+            })
             .collect();
         v[7][2] += 1e-3;
         let quads = [

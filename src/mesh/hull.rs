@@ -169,7 +169,13 @@ mod tests {
     #[test]
     fn hull_of_cube_corners_and_interior_points() {
         let mut pts: Vec<[f64; 3]> = (0..8)
-            .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+            .map(|i| {
+                [
+                    f64::from(i & 1),
+                    f64::from((i >> 1) & 1),
+                    f64::from((i >> 2) & 1),
+                ]
+            })
             .collect();
         pts.push([0.5, 0.5, 0.5]);
         pts.push([0.2, 0.7, 0.1]);
@@ -186,9 +192,9 @@ mod tests {
         let pts: Vec<[f64; 3]> = (0..8)
             .map(|i| {
                 [
-                    1e-3 * (i & 1) as f64 + 5.0,
-                    1e-3 * ((i >> 1) & 1) as f64,
-                    1e-3 * ((i >> 2) & 1) as f64,
+                    1e-3 * f64::from(i & 1) + 5.0,
+                    1e-3 * f64::from((i >> 1) & 1),
+                    1e-3 * f64::from((i >> 2) & 1),
                 ]
             })
             .collect();
@@ -199,7 +205,9 @@ mod tests {
 
     #[test]
     fn flat_points_are_degenerate() {
-        let pts: Vec<[f64; 3]> = (0..10).map(|i| [i as f64, (i * i) as f64, 0.0]).collect();
+        let pts: Vec<[f64; 3]> = (0..10)
+            .map(|i| [f64::from(i), f64::from(i * i), 0.0])
+            .collect();
         assert!(matches!(convex_hull(&pts), Err(HullError::Degenerate)));
     }
 
@@ -214,15 +222,21 @@ mod tests {
             (rng >> 11) as f64 / (1u64 << 53) as f64
         };
         let mut pts: Vec<[f64; 3]> = (0..20_000).map(|_| [next(), next(), next()]).collect();
-        pts.extend((0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]));
+        pts.extend((0..8).map(|i| {
+            [
+                f64::from(i & 1),
+                f64::from((i >> 1) & 1),
+                f64::from((i >> 2) & 1),
+            ]
+        }));
         let (v, t) = convex_hull(&pts).expect("hull");
         let mp = crate::mass::MassProperties::from_trimesh(&v, &t, 1.0);
         assert!((mp.mass - 1.0).abs() < 1e-14, "{}", mp.mass);
         // 40,000 points on four circles are all hull vertices: refused, not gigabytes.
         let circles: Vec<[f64; 3]> = (0..40_000)
             .map(|i| {
-                let t = i as f64 * 2.0 * std::f64::consts::PI / 10_000.0;
-                [t.cos(), t.sin(), (i % 4) as f64]
+                let t = f64::from(i) * 2.0 * std::f64::consts::PI / 10_000.0;
+                [t.cos(), t.sin(), f64::from(i % 4)]
             })
             .collect();
         assert!(

@@ -173,8 +173,7 @@ fn read_unguarded(path: &Path) -> Result<RawMesh, MeshError> {
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
-            .map(|e| format!(".{e}"))
-            .unwrap_or_else(|| "(no extension)".into());
+            .map_or_else(|| "(no extension)".into(), |e| format!(".{e}"));
         MeshError::new(path, None, MeshErrorKind::UnknownFormat(ext))
     })?;
     let bytes = crate::input::read_file(path)
@@ -200,7 +199,7 @@ pub fn validate(mesh: &RawMesh, path: &Path) -> Result<(), MeshError> {
             path,
             None,
             MeshErrorKind::IndexOutOfRange {
-                index: bad as i64,
+                index: i64::from(bad),
                 vertices: n,
             },
         ));

@@ -22,8 +22,6 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     // Faces with fewer than three vertices: how many, and the line of the first.
     let mut degenerate: Option<usize> = None;
     let mut degenerate_count = 0usize;
-    let err =
-        |line: usize, msg: String| MeshError::new(path, Some(line), MeshErrorKind::Syntax(msg));
     let mut pending = String::new();
     let mut start_line = 0;
     // Line by line from the bytes: a stray non-UTF-8 byte (a Latin-1 comment) costs a copy of its
@@ -54,47 +52,9 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
             continue;
         };
         match keyword {
-            "v" => {
-                let mut p = [0.0; 3];
-                for c in p.iter_mut() {
-                    let w = words
-                        .next()
-                        .ok_or_else(|| err(lineno, "`v` needs three coordinates".into()))?;
-                    *c = parse_f64(w)
-                        .ok_or_else(|| err(lineno, format!("`{w}` is not a number")))?;
-                    if !c.is_finite() {
-                        return Err(MeshError::new(path, Some(lineno), MeshErrorKind::NotFinite));
-                    }
-                }
-                vertices.push(p);
-            }
+            "v" => vertices.push(vertex(words, lineno, path)?),
             "f" => {
-                face.clear();
-                for w in words {
-                    let idx = w.split('/').next().unwrap_or("");
-                    let i: i64 = idx
-                        .parse()
-                        .map_err(|_| err(lineno, format!("`{w}` is not a vertex index")))?;
-                    let n = vertices.len() as i64;
-                    let resolved = if i > 0 {
-                        i - 1
-                    } else if i < 0 {
-                        n + i
-                    } else {
-                        -1
-                    };
-                    if resolved < 0 || resolved >= n {
-                        return Err(MeshError::new(
-                            path,
-                            Some(lineno),
-                            MeshErrorKind::IndexOutOfRange {
-                                index: i,
-                                vertices: vertices.len(),
-                            },
-                        ));
-                    }
-                    face.push(resolved as u32);
-                }
+                face_indices(words, vertices.len(), &mut face, lineno, path)?;
                 // A face of fewer than three vertices encloses nothing: skipped and counted, as other
                 // OBJ readers (assimp, tinyobjloader) do.
                 if face.len() < 3 {
@@ -127,6 +87,66 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         notes,
         warnings,
     })
+}
+
+/// The three coordinates of a `v` line.
+fn vertex<'a>(
+    mut words: impl Iterator<Item = &'a str>,
+    lineno: usize,
+    path: &Path,
+) -> Result<[f64; 3], MeshError> {
+    let err =
+        |line: usize, msg: String| MeshError::new(path, Some(line), MeshErrorKind::Syntax(msg));
+    let mut p = [0.0; 3];
+    for c in p.iter_mut() {
+        let w = words
+            .next()
+            .ok_or_else(|| err(lineno, "`v` needs three coordinates".into()))?;
+        *c = parse_f64(w).ok_or_else(|| err(lineno, format!("`{w}` is not a number")))?;
+        if !c.is_finite() {
+            return Err(MeshError::new(path, Some(lineno), MeshErrorKind::NotFinite));
+        }
+    }
+    Ok(p)
+}
+
+/// The vertex indices of an `f` line into `face` (0-based; negative ones count back from the
+/// `vertices` read so far; texture and normal indices ignored).
+fn face_indices<'a>(
+    words: impl Iterator<Item = &'a str>,
+    vertices: usize,
+    face: &mut Vec<u32>,
+    lineno: usize,
+    path: &Path,
+) -> Result<(), MeshError> {
+    face.clear();
+    for w in words {
+        let idx = w.split('/').next().unwrap_or("");
+        let i: i64 = idx.parse().map_err(|_| {
+            MeshError::new(
+                path,
+                Some(lineno),
+                MeshErrorKind::Syntax(format!("`{w}` is not a vertex index")),
+            )
+        })?;
+        let n = vertices as i64;
+        let resolved = if i > 0 {
+            i - 1
+        } else if i < 0 {
+            n + i
+        } else {
+            -1
+        };
+        if resolved < 0 || resolved >= n {
+            return Err(MeshError::new(
+                path,
+                Some(lineno),
+                MeshErrorKind::IndexOutOfRange { index: i, vertices },
+            ));
+        }
+        face.push(resolved as u32);
+    }
+    Ok(())
 }
 
 #[cfg(test)]

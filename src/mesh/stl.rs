@@ -14,6 +14,7 @@
 use super::weld::VertexTable;
 use super::{parse_f64, MeshError, MeshErrorKind, RawMesh};
 use crate::mass::Polygons;
+use std::fmt::Write as _;
 use std::path::Path;
 
 /// Parses STL bytes (binary or ASCII). Corners with bit-identical coordinates share one vertex, in
@@ -110,6 +111,7 @@ fn binary(bytes: &[u8], n: usize, header_count: Option<usize>) -> RawMesh {
     }
 }
 
+/// Parses ASCII STL; errors carry the line.
 fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         MeshError::new(
@@ -138,26 +140,7 @@ fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
                         MeshErrorKind::Syntax("`vertex` outside `outer loop`".into()),
                     ));
                 }
-                let mut p = [0.0; 3];
-                for c in p.iter_mut() {
-                    let w = words.next().ok_or_else(|| {
-                        MeshError::new(
-                            path,
-                            Some(lineno),
-                            MeshErrorKind::Syntax("`vertex` needs three coordinates".into()),
-                        )
-                    })?;
-                    *c = parse_f64(w).ok_or_else(|| {
-                        MeshError::new(
-                            path,
-                            Some(lineno),
-                            MeshErrorKind::Syntax(format!("`{w}` is not a number")),
-                        )
-                    })?;
-                    if !c.is_finite() {
-                        return Err(MeshError::new(path, Some(lineno), MeshErrorKind::NotFinite));
-                    }
-                }
+                let p = ascii_vertex(words, lineno, path)?;
                 current.push(vertices.insert(p));
             }
             "outer" => {
@@ -200,6 +183,35 @@ fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     })
 }
 
+/// The three coordinates after an ASCII STL `vertex`.
+fn ascii_vertex<'a>(
+    mut words: impl Iterator<Item = &'a str>,
+    lineno: usize,
+    path: &Path,
+) -> Result<[f64; 3], MeshError> {
+    let mut p = [0.0; 3];
+    for c in p.iter_mut() {
+        let w = words.next().ok_or_else(|| {
+            MeshError::new(
+                path,
+                Some(lineno),
+                MeshErrorKind::Syntax("`vertex` needs three coordinates".into()),
+            )
+        })?;
+        *c = parse_f64(w).ok_or_else(|| {
+            MeshError::new(
+                path,
+                Some(lineno),
+                MeshErrorKind::Syntax(format!("`{w}` is not a number")),
+            )
+        })?;
+        if !c.is_finite() {
+            return Err(MeshError::new(path, Some(lineno), MeshErrorKind::NotFinite));
+        }
+    }
+    Ok(p)
+}
+
 /// Writes a binary STL (used by tests and fixture generators).
 pub fn write_binary(header: &[u8], vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<u8> {
     let mut out = vec![0u8; 80];
@@ -224,7 +236,7 @@ pub fn write_ascii(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> String {
         s.push_str("  facet normal 0 0 0\n    outer loop\n");
         for &i in t {
             let v = vertices[i as usize];
-            s.push_str(&format!("      vertex {} {} {}\n", v[0], v[1], v[2]));
+            let _ = writeln!(s, "      vertex {} {} {}", v[0], v[1], v[2]);
         }
         s.push_str("    endloop\n  endfacet\n");
     }

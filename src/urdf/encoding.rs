@@ -100,7 +100,7 @@ impl DecodeError {
             .map_or(0, |i| i + 1);
         DecodeError {
             offset,
-            line: 1 + before.iter().filter(|&&b| b == b'\n').count(),
+            line: 1 + crate::text::count_newlines(before),
             column: 1 + before.len() - line_start,
             message,
         }
@@ -130,93 +130,119 @@ fn declared_encoding(bytes: &[u8]) -> Option<&[u8]> {
 
 /// Decodes a URDF file's bytes to UTF-8 text.
 pub fn decode(bytes: Vec<u8>) -> Result<(String, SourceEncoding), DecodeError> {
-    // UTF-16: a byte-order mark, or `<?` as 16-bit units (XML 1.0 appendix F).
-    let utf16 = match bytes.get(..4) {
+    if let Some((big_endian, bom)) = utf16_form(&bytes) {
+        return decode_utf16(&bytes, big_endian, bom);
+    }
+    match declared_encoder(&bytes)? {
+        None => decode_utf8(bytes),
+        Some(encoding) => decode_declared(&bytes, encoding),
+    }
+}
+
+/// `(big_endian, bom)` if the bytes are UTF-16: a byte-order mark, or `<?` as 16-bit units (XML 1.0
+/// appendix F).
+fn utf16_form(bytes: &[u8]) -> Option<(bool, bool)> {
+    match bytes.get(..4) {
         Some([0xff, 0xfe, ..]) => Some((false, true)),
         Some([0xfe, 0xff, ..]) => Some((true, true)),
         Some([b'<', 0, b'?', 0]) => Some((false, false)),
         Some([0, b'<', 0, b'?']) => Some((true, false)),
         _ => None,
-    };
-    if let Some((big_endian, bom)) = utf16 {
-        let body = &bytes[if bom { 2 } else { 0 }..];
-        if body.len() % 2 != 0 {
-            return Err(DecodeError::at(
-                &bytes,
-                bytes.len() - 1,
-                "the UTF-16 file has an odd number of bytes (truncated?)".into(),
-            ));
-        }
-        let units = body.chunks_exact(2).map(|c| {
-            if big_endian {
-                u16::from_be_bytes([c[0], c[1]])
-            } else {
-                u16::from_le_bytes([c[0], c[1]])
-            }
-        });
-        let mut text = String::with_capacity(body.len() / 2);
-        for (k, c) in char::decode_utf16(units).enumerate() {
-            match c {
-                Ok(c) => text.push(c),
-                Err(_) => {
-                    return Err(DecodeError::at(
-                        &bytes,
-                        if bom { 2 } else { 0 } + 2 * k,
-                        "not valid UTF-16 (an unpaired surrogate)".into(),
-                    ))
-                }
-            }
-        }
-        return Ok((text, SourceEncoding::Utf16 { big_endian, bom }));
     }
-    let label = declared_encoding(&bytes);
-    let encoding = match label {
-        None => None,
-        Some(l) => match Encoding::for_label(l) {
-            // A UTF-16 label on bytes that are not UTF-16 is a stale declaration: read them as UTF-8.
-            Some(e) if e == encoding_rs::UTF_8 || e == encoding_rs::UTF_16LE || e == encoding_rs::UTF_16BE => None,
-            Some(e) => Some(e),
-            None => {
+}
+
+/// Decodes UTF-16 bytes (after the byte-order mark if `bom`); errors point at the bad unit.
+fn decode_utf16(
+    bytes: &[u8],
+    big_endian: bool,
+    bom: bool,
+) -> Result<(String, SourceEncoding), DecodeError> {
+    let body = &bytes[if bom { 2 } else { 0 }..];
+    if body.len() % 2 != 0 {
+        return Err(DecodeError::at(
+            bytes,
+            bytes.len() - 1,
+            "the UTF-16 file has an odd number of bytes (truncated?)".into(),
+        ));
+    }
+    let units = body.chunks_exact(2).map(|c| {
+        if big_endian {
+            u16::from_be_bytes([c[0], c[1]])
+        } else {
+            u16::from_le_bytes([c[0], c[1]])
+        }
+    });
+    let mut text = String::with_capacity(body.len() / 2);
+    for (k, c) in char::decode_utf16(units).enumerate() {
+        match c {
+            Ok(c) => text.push(c),
+            Err(_) => {
                 return Err(DecodeError::at(
-                    &bytes,
-                    0,
-                    format!(
-                        "the XML declaration names the encoding `{}`, which urdf-inertia does not know; convert the file to UTF-8",
-                        String::from_utf8_lossy(l)
-                    ),
+                    bytes,
+                    if bom { 2 } else { 0 } + 2 * k,
+                    "not valid UTF-16 (an unpaired surrogate)".into(),
                 ))
             }
-        },
-    };
-    match encoding {
-        None => String::from_utf8(bytes)
-            .map(|t| (t, SourceEncoding::Utf8))
-            .map_err(|e| {
-                let offset = e.utf8_error().valid_up_to();
-                DecodeError::at(
-                    e.as_bytes(),
-                    offset,
-                    format!("not valid UTF-8 (byte 0x{:02x}), and the XML declaration names no other encoding; if the file is Latin-1, declare it (<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?>) or convert it to UTF-8", e.as_bytes().get(offset).copied().unwrap_or(0)),
-                )
-            }),
-        Some(encoding) => {
-            let (text, malformed) = encoding.decode_without_bom_handling(&bytes);
-            if malformed {
-                return Err(DecodeError::at(
-                    &bytes,
-                    0,
-                    format!(
-                        "not valid {} text, although the XML declaration says so",
-                        encoding.name()
-                    ),
-                ));
-            }
-            let text = text.into_owned();
-            let (again, _, unmappable) = encoding.encode(&text);
-            let lossless = !unmappable && again.as_ref() == bytes.as_slice();
-            Ok((text, SourceEncoding::Declared { encoding, lossless }))
         }
     }
+    Ok((text, SourceEncoding::Utf16 { big_endian, bom }))
+}
+
+/// The encoding the XML declaration names, if it is not UTF-8 (nor a stale UTF-16 label); an
+/// unknown name is an error.
+fn declared_encoder(bytes: &[u8]) -> Result<Option<&'static Encoding>, DecodeError> {
+    let Some(l) = declared_encoding(bytes) else {
+        return Ok(None);
+    };
+    match Encoding::for_label(l) {
+        // A UTF-16 label on bytes that are not UTF-16 is a stale declaration: read them as UTF-8.
+        Some(e) if e == encoding_rs::UTF_8 || e == encoding_rs::UTF_16LE || e == encoding_rs::UTF_16BE => Ok(None),
+        Some(e) => Ok(Some(e)),
+        None => Err(DecodeError::at(
+            bytes,
+            0,
+            format!(
+                "the XML declaration names the encoding `{}`, which urdf-inertia does not know; convert the file to UTF-8",
+                String::from_utf8_lossy(l)
+            ),
+        )),
+    }
+}
+
+/// UTF-8 bytes as they are; an error suggests declaring Latin-1.
+fn decode_utf8(bytes: Vec<u8>) -> Result<(String, SourceEncoding), DecodeError> {
+    String::from_utf8(bytes)
+        .map(|t| (t, SourceEncoding::Utf8))
+        .map_err(|e| {
+            let offset = e.utf8_error().valid_up_to();
+            DecodeError::at(
+                e.as_bytes(),
+                offset,
+                format!("not valid UTF-8 (byte 0x{:02x}), and the XML declaration names no other encoding; if the file is Latin-1, declare it (<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?>) or convert it to UTF-8", e.as_bytes().get(offset).copied().unwrap_or(0)),
+            )
+        })
+}
+
+/// Bytes in a declared legacy encoding; notes whether writing the text back gives the same bytes.
+fn decode_declared(
+    bytes: &[u8],
+    encoding: &'static Encoding,
+) -> Result<(String, SourceEncoding), DecodeError> {
+    let (text, malformed) = encoding.decode_without_bom_handling(bytes);
+    if malformed {
+        return Err(DecodeError::at(
+            bytes,
+            0,
+            format!(
+                "not valid {} text, although the XML declaration says so",
+                encoding.name()
+            ),
+        ));
+    }
+    let text = text.into_owned();
+    let (again, _, unmappable) = encoding.encode(&text);
+    let lossless = !unmappable && again.as_ref() == bytes;
+    Ok((text, SourceEncoding::Declared { encoding, lossless }))
 }
 
 #[cfg(test)]

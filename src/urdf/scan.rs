@@ -178,13 +178,12 @@ impl std::error::Error for UrdfError {}
 pub fn line_col(text: &str, pos: usize) -> (usize, usize) {
     let pos = pos.min(text.len());
     let before = &text.as_bytes()[..pos];
-    let line = 1 + before.iter().filter(|&&b| b == b'\n').count();
+    let line = 1 + crate::text::count_newlines(before);
     let col = 1 + pos
         - before
             .iter()
             .rposition(|&b| b == b'\n')
-            .map(|i| i + 1)
-            .unwrap_or(0);
+            .map_or(0, |i| i + 1);
     (line, col)
 }
 
@@ -207,17 +206,17 @@ fn attrs(e: &BytesStart<'_>) -> Result<HashMap<String, String>, (usize, String)>
             | AttrError::ExpectedQuote(at, _) => (at, format!("malformed attribute: {err}")),
         })?;
         let key = String::from_utf8_lossy(a.key.as_ref()).into_owned();
-        let v = a
-            .unescape_value()
-            .map(|v| v.into_owned())
-            .unwrap_or_else(|_| String::from_utf8_lossy(&a.value).into_owned());
+        let v = a.unescape_value().map_or_else(
+            |_| String::from_utf8_lossy(&a.value).into_owned(),
+            |v| v.into_owned(),
+        );
         m.insert(key, v);
     }
     Ok(m)
 }
 
 fn indent_before(text: &str, pos: usize) -> Option<String> {
-    let line_start = text[..pos].rfind('\n').map(|i| i + 1).unwrap_or(0);
+    let line_start = text[..pos].rfind('\n').map_or(0, |i| i + 1);
     let ws = &text[line_start..pos];
     if ws.chars().all(|c| c == ' ' || c == '\t') {
         Some(ws.to_string())
@@ -297,248 +296,381 @@ fn warning(line: usize, link: &Option<Link>, message: String) -> Diagnostic {
     )
 }
 
-/// Scans URDF text. `path` is used in messages and for resolving relative mesh paths.
-pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
-    let err = |pos: usize, message: String| {
-        let (line, column) = line_col(&text, pos);
+/// One start (or empty) tag as the scanner sees it.
+struct Tag<'a> {
+    /// Its attributes.
+    a: &'a HashMap<String, String>,
+    /// Byte offset of its `<`.
+    pos: usize,
+    /// Byte offset just after its `>`.
+    end: usize,
+    /// Its line.
+    line: usize,
+    /// Whether it is self-closing (`<x/>`).
+    empty: bool,
+}
+
+/// The state of one scan: the open elements and the link, collision and inertial being read. One method
+/// per element kind keeps each of urdfdom's reading rules in a small place.
+struct Scanner<'t> {
+    text: &'t str,
+    path: &'t Path,
+    /// Length of a UTF-8 byte-order mark, which quick-xml does not count in its positions.
+    bom: usize,
+    stack: Vec<String>,
+    robot_name: Option<String>,
+    links: Vec<Link>,
+    current: Option<Link>,
+    collision: Option<CollisionInProgress>,
+    inertial: Option<InertialInProgress>,
+    /// The line of each link name seen so far.
+    seen: HashMap<String, usize>,
+    notes: Vec<Diagnostic>,
+    /// Line of the first sign of xacro (xmlns:xacro on the root, a <xacro:…> element).
+    xacro: Option<usize>,
+    /// Line of the root if it declares xmlns:xacro (xacro's own output keeps the declaration).
+    xacro_namespace: Option<usize>,
+}
+
+/// What a scan yields besides the text: the robot's name, its links and the diagnostics.
+type Scanned = (String, Vec<Link>, Vec<Diagnostic>);
+
+impl<'t> Scanner<'t> {
+    fn new(text: &'t str, path: &'t Path) -> Self {
+        // quick-xml does not count a UTF-8 byte-order mark in its positions: read after it and add it back.
+        let bom = if text.starts_with('\u{feff}') {
+            '\u{feff}'.len_utf8()
+        } else {
+            0
+        };
+        Scanner {
+            text,
+            path,
+            bom,
+            stack: Vec::new(),
+            robot_name: None,
+            links: Vec::new(),
+            current: None,
+            collision: None,
+            inertial: None,
+            seen: HashMap::new(),
+            notes: Vec::new(),
+            xacro: None,
+            xacro_namespace: None,
+        }
+    }
+
+    /// The error at byte offset `pos`, with its line and column.
+    fn err(&self, pos: usize, message: String) -> UrdfError {
+        let (line, column) = line_col(self.text, pos);
         UrdfError {
-            path: path.to_path_buf(),
+            path: self.path.to_path_buf(),
             line,
             column,
             message: xacro_hint(message),
         }
-    };
-    // quick-xml does not count a UTF-8 byte-order mark in its positions: read after it and add it back.
-    let bom = if text.starts_with('\u{feff}') {
-        '\u{feff}'.len_utf8()
-    } else {
-        0
-    };
-    let mut reader = Reader::from_str(&text[bom..]);
-    reader.config_mut().check_end_names = true;
-    let mut lines = LineCounter::new(text.as_bytes());
-    let mut stack: Vec<String> = Vec::new();
-    let mut robot_name: Option<String> = None;
-    let mut links: Vec<Link> = Vec::new();
-    let mut current: Option<Link> = None;
-    let mut collision: Option<CollisionInProgress> = None;
-    let mut inertial: Option<InertialInProgress> = None;
-    let mut seen: HashMap<String, usize> = HashMap::new();
-    let mut notes: Vec<Diagnostic> = Vec::new();
-    // Line of the first sign of xacro (xmlns:xacro on the root, a <xacro:…> element).
-    let mut xacro: Option<usize> = None;
-    // Line of the root if it declares xmlns:xacro (xacro's own output keeps the declaration).
-    let mut xacro_namespace: Option<usize> = None;
+    }
 
-    loop {
-        let pos = bom + reader.buffer_position() as usize;
-        let event = match reader.read_event() {
-            Ok(e) => e,
-            Err(e) => {
-                return Err(err(
-                    bom + reader.error_position() as usize,
-                    format!("malformed XML: {e}"),
-                ))
-            }
-        };
-        let (e, empty) = match event {
-            Event::Start(e) => (e, false),
-            Event::Empty(e) => (e, true),
-            Event::End(_) => {
-                let name = stack.pop().unwrap_or_default();
-                let end = bom + reader.buffer_position() as usize;
-                match (stack.len(), name.as_str()) {
-                    (1, "link") => {
-                        if let Some(link) = current.take() {
-                            finish_link(link, &mut links, &mut notes);
-                        }
-                    }
-                    (2, "collision") => {
-                        finish_collision(collision.take(), &mut current, &mut notes)
-                    }
-                    (2, "inertial") => {
-                        if let Some(mut i) = inertial.take() {
-                            i.span.end = end;
-                            finish_inertial(i, &mut current, &mut notes);
-                        }
-                    }
-                    _ => {}
+    /// Reads every event of the document, then checks how it ended.
+    fn run(mut self) -> Result<Scanned, UrdfError> {
+        let mut reader = Reader::from_str(&self.text[self.bom..]);
+        reader.config_mut().check_end_names = true;
+        let mut lines = LineCounter::new(self.text.as_bytes());
+        loop {
+            let pos = self.bom + reader.buffer_position() as usize;
+            let event = match reader.read_event() {
+                Ok(e) => e,
+                Err(e) => {
+                    return Err(self.err(
+                        self.bom + reader.error_position() as usize,
+                        format!("malformed XML: {e}"),
+                    ))
                 }
-                continue;
+            };
+            let end = self.bom + reader.buffer_position() as usize;
+            let (e, empty) = match event {
+                Event::Start(e) => (e, false),
+                Event::Empty(e) => (e, true),
+                Event::End(_) => {
+                    self.end_element(end);
+                    continue;
+                }
+                Event::Eof => break,
+                _ => continue,
+            };
+            let name = String::from_utf8_lossy(e.name().as_ref()).into_owned();
+            let a = attrs(&e).map_err(|(at, m)| self.err(pos + 1 + at, m))?;
+            let tag = Tag {
+                a: &a,
+                pos,
+                end,
+                line: lines.at(pos),
+                empty,
+            };
+            self.start_element(&name, &tag)?;
+            if !empty {
+                self.stack.push(name);
             }
-            Event::Eof => break,
-            _ => continue,
-        };
-        let name = String::from_utf8_lossy(e.name().as_ref()).into_owned();
-        let depth = stack.len();
-        let a = attrs(&e).map_err(|(at, m)| err(pos + 1 + at, m))?;
-        let line = lines.at(pos);
-        if name.starts_with("xacro:") {
-            xacro.get_or_insert(line);
         }
-        match (depth, name.as_str()) {
-            (0, "robot") => {
-                robot_name = Some(a.get("name").cloned().unwrap_or_default());
-                if a.contains_key("xmlns:xacro") {
-                    xacro_namespace = Some(line);
-                }
-            }
-            (0, other) => return Err(err(pos, format!("the root element is <{other}>, not <robot>: this is not a URDF (run xacro first if it is a .xacro file)"))),
+        self.finish()
+    }
+
+    /// An end tag: finishes the link, collision or inertial it closes.
+    fn end_element(&mut self, end: usize) {
+        let name = self.stack.pop().unwrap_or_default();
+        match (self.stack.len(), name.as_str()) {
             (1, "link") => {
-                let lname = a.get("name").cloned().ok_or_else(|| err(pos, "<link> without a name".into()))?;
-                if let Some(first) = seen.insert(lname.clone(), line) {
-                    return Err(err(pos, format!("duplicate link name `{lname}` on lines {first} and {line}; link names must be unique (urdfdom refuses the file too)")));
-                }
-                let link = Link {
-                    name: lname,
-                    line,
-                    start: pos,
-                    open_end: bom + reader.buffer_position() as usize,
-                    self_closing: empty,
-                    indent: indent_before(&text, pos).unwrap_or_default(),
-                    child_indent: None,
-                    inertial: None,
-                    extra_inertials: Vec::new(),
-                    collisions: Vec::new(),
-                };
-                if empty {
-                    finish_link(link, &mut links, &mut notes);
-                } else {
-                    current = Some(link);
+                if let Some(link) = self.current.take() {
+                    finish_link(link, &mut self.links, &mut self.notes);
                 }
             }
-            (2, child) if current.is_some() => {
-                if let Some(link) = current.as_mut() {
-                    if link.child_indent.is_none() {
-                        link.child_indent = indent_before(&text, pos);
-                    }
-                }
-                match child {
-                    "collision" => {
-                        let index = current.as_ref().map(|l| l.collisions.len() + 1).unwrap_or(1);
-                        collision = Some(CollisionInProgress {
-                            index,
-                            line,
-                            name: a.get("name").cloned(),
-                            origin: Pose::default(),
-                            origin_line: None,
-                            geometries: 0,
-                            shape: None,
-                            error: None,
-                        });
-                        if empty {
-                            finish_collision(collision.take(), &mut current, &mut notes);
-                        }
-                    }
-                    "inertial" => {
-                        let first = current.as_ref().is_some_and(|l| l.inertial.is_none());
-                        let span = InertialSpan { start: pos, end: bom + reader.buffer_position() as usize, line, value: Inertial::default(), problem: None };
-                        let i = InertialInProgress { span, first, seen: HashMap::new() };
-                        if empty {
-                            finish_inertial(i, &mut current, &mut notes);
-                        } else {
-                            inertial = Some(i);
-                        }
-                    }
-                    _ => {}
-                }
+            (2, "collision") => {
+                finish_collision(self.collision.take(), &mut self.current, &mut self.notes);
             }
-            (3, "origin") if stack[2] == "collision" => {
-                if let Some(c) = collision.as_mut() {
-                    match c.origin_line {
-                        None => {
-                            c.origin_line = Some(line);
-                            match pose(&a) {
-                                Ok(p) => c.origin = p,
-                                Err(m) => c.error = Some(Geometry::Invalid { line, message: xacro_hint(format!("<origin> {m}")) }),
-                            }
-                        }
-                        Some(first) => notes.push(warning(line, &current, format!("collision {}: a second <origin> is ignored (urdfdom reads the first, on line {first}); remove one", c.index))),
-                    }
-                }
-            }
-            (3, "geometry") if stack[2] == "collision" => {
-                if let Some(c) = collision.as_mut() {
-                    c.geometries += 1;
-                    if c.geometries > 1 {
-                        notes.push(warning(line, &current, format!("collision {}: a second <geometry> is ignored (urdfdom reads the first); give each shape its own <collision>", c.index)));
-                    }
-                }
-            }
-            (4, g) if stack[2] == "collision" && stack[3] == "geometry" => {
-                if let Some(c) = collision.as_mut().filter(|c| c.geometries == 1) {
-                    match &c.shape {
-                        None => {
-                            let geometry = if g == "origin" {
-                                Geometry::Invalid { line, message: "<origin> is the first element of <geometry>, where the shape (box, cylinder, sphere, capsule or mesh) must be, so urdfdom refuses this collision; move the <origin> into <collision>, before <geometry>".into() }
-                            } else {
-                                geometry(g, &a).unwrap_or_else(|m| Geometry::Invalid { line, message: xacro_hint(m) })
-                            };
-                            c.shape = Some((geometry, g.to_string(), line));
-                        }
-                        Some((_, first, first_line)) => {
-                            let message = if g == "origin" {
-                                format!("collision {}: <origin> inside <geometry> is ignored (as urdfdom does): an origin belongs in <collision>, before <geometry>", c.index)
-                            } else {
-                                format!("collision {}: a second shape <{g}> in <geometry> is ignored (urdfdom reads only the first, <{first}> on line {first_line}); give each shape its own <collision>", c.index)
-                            };
-                            notes.push(warning(line, &current, message));
-                        }
-                    }
-                }
-            }
-            (3, child @ ("origin" | "mass" | "inertia")) if stack[2] == "inertial" => {
-                if let Some(i) = inertial.as_mut().filter(|i| i.first) {
-                    if let Some(first) = i.seen.get(child) {
-                        notes.push(warning(line, &current, format!("a second <{child}> in <inertial> is ignored (urdfdom reads the first, on line {first})")));
-                    } else {
-                        i.seen.insert(child.to_string(), line);
-                        let span = &mut i.span;
-                        let r = match child {
-                            "origin" => pose(&a).map(|p| span.value.origin = p),
-                            "mass" => num(&a, "value").map(|m| span.value.mass = Some(m)),
-                            _ => (|| {
-                                Ok([num(&a, "ixx")?, num(&a, "ixy")?, num(&a, "ixz")?, num(&a, "iyy")?, num(&a, "iyz")?, num(&a, "izz")?])
-                            })()
-                            .map(|i| span.value.inertia = Some(i)),
-                        };
-                        if let Err(m) = r {
-                            span.problem.get_or_insert(format!("line {line}: <{child}>: {m}"));
-                        }
-                    }
+            (2, "inertial") => {
+                if let Some(mut i) = self.inertial.take() {
+                    i.span.end = end;
+                    finish_inertial(i, &mut self.current, &mut self.notes);
                 }
             }
             _ => {}
         }
-        if !empty {
-            stack.push(name);
+    }
+
+    /// A start or empty tag: dispatches on its depth and name (and its parents').
+    fn start_element(&mut self, name: &str, tag: &Tag<'_>) -> Result<(), UrdfError> {
+        if name.starts_with("xacro:") {
+            self.xacro.get_or_insert(tag.line);
+        }
+        let in_collision = self.stack.get(2).is_some_and(|s| s == "collision");
+        match (self.stack.len(), name) {
+            (0, "robot") => {
+                self.robot_name = Some(tag.a.get("name").cloned().unwrap_or_default());
+                if tag.a.contains_key("xmlns:xacro") {
+                    self.xacro_namespace = Some(tag.line);
+                }
+            }
+            (0, other) => return Err(self.err(tag.pos, format!("the root element is <{other}>, not <robot>: this is not a URDF (run xacro first if it is a .xacro file)"))),
+            (1, "link") => self.link(tag)?,
+            (2, child) if self.current.is_some() => self.link_child(child, tag),
+            (3, "origin") if in_collision => self.collision_origin(tag),
+            (3, "geometry") if in_collision => self.collision_geometry(tag.line),
+            (4, g) if in_collision && self.stack[3] == "geometry" => self.shape(g, tag),
+            (3, child @ ("origin" | "mass" | "inertia")) if self.stack[2] == "inertial" => {
+                self.inertial_child(child, tag);
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// `<link>`: a new link (names must be unique, as urdfdom requires).
+    fn link(&mut self, tag: &Tag<'_>) -> Result<(), UrdfError> {
+        let (pos, line) = (tag.pos, tag.line);
+        let lname = tag
+            .a
+            .get("name")
+            .cloned()
+            .ok_or_else(|| self.err(pos, "<link> without a name".into()))?;
+        if let Some(first) = self.seen.insert(lname.clone(), line) {
+            return Err(self.err(pos, format!("duplicate link name `{lname}` on lines {first} and {line}; link names must be unique (urdfdom refuses the file too)")));
+        }
+        let link = Link {
+            name: lname,
+            line,
+            start: pos,
+            open_end: tag.end,
+            self_closing: tag.empty,
+            indent: indent_before(self.text, pos).unwrap_or_default(),
+            child_indent: None,
+            inertial: None,
+            extra_inertials: Vec::new(),
+            collisions: Vec::new(),
+        };
+        if tag.empty {
+            finish_link(link, &mut self.links, &mut self.notes);
+        } else {
+            self.current = Some(link);
+        }
+        Ok(())
+    }
+
+    /// A child of `<link>`: starts a `<collision>` or an `<inertial>`; notes the children's indent.
+    fn link_child(&mut self, child: &str, tag: &Tag<'_>) {
+        if let Some(link) = self.current.as_mut() {
+            if link.child_indent.is_none() {
+                link.child_indent = indent_before(self.text, tag.pos);
+            }
+        }
+        match child {
+            "collision" => {
+                let index = self.current.as_ref().map_or(1, |l| l.collisions.len() + 1);
+                self.collision = Some(CollisionInProgress {
+                    index,
+                    line: tag.line,
+                    name: tag.a.get("name").cloned(),
+                    origin: Pose::default(),
+                    origin_line: None,
+                    geometries: 0,
+                    shape: None,
+                    error: None,
+                });
+                if tag.empty {
+                    finish_collision(self.collision.take(), &mut self.current, &mut self.notes);
+                }
+            }
+            "inertial" => {
+                let first = self.current.as_ref().is_some_and(|l| l.inertial.is_none());
+                let span = InertialSpan {
+                    start: tag.pos,
+                    end: tag.end,
+                    line: tag.line,
+                    value: Inertial::default(),
+                    problem: None,
+                };
+                let i = InertialInProgress {
+                    span,
+                    first,
+                    seen: HashMap::new(),
+                };
+                if tag.empty {
+                    finish_inertial(i, &mut self.current, &mut self.notes);
+                } else {
+                    self.inertial = Some(i);
+                }
+            }
+            _ => {}
         }
     }
-    let name = robot_name.ok_or_else(|| err(0, "no <robot> element: this is not a URDF".into()))?;
-    if !stack.is_empty() {
-        return Err(err(
-            text.len(),
-            format!(
-                "the file ends inside <{}>",
-                stack.last().cloned().unwrap_or_default()
-            ),
-        ));
-    }
-    let xacro_note = match (xacro, xacro_namespace) {
-        (Some(line), _) => Some((Code::UrdfXacro, line, "this file uses xacro (<xacro:…> elements): links inside xacro macros are not seen and ${…} expressions are not expanded; run `xacro FILE.urdf.xacro > FILE.urdf` first and give urdf-inertia the result")),
-        // xacro's output keeps the declaration, so most expanded URDFs have it: a softer note.
-        (None, Some(line)) => Some((Code::UrdfXacroNamespace, line, "the root declares xmlns:xacro: if this is a xacro source rather than xacro's output, links inside its macros are not seen; run `xacro FILE.urdf.xacro > FILE.urdf` first")),
-        (None, None) => None,
-    };
-    if let Some((code, line, message)) = xacro_note {
-        notes.push(diagnostic(code, line, None, message.into()));
-    }
-    notes.sort_by_key(Diagnostic::line);
-    for n in &mut notes {
-        if let Some(l) = n.location.as_mut() {
-            l.file = Some(path.to_path_buf());
+
+    /// `<origin>` in `<collision>`: the first is read, later ones are ignored with a warning.
+    fn collision_origin(&mut self, tag: &Tag<'_>) {
+        let line = tag.line;
+        let Some(c) = self.collision.as_mut() else {
+            return;
+        };
+        match c.origin_line {
+            None => {
+                c.origin_line = Some(line);
+                match pose(tag.a) {
+                    Ok(p) => c.origin = p,
+                    Err(m) => c.error = Some(Geometry::Invalid { line, message: xacro_hint(format!("<origin> {m}")) }),
+                }
+            }
+            Some(first) => self.notes.push(warning(line, &self.current, format!("collision {}: a second <origin> is ignored (urdfdom reads the first, on line {first}); remove one", c.index))),
         }
     }
+
+    /// `<geometry>` in `<collision>`: counted, since urdfdom reads only the first.
+    fn collision_geometry(&mut self, line: usize) {
+        if let Some(c) = self.collision.as_mut() {
+            c.geometries += 1;
+            if c.geometries > 1 {
+                self.notes.push(warning(line, &self.current, format!("collision {}: a second <geometry> is ignored (urdfdom reads the first); give each shape its own <collision>", c.index)));
+            }
+        }
+    }
+
+    /// A child `g` of the first `<geometry>`: the first is the shape, later ones are ignored with a warning.
+    fn shape(&mut self, g: &str, tag: &Tag<'_>) {
+        let line = tag.line;
+        let Some(c) = self.collision.as_mut().filter(|c| c.geometries == 1) else {
+            return;
+        };
+        match &c.shape {
+            None => {
+                let geometry = if g == "origin" {
+                    Geometry::Invalid { line, message: "<origin> is the first element of <geometry>, where the shape (box, cylinder, sphere, capsule or mesh) must be, so urdfdom refuses this collision; move the <origin> into <collision>, before <geometry>".into() }
+                } else {
+                    geometry(g, tag.a).unwrap_or_else(|m| Geometry::Invalid {
+                        line,
+                        message: xacro_hint(m),
+                    })
+                };
+                c.shape = Some((geometry, g.to_string(), line));
+            }
+            Some((_, first, first_line)) => {
+                let message = if g == "origin" {
+                    format!("collision {}: <origin> inside <geometry> is ignored (as urdfdom does): an origin belongs in <collision>, before <geometry>", c.index)
+                } else {
+                    format!("collision {}: a second shape <{g}> in <geometry> is ignored (urdfdom reads only the first, <{first}> on line {first_line}); give each shape its own <collision>", c.index)
+                };
+                self.notes.push(warning(line, &self.current, message));
+            }
+        }
+    }
+
+    /// `<origin>`, `<mass>` or `<inertia>` in the link's first `<inertial>`: the first of each is read.
+    fn inertial_child(&mut self, child: &str, tag: &Tag<'_>) {
+        let (a, line) = (tag.a, tag.line);
+        let Some(i) = self.inertial.as_mut().filter(|i| i.first) else {
+            return;
+        };
+        if let Some(first) = i.seen.get(child) {
+            self.notes.push(warning(line, &self.current, format!("a second <{child}> in <inertial> is ignored (urdfdom reads the first, on line {first})")));
+            return;
+        }
+        i.seen.insert(child.to_string(), line);
+        let span = &mut i.span;
+        let r = match child {
+            "origin" => pose(a).map(|p| span.value.origin = p),
+            "mass" => num(a, "value").map(|m| span.value.mass = Some(m)),
+            _ => (|| {
+                Ok([
+                    num(a, "ixx")?,
+                    num(a, "ixy")?,
+                    num(a, "ixz")?,
+                    num(a, "iyy")?,
+                    num(a, "iyz")?,
+                    num(a, "izz")?,
+                ])
+            })()
+            .map(|i| span.value.inertia = Some(i)),
+        };
+        if let Err(m) = r {
+            span.problem
+                .get_or_insert(format!("line {line}: <{child}>: {m}"));
+        }
+    }
+
+    /// The end of the document: a `<robot>` must have been read and closed; adds the xacro note and
+    /// puts the diagnostics in line order with the file.
+    fn finish(mut self) -> Result<Scanned, UrdfError> {
+        let Some(name) = self.robot_name.take() else {
+            return Err(self.err(0, "no <robot> element: this is not a URDF".into()));
+        };
+        if !self.stack.is_empty() {
+            return Err(self.err(
+                self.text.len(),
+                format!(
+                    "the file ends inside <{}>",
+                    self.stack.last().cloned().unwrap_or_default()
+                ),
+            ));
+        }
+        let xacro_note = match (self.xacro, self.xacro_namespace) {
+            (Some(line), _) => Some((Code::UrdfXacro, line, "this file uses xacro (<xacro:…> elements): links inside xacro macros are not seen and ${…} expressions are not expanded; run `xacro FILE.urdf.xacro > FILE.urdf` first and give urdf-inertia the result")),
+            // xacro's output keeps the declaration, so most expanded URDFs have it: a softer note.
+            (None, Some(line)) => Some((Code::UrdfXacroNamespace, line, "the root declares xmlns:xacro: if this is a xacro source rather than xacro's output, links inside its macros are not seen; run `xacro FILE.urdf.xacro > FILE.urdf` first")),
+            (None, None) => None,
+        };
+        let mut notes = self.notes;
+        if let Some((code, line, message)) = xacro_note {
+            notes.push(diagnostic(code, line, None, message.into()));
+        }
+        notes.sort_by_key(Diagnostic::line);
+        for n in &mut notes {
+            if let Some(l) = n.location.as_mut() {
+                l.file = Some(self.path.to_path_buf());
+            }
+        }
+        Ok((name, self.links, notes))
+    }
+}
+
+/// Scans URDF text. `path` is used in messages and for resolving relative mesh paths.
+pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
+    let (name, links, notes) = Scanner::new(&text, path).run()?;
     let newline = if text.contains("\r\n") { "\r\n" } else { "\n" };
     Ok(Robot {
         path: path.to_path_buf(),
@@ -644,7 +776,7 @@ fn finish_inertial(i: InertialInProgress, current: &mut Option<Link>, notes: &mu
     if i.first {
         link.inertial = Some(i.span);
     } else {
-        let first = link.inertial.as_ref().map(|s| s.line).unwrap_or(link.line);
+        let first = link.inertial.as_ref().map_or(link.line, |s| s.line);
         notes.push(diagnostic(
             Code::UrdfIgnoredElement,
             i.span.line,

@@ -44,6 +44,7 @@ pub fn exact_integrals_about_centre(v: &[[f64; 3]], tris: &[[u32; 3]]) -> [BigRa
     exact_integrals_with(v, tris, true)
 }
 
+#[allow(clippy::too_many_lines)] // Mirtich's sums in exact arithmetic, written out term by term like the kernel
 fn exact_integrals_with(v: &[[f64; 3]], tris: &[[u32; 3]], centred: bool) -> [BigRational; 10] {
     let mut emin = v
         .iter()
@@ -313,7 +314,7 @@ pub fn box_mesh(s: [f64; 3]) -> Mesh {
 pub fn cylinder_mesh(r: f64, l: f64, n: u32) -> Mesh {
     let mut v = vec![[0.0, 0.0, -l / 2.0], [0.0, 0.0, l / 2.0]];
     for i in 0..n {
-        let a = 2.0 * std::f64::consts::PI * i as f64 / n as f64;
+        let a = 2.0 * std::f64::consts::PI * f64::from(i) / f64::from(n);
         v.push([r * a.cos(), r * a.sin(), -l / 2.0]);
         v.push([r * a.cos(), r * a.sin(), l / 2.0]);
     }

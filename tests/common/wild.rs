@@ -245,6 +245,7 @@ pub fn bases() -> Vec<(String, Mesh)> {
 
 /// Every case: each base stored five wild ways (closed up to noise), plus real holes, an inward
 /// component, a cavity and duplicated faces.
+#[allow(clippy::too_many_lines)] // a table of cases
 pub fn cases() -> Vec<Case> {
     let mut rng = Rng(0x5EED);
     let mut out = Vec::new();
