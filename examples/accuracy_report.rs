@@ -620,13 +620,10 @@ fn main() -> std::io::Result<()> {
     Ok(())
 }
 
-fn corpus(md: &mut String, share: &std::path::Path) {
-    use urdf_inertia::density::DensityMap;
-    use urdf_inertia::fill::{compute_with, FillOptions, MeshCache};
-    use urdf_inertia::urdf::resolve::PackageResolver;
-    let robots = share.join("example-robot-data/robots");
+/// Every `.urdf` file below `dir`, sorted.
+fn urdfs_under(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
     let mut urdfs = Vec::new();
-    let mut stack = vec![robots.clone()];
+    let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
         for entry in std::fs::read_dir(&d).into_iter().flatten().flatten() {
             let p = entry.path();
@@ -638,6 +635,15 @@ fn corpus(md: &mut String, share: &std::path::Path) {
         }
     }
     urdfs.sort();
+    urdfs
+}
+
+fn corpus(md: &mut String, share: &std::path::Path) {
+    use urdf_inertia::density::DensityMap;
+    use urdf_inertia::fill::{compute_with, FillOptions, MeshCache};
+    use urdf_inertia::urdf::resolve::PackageResolver;
+    let robots = share.join("example-robot-data/robots");
+    let urdfs = urdfs_under(&robots);
     let resolver = PackageResolver::new(&[(
         "example-robot-data".into(),
         share.join("example-robot-data"),

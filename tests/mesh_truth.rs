@@ -7,6 +7,21 @@ use common::wild::{self, Expect};
 use std::fmt::Write as _;
 use urdf_inertia::mesh::health::HealthOptions;
 
+/// Runs the real binary and returns its stdout, asserting exit 0.
+fn urdf_inertia(args: &[&str]) -> Vec<u8> {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
+        .args(args)
+        .output()
+        .expect("run");
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out.stdout
+}
+
 #[test]
 fn generators_make_closed_outward_meshes() {
     for (name, base) in wild::bases() {
@@ -106,24 +121,15 @@ fn needles_through_the_mesh_command() {
         }
         let path = tmp.path().join(name);
         std::fs::write(&path, obj).expect("write");
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
-            .args([
-                "mesh",
-                path.to_str().expect("utf-8"),
-                "--format",
-                "json",
-                "--digits",
-                "full",
-            ])
-            .output()
-            .expect("run");
-        assert_eq!(
-            out.status.code(),
-            Some(0),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+        let stdout = urdf_inertia(&[
+            "mesh",
+            path.to_str().expect("utf-8"),
+            "--format",
+            "json",
+            "--digits",
+            "full",
+        ]);
+        let json: serde_json::Value = serde_json::from_slice(&stdout).expect("json");
         let inertia: [[f64; 3]; 3] =
             serde_json::from_value(json["inertia"].clone()).expect("inertia");
         let volume = json["volume"].as_f64().expect("volume");
@@ -173,24 +179,15 @@ fn large_error_estimates_do_not_round_numbers_away() {
     )
     .expect("write");
     let fill = |digits: &str| {
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
-            .args([
-                "fill",
-                urdf.to_str().expect("utf-8"),
-                "--density",
-                "1",
-                "--digits",
-                digits,
-            ])
-            .output()
-            .expect("run");
-        assert_eq!(
-            out.status.code(),
-            Some(0),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let text = String::from_utf8(out.stdout).expect("utf-8");
+        let stdout = urdf_inertia(&[
+            "fill",
+            urdf.to_str().expect("utf-8"),
+            "--density",
+            "1",
+            "--digits",
+            digits,
+        ]);
+        let text = String::from_utf8(stdout).expect("utf-8");
         let mass: f64 = text
             .split("<mass value=\"")
             .nth(1)
@@ -205,14 +202,6 @@ fn large_error_estimates_do_not_round_numbers_away() {
     assert!((auto - full).abs() <= 1e-6 * full, "{auto} against {full}");
     let filled = tmp.path().join("filled.urdf");
     std::fs::write(&filled, auto_text).expect("write");
-    let check = std::process::Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
-        .args(["check", filled.to_str().expect("utf-8")])
-        .output()
-        .expect("run");
-    assert_eq!(
-        check.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&check.stderr)
-    );
+    // `check` exits 0 on the rounded output.
+    urdf_inertia(&["check", filled.to_str().expect("utf-8")]);
 }

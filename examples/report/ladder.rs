@@ -60,22 +60,14 @@ fn synthetic(md: &mut String) {
 fn corpus(md: &mut String, share: &Path) {
     let robots = share.join("example-robot-data/robots");
     let mut files: Vec<PathBuf> = Vec::new();
-    let mut stack = vec![robots.clone()];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).into_iter().flatten().flatten() {
-            let p = entry.path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.extension().and_then(|e| e.to_str()) == Some("urdf") {
-                let text = std::fs::read_to_string(&p).unwrap_or_default();
-                for block in text.split("<collision").skip(1) {
-                    let block = block.split("</collision>").next().unwrap_or("");
-                    if let Some(rest) = block.split("filename=\"").nth(1) {
-                        let uri = rest.split('"').next().unwrap_or("");
-                        let rel = uri.trim_start_matches("package://").trim_start_matches('/');
-                        files.push(share.join(rel));
-                    }
-                }
+    for p in super::urdfs_under(&robots) {
+        let text = std::fs::read_to_string(&p).unwrap_or_default();
+        for block in text.split("<collision").skip(1) {
+            let block = block.split("</collision>").next().unwrap_or("");
+            if let Some(rest) = block.split("filename=\"").nth(1) {
+                let uri = rest.split('"').next().unwrap_or("");
+                let rel = uri.trim_start_matches("package://").trim_start_matches('/');
+                files.push(share.join(rel));
             }
         }
     }
