@@ -7,7 +7,7 @@
 //! URDF reading (2xx), density (3xx), overlap (4xx), output (5xx). README's "Diagnostics" table lists
 //! them.
 
-use crate::mesh::health::{Rung, Solid};
+use crate::mesh::health::{HealthKind, Rung, Solid};
 use crate::mesh::MeshError;
 use serde::{Serialize, Serializer};
 use std::fmt;
@@ -56,6 +56,8 @@ pub enum Code {
     MeshReaderNote,
     /// UI106: a mesh over 10 m across (likely millimetres without `scale`).
     MeshTooLarge,
+    /// UI107: faces dropped in pairs, a face and its reverse (they cancel in the integral).
+    MeshFacesCancelled,
     /// UI201: an element urdfdom ignores (a second `<origin>`, `<geometry>`, shape, `<inertial>`).
     UrdfIgnoredElement,
     /// UI202: a `<collision>` without a shape, ignored.
@@ -80,13 +82,14 @@ pub enum Code {
 
 impl Code {
     /// Every code, in table order.
-    pub const ALL: [Code; 16] = [
+    pub const ALL: [Code; 17] = [
         Code::MeshRepaired,
         Code::MeshFacesDropped,
         Code::MeshWelded,
         Code::MeshReaderSkipped,
         Code::MeshReaderNote,
         Code::MeshTooLarge,
+        Code::MeshFacesCancelled,
         Code::UrdfIgnoredElement,
         Code::UrdfEmptyCollision,
         Code::UrdfZeroVolume,
@@ -108,6 +111,7 @@ impl Code {
             Code::MeshReaderSkipped => "UI104",
             Code::MeshReaderNote => "UI105",
             Code::MeshTooLarge => "UI106",
+            Code::MeshFacesCancelled => "UI107",
             Code::UrdfIgnoredElement => "UI201",
             Code::UrdfEmptyCollision => "UI202",
             Code::UrdfZeroVolume => "UI203",
@@ -126,6 +130,7 @@ impl Code {
         match self {
             Code::MeshWelded
             | Code::MeshReaderNote
+            | Code::MeshFacesCancelled
             | Code::UrdfZeroVolume
             | Code::UrdfXacroNamespace
             | Code::UrdfFrameInertial => Severity::Note,
@@ -267,25 +272,20 @@ impl Serialize for Provenance {
 /// *dropped*, every other warning is the rung's repair; a note about welding is the ladder's, the
 /// rest are the reader's. When `Solid` carries codes itself, this becomes a plain copy.
 pub fn mesh_health(solid: &Solid) -> Vec<Diagnostic> {
-    let warnings = solid.warnings.iter().map(|w| {
-        let code = if w.contains("skipped") {
-            Code::MeshReaderSkipped
-        } else if w.contains("dropped") {
-            Code::MeshFacesDropped
-        } else {
-            Code::MeshRepaired
-        };
-        Diagnostic::new(code, w.clone())
-    });
-    let notes = solid.notes.iter().map(|n| {
-        let code = if n.contains("welded") {
-            Code::MeshWelded
-        } else {
-            Code::MeshReaderNote
-        };
-        Diagnostic::new(code, n.clone())
-    });
-    warnings.chain(notes).collect()
+    let code = |kind: HealthKind| match kind {
+        HealthKind::Repaired => Code::MeshRepaired,
+        HealthKind::FacesDropped => Code::MeshFacesDropped,
+        HealthKind::FacesCancelled => Code::MeshFacesCancelled,
+        HealthKind::Welded => Code::MeshWelded,
+        HealthKind::ReaderSkipped => Code::MeshReaderSkipped,
+        HealthKind::ReaderNote => Code::MeshReaderNote,
+    };
+    solid
+        .warnings
+        .iter()
+        .chain(&solid.notes)
+        .map(|m| Diagnostic::new(code(m.kind), m.text.clone()))
+        .collect()
 }
 
 /// A collision of a link: its 1-based index and line.

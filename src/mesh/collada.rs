@@ -12,6 +12,7 @@
 //! * `<triangles>`, `<polylist>` and `<polygons>` are read (polygons stay polygons; holes in `<ph>` are
 //!   not supported and reported); `<lines>` and `<linestrips>` carry no surface and are skipped.
 
+use super::affine::{self, compose, Affine, IDENTITY};
 use super::{parse_f64, MeshError, MeshErrorKind, RawMesh};
 use crate::mass::{Mat3, Polygons};
 use crate::text::{line_of, LineCounter};
@@ -201,19 +202,6 @@ fn add_text(top: &mut El, piece: &[u8], pos: usize, bytes: &[u8]) {
             Text::Joined(s)
         }
     };
-}
-
-type Affine = (Mat3, [f64; 3]);
-
-const IDENTITY: Affine = (
-    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
-    [0.0; 3],
-);
-
-fn compose(a: &Affine, b: &Affine) -> Affine {
-    let m = crate::mass::mat_mul(&a.0, &b.0);
-    let t = crate::mass::mat_vec(&a.0, b.1);
-    (m, [t[0] + a.1[0], t[1] + a.1[1], t[2] + a.1[2]])
 }
 
 /// The numbers of an element's text, one at a time (a `<p>` of millions of indices is never a list).
@@ -749,13 +737,10 @@ impl Instancer<'_> {
             ]);
         }
         // A mirroring node transform reverses the faces' orientation.
-        let m = &xf.0;
-        let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+        let mirrored = affine::mirrors(xf);
         for face in f.iter() {
             let mut g: Vec<u32> = face.iter().map(|i| i + base).collect();
-            if det < 0.0 {
+            if mirrored {
                 g.reverse();
             }
             self.out.faces.push(&g);

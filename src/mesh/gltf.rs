@@ -19,6 +19,7 @@
 //! change geometry (material-only extensions are accepted). Every offset and length is checked before the
 //! crate reads an accessor, and the crate call is also guarded against panics, so no input panics.
 
+use super::affine::{self, compose, Affine, IDENTITY};
 use super::{MeshError, MeshErrorKind, RawMesh};
 use crate::mass::Polygons;
 use base64::Engine as _;
@@ -38,25 +39,6 @@ const GEOMETRY_NEUTRAL_PREFIXES: &[&str] = &[
 const MAX_DEPTH: usize = 256;
 /// Node visits allowed in one traversal (a node shared by many parents could otherwise explode).
 const MAX_VISITS: usize = 1_000_000;
-
-type Affine = ([[f64; 3]; 3], [f64; 3]);
-
-const IDENTITY: Affine = (
-    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
-    [0.0; 3],
-);
-
-fn compose(a: &Affine, b: &Affine) -> Affine {
-    let m = crate::mass::mat_mul(&a.0, &b.0);
-    let t = crate::mass::mat_vec(&a.0, b.1);
-    (m, [t[0] + a.1[0], t[1] + a.1[1], t[2] + a.1[2]])
-}
-
-fn det(m: &[[f64; 3]; 3]) -> f64 {
-    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-}
 
 fn syntax(path: &Path, msg: String) -> MeshError {
     MeshError::new(path, None, MeshErrorKind::Syntax(msg))
@@ -332,7 +314,7 @@ fn add_primitive(
         out.vertices
             .push([q[0] + xf.1[0], q[1] + xf.1[1], q[2] + xf.1[2]]);
     }
-    push_triangles(mode, &indices, base, det(&xf.0) < 0.0, out);
+    push_triangles(mode, &indices, base, affine::mirrors(xf), out);
     Ok(())
 }
 

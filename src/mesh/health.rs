@@ -158,6 +158,55 @@ impl ErrorEstimate {
     }
 }
 
+/// What a health message is about (the diagnostic layer gives each kind its code).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HealthKind {
+    /// The solid is not the stored surface as it is: re-oriented, inverted, capped, non-manifold, hull.
+    Repaired,
+    /// Degenerate faces or faces stored twice left out.
+    FacesDropped,
+    /// A face and its reverse left out in pairs (they cancel).
+    FacesCancelled,
+    /// Closed once float-noise cracks are welded; integrated as stored.
+    Welded,
+    /// The reader left something out of the solid (faces it could not use).
+    ReaderSkipped,
+    /// The reader tolerated something harmless.
+    ReaderNote,
+}
+
+/// One message of the ladder: its kind and its text (which it reads as, for printing and matching).
+#[derive(Debug, Clone, PartialEq)]
+pub struct HealthMessage {
+    pub kind: HealthKind,
+    pub text: String,
+}
+
+impl HealthMessage {
+    fn new(kind: HealthKind, text: String) -> Self {
+        HealthMessage { kind, text }
+    }
+}
+
+impl std::ops::Deref for HealthMessage {
+    type Target = str;
+    fn deref(&self) -> &str {
+        &self.text
+    }
+}
+
+impl std::fmt::Display for HealthMessage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.text)
+    }
+}
+
+impl serde::Serialize for HealthMessage {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&self.text)
+    }
+}
+
 /// A closed, outward solid ready to integrate, with its unit-density mass properties.
 #[derive(Debug, Clone)]
 pub struct Solid {
@@ -165,9 +214,9 @@ pub struct Solid {
     pub faces: Polygons,
     pub rung: Rung,
     /// Messages for the user: what was done to the mesh and why.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<HealthMessage>,
     /// What the user may want to know but need not act on (a weld within tolerance, reader notes).
-    pub notes: Vec<String>,
+    pub notes: Vec<HealthMessage>,
     /// Mass properties at density 1 (mass = volume), in the mesh frame.
     pub unit: MassProperties,
     /// Bound on the relative error of volume and central inertia: `error.total()`.
@@ -549,8 +598,8 @@ fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize, usize) {
 struct Ladder<'a> {
     path: &'a Path,
     options: HealthOptions,
-    warnings: Vec<String>,
-    notes: Vec<String>,
+    warnings: Vec<HealthMessage>,
+    notes: Vec<HealthMessage>,
     faces_read: usize,
     /// The integrals of the faces `finish` gets, when a rung already has them (a clean mesh is then
     /// integrated twice, not three times: once here, once about a second reference point).
@@ -558,6 +607,14 @@ struct Ladder<'a> {
 }
 
 impl Ladder<'_> {
+    fn warn(&mut self, kind: HealthKind, text: String) {
+        self.warnings.push(HealthMessage::new(kind, text));
+    }
+
+    fn note(&mut self, kind: HealthKind, text: String) {
+        self.notes.push(HealthMessage::new(kind, text));
+    }
+
     fn strict(&self, what: &str) -> Result<(), MeshError> {
         if self.options.strict {
             Err(MeshError::new(
@@ -592,7 +649,7 @@ impl Ladder<'_> {
         let bound = model.bound(&unit, &vertices);
         let model_error = bound.relative;
         if let Some(m) = message(model_error) {
-            self.warnings.push(m);
+            self.warn(HealthKind::Repaired, m);
         }
         let mut rung = rung;
         if let Rung::Capped {
@@ -727,17 +784,28 @@ pub fn make_solid_stored_as(
     let mut ladder = Ladder {
         path,
         options,
-        warnings: mesh.warnings.clone(),
-        notes: mesh.notes.clone(),
+        warnings: mesh
+            .warnings
+            .iter()
+            .map(|w| HealthMessage::new(HealthKind::ReaderSkipped, w.clone()))
+            .collect(),
+        notes: mesh
+            .notes
+            .iter()
+            .map(|n| HealthMessage::new(HealthKind::ReaderNote, n.clone()))
+            .collect(),
         faces_read: mesh.faces.len(),
         known: None,
     };
     let exact = weld::exact(&mesh.vertices, &mesh.faces);
     if exact.dropped > 0 {
-        ladder.warnings.push(format!(
-            "{} degenerate faces (repeated vertices) dropped",
-            exact.dropped
-        ));
+        ladder.warn(
+            HealthKind::FacesDropped,
+            format!(
+                "{} degenerate faces (repeated vertices) dropped",
+                exact.dropped
+            ),
+        );
     }
     if exact.faces.is_empty() {
         return Err(MeshError::new(path, None, MeshErrorKind::Empty));
@@ -756,19 +824,22 @@ pub fn make_solid_stored_as(
     let w = tolerant_welding(exact, precision());
     let te = edges(&w.topology);
     if w.duplicates > 0 {
-        ladder.warnings.push(format!(
+        ladder.warn(
+            HealthKind::FacesDropped,
+            format!(
             "{} faces stored more than once dropped (the copies would count their volume twice)",
             w.duplicates
-        ));
+        ),
+        );
     }
     if w.cancelled > 0 {
-        ladder.notes.push(format!(
+        ladder.note(HealthKind::FacesCancelled, format!(
             "{} faces dropped in pairs, each a face and its reverse (a wall of no thickness; they cancel)",
             w.cancelled
         ));
     }
     if w.collapsed > 0 {
-        ladder.notes.push(format!(
+        ladder.note(HealthKind::Welded, format!(
             "{} sliver faces collapse when corners within {:.1e} m are welded; left out of the topology",
             w.collapsed, w.tolerant.tolerance.largest
         ));
@@ -816,10 +887,13 @@ fn consistent_closed(
             let all = vec![true; k.len()];
             apply(k, &all);
         }
-        ladder.warnings.push(format!(
-            "all {} faces wound inward (negative volume); flipped",
-            faces.len()
-        ));
+        ladder.warn(
+            HealthKind::Repaired,
+            format!(
+                "all {} faces wound inward (negative volume); flipped",
+                faces.len()
+            ),
+        );
         rung = Rung::Inverted;
     }
     let topology_faces = kept.as_ref().unwrap_or(&faces);
@@ -833,7 +907,7 @@ fn consistent_closed(
             apply(&mut out, &reversed);
             let flipped = reversed.iter().filter(|r| **r).count();
             let turned = flip.iter().filter(|f| **f).count();
-            ladder.warnings.push(format!(
+            ladder.warn(HealthKind::Repaired, format!(
                 "{turned} of {ncomp} closed components wound inward although no other component encloses them (a cavity must lie inside a solid); {flipped} faces flipped"
             ));
             let model = open_volume(&vertices, &out);
@@ -850,7 +924,7 @@ fn consistent_closed(
         tolerance,
     } = rung
     {
-        ladder.notes.push(format!(
+        ladder.note(HealthKind::Welded, format!(
             "closed once {merged_vertices} corners stored up to {widest_crack:.1e} m apart are welded (tolerance {tolerance:.1e} m); integrated as stored"
         ));
     }
@@ -951,7 +1025,7 @@ fn reoriented(
         "{} faces wound against their neighbours",
         te.inconsistent
     ))?;
-    ladder.warnings.push(format!(
+    ladder.warn(HealthKind::Repaired, format!(
         "closed, but {flipped} of {} faces were wound against their neighbours ({} edges disagreed); re-oriented each of {} component(s) outward",
         faces.len(),
         te.inconsistent,
@@ -1079,11 +1153,12 @@ fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result<Sol
         for f in caps.faces.iter() {
             capped.push(f);
         }
-        let volume = signed_volume(&vertices, &capped);
+        let unit = unit_props(&vertices, &capped, None);
+        let volume = unit.mass;
         let cracks = open_volume(&vertices, &capped);
         // The caps are used when the bound they leave on volume and inertia is small enough.
         let relative = caps_model(&caps, cracks, winding.nested)
-            .bound(&unit_props(&vertices, &capped, None), &vertices)
+            .bound(&unit, &vertices)
             .relative;
         if !(volume > 0.0 && relative.is_finite()) {
             continue;
@@ -1123,7 +1198,7 @@ fn non_manifold(
     what: &str,
 ) -> Result<Solid, MeshError> {
     ladder.strict(&format!("mesh is {what}"))?;
-    ladder.warnings.push(format!("mesh is {what} but has no holes: integrated as it is{} (a region enclosed by two overlapping shells would count twice)", winding.flips()));
+    ladder.warn(HealthKind::Repaired, format!("mesh is {what} but has no holes: integrated as it is{} (a region enclosed by two overlapping shells would count twice)", winding.flips()));
     let model = open_volume(&w.vertices, &winding.faces) + winding.nested;
     let rung = Rung::NonManifold {
         nonmanifold_edges: te.nonmanifold,
@@ -1175,7 +1250,7 @@ fn with_caps(
     let (lo, hi) = bbox(&w.vertices);
     let spans = caps.area * dist(lo, hi);
     if (spans + caps.bound + plan.cracks) / plan.volume <= SLIVERS && winding.flipped == 0 {
-        ladder.notes.push(format!(
+        ladder.note(HealthKind::Welded, format!(
             "closed up to slivers once corners within {:.1e} m are welded ({} boundary edges bound {:.1e} m² in all); integrated as stored",
             w.tolerant.tolerance.largest, te.boundary, caps.area
         ));

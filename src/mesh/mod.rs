@@ -5,6 +5,7 @@
 //! lines. Polygons stay polygons. Coordinates are read as f64 (binary STL's and glTF's f32 values convert
 //! exactly).
 
+mod affine;
 pub mod cache;
 pub mod collada;
 pub mod gltf;
