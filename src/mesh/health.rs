@@ -30,6 +30,7 @@ use super::{hull, weld, MeshError, MeshErrorKind, RawMesh};
 use crate::mass::integrals::{bounding_box_centre, volume_integrals, VolumeIntegrals};
 use crate::mass::{frobenius, IntegrationOptions, MassProperties, Polygons};
 use rustc_hash::FxHashMap;
+use std::borrow::Cow;
 use std::path::Path;
 
 /// Which rung of the repair ladder produced a solid's numbers.
@@ -257,6 +258,18 @@ struct Edges {
     inconsistent: usize,
     /// Boundary edges as directed in their face.
     boundary_half_edges: Vec<(u32, u32)>,
+    /// Per-face component ids and their number, when [`closed_consistent`] proved the surface clean
+    /// (then `pairs` is empty: the components are all a clean surface needs of its topology).
+    components: Option<(Vec<u32>, usize)>,
+}
+
+impl Edges {
+    /// Per-face component ids over manifold edges and their number.
+    fn components(&mut self, nfaces: usize) -> (Vec<u32>, usize) {
+        self.components
+            .take()
+            .unwrap_or_else(|| components(nfaces, &self.pairs))
+    }
 }
 
 impl Edges {
@@ -284,13 +297,12 @@ impl Edges {
 }
 
 /// The edge structure of `faces`. A closed, consistently wound surface (the common case) is proven so
-/// by [`closed_consistent_pairs`], which builds only the face pairs; anything else gets the full
-/// analysis below (a sort of every half-edge by its undirected key), whose boundary edges come in key
-/// order.
+/// by [`closed_consistent`], which yields only the components; anything else gets the full analysis
+/// below (a sort of every half-edge by its undirected key), whose boundary edges come in key order.
 fn edges(faces: &Polygons) -> Edges {
-    if let Some(pairs) = closed_consistent_pairs(faces) {
+    if let Some(components) = closed_consistent(faces) {
         return Edges {
-            pairs,
+            components: Some(components),
             ..Edges::default()
         };
     }
@@ -337,45 +349,20 @@ fn edges(faces: &Polygons) -> Edges {
     e
 }
 
-/// The faces sharing each edge when every directed edge `u → v` of `faces` has exactly one twin
-/// `v → u` (then each undirected edge has one half-edge each way: closed, edge-manifold, consistently
-/// wound); `None` otherwise. Half-edges are bucketed by their start vertex (a counting sort of the
-/// corners), so the check costs a few linear passes instead of a sort; pairs come in order of their
-/// smaller vertex.
-fn closed_consistent_pairs(faces: &Polygons) -> Option<Vec<(u32, u32, bool)>> {
+/// The face components (as [`components`] numbers them) when every directed edge `u → v` of `faces`
+/// has exactly one twin `v → u` (then each undirected edge has one half-edge each way: closed,
+/// edge-manifold, consistently wound); `None` otherwise.
+///
+/// Half-edges are bucketed by their start vertex (a counting sort), each entry holding its end and its
+/// face, so a twin is found by scanning the handful of entries of its start: a few linear passes and
+/// no sort. Faces are joined as twins are found (union-find), so no list of face pairs is built.
+/// Measured on a 1.3 M-face sphere (callgrind): 503 → N instructions per face for the proof and the
+/// components together.
+fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
     let idx = &faces.indices;
     let n = *idx.iter().max()? as usize + 1;
-    if faces.all_triangles() {
-        let next = |c: usize| if c % 3 == 2 { c - 2 } else { c + 1 };
-        return twin_pairs(idx, n, |c| idx[next(c)], |c| (c / 3) as u32);
-    }
-    let mut face_of = vec![0u32; idx.len()];
-    for i in 0..faces.len() {
-        let (a, b) = (faces.starts[i] as usize, faces.starts[i + 1] as usize);
-        face_of[a..b].fill(i as u32);
-    }
-    let next = |c: usize| {
-        let f = face_of[c] as usize;
-        if c + 1 == faces.starts[f + 1] as usize {
-            faces.starts[f] as usize
-        } else {
-            c + 1
-        }
-    };
-    twin_pairs(idx, n, |c| idx[next(c)], |c| face_of[c])
-}
-
-/// [`closed_consistent_pairs`] over the corners `idx` of `n` vertices, given each corner's half-edge
-/// end and face. Only the corners are bucketed (4 bytes per half-edge): the ends are read back through
-/// `end`, which for a mesh in any spatially coherent order stays in cache.
-fn twin_pairs(
-    idx: &[u32],
-    n: usize,
-    end: impl Fn(usize) -> u32,
-    face: impl Fn(usize) -> u32,
-) -> Option<Vec<(u32, u32, bool)>> {
     let h = idx.len();
-    // Corners starting at vertex u: `corner[start[u]..start[u + 1]]`.
+    // Entries starting at vertex u, after the fill: `out[start[u]..start[u + 1]]`, with start[0] = 0.
     let mut start = vec![0u32; n + 1];
     for &u in idx {
         start[u as usize + 1] += 1;
@@ -383,43 +370,102 @@ fn twin_pairs(
     for i in 0..n {
         start[i + 1] += start[i];
     }
-    let mut fill = start[..n].to_vec();
-    let mut corner = vec![0u32; h];
-    for (c, &u) in idx.iter().enumerate() {
-        let s = &mut fill[u as usize];
-        corner[*s as usize] = c as u32;
+    // Filling advances start[u] to where u's entries end, which is where u + 1's begin: after the
+    // fill, u's entries are `start[u - 1]..start[u]` (a shift instead of a second cursor array).
+    let mut out = vec![(0u32, 0u32); h];
+    let mut put = |u: u32, v: u32, f: u32| {
+        let s = &mut start[u as usize];
+        out[*s as usize] = (v, f);
         *s += 1;
+    };
+    if faces.all_triangles() {
+        for (f, t) in idx.chunks_exact(3).enumerate() {
+            let f = f as u32;
+            put(t[0], t[1], f);
+            put(t[1], t[2], f);
+            put(t[2], t[0], f);
+        }
+    } else {
+        for (f, face) in faces.iter().enumerate() {
+            for k in 0..face.len() {
+                put(face[k], face[(k + 1) % face.len()], f as u32);
+            }
+        }
     }
-    drop(fill);
+    let bucket = |u: usize| {
+        let lo = if u == 0 { 0 } else { start[u - 1] as usize };
+        &out[lo..start[u] as usize]
+    };
+    let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
     // Each half-edge u → v with u < v must be alone in u's list and find exactly one v → u; when
     // those pairs account for every half-edge, no half-edge v → u is left without its twin.
-    let mut pairs = Vec::with_capacity(h / 2);
-    let mut ends: Vec<u32> = Vec::new();
+    let mut paired = 0usize;
     for u in 0..n {
-        let out = &corner[start[u] as usize..start[u + 1] as usize];
-        ends.clear();
-        ends.extend(out.iter().map(|&c| end(c as usize)));
-        for (i, &v) in ends.iter().enumerate() {
-            let v = v as usize;
-            if v <= u {
-                if v == u {
+        let mine = bucket(u);
+        for (i, &(v, f)) in mine.iter().enumerate() {
+            if v as usize <= u {
+                if v as usize == u {
                     return None;
                 }
                 continue;
             }
-            if ends[..i].contains(&(v as u32)) {
+            if mine[..i].iter().any(|e| e.0 == v) {
                 return None;
             }
-            let back = &corner[start[v] as usize..start[v + 1] as usize];
-            let mut twins = back.iter().filter(|&&c| end(c as usize) as usize == u);
-            let &t = twins.next()?;
+            let mut twins = bucket(v as usize).iter().filter(|e| e.0 as usize == u);
+            let &(_, g) = twins.next()?;
             if twins.next().is_some() {
                 return None;
             }
-            pairs.push((face(out[i] as usize), face(t as usize), false));
+            union(&mut parent, f, g);
+            paired += 1;
         }
     }
-    (2 * pairs.len() == h).then_some(pairs)
+    (2 * paired == h).then(|| label(parent))
+}
+
+/// The root of `x` in a union-find forest, halving the path on the way.
+fn root(parent: &mut [u32], mut x: u32) -> u32 {
+    while parent[x as usize] != x {
+        let up = parent[parent[x as usize] as usize];
+        parent[x as usize] = up;
+        x = up;
+    }
+    x
+}
+
+/// Joins the sets of `a` and `b`; the smaller root becomes the root.
+fn union(parent: &mut [u32], a: u32, b: u32) {
+    let (ra, rb) = (root(parent, a), root(parent, b));
+    if ra != rb {
+        parent[ra.max(rb) as usize] = ra.min(rb);
+    }
+}
+
+/// Per-element set ids numbered by first appearance, and their number.
+fn label(mut parent: Vec<u32>) -> (Vec<u32>, usize) {
+    // One set (the common case) needs no root walks: every id is 0.
+    let roots = parent
+        .iter()
+        .enumerate()
+        .filter(|&(i, &p)| p as usize == i)
+        .count();
+    if roots == 1 {
+        parent.fill(0);
+        return (parent, 1);
+    }
+    let mut id = vec![u32::MAX; parent.len()];
+    let mut comp = Vec::with_capacity(parent.len());
+    let mut n = 0u32;
+    for f in 0..parent.len() as u32 {
+        let r = root(&mut parent, f) as usize;
+        if id[r] == u32::MAX {
+            id[r] = n;
+            n += 1;
+        }
+        comp.push(id[r]);
+    }
+    (comp, n as usize)
 }
 
 /// A consistent orientation of each connected component (over manifold edges): per-face flips,
@@ -770,7 +816,7 @@ fn reach(unit: &MassProperties, vertices: &[[f64; 3]]) -> f64 {
 /// Turns a scaled mesh into a solid by the ladder in the module docs, its coordinates taken as f64
 /// values (see [`make_solid_stored_as`] for meshes stored in f32).
 pub fn make_solid(mesh: &RawMesh, path: &Path, options: HealthOptions) -> Result<Solid, MeshError> {
-    make_solid_stored_as(mesh, path, options, || weld::Precision::F64)
+    heal(Cow::Borrowed(mesh), path, options, |_| weld::Precision::F64)
 }
 
 /// Turns a scaled mesh into a solid; `precision` tells how its file stored the coordinates, which sets
@@ -780,6 +826,18 @@ pub fn make_solid_stored_as(
     path: &Path,
     options: HealthOptions,
     precision: impl FnOnce() -> weld::Precision,
+) -> Result<Solid, MeshError> {
+    heal(Cow::Borrowed(mesh), path, options, |_| precision())
+}
+
+/// [`make_solid_stored_as`] on a mesh that may be owned: a mesh its reader welded
+/// ([`RawMesh::welded`]) and that is owned becomes the solid without a copy and without a second weld.
+/// `precision` gets the (scaled, welded) vertices and is asked only when the tolerant pass runs.
+pub fn heal(
+    mesh: Cow<'_, RawMesh>,
+    path: &Path,
+    options: HealthOptions,
+    precision: impl FnOnce(&[[f64; 3]]) -> weld::Precision,
 ) -> Result<Solid, MeshError> {
     let mut ladder = Ladder {
         path,
@@ -797,7 +855,12 @@ pub fn make_solid_stored_as(
         faces_read: mesh.faces.len(),
         known: None,
     };
-    let exact = weld::exact(&mesh.vertices, &mesh.faces);
+    let exact = if mesh.welded {
+        let mesh = mesh.into_owned();
+        weld::already_welded(mesh.vertices, mesh.faces)
+    } else {
+        weld::exact(&mesh.vertices, &mesh.faces)
+    };
     if exact.dropped > 0 {
         ladder.warn(
             HealthKind::FacesDropped,
@@ -810,19 +873,21 @@ pub fn make_solid_stored_as(
     if exact.faces.is_empty() {
         return Err(MeshError::new(path, None, MeshErrorKind::Empty));
     }
-    let e = edges(&exact.faces);
+    let mut e = edges(&exact.faces);
     if e.closed() && e.inconsistent == 0 {
+        let components = e.components(exact.faces.len());
         return consistent_closed(
             ladder,
             exact.vertices,
             exact.faces,
             None,
-            &e.pairs,
+            components,
             Rung::Exact,
         );
     }
-    let w = tolerant_welding(exact, precision());
-    let te = edges(&w.topology);
+    let precision = precision(&exact.vertices);
+    let w = tolerant_welding(exact, precision);
+    let mut te = edges(&w.topology);
     if w.duplicates > 0 {
         ladder.warn(
             HealthKind::FacesDropped,
@@ -850,7 +915,8 @@ pub fn make_solid_stored_as(
             widest_crack: w.tolerant.widest,
             tolerance: w.tolerant.tolerance.largest,
         };
-        return consistent_closed(ladder, w.vertices, w.stored, Some(w.kept), &te.pairs, rung);
+        let components = te.components(w.topology.len());
+        return consistent_closed(ladder, w.vertices, w.stored, Some(w.kept), components, rung);
     }
     if te.closed() {
         if let Some(o) = orient(w.topology.len(), &te.pairs) {
@@ -863,13 +929,14 @@ pub fn make_solid_stored_as(
 /// Closed and consistent (bit-exact or after the tolerant weld): as stored, flipped if inward, or with
 /// the components re-oriented whose winding contradicts their nesting.
 ///
-/// `kept` are the faces the topology (`pairs`) numbers, `None` when they are `stored` themselves.
+/// `kept` are the faces the topology (the component ids `comp`) numbers, `None` when they are `stored`
+/// themselves.
 fn consistent_closed(
     mut ladder: Ladder<'_>,
     vertices: Vec<[f64; 3]>,
     stored: Polygons,
     kept: Option<Polygons>,
-    pairs: &[(u32, u32, bool)],
+    (comp, ncomp): (Vec<u32>, usize),
     rung: Rung,
 ) -> Result<Solid, MeshError> {
     // Closed only once welded within tolerance: the stored surface's vector area is not exactly 0.
@@ -897,7 +964,6 @@ fn consistent_closed(
         rung = Rung::Inverted;
     }
     let topology_faces = kept.as_ref().unwrap_or(&faces);
-    let (comp, ncomp) = components(topology_faces.len(), pairs);
     if ncomp > 1 {
         let flip = misoriented(&vertices, topology_faces, &comp, ncomp);
         if flip.iter().any(|f| *f) {
@@ -942,32 +1008,10 @@ fn consistent_closed(
 /// number of components.
 fn components(nfaces: usize, pairs: &[(u32, u32, bool)]) -> (Vec<u32>, usize) {
     let mut parent: Vec<u32> = (0..nfaces as u32).collect();
-    fn root(parent: &mut [u32], mut x: u32) -> u32 {
-        while parent[x as usize] != x {
-            let up = parent[parent[x as usize] as usize];
-            parent[x as usize] = up;
-            x = up;
-        }
-        x
-    }
     for &(a, b, _) in pairs {
-        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
-        if ra != rb {
-            parent[ra.max(rb) as usize] = ra.min(rb);
-        }
+        union(&mut parent, a, b);
     }
-    let mut id = vec![u32::MAX; nfaces];
-    let mut comp = Vec::with_capacity(nfaces);
-    let mut n = 0u32;
-    for f in 0..nfaces as u32 {
-        let r = root(&mut parent, f) as usize;
-        if id[r] == u32::MAX {
-            id[r] = n;
-            n += 1;
-        }
-        comp.push(id[r]);
-    }
-    (comp, n as usize)
+    label(parent)
 }
 
 /// Components beyond this many are not checked for nesting (quadratic in the components).

@@ -16,6 +16,7 @@ pub mod stl;
 pub mod weld;
 
 use crate::mass::Polygons;
+use std::borrow::Cow;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -29,6 +30,10 @@ pub struct RawMesh {
     pub notes: Vec<String>,
     /// Things the reader left out of the solid (faces it could not use), for the report.
     pub warnings: Vec<String>,
+    /// The reader welded as it read: the vertices are pairwise distinct in their bits and none is
+    /// −0.0, so the health step's exact weld has nothing to merge and is skipped (it only drops
+    /// collapsed faces). `false` is always safe.
+    pub welded: bool,
 }
 
 /// The mesh formats urdf-inertia reads.
@@ -218,6 +223,8 @@ pub fn apply_scale(mesh: &RawMesh, scale: [f64; 3], path: &Path) -> Result<RawMe
         return Err(MeshError::new(path, None, MeshErrorKind::BadScale(scale)));
     }
     let mut out = mesh.clone();
+    // A product can round two distinct coordinates to one value, or give −0.0: weld again.
+    out.welded &= scale == [1.0; 3];
     if scale != [1.0, 1.0, 1.0] {
         for v in out.vertices.iter_mut() {
             *v = [v[0] * scale[0], v[1] * scale[1], v[2] * scale[2]];
@@ -238,7 +245,7 @@ pub fn load_solid(
     options: health::HealthOptions,
 ) -> Result<health::Solid, MeshError> {
     let raw = read(path)?;
-    solid_from_raw(&raw, scale, path, options)
+    solid_from_owned(raw, scale, path, options)
 }
 
 /// Scales and heals an already read mesh (a file used with several scales is read once).
@@ -248,16 +255,35 @@ pub fn solid_from_raw(
     path: &Path,
     options: health::HealthOptions,
 ) -> Result<health::Solid, MeshError> {
+    solid_from(Cow::Borrowed(raw), scale, path, options)
+}
+
+/// [`solid_from_raw`] for a mesh used once: at unit scale its vertices and faces become the solid's
+/// without a copy.
+pub fn solid_from_owned(
+    raw: RawMesh,
+    scale: [f64; 3],
+    path: &Path,
+    options: health::HealthOptions,
+) -> Result<health::Solid, MeshError> {
+    solid_from(Cow::Owned(raw), scale, path, options)
+}
+
+fn solid_from(
+    raw: Cow<'_, RawMesh>,
+    scale: [f64; 3],
+    path: &Path,
+    options: health::HealthOptions,
+) -> Result<health::Solid, MeshError> {
     catching_panics(path, || {
-        // A unit scale (the common case) uses the mesh as read rather than a copy of it.
-        let scaled = if scale == [1.0; 3] {
-            std::borrow::Cow::Borrowed(raw)
-        } else {
-            std::borrow::Cow::Owned(apply_scale(raw, scale, path)?)
-        };
+        if scale == [1.0; 3] {
+            // A unit scale (the common case) uses the mesh as read.
+            return health::heal(raw, path, options, weld::Precision::of);
+        }
+        let scaled = apply_scale(&raw, scale, path)?;
         // The precision of the file's own numbers, before the scale multiplies them; the largest
         // coordinate scales with them, so the tolerance in ulps of it stays right.
-        health::make_solid_stored_as(&scaled, path, options, || {
+        health::heal(Cow::Owned(scaled), path, options, |_| {
             weld::Precision::of(&raw.vertices)
         })
     })

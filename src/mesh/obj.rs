@@ -86,6 +86,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         faces,
         notes,
         warnings,
+        welded: false,
     })
 }
 

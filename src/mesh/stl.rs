@@ -87,13 +87,22 @@ fn binary(bytes: &[u8], n: usize, header_count: Option<usize>) -> RawMesh {
     // A closed triangle mesh has about half as many vertices as faces.
     let mut table = VertexTable::with_capacity(n / 2 + 16);
     let mut indices = Vec::with_capacity(3 * n);
-    let records = bytes[84..84 + 50 * n].chunks_exact(50);
-    for r in records {
-        let f = |o: usize| f64::from(f32::from_le_bytes([r[o], r[o + 1], r[o + 2], r[o + 3]]));
-        // Skip the normal (bytes 0..12); the corners follow.
-        for o in [12, 24, 36] {
-            indices.push(table.insert([f(o), f(o + 4), f(o + 8)]));
+    // Records are decoded a group at a time and their corners inserted together, so that the table
+    // can overlap its cache misses (`VertexTable::extend`).
+    let mut corners: Vec<[f64; 3]> = Vec::with_capacity(3 * 16);
+    for group in bytes[84..84 + 50 * n].chunks(50 * 16) {
+        corners.clear();
+        for r in group.chunks_exact(50) {
+            // + 0.0 folds −0.0 into 0.0, so that both weld (`RawMesh::welded`).
+            let f = |o: usize| {
+                f64::from(f32::from_le_bytes([r[o], r[o + 1], r[o + 2], r[o + 3]])) + 0.0
+            };
+            // Skip the normal (bytes 0..12); the corners follow.
+            for o in [12, 24, 36] {
+                corners.push([f(o), f(o + 4), f(o + 8)]);
+            }
         }
+        table.extend(&corners, &mut indices);
     }
     let vertices = table.into_vertices();
     let starts = (0..=n as u32).map(|i| 3 * i).collect();
@@ -108,6 +117,7 @@ fn binary(bytes: &[u8], n: usize, header_count: Option<usize>) -> RawMesh {
         faces: Polygons { indices, starts },
         notes,
         warnings: Vec::new(),
+        welded: true,
     }
 }
 
@@ -180,6 +190,7 @@ fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         faces,
         notes: Vec::new(),
         warnings: Vec::new(),
+        welded: true,
     })
 }
 
@@ -208,6 +219,8 @@ fn ascii_vertex<'a>(
         if !c.is_finite() {
             return Err(MeshError::new(path, Some(lineno), MeshErrorKind::NotFinite));
         }
+        // −0.0 folds into 0.0, so that both weld (`RawMesh::welded`).
+        *c += 0.0;
     }
     Ok(p)
 }
