@@ -70,6 +70,14 @@ fn kind(ft: fs::FileType) -> &'static str {
 /// The whole content of a regular file no larger than [`max_file_size`]. The error says why, without
 /// the path (callers name the file and what it is).
 pub fn read_file(path: &Path) -> Result<Vec<u8>, String> {
+    let (file, len) = open_file(path)?;
+    read_rest(file, Vec::with_capacity(len as usize))
+}
+
+/// A regular file no larger than [`max_file_size`], opened for reading, and its length: for readers
+/// that stream a big file instead of holding all of it (then they must read no more than the
+/// length, and treat a shorter file as truncated).
+pub fn open_file(path: &Path) -> Result<(File, u64), String> {
     let regular = |meta: &fs::Metadata| {
         if meta.is_file() {
             Ok(())
@@ -85,21 +93,31 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>, String> {
     let file = File::open(path).map_err(|e| e.to_string())?;
     let meta = file.metadata().map_err(|e| e.to_string())?;
     regular(&meta)?;
-    let limit = max_file_size();
-    let too_large = || {
-        format!("is larger than the limit of {limit} bytes (raise it with --max-file-size or {MAX_FILE_SIZE_ENV})")
-    };
-    if meta.len() > limit {
+    if meta.len() > max_file_size() {
         return Err(too_large());
     }
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    file.take(limit.saturating_add(1))
+    Ok((file, meta.len()))
+}
+
+/// Appends the rest of `file` to `bytes`, up to [`max_file_size`] in all (a file can grow after its
+/// size was checked).
+pub fn read_rest(file: File, mut bytes: Vec<u8>) -> Result<Vec<u8>, String> {
+    let limit = max_file_size();
+    let room = limit.saturating_sub(bytes.len() as u64);
+    file.take(room.saturating_add(1))
         .read_to_end(&mut bytes)
         .map_err(|e| e.to_string())?;
     if bytes.len() as u64 > limit {
         return Err(too_large());
     }
     Ok(bytes)
+}
+
+fn too_large() -> String {
+    format!(
+        "is larger than the limit of {} bytes (raise it with --max-file-size or {MAX_FILE_SIZE_ENV})",
+        max_file_size()
+    )
 }
 
 #[cfg(test)]

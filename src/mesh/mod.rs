@@ -182,6 +182,12 @@ fn read_unguarded(path: &Path) -> Result<RawMesh, MeshError> {
             .map_or_else(|| "(no extension)".into(), |e| format!(".{e}"));
         MeshError::new(path, None, MeshErrorKind::UnknownFormat(ext))
     })?;
+    if format == MeshFormat::Stl {
+        // Streamed: a big binary file is never held whole.
+        let mesh = stl::read(path)?;
+        validate(&mesh, path)?;
+        return Ok(mesh);
+    }
     let bytes = crate::input::read_file(path)
         .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e)))?;
     let mesh = match format {

@@ -9,13 +9,17 @@
 //! OBJ files of example-robot-data, e.g. alexander's LeftThigh.obj: 985 faces against the file's 983),
 //! re-indexes each object separately, and its errors carry no line number.
 
+use super::weld::VertexTable;
 use super::{parse_f64, MeshError, MeshErrorKind, RawMesh};
 use crate::mass::Polygons;
 use std::path::Path;
 
-/// Parses OBJ text.
+/// Parses OBJ text. Vertices with bit-identical coordinates are welded as they are read (the health
+/// step's exact weld, done here so that it is not done again): faces index the distinct vertices.
 pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
-    let mut vertices: Vec<[f64; 3]> = Vec::new();
+    let mut vertices = VertexTable::with_capacity(bytes.len() / 128 + 16);
+    // The distinct vertex of each `v` line, in file order (what face indices count).
+    let mut remap: Vec<u32> = Vec::new();
     let mut faces = Polygons::new();
     let mut face: Vec<u32> = Vec::new();
     let mut objects = 0usize;
@@ -52,9 +56,16 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
             continue;
         };
         match keyword {
-            "v" => vertices.push(vertex(words, lineno, path)?),
+            "v" => {
+                let p = vertex(words, lineno, path)?;
+                // + 0.0 folds −0.0 into 0.0, so that both weld (`RawMesh::welded`).
+                remap.push(vertices.insert(p.map(|x| x + 0.0)));
+            }
             "f" => {
-                face_indices(words, vertices.len(), &mut face, lineno, path)?;
+                face_indices(words, remap.len(), &mut face, lineno, path)?;
+                for i in face.iter_mut() {
+                    *i = remap[*i as usize];
+                }
                 // A face of fewer than three vertices encloses nothing: skipped and counted, as other
                 // OBJ readers (assimp, tinyobjloader) do.
                 if face.len() < 3 {
@@ -82,11 +93,11 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         ));
     }
     Ok(RawMesh {
-        vertices,
+        vertices: vertices.into_vertices(),
         faces,
         notes,
         warnings,
-        welded: false,
+        welded: true,
     })
 }
 
