@@ -307,15 +307,91 @@ fn add_primitive(
     if pos.count() == 0 {
         return Ok(());
     }
-    let (positions, indices) = read_primitive(prim, &pos, buffers, path)?;
-    let base = out.vertices.len() as u32;
-    for p in &positions {
+    let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let cannot = |what: &str, index: usize| {
+        syntax(path, format!("{what} accessor {index} cannot be read"))
+    };
+    let positions = reader
+        .read_positions()
+        .ok_or_else(|| cannot("POSITION", pos.index()))?;
+    // Positions are transformed straight into the mesh, and triangle indices streamed into its
+    // faces: the primitive's data is not copied first.
+    let base = out.vertices.len();
+    out.vertices.extend(positions.map(|p| {
         let q = crate::mass::mat_vec(&xf.0, p.map(f64::from));
-        out.vertices
-            .push([q[0] + xf.1[0], q[1] + xf.1[1], q[2] + xf.1[2]]);
+        [q[0] + xf.1[0], q[1] + xf.1[1], q[2] + xf.1[2]]
+    }));
+    let n = out.vertices.len() - base;
+    let (base, mirrored) = (base as u32, affine::mirrors(xf));
+    match prim.indices() {
+        Some(acc) if acc.count() == 0 => Ok(()),
+        Some(acc) => {
+            let indices = reader
+                .read_indices()
+                .ok_or_else(|| cannot("index", acc.index()))?
+                .into_u32();
+            if mode == Mode::Triangles {
+                return stream_triangles(indices, acc.count(), n, base, mirrored, out, path);
+            }
+            let indices: Vec<u32> = indices.collect();
+            check_indices(&indices, n, path)?;
+            push_triangles(mode, &indices, base, mirrored, out);
+            Ok(())
+        }
+        None if mode == Mode::Triangles => {
+            stream_triangles(0..n as u32, n, n, base, mirrored, out, path)
+        }
+        None => {
+            let indices: Vec<u32> = (0..n as u32).collect();
+            push_triangles(mode, &indices, base, mirrored, out);
+            Ok(())
+        }
     }
-    push_triangles(mode, &indices, base, affine::mirrors(xf), out);
+}
+
+/// The triangles of a TRIANGLES primitive's `count` indices into its `n` vertices (offset by `base`),
+/// each index checked as it is read; reversed if the node's transform mirrors.
+fn stream_triangles(
+    mut indices: impl Iterator<Item = u32>,
+    count: usize,
+    n: usize,
+    base: u32,
+    mirrored: bool,
+    out: &mut RawMesh,
+    path: &Path,
+) -> Result<(), MeshError> {
+    if count % 3 != 0 {
+        out.notes.push(format!(
+            "a triangle primitive has {count} indices, not a multiple of 3 (the last {} ignored)",
+            count % 3
+        ));
+    }
+    for _ in 0..count / 3 {
+        let mut t = [0u32; 3];
+        for i in &mut t {
+            *i = indices.next().unwrap_or(u32::MAX);
+            check_indices(std::slice::from_ref(i), n, path)?;
+            *i += base;
+        }
+        out.faces
+            .push(&if mirrored { [t[0], t[2], t[1]] } else { t });
+    }
     Ok(())
+}
+
+/// Every index below the primitive's vertex count `n`.
+fn check_indices(indices: &[u32], n: usize, path: &Path) -> Result<(), MeshError> {
+    match indices.iter().find(|&&i| i as usize >= n) {
+        Some(&bad) => Err(MeshError::new(
+            path,
+            None,
+            MeshErrorKind::IndexOutOfRange {
+                index: i64::from(bad),
+                vertices: n,
+            },
+        )),
+        None => Ok(()),
+    }
 }
 
 /// Checks a primitive's POSITION accessor (float VEC3) and its index accessor (unsigned scalars) before
@@ -359,52 +435,6 @@ fn check_primitive_accessors(
     Ok(())
 }
 
-/// A primitive's positions and vertex indices (`0..n` without an index accessor), each index checked
-/// against the positions.
-fn read_primitive(
-    prim: &gltf::Primitive<'_>,
-    pos: &gltf::Accessor<'_>,
-    buffers: &[Vec<u8>],
-    path: &Path,
-) -> Result<(Vec<[f32; 3]>, Vec<u32>), MeshError> {
-    let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-    let positions: Vec<[f32; 3]> =
-        reader
-            .read_positions()
-            .map(|it| it.collect())
-            .ok_or_else(|| {
-                syntax(
-                    path,
-                    format!("POSITION accessor {} cannot be read", pos.index()),
-                )
-            })?;
-    let indices: Vec<u32> = match &prim.indices() {
-        Some(acc) if acc.count() == 0 => Vec::new(),
-        Some(acc) => reader
-            .read_indices()
-            .map(|it| it.into_u32().collect())
-            .ok_or_else(|| {
-                syntax(
-                    path,
-                    format!("index accessor {} cannot be read", acc.index()),
-                )
-            })?,
-        None => (0..positions.len() as u32).collect(),
-    };
-    let n = positions.len();
-    if let Some(&bad) = indices.iter().find(|&&i| i as usize >= n) {
-        return Err(MeshError::new(
-            path,
-            None,
-            MeshErrorKind::IndexOutOfRange {
-                index: i64::from(bad),
-                vertices: n,
-            },
-        ));
-    }
-    Ok((positions, indices))
-}
-
 /// The triangles of a primitive's `indices` (offset by `base`) in its `mode`, reversed if the node's
 /// transform mirrors.
 fn push_triangles(mode: Mode, indices: &[u32], base: u32, mirrored: bool, out: &mut RawMesh) {
@@ -441,18 +471,8 @@ fn push_triangles(mode: Mode, indices: &[u32], base: u32, mirrored: bool, out: &
                 push(a, b, c);
             }
         }
-        _ => {
-            if indices.len() % 3 != 0 {
-                out.notes.push(format!(
-                    "a triangle primitive has {} indices, not a multiple of 3 (the last {} ignored)",
-                    indices.len(),
-                    indices.len() % 3
-                ));
-            }
-            for t in indices.chunks_exact(3) {
-                push(t[0], t[1], t[2]);
-            }
-        }
+        // TRIANGLES primitives are streamed by `stream_triangles`.
+        _ => {}
     }
 }
 
