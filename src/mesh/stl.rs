@@ -90,7 +90,7 @@ fn binary(bytes: &[u8], n: usize, header_count: Option<usize>) -> RawMesh {
 }
 
 /// Reads an STL file. A binary file whose length matches its header (nearly every one) is read in
-/// pieces of a few hundred kilobytes, each welded as it arrives, so the file is never held whole:
+/// pieces of a few megabytes, each welded as it arrives, so the file is never held whole:
 /// on a 1.3 M-face file (65.5 MB) that saves the 65.5 MB buffer, and the page faults of filling it.
 /// Anything else is read whole and given to [`parse`].
 pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
@@ -108,11 +108,10 @@ pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
     }
     let n = n as usize;
     let mut reader = Binary::new(n);
-    const PIECE: usize = 4096;
-    let mut buf = vec![0u8; 50 * PIECE];
+    let mut buf = vec![0u8; 50 * CHUNK * PIECE];
     let mut left = n;
     while left > 0 {
-        let m = left.min(PIECE);
+        let m = left.min(CHUNK * PIECE);
         file.read_exact(&mut buf[..50 * m]).map_err(|e| {
             MeshError::new(
                 path,
@@ -129,11 +128,49 @@ pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
     Ok(reader.finish(None))
 }
 
+/// Chunks read and welded at a time: two per thread on two cores, 1.6 MB each.
+const PIECE: usize = 4;
+
 /// A binary STL reader fed whole 50-byte records.
+///
+/// Records are welded in two steps. Each chunk of [`CHUNK`] records is welded on its own first, in
+/// parallel (rayon), into a table small enough for the L2 cache; then the chunks' distinct vertices
+/// are added to the mesh's table in chunk order. A vertex is numbered where it first appears in the
+/// file either way, so the result is the sequential weld's, bit for bit, for any number of threads;
+/// and the big table, whose every probe is a cache miss, sees each vertex about once instead of at
+/// each of its six or so corners. Measured on a 1.3 M-face sphere (whole process, one thread):
+/// N → M ms.
 struct Binary {
     table: VertexTable,
     indices: Vec<u32>,
-    corners: Vec<[f64; 3]>,
+}
+
+/// Records welded on their own before joining the mesh's table: 16 Ki faces make about 8 Ki
+/// vertices, a table of 128 KiB.
+const CHUNK: usize = 16 * 1024;
+
+/// The distinct vertices of a chunk of records in order of first appearance, and its corners as
+/// indices into them.
+fn weld_chunk(records: &[u8]) -> (Vec<[f64; 3]>, Vec<u32>) {
+    let n = records.len() / 50;
+    let mut table = VertexTable::with_capacity(n / 2 + 16);
+    let mut indices = Vec::with_capacity(3 * n);
+    let mut corners: Vec<[f64; 3]> = Vec::with_capacity(3 * 16);
+    for group in records.chunks(50 * 16) {
+        corners.clear();
+        for r in group.chunks_exact(50) {
+            // + 0.0 folds −0.0 into 0.0, so that both weld (`RawMesh::welded`).
+            let f = |o: usize| {
+                f64::from(f32::from_le_bytes([r[o], r[o + 1], r[o + 2], r[o + 3]])) + 0.0
+            };
+            // Skip the normal (bytes 0..12); the corners follow.
+            for o in [12, 24, 36] {
+                corners.push([f(o), f(o + 4), f(o + 8)]);
+            }
+        }
+        table.extend(&corners, &mut indices);
+    }
+    (table.into_vertices(), indices)
 }
 
 impl Binary {
@@ -142,26 +179,22 @@ impl Binary {
             // A closed triangle mesh has about half as many vertices as faces.
             table: VertexTable::with_capacity(n / 2 + 16),
             indices: Vec::with_capacity(3 * n),
-            corners: Vec::with_capacity(3 * 16),
         }
     }
 
-    /// Reads whole records. They are decoded a group at a time and their corners inserted together,
-    /// so that the table can overlap its cache misses (`VertexTable::extend`).
+    /// Reads whole records, [`PIECE`] chunks at a time.
     fn feed(&mut self, records: &[u8]) {
-        for group in records.chunks(50 * 16) {
-            self.corners.clear();
-            for r in group.chunks_exact(50) {
-                // + 0.0 folds −0.0 into 0.0, so that both weld (`RawMesh::welded`).
-                let f = |o: usize| {
-                    f64::from(f32::from_le_bytes([r[o], r[o + 1], r[o + 2], r[o + 3]])) + 0.0
-                };
-                // Skip the normal (bytes 0..12); the corners follow.
-                for o in [12, 24, 36] {
-                    self.corners.push([f(o), f(o + 4), f(o + 8)]);
-                }
+        use rayon::prelude::*;
+        let mut map: Vec<u32> = Vec::new();
+        for piece in records.chunks(50 * CHUNK * PIECE) {
+            let welded: Vec<(Vec<[f64; 3]>, Vec<u32>)> =
+                piece.par_chunks(50 * CHUNK).map(weld_chunk).collect();
+            for (vertices, indices) in welded {
+                map.clear();
+                self.table.extend(&vertices, &mut map);
+                self.indices
+                    .extend(indices.iter().map(|&i| map[i as usize]));
             }
-            self.table.extend(&self.corners, &mut self.indices);
         }
     }
 
