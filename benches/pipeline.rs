@@ -1,18 +1,17 @@
-//! The mesh pipeline stage by stage, on generated binary STL meshes of 1 k to 1.3 M faces (5.2 M with
-//! `URDF_INERTIA_BENCH_HUGE=1`), reported as time per mesh and faces/s (ns per face = 1e9 / throughput).
+//! The mesh pipeline stage by stage, on generated binary STL tori of 1 k to 1 M faces (4.2 M and
+//! 10.2 M with `URDF_INERTIA_BENCH_HUGE=1`), reported as time per mesh and faces/s (ns per face =
+//! 1e9 / throughput).
 //!
 //! `cargo bench --bench pipeline`. Stages:
-//! * `read`: binary STL bytes (in memory) to a [`RawMesh`], corners welded as they are read;
-//! * `weld`: the health step's exact weld of that mesh (bit-identical corners, dropped faces);
-//! * `weld-soup`: the same weld of a triangle soup (three vertices per face, as readers without a
-//!   welding pass deliver);
-//! * `integrate`: one integration of the ten volume integrals (the ladder runs three on a clean mesh:
-//!   sign, value, and the round-off estimate about a second reference point);
-//! * `heal`: `make_solid`, everything after reading: weld, edge analysis, ladder and integrations;
+//! * `read`: binary STL bytes (in memory) to a [`RawMesh`], corners welded as they are read (in
+//!   chunks, in parallel when there are threads);
+//! * `weld-soup`: the health step's exact weld of a triangle soup (three vertices per face, what a
+//!   reader that does not weld delivers; a welded STL skips this step);
+//! * `edges`: the proof that the surface is closed and consistently wound, with its components;
+//! * `integrate`: one integration of the ten volume integrals (a clean mesh takes two: the value,
+//!   and the round-off estimate about a second reference point);
+//! * `heal`: `make_solid`, everything after reading: edge analysis, ladder and integrations;
 //! * `end-to-end`: read + heal, what `urdf-inertia mesh` does after the file is in memory.
-//!
-//! The edge analysis alone is `heal − weld − 3 × integrate` less the ladder's own small passes; the
-//! callgrind profile in docs/accuracy.md splits it exactly.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -25,13 +24,14 @@ use urdf_inertia::mesh::{self, health, stl, weld, RawMesh};
 
 fn pipeline(c: &mut Criterion) {
     let mut group = c.benchmark_group("pipeline");
-    let mut levels = vec![4u32, 5, 6, 7, 8, 9];
+    // Tori of 2k × k quads: 4k² faces.
+    let mut sizes = vec![16u32, 32, 64, 128, 256, 512];
     if std::env::var_os("URDF_INERTIA_BENCH_HUGE").is_some() {
-        levels.push(10);
+        sizes.extend([1024, 1600]);
     }
     let path = Path::new("bench.stl");
-    for level in levels {
-        let (v, f) = common::icosphere(level);
+    for k in sizes {
+        let (v, f) = common::wild::torus(1.0, 0.4, 2 * k, k);
         // A 0.1 m part away from the origin, as real parts are.
         let v: Vec<[f64; 3]> = v
             .iter()
@@ -58,12 +58,8 @@ fn pipeline(c: &mut Criterion) {
         group.bench_with_input(BenchmarkId::new("read", n), &bytes, |b, bytes| {
             b.iter(|| stl::parse(black_box(bytes), path).map(|m| m.faces.len()))
         });
-        group.bench_with_input(BenchmarkId::new("weld", n), &raw, |b, raw| {
-            b.iter(|| {
-                weld::exact(black_box(&raw.vertices), &raw.faces)
-                    .faces
-                    .len()
-            })
+        group.bench_with_input(BenchmarkId::new("edges", n), &raw, |b, raw| {
+            b.iter(|| health::closed_consistent(black_box(&raw.faces)).map(|c| c.1))
         });
         group.bench_with_input(BenchmarkId::new("weld-soup", n), &soup, |b, soup| {
             b.iter(|| {
@@ -72,8 +68,7 @@ fn pipeline(c: &mut Criterion) {
                     .len()
             })
         });
-        let welded = weld::exact(&raw.vertices, &raw.faces);
-        group.bench_with_input(BenchmarkId::new("integrate", n), &welded, |b, w| {
+        group.bench_with_input(BenchmarkId::new("integrate", n), &raw, |b, w| {
             b.iter(|| {
                 volume_integrals(
                     black_box(&w.vertices),

@@ -358,7 +358,7 @@ fn edges(faces: &Polygons) -> Edges {
 /// no sort. Faces are joined as twins are found (union-find), so no list of face pairs is built.
 /// Measured on a 1.3 M-face sphere (callgrind): 503 → N instructions per face for the proof and the
 /// components together.
-fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
+pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
     let idx = &faces.indices;
     let n = *idx.iter().max()? as usize + 1;
     let h = idx.len();
