@@ -890,11 +890,19 @@ fn pipeline_section(md: &mut String) -> std::io::Result<()> {
         };
         let (read, edges, integrate, heal, e2e) = one.install(|| {
             let read = time(budget, || stl::parse(&bytes, path).map(|m| m.faces.len()));
-            let edges = time(budget, || health::closed_consistent(&raw.faces).map(|c| c.1));
+            let edges = time(budget, || {
+                health::closed_consistent(&raw.faces).map(|c| c.1)
+            });
             let integrate = time(budget, || {
                 volume_integrals(&raw.vertices, &raw.faces, &IntegrationOptions::accurate())
             });
-            (read, edges, integrate, time(budget, heal_once), time(budget, e2e_once))
+            (
+                read,
+                edges,
+                integrate,
+                time(budget, heal_once),
+                time(budget, e2e_once),
+            )
         });
         let e2e2 = two.install(|| time(budget, e2e_once));
         writeln!(
@@ -919,7 +927,10 @@ fn pipeline_section(md: &mut String) -> std::io::Result<()> {
         .unwrap_or_else(|| "?".into());
     if let (Some(first), Some(last)) = (e2e_per_face.first(), e2e_per_face.last()) {
         let worst = e2e_per_face.iter().map(|e| e.1).fold(0.0, f64::max);
-        let best = e2e_per_face.iter().map(|e| e.1).fold(f64::INFINITY, f64::min);
+        let best = e2e_per_face
+            .iter()
+            .map(|e| e.1)
+            .fold(f64::INFINITY, f64::min);
         writeln!(md, "\nAll figures in ns per face. End to end, from {} to {} faces the cost per face changes {:.2}× (largest over smallest per-face cost across sizes {:.2}×). Load average at the end of these runs: {load} (timings on a shared machine are noisy; callgrind instruction counts in the commit messages are not).", first.0, last.0, last.1 / first.1, worst / best).ok();
     }
 

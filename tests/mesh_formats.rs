@@ -572,8 +572,14 @@ fn chunked_parallel_weld_is_the_sequential_weld() {
             assert!(m.welded);
             assert_eq!(m.faces.indices, indices, "{threads} threads");
             assert_eq!(
-                m.vertices.iter().map(|p| p.map(f64::to_bits)).collect::<Vec<_>>(),
-                vertices.iter().map(|p| p.map(f64::to_bits)).collect::<Vec<_>>()
+                m.vertices
+                    .iter()
+                    .map(|p| p.map(f64::to_bits))
+                    .collect::<Vec<_>>(),
+                vertices
+                    .iter()
+                    .map(|p| p.map(f64::to_bits))
+                    .collect::<Vec<_>>()
             );
         }
     }

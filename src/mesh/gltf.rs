@@ -308,9 +308,8 @@ fn add_primitive(
         return Ok(());
     }
     let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-    let cannot = |what: &str, index: usize| {
-        syntax(path, format!("{what} accessor {index} cannot be read"))
-    };
+    let cannot =
+        |what: &str, index: usize| syntax(path, format!("{what} accessor {index} cannot be read"));
     let positions = reader
         .read_positions()
         .ok_or_else(|| cannot("POSITION", pos.index()))?;

@@ -652,7 +652,27 @@ struct Ladder<'a> {
     known: Option<VolumeIntegrals>,
 }
 
-impl Ladder<'_> {
+impl<'a> Ladder<'a> {
+    /// A ladder starting with what the reader said about `mesh`.
+    fn new(mesh: &RawMesh, path: &'a Path, options: HealthOptions) -> Self {
+        Ladder {
+            path,
+            options,
+            warnings: mesh
+                .warnings
+                .iter()
+                .map(|w| HealthMessage::new(HealthKind::ReaderSkipped, w.clone()))
+                .collect(),
+            notes: mesh
+                .notes
+                .iter()
+                .map(|n| HealthMessage::new(HealthKind::ReaderNote, n.clone()))
+                .collect(),
+            faces_read: mesh.faces.len(),
+            known: None,
+        }
+    }
+
     fn warn(&mut self, kind: HealthKind, text: String) {
         self.warnings.push(HealthMessage::new(kind, text));
     }
@@ -839,22 +859,7 @@ pub fn heal(
     options: HealthOptions,
     precision: impl FnOnce(&[[f64; 3]]) -> weld::Precision,
 ) -> Result<Solid, MeshError> {
-    let mut ladder = Ladder {
-        path,
-        options,
-        warnings: mesh
-            .warnings
-            .iter()
-            .map(|w| HealthMessage::new(HealthKind::ReaderSkipped, w.clone()))
-            .collect(),
-        notes: mesh
-            .notes
-            .iter()
-            .map(|n| HealthMessage::new(HealthKind::ReaderNote, n.clone()))
-            .collect(),
-        faces_read: mesh.faces.len(),
-        known: None,
-    };
+    let mut ladder = Ladder::new(&mesh, path, options);
     let exact = if mesh.welded {
         let mesh = mesh.into_owned();
         weld::already_welded(mesh.vertices, mesh.faces)

@@ -98,10 +98,11 @@ pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
     let io = |e: String| MeshError::new(path, None, MeshErrorKind::Io(e));
     let (mut file, len) = crate::input::open_file(path).map_err(io)?;
     let mut header = vec![0u8; 84.min(len as usize)];
-    file.read_exact(&mut header).map_err(|e| io(e.to_string()))?;
-    let n = header
-        .get(80..84)
-        .map_or(0, |c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]) as u64);
+    file.read_exact(&mut header)
+        .map_err(|e| io(e.to_string()))?;
+    let n = header.get(80..84).map_or(0, |c| {
+        u64::from(u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+    });
     if n == 0 || 84 + 50 * n != len {
         let bytes = crate::input::read_rest(file, header).map_err(io)?;
         return parse(&bytes, path);
