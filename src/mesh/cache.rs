@@ -2,9 +2,9 @@
 //! links of a robot and across robots (`check a.urdf b.urdf`, a corpus).
 
 use super::health::{HealthOptions, Solid};
-use super::{read, solid_from_raw, MeshError};
+use super::{read, solid_from_owned, solid_from_raw, MeshError, RawMesh};
 use std::collections::HashMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -42,7 +42,7 @@ impl MeshCache {
         let t1 = Instant::now();
         self.load_time += t1 - t0;
         let solid = raw
-            .and_then(|raw| solid_from_raw(&raw, scale, path, options))
+            .and_then(|raw| solid_from_owned(raw, scale, path, options))
             .map(Arc::new);
         self.integrate_time += t1.elapsed();
         self.solids.insert(key, solid.clone());
@@ -82,18 +82,9 @@ impl MeshCache {
                 let t0 = Instant::now();
                 let raw = read(path);
                 let t1 = Instant::now();
-                let solids = scales
-                    .into_iter()
-                    .map(|scale| {
-                        let solid = match &raw {
-                            Ok(r) => solid_from_raw(r, scale, path, options).map(Arc::new),
-                            Err(e) => Err(e.clone()),
-                        };
-                        (scale, solid)
-                    })
-                    .collect();
-                // The raw mesh ends here, before the next file of this thread is read.
-                (path.clone(), raw.err(), solids, t1 - t0, t1.elapsed())
+                let (solids, error) = heal_scales(raw, &scales, path, options);
+                // The raw mesh has ended, before the next file of this thread is read.
+                (path.clone(), error, solids, t1 - t0, t1.elapsed())
             })
             .collect();
         for (path, raw, solids, load, integrate) in loaded {
@@ -112,3 +103,34 @@ impl MeshCache {
         self.read.len()
     }
 }
+
+/// The solids of one read mesh at each of its scales, and the read error if there was one. The last
+/// scale takes the mesh itself, so a file used at one scale (the common case) is not copied.
+fn heal_scales(
+    raw: Result<RawMesh, MeshError>,
+    scales: &[[f64; 3]],
+    path: &Path,
+    options: HealthOptions,
+) -> (SolidsByScale, Option<MeshError>) {
+    let raw = match raw {
+        Ok(raw) => raw,
+        Err(e) => {
+            let solids = scales.iter().map(|&s| (s, Err(e.clone()))).collect();
+            return (solids, Some(e));
+        }
+    };
+    let Some((&last, rest)) = scales.split_last() else {
+        return (Vec::new(), None);
+    };
+    let mut solids: SolidsByScale = rest
+        .iter()
+        .map(|&s| (s, solid_from_raw(&raw, s, path, options).map(Arc::new)))
+        .collect();
+    solids.push((
+        last,
+        solid_from_owned(raw, last, path, options).map(Arc::new),
+    ));
+    (solids, None)
+}
+
+type SolidsByScale = Vec<([f64; 3], Result<Arc<Solid>, MeshError>)>;
