@@ -289,29 +289,62 @@ pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
     (s, e)
 }
 
-/// Exact product: `p + e == a * b`.
+/// Exact product: `p + e == a * b` (barring overflow and underflow).
+///
+/// With hardware FMA the error term is one fused multiply-add.
+#[cfg(target_feature = "fma")]
 #[inline(always)]
 pub(crate) fn two_prod(a: f64, b: f64) -> (f64, f64) {
     let p = a * b;
     (p, a.mul_add(b, -p))
 }
 
+/// Exact product: `p + e == a * b` (barring overflow and underflow).
+///
+/// Dekker's TwoProduct with Veltkamp's splitting instead of `mul_add`: on baseline x86-64 (no FMA in
+/// `rustc --print cfg`) `mul_add` is a call into libm that blocks vectorisation of the accurate-face
+/// path. Both give the same `e`: the product's rounding error is representable and each computes it
+/// exactly, so the results are bit for bit those of the FMA version, unless a split overflows
+/// (|a| or |b| above ~2^996) or a partial product underflows (|a·b| below ~2^-969), far outside
+/// what a mesh's coordinates relative to its centre produce.
+#[cfg(not(target_feature = "fma"))]
+#[inline(always)]
+pub(crate) fn two_prod(a: f64, b: f64) -> (f64, f64) {
+    let p = a * b;
+    let (ah, al) = split(a);
+    let (bh, bl) = split(b);
+    (p, al * bl - (((p - ah * bh) - al * bh) - ah * bl))
+}
+
+/// Veltkamp's splitting: `hi + lo == a` exactly, each half with at most 26 significant bits, so
+/// products of halves are exact.
+#[cfg(not(target_feature = "fma"))]
+#[inline(always)]
+fn split(a: f64) -> (f64, f64) {
+    // 2^27 + 1.
+    let t = 134_217_729.0 * a;
+    let hi = t - (t - a);
+    (hi, a - hi)
+}
+
+/// `a·(b×c) = Σ sign · a_i b_j c_k` over the six permutations `(i, j, k, sign)`.
+const TRIPLE_TERMS: [(usize, usize, usize, f64); 6] = [
+    (0, 1, 2, 1.0),
+    (0, 2, 1, -1.0),
+    (1, 2, 0, 1.0),
+    (1, 0, 2, -1.0),
+    (2, 0, 1, 1.0),
+    (2, 1, 0, -1.0),
+];
+
 /// Error-free-transformation evaluation of `a · (b × c)`, accurate to a few ulps of the result
 /// whatever the cancellation (each triple product is expanded exactly to three terms, then summed
-/// with compensation).
+/// with compensation). The reference for the lane-wise [`Batch::accurate_triples`].
+#[cfg(test)]
 fn accurate_triple(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> f64 {
-    // a·(b×c) = Σ sign · a_i b_j c_k over the six permutations.
-    const PERMS: [(usize, usize, usize, f64); 6] = [
-        (0, 1, 2, 1.0),
-        (0, 2, 1, -1.0),
-        (1, 2, 0, 1.0),
-        (1, 0, 2, -1.0),
-        (2, 0, 1, 1.0),
-        (2, 1, 0, -1.0),
-    ];
     let mut s = 0.0;
     let mut comp = 0.0;
-    for &(i, j, k, sign) in &PERMS {
+    for &(i, j, k, sign) in &TRIPLE_TERMS {
         let (p, pe) = two_prod(b[j], c[k]);
         let (q, qe) = two_prod(a[i], p);
         let r = a[i] * pe; // error of order eps² relative to the triple product
@@ -424,6 +457,32 @@ impl Batch {
         self.len += 1;
     }
 
+    /// [`accurate_triple`] for every lane, written lane-wise so that it vectorises: the same
+    /// operations per lane in the same order, so the same bits as one triangle at a time.
+    #[inline(always)]
+    fn accurate_triples(&self) -> [f64; LANES] {
+        let [a, b, c] = &self.p;
+        let mut s = [0.0; LANES];
+        let mut comp = [0.0; LANES];
+        for &(i, j, k, sign) in &TRIPLE_TERMS {
+            for l in 0..LANES {
+                let (p, pe) = two_prod(b[j][l], c[k][l]);
+                let (q, qe) = two_prod(a[i][l], p);
+                let r = a[i][l] * pe;
+                for term in [q, qe, r] {
+                    let (t, e) = two_sum(s[l], sign * term);
+                    s[l] = t;
+                    comp[l] += e;
+                }
+            }
+        }
+        let mut out = [0.0; LANES];
+        for l in 0..LANES {
+            out[l] = s[l] + comp[l];
+        }
+        out
+    }
+
     /// The raw contributions of the batch's triangles, `terms[integral][lane]` (lanes past `len` are
     /// zero triangles and contribute 0).
     #[inline(always)]
@@ -450,11 +509,12 @@ impl Batch {
                 * (e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
             slow[l] = d[l] * d[l] * 16_777_216.0 < aa * ee;
         }
-        if accurate {
+        if accurate && slow[..self.len].contains(&true) {
+            // All lanes at once, then select: branch-free lanes vectorise (see `accurate_triples`).
+            let exact = self.accurate_triples();
             for l in 0..self.len {
                 if slow[l] {
-                    let g = |p: &[[f64; LANES]; 3]| [p[0][l], p[1][l], p[2][l]];
-                    d[l] = accurate_triple(&g(a), &g(b), &g(c));
+                    d[l] = exact[l];
                 }
             }
         }
@@ -1010,5 +1070,36 @@ mod tests {
         // expand: -e - e + (1+e)(2e + e²) = -2e + 2e + e² + 2e² + e³ = 3e² + e³
         let want = 3.0 * e * e + e * e * e;
         assert_eq!(accurate_triple(&a, &b, &c), want);
+    }
+
+    /// The lane-wise accurate evaluation is the scalar one, bit for bit, in every lane.
+    #[test]
+    fn accurate_triples_match_scalar_per_lane() {
+        let mut x = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            // Mixed magnitudes and signs: near-cancelling triples come from the shared offset.
+            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let mut batch = Batch::new();
+        for round in 0..100 {
+            let offset = [next(), next(), next()].map(|o| o * 1e4);
+            let scale = 10f64.powi(round % 12 - 6);
+            for corner in 0..3 {
+                for axis in 0..3 {
+                    for l in 0..LANES {
+                        batch.p[corner][axis][l] = offset[axis] + scale * next();
+                    }
+                }
+            }
+            let lanes = batch.accurate_triples();
+            for l in 0..LANES {
+                let g = |c: usize| [0, 1, 2].map(|k| batch.p[c][k][l]);
+                let want = accurate_triple(&g(0), &g(1), &g(2));
+                assert_eq!(lanes[l].to_bits(), want.to_bits(), "round {round} lane {l}");
+            }
+        }
     }
 }
