@@ -13,6 +13,10 @@
 //! * `heal`: `make_solid`, everything after reading: edge analysis, ladder and integrations;
 //! * `end-to-end`: read + heal, what `urdf-inertia mesh` does after the file is in memory.
 
+// The allocator of the `urdf-inertia` binary (see src/main.rs), so that timings are the binary's.
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 #[path = "../tests/common/mod.rs"]
 mod common;
 

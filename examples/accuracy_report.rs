@@ -10,6 +10,10 @@
 //!
 //! Every error is against exact rational arithmetic on the stored mesh (tests/common's reference).
 
+// The allocator of the `urdf-inertia` binary (see src/main.rs), so that timings are the binary's.
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 #[path = "../tests/common/mod.rs"]
 mod common;
 #[path = "report/ladder.rs"]
