@@ -257,6 +257,8 @@ struct Edges {
     inconsistent: usize,
     /// Boundary edges as directed in their face.
     boundary_half_edges: Vec<(u32, u32)>,
+    /// The face of each boundary edge.
+    boundary_faces: Vec<u32>,
 }
 
 impl Edges {
@@ -296,8 +298,9 @@ fn edges(faces: &Polygons) -> Edges {
     }
     let mut e = Edges::default();
     for_each_edge(faces, |half: &[(u32, u32, bool)], lo: u32| match half {
-        [(hi, _, forward)] => {
+        [(hi, face, forward)] => {
             e.boundary += 1;
+            e.boundary_faces.push(*face);
             e.boundary_half_edges
                 .push(if *forward { (lo, *hi) } else { (*hi, lo) });
         }
@@ -443,12 +446,28 @@ struct Orientation {
     ncomp: usize,
 }
 
+/// The flips are forced within a component once its first face is fixed, and the component ids go
+/// by first face, so neither depends on the order of `pairs` or of the search.
 fn orient(nfaces: usize, pairs: &[(u32, u32, bool)]) -> Option<Orientation> {
-    let mut adj: Vec<Vec<(u32, bool)>> = vec![Vec::new(); nfaces];
-    for &(a, b, same) in pairs {
-        adj[a as usize].push((b, same));
-        adj[b as usize].push((a, same));
+    // Neighbours in one flat array (`adj[at[f]..at[f + 1]]`) instead of a Vec per face: the
+    // per-face allocations and frees took half of this function on the 48 k-face borinot base.
+    let mut at = vec![0u32; nfaces + 1];
+    for &(a, b, _) in pairs {
+        at[a as usize + 1] += 1;
+        at[b as usize + 1] += 1;
     }
+    for i in 0..nfaces {
+        at[i + 1] += at[i];
+    }
+    let mut fill = at[..nfaces].to_vec();
+    let mut adj = vec![(0u32, false); 2 * pairs.len()];
+    for &(a, b, same) in pairs {
+        for (x, y) in [(a, b), (b, a)] {
+            adj[fill[x as usize] as usize] = (y, same);
+            fill[x as usize] += 1;
+        }
+    }
+    let adj = |f: usize| &adj[at[f] as usize..at[f + 1] as usize];
     let mut flip = vec![false; nfaces];
     let mut comp = vec![u32::MAX; nfaces];
     let mut ncomp = 0u32;
@@ -460,7 +479,7 @@ fn orient(nfaces: usize, pairs: &[(u32, u32, bool)]) -> Option<Orientation> {
         comp[start] = ncomp;
         stack.push(start);
         while let Some(f) = stack.pop() {
-            for &(g, same) in &adj[f] {
+            for &(g, same) in adj(f) {
                 // Same traversal direction on the shared edge: exactly one of the two must flip.
                 let want = flip[f] ^ same;
                 if comp[g as usize] == u32::MAX {
@@ -1099,11 +1118,15 @@ fn apply(faces: &mut Polygons, reversed: &[bool]) {
     }
 }
 
-/// One way to wind an open or non-manifold mesh: the stored faces kept by the weld and their
-/// topology, both with the same faces reversed.
+/// One way to wind an open or non-manifold mesh: the stored faces kept by the weld with some faces
+/// reversed, and the boundary edges of their topology as directed then.
 struct Winding {
     faces: Polygons,
-    topology: Polygons,
+    /// What `edges(topology)` gives as `boundary_half_edges` for the topology with the same faces
+    /// reversed: the same edges in the same (key) order, each turned round if its face is. Derived
+    /// from the topology's edges rather than analysing each winding again (a third and fourth pass
+    /// over every half-edge).
+    boundary: Vec<(u32, u32)>,
     flipped: usize,
     /// Volume of components re-oriented inside another's bounding box (m³).
     nested: f64,
@@ -1126,12 +1149,20 @@ fn windings(w: &Welding, te: &Edges) -> Vec<Winding> {
     if let Some(o) = orient(w.topology.len(), &te.pairs) {
         let turned = outward(&w.vertices, &w.kept, &o);
         if turned.flipped > 0 {
-            let (mut faces, mut topology) = (w.kept.clone(), w.topology.clone());
+            let mut faces = w.kept.clone();
             apply(&mut faces, &turned.reversed);
-            apply(&mut topology, &turned.reversed);
+            let boundary = (te.boundary_half_edges.iter().zip(&te.boundary_faces))
+                .map(|(&(u, v), &f)| {
+                    if turned.reversed[f as usize] {
+                        (v, u)
+                    } else {
+                        (u, v)
+                    }
+                })
+                .collect();
             out.push(Winding {
                 faces,
-                topology,
+                boundary,
                 flipped: turned.flipped,
                 nested: turned.nested,
             });
@@ -1139,7 +1170,7 @@ fn windings(w: &Welding, te: &Edges) -> Vec<Winding> {
     }
     out.push(Winding {
         faces: w.kept.clone(),
-        topology: w.topology.clone(),
+        boundary: te.boundary_half_edges.clone(),
         flipped: 0,
         nested: 0.0,
     });
@@ -1157,7 +1188,7 @@ fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result<Sol
             }
             continue;
         }
-        let Some(caps) = cap_holes(&w.vertices, &winding.topology) else {
+        let Some(caps) = cap_holes(&w.vertices, &winding.boundary) else {
             continue;
         };
         let mut vertices = w.vertices.clone();
@@ -1521,9 +1552,9 @@ struct Caps {
 /// edges so the result is consistently oriented. The volume uncertainty bound: two surfaces spanning
 /// a loop that both lie within the loop's largest distance `d` from its mean plane enclose at most
 /// 2·d × (cap area) between them; boundary chains that do not close add |vector area| × diagonal / 6.
-/// `None` when there are no boundary edges.
-fn cap_holes(vertices: &[[f64; 3]], faces: &Polygons) -> Option<Caps> {
-    let half = edges(faces).boundary_half_edges;
+/// `None` when there are no boundary edges. `half` are the boundary edges as directed in their faces,
+/// in the order of [`edges`].
+fn cap_holes(vertices: &[[f64; 3]], half: &[(u32, u32)]) -> Option<Caps> {
     if half.is_empty() {
         return None;
     }

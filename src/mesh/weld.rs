@@ -258,33 +258,37 @@ impl Precision {
     }
 }
 
-/// [`significant_digits`] where [`Precision::of`] needs it: exact from 6 to 9, 10 for any count
-/// above 9 and at most 5 for any count below 6 (`Precision::of` cannot tell those apart). Asking
-/// whether some decimal of d digits reads back as `x`, with Clinger's exact fast path, instead of
-/// formatting `x`: formatting took 16% of healing the 48 k-face borinot base (a DAE of 6-digit
-/// decimals, 145 k coordinates at ~150 ns each).
+/// [`significant_digits`] where [`Precision::of`] needs it: exact up to 9, 10 for any count above.
+/// Found by asking which decimal of 9 digits reads back as `x` (Clinger's exact fast path) instead
+/// of formatting `x`: formatting took 16% of healing the 48 k-face borinot base (a DAE of 6-digit
+/// decimals, ~150 ns per coordinate).
 fn digits_up_to_ten(x: f64) -> usize {
     if x == 0.0 {
         return 0;
     }
-    match reads_back_from(x, 9) {
+    match nine_digits(x) {
         None => significant_digits(x).min(10),
-        Some(false) => 10,
-        Some(true) if reads_back_from(x, 5) == Some(true) => 5,
-        Some(true) => (6..9)
-            .find(|&d| reads_back_from(x, d) == Some(true))
-            .unwrap_or(9),
+        Some(None) => 10,
+        Some(Some(mut m)) => {
+            // Decimals of 9 digits are more than 2 ulps apart, so at most one reads back as `x`;
+            // a shorter one that did would be it with zeros appended.
+            while m % 10 == 0 {
+                m /= 10;
+            }
+            m.ilog10() as usize + 1
+        }
     }
 }
 
-/// Whether a decimal of at most `d` (≤ 15) significant digits reads back as `x` (≠ 0); `None` when the
-/// decimal exponent is out of the range where the fast path is exact.
+/// The mantissa m < 10⁹ of a decimal m·10^k that reads back as `x` (≠ 0), `Some(None)` when there
+/// is none, `None` when the decimal exponent is out of the range where the fast path is exact.
 ///
 /// Clinger's fast path: for an integer m < 2⁵³ and |k| ≤ 22, m and 10^|k| are exact f64 values, so
 /// one correctly rounded product or quotient is the correctly rounded value of m·10^k, which is what
 /// parsing the decimal gives. A decimal reading back as `x` lies within half an ulp of it, so its
-/// exponent is within one of `x`'s own and its mantissa within one of `x`/10^k rounded.
-fn reads_back_from(x: f64, d: usize) -> Option<bool> {
+/// exponent is within one of the one giving `x` 9 digits, and its mantissa within one of `x`/10^k
+/// rounded.
+fn nine_digits(x: f64) -> Option<Option<u64>> {
     const POW10: [f64; 23] = [
         1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
         1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
@@ -294,19 +298,18 @@ fn reads_back_from(x: f64, d: usize) -> Option<bool> {
     if !e.is_finite() {
         return None;
     }
-    let k0 = e as i32 - d as i32 + 1;
-    let limit = POW10[d];
-    for k in k0 - 1..=k0 + 1 {
+    let k0 = e as i32 - 8;
+    for k in [k0, k0 - 1, k0 + 1] {
         let p = *POW10.get(k.unsigned_abs() as usize)?;
-        let value = |m: f64| if k >= 0 { m * p } else { m / p };
         let y = if k >= 0 { x / p } else { x * p }.round();
-        for m in [y - 1.0, y, y + 1.0] {
-            if m >= 1.0 && m < limit && value(m) == x {
-                return Some(true);
+        for m in [y, y - 1.0, y + 1.0] {
+            let value = if k >= 0 { m * p } else { m / p };
+            if (1.0..1e9).contains(&m) && value == x {
+                return Some(Some(m as u64));
             }
         }
     }
-    Some(false)
+    Some(None)
 }
 
 /// Significant digits of the shortest decimal that reads back as `x`.
@@ -504,8 +507,7 @@ mod tests {
             for y in [x, f64::from_bits(x.to_bits() + 1), -x, f32_value] {
                 let want = significant_digits(y);
                 let got = digits_up_to_ten(y);
-                let class = |n: usize| if n == 0 { 0 } else { n.clamp(5, 10) };
-                assert_eq!(class(got), class(want), "{y:e}");
+                assert_eq!(got, want.min(10), "{y:e}");
             }
         }
     }
