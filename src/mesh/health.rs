@@ -594,7 +594,7 @@ fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize, usize) {
             others.push((key, reversed, i as u32));
         }
     }
-    keys.sort_unstable();
+    sort_by_first_vertex(&mut keys);
     others.sort_unstable();
     let mut dropped = vec![false; faces.len()];
     let (mut repeated, mut cancelled) = (0, 0);
@@ -623,6 +623,31 @@ fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize, usize) {
         drop_group(&members);
     }
     (dropped, repeated, cancelled)
+}
+
+/// Sorts triangle keys as `sort_unstable` would (they are all distinct, so the order is the same):
+/// a counting sort by the first vertex, then each bucket, a handful of keys, on its own. A comparison
+/// sort of all keys took 6% of healing the 381 ERD meshes.
+fn sort_by_first_vertex(keys: &mut Vec<([u32; 3], bool, u32)>) {
+    let n = keys.iter().map(|k| k.0[0] as usize + 1).max().unwrap_or(0);
+    let mut start = vec![0u32; n + 1];
+    for k in keys.iter() {
+        start[k.0[0] as usize + 1] += 1;
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start[..n].to_vec();
+    let mut sorted = vec![([0u32; 3], false, 0u32); keys.len()];
+    for k in keys.iter() {
+        let s = &mut fill[k.0[0] as usize];
+        sorted[*s as usize] = *k;
+        *s += 1;
+    }
+    for w in start.windows(2) {
+        sorted[w[0] as usize..w[1] as usize].sort_unstable();
+    }
+    *keys = sorted;
 }
 
 /// Shared by the rungs: where the mesh came from and what has been said about it.
