@@ -52,7 +52,6 @@ impl MeshCache {
     /// Reads and heals every not yet cached (file, scale) pair on all cores: each file once, then each
     /// of its scales. Times are summed over threads (CPU time).
     pub fn preload(&mut self, items: &[(PathBuf, [f64; 3])], options: HealthOptions) {
-        use rayon::prelude::*;
         let mut by_file: HashMap<&PathBuf, Vec<[f64; 3]>> = HashMap::new();
         for (path, scale) in items {
             if !self
@@ -68,25 +67,15 @@ impl MeshCache {
                 }
             }
         }
-        type Loaded = (
-            PathBuf,
-            Option<MeshError>,
-            Vec<([f64; 3], Result<Arc<Solid>, MeshError>)>,
-            Duration,
-            Duration,
-        );
-        let work: Vec<(&PathBuf, Vec<[f64; 3]>)> = by_file.into_iter().collect();
-        let loaded: Vec<Loaded> = work
-            .into_par_iter()
-            .map(|(path, scales)| {
-                let t0 = Instant::now();
-                let raw = read(path);
-                let t1 = Instant::now();
-                let (solids, error) = heal_scales(raw, &scales, path, options);
-                // The raw mesh has ended, before the next file of this thread is read.
-                (path.clone(), error, solids, t1 - t0, t1.elapsed())
-            })
+        // Largest files first, each taken by the next free thread (greedy longest-first): with the
+        // hash map's random order, or rayon's halving of a sorted list, a robot's largest mesh could
+        // start last on a core while the other idled. The results do not depend on the order.
+        let mut work: Vec<(u64, &PathBuf, Vec<[f64; 3]>)> = by_file
+            .into_iter()
+            .map(|(p, s)| (std::fs::metadata(p).map_or(0, |m| m.len()), p, s))
             .collect();
+        work.sort_by(|a, b| b.0.cmp(&a.0).then_with(|| a.1.cmp(b.1)));
+        let loaded = in_order_of_need(&work, |(_, path, scales)| load_file(path, scales, options));
         for (path, raw, solids, load, integrate) in loaded {
             self.load_time += load;
             self.integrate_time += integrate;
@@ -134,3 +123,47 @@ fn heal_scales(
 }
 
 type SolidsByScale = Vec<([f64; 3], Result<Arc<Solid>, MeshError>)>;
+
+/// A file read and its scales healed: the path, the read error, the solids, read and heal times.
+type Loaded = (
+    PathBuf,
+    Option<MeshError>,
+    SolidsByScale,
+    Duration,
+    Duration,
+);
+
+fn load_file(path: &Path, scales: &[[f64; 3]], options: HealthOptions) -> Loaded {
+    let t0 = Instant::now();
+    let raw = read(path);
+    let t1 = Instant::now();
+    let (solids, error) = heal_scales(raw, scales, path, options);
+    // The raw mesh has ended, before the next file of this thread is read.
+    (path.to_path_buf(), error, solids, t1 - t0, t1.elapsed())
+}
+
+/// `f` of every item on all of rayon's threads, each thread taking the next item in order when it is
+/// free; the results in the items' order.
+fn in_order_of_need<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Mutex;
+    let next = AtomicUsize::new(0);
+    let done: Mutex<Vec<(usize, R)>> = Mutex::new(Vec::with_capacity(items.len()));
+    rayon::scope(|s| {
+        for _ in 0..rayon::current_num_threads().min(items.len()) {
+            s.spawn(|_| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(item) = items.get(i) else { break };
+                let r = f(item);
+                done.lock()
+                    .unwrap_or_else(std::sync::PoisonError::into_inner)
+                    .push((i, r));
+            });
+        }
+    });
+    let mut done = done
+        .into_inner()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    done.sort_by_key(|d| d.0);
+    done.into_iter().map(|d| d.1).collect()
+}
