@@ -272,9 +272,7 @@ impl Edges {
             .take()
             .unwrap_or_else(|| components(nfaces, &self.pairs))
     }
-}
 
-impl Edges {
     fn closed(&self) -> bool {
         self.boundary == 0 && self.nonmanifold == 0
     }
