@@ -46,24 +46,78 @@ pub enum PartShape {
     Mesh(Arc<Solid>),
 }
 
-/// A closed triangle mesh bucketed on a (y, z) grid for point-in-solid tests by ray parity.
+/// A box `(lo, hi)`.
+pub type Aabb = ([f64; 3], [f64; 3]);
+
+/// A closed triangle mesh's triangles bucketed on a (y, z) grid for point-in-solid tests by ray parity:
+/// all of them, or (for the overlap estimate) only those that can decide a point in a given region.
 ///
 /// The buckets are one flat list (`entries`, bucket `c` is `entries[starts[c]..starts[c + 1]]`), so the
 /// memory is the references themselves and nothing per bucket but an offset.
 #[derive(Debug)]
 pub struct MeshLocator {
-    vertices: Vec<[f64; 3]>,
-    triangles: Vec<[u32; 3]>,
+    /// The located triangles, copied as the ray test reads them: a bucket's tests read one block per
+    /// triangle instead of three vertices scattered over the mesh (and the locator need not hold it).
+    triangles: Vec<RayTriangle>,
     lo: [f64; 2],
     cell: [f64; 2],
     grid: usize,
     starts: Vec<usize>,
     entries: Vec<u32>,
+    /// The low corner of the whole mesh's (y, z) extent: a point below it is outside, as it always
+    /// was when the grid spanned the whole mesh.
+    floor: [f64; 2],
+}
+
+/// A triangle as [`MeshLocator::contains`] reads it: for each edge (opposite corner 0, 1, 2) the end
+/// its signed area is taken from, the edge vector from there, and whether the edge owns points on it
+/// ([`edge_rule`]); and the corners' x. Computed once per triangle instead of once per point test.
+#[derive(Debug, Clone, Copy)]
+struct RayTriangle {
+    from: [[f64; 2]; 3],
+    edge: [[f64; 2]; 3],
+    owns: [bool; 3],
+    x: [f64; 3],
+}
+
+impl RayTriangle {
+    fn new(p: &[[f64; 3]; 3]) -> Self {
+        let mut t = RayTriangle {
+            from: [[0.0; 2]; 3],
+            edge: [[0.0; 2]; 3],
+            owns: [false; 3],
+            x: p.map(|v| v[0]),
+        };
+        for e in 0..3 {
+            let (a, b) = (p[(e + 1) % 3], p[(e + 2) % 3]);
+            let owns = edge_rule(a, b);
+            let (o, f) = if owns { (a, b) } else { (b, a) };
+            t.from[e] = [o[1], o[2]];
+            t.edge[e] = [f[1] - o[1], f[2] - o[2]];
+            t.owns[e] = owns;
+        }
+        t
+    }
+
+    /// Twice the signed area of edge `e` and `q` projected on the (y, z) plane, evaluated from the
+    /// edge's own first end (by [`edge_rule`]) so that the two triangles sharing an edge get exactly
+    /// opposite values: rounding must not put a point on that edge inside both or neither.
+    fn orient(&self, e: usize, q: [f64; 3]) -> f64 {
+        let ([oy, oz], [dy, dz]) = (self.from[e], self.edge[e]);
+        let area = dy * (q[2] - oz) - dz * (q[1] - oy);
+        if self.owns[e] {
+            area
+        } else {
+            -area
+        }
+    }
 }
 
 /// The range of cells a closed interval `[a, b]` meets along axis `k` of a grid.
 fn cells(a: f64, b: f64, lo: f64, cell: f64, grid: usize) -> (usize, usize) {
-    let index = |x: f64| (((x - lo) / cell).floor().max(0.0) as usize).min(grid - 1);
+    // The cast saturates (below 0 and NaN give 0): `floor().max(0.0)`'s cell without its libm call
+    // (floor was 1.7% of the ERD fill).
+    let index = |x: f64| (((x - lo) / cell) as usize).min(grid - 1);
     // A little slack: a point on a cell border goes to the upper cell, and rounding must not lose it.
     let pad = 1e-7 * cell;
     (index(a - pad), index(b + pad))
@@ -92,42 +146,164 @@ fn z_extent_in_band(p: &[[f64; 2]; 3], y0: f64, y1: f64) -> Option<(f64, f64)> {
     (lo <= hi).then_some((lo, hi))
 }
 
+/// The solid's faces fan-triangulated, as corner coordinates.
+fn corners(solid: &Solid) -> impl Iterator<Item = [[f64; 3]; 3]> + '_ {
+    let v = &solid.vertices;
+    solid.faces.iter().flat_map(move |f| {
+        (1..f.len().saturating_sub(1)).map(move |k| [f[0], f[k], f[k + 1]].map(|i| v[i as usize]))
+    })
+}
+
+/// The triangles of the solid's fan triangulation.
+fn triangle_count(solid: &Solid) -> usize {
+    solid.faces.iter().map(|f| f.len().saturating_sub(2)).sum()
+}
+
+/// The cells per axis for `triangles` triangles at about four per cell, at most 256 × 256.
+fn default_grid(triangles: usize) -> usize {
+    ((triangles as f64 / 4.0).sqrt().ceil() as usize).clamp(1, 256)
+}
+
+/// A triangle's bounding box.
+fn triangle_box(t: &[[f64; 3]; 3]) -> Aabb {
+    let lo = [0, 1, 2].map(|k| t[0][k].min(t[1][k]).min(t[2][k]));
+    let hi = [0, 1, 2].map(|k| t[0][k].max(t[1][k]).max(t[2][k]));
+    (lo, hi)
+}
+
+/// Cell references a grid over the whole mesh holds, bounded above (a triangle's rows of cells lie
+/// within its bounding box of cells), with that grid's size: what [`MeshLocator::with_budget`] builds.
+struct WholeMeshBound {
+    lo: [f64; 2],
+    cell: [f64; 2],
+    grid: usize,
+    entries: usize,
+}
+
+impl WholeMeshBound {
+    fn new(solid: &Solid) -> Self {
+        let grid = default_grid(triangle_count(solid));
+        let (lo, cell) = MeshLocator::frame(&solid.vertices, grid);
+        WholeMeshBound {
+            lo,
+            cell,
+            grid,
+            entries: 0,
+        }
+    }
+
+    fn add(&mut self, b: &Aabb) {
+        let (a0, a1) = cells(b.0[1], b.1[1], self.lo[0], self.cell[0], self.grid);
+        let (b0, b1) = cells(b.0[2], b.1[2], self.lo[1], self.cell[1], self.grid);
+        self.entries += (a1 - a0 + 1) * (b1 - b0 + 1);
+    }
+
+    /// The bound on the whole-mesh locator's point cost, if its grid is surely the first tried.
+    fn cost(&self) -> Option<usize> {
+        (self.entries <= LOCATOR_ENTRIES).then(|| 2 + self.entries / (self.grid * self.grid))
+    }
+}
+
 impl MeshLocator {
     /// Buckets `solid`'s triangles within [`LOCATOR_ENTRIES`] references; a mesh of more triangles than
     /// that gets one bucket holding them all.
     pub fn new(solid: &Solid) -> Self {
-        Self::with_budget(solid, LOCATOR_ENTRIES).unwrap_or_else(|| Self::with_grid(solid, 1))
+        Self::with_budget(solid, LOCATOR_ENTRIES).unwrap_or_else(|| {
+            let triangles: Vec<_> = corners(solid).collect();
+            let (lo, cell) = Self::frame(&solid.vertices, 1);
+            Self::bucket(triangles, lo, cell, 1, usize::MAX, Self::floor(solid)).expect("no budget")
+        })
     }
 
     /// Buckets `solid`'s triangles on the finest grid (at most 256 × 256, about four triangles per
     /// cell) whose buckets hold at most `entries` references in all; `None` if none does.
     pub fn with_budget(solid: &Solid, entries: usize) -> Option<Self> {
-        let triangles = solid.faces.triangles();
+        let mut triangles: Vec<_> = corners(solid).collect();
         if triangles.len() > entries {
             return None;
         }
-        let mut grid = ((triangles.len() as f64 / 4.0).sqrt().ceil() as usize).clamp(1, 256);
+        let mut grid = default_grid(triangles.len());
         loop {
             let (lo, cell) = Self::frame(&solid.vertices, grid);
-            let mut count = 0usize;
-            for tri in &triangles {
-                Self::rows(&solid.vertices, tri, lo, cell, grid, |_, b0, b1| {
-                    count += b1 - b0 + 1
-                });
-                if count > entries {
-                    break;
-                }
-            }
-            if count <= entries || grid == 1 {
-                return (count <= entries).then(|| Self::build(solid, triangles, grid));
+            match Self::bucket(triangles, lo, cell, grid, entries, Self::floor(solid)) {
+                Ok(l) => return Some(l),
+                Err(_) if grid == 1 => return None,
+                Err(t) => triangles = t,
             }
             grid /= 2;
         }
     }
 
-    /// Buckets on a `grid` × `grid` grid, whatever the memory.
-    fn with_grid(solid: &Solid, grid: usize) -> Self {
-        Self::build(solid, solid.faces.triangles(), grid.max(1))
+    /// What one point test of the locator [`Self::with_budget`] builds over the whole mesh costs, in
+    /// primitive tests: the triangles of an average bucket. (The overlap estimate sizes its sampling
+    /// grid by it, whatever locator it tests with.)
+    fn whole_mesh_cost(solid: &Solid) -> usize {
+        let triangles: Vec<_> = corners(solid).collect();
+        let mut grid = default_grid(triangles.len());
+        let mut starts = Vec::new();
+        while triangles.len() <= LOCATOR_ENTRIES {
+            let (lo, cell) = Self::frame(&solid.vertices, grid);
+            match Self::count(&triangles, lo, cell, grid, LOCATOR_ENTRIES, &mut starts) {
+                Some(n) => return 2 + n / (grid * grid),
+                None if grid == 1 => break,
+                None => grid /= 2,
+            }
+        }
+        usize::MAX / 4
+    }
+
+    /// Buckets the triangles of `solid` that can decide a point in `region` (mesh frame): those whose
+    /// (y, z) projection meets the region's and that reach past its low x (rays go along +x), on a grid
+    /// over the region. Also returns the bound on the whole-mesh locator's cost (see
+    /// [`WholeMeshBound`]), `None` when the bound says nothing. `None` when the mesh has more triangles
+    /// than [`LOCATOR_ENTRIES`].
+    fn within(solid: &Solid, region: &Aabb) -> Option<(Self, Option<usize>)> {
+        let mut bound = WholeMeshBound::new(solid);
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        let mut triangles = Vec::new();
+        let mut all = 0usize;
+        for t in corners(solid) {
+            all += 1;
+            let b = triangle_box(&t);
+            bound.add(&b);
+            if b.1[0] >= region.0[0]
+                && (1..3).all(|k| b.1[k] >= region.0[k] && b.0[k] <= region.1[k])
+            {
+                for k in 0..2 {
+                    lo[k] = lo[k].min(b.0[k + 1]);
+                    hi[k] = hi[k].max(b.1[k + 1]);
+                }
+                triangles.push(t);
+            }
+        }
+        if all > LOCATOR_ENTRIES {
+            return None;
+        }
+        // The grid spans where the region and the triangles meet.
+        for k in 0..2 {
+            lo[k] = lo[k].max(region.0[k + 1]);
+            hi[k] = hi[k].min(region.1[k + 1]).max(lo[k]);
+        }
+        if triangles.is_empty() {
+            (lo, hi) = ([0.0; 2], [0.0; 2]);
+        }
+        let mut grid = default_grid(triangles.len());
+        loop {
+            let cell = [0, 1].map(|k| ((hi[k] - lo[k]) / grid as f64).max(f64::MIN_POSITIVE));
+            // One bucket holds every triangle, within the budget since the mesh is.
+            let budget = if grid == 1 {
+                usize::MAX
+            } else {
+                LOCATOR_ENTRIES
+            };
+            let floor = Self::floor(solid);
+            match Self::bucket(triangles, lo, cell, grid, budget, floor) {
+                Ok(l) => return Some((l, bound.cost())),
+                Err(t) => triangles = t,
+            }
+            grid /= 2;
+        }
     }
 
     /// The grid's origin and cell size over the vertices' (y, z) extent.
@@ -148,19 +324,20 @@ impl MeshLocator {
         (lo, cell)
     }
 
+    /// The low corner of the (y, z) extent of the solid's vertices.
+    fn floor(solid: &Solid) -> [f64; 2] {
+        Self::frame(&solid.vertices, 1).0
+    }
+
     /// Calls `f(row, first column, last column)` for each row of cells the triangle's projection meets.
     fn rows(
-        vertices: &[[f64; 3]],
-        tri: &[u32; 3],
+        t: &[[f64; 3]; 3],
         lo: [f64; 2],
         cell: [f64; 2],
         grid: usize,
         mut f: impl FnMut(usize, usize, usize),
     ) {
-        let p = tri.map(|i| {
-            let v = vertices[i as usize];
-            [v[1], v[2]]
-        });
+        let p = t.map(|v| [v[1], v[2]]);
         let ymin = p[0][0].min(p[1][0]).min(p[2][0]);
         let ymax = p[0][0].max(p[1][0]).max(p[2][0]);
         let zmin = p[0][1].min(p[1][1]).min(p[2][1]);
@@ -173,45 +350,81 @@ impl MeshLocator {
             // The first and last rows reach to the grid's border (points there are clamped into them).
             let y0 = if a == 0 { f64::NEG_INFINITY } else { y0 };
             let y1 = if a == grid - 1 { f64::INFINITY } else { y1 };
+            if ymin >= y0 && ymax <= y1 {
+                // The whole triangle is in the band (most are: a cell holds about four), so its cut
+                // is itself; the same cells as below, without the clipping.
+                let (b0, b1) = cells(zmin, zmax, lo[1], cell[1], grid);
+                f(a, b0, b1);
+                continue;
+            }
             let (z0, z1) = z_extent_in_band(&p, y0, y1).unwrap_or((zmin, zmax));
             let (b0, b1) = cells(z0.max(zmin), z1.min(zmax), lo[1], cell[1], grid);
             f(a, b0, b1);
         }
     }
 
-    fn build(solid: &Solid, triangles: Vec<[u32; 3]>, grid: usize) -> Self {
-        let vertices = &solid.vertices;
-        let (lo, cell) = Self::frame(vertices, grid);
-        let mut starts = vec![0usize; grid * grid + 1];
-        for tri in &triangles {
-            Self::rows(vertices, tri, lo, cell, grid, |a, b0, b1| {
+    /// Counts each bucket's references into `starts[c + 1]`; the total, or `None` past `budget`.
+    fn count(
+        triangles: &[[[f64; 3]; 3]],
+        lo: [f64; 2],
+        cell: [f64; 2],
+        grid: usize,
+        budget: usize,
+        starts: &mut Vec<usize>,
+    ) -> Option<usize> {
+        starts.clear();
+        starts.resize(grid * grid + 1, 0);
+        let mut total = 0usize;
+        for t in triangles {
+            Self::rows(t, lo, cell, grid, |a, b0, b1| {
+                total += b1 - b0 + 1;
                 for b in b0..=b1 {
                     starts[a * grid + b + 1] += 1;
                 }
             });
+            if total > budget {
+                return None;
+            }
         }
+        Some(total)
+    }
+
+    /// Buckets the triangles on the given grid if they take at most `budget` references; the triangles
+    /// back otherwise. One counting pass into the final offsets, one filling pass.
+    fn bucket(
+        triangles: Vec<[[f64; 3]; 3]>,
+        lo: [f64; 2],
+        cell: [f64; 2],
+        grid: usize,
+        budget: usize,
+        floor: [f64; 2],
+    ) -> Result<Self, Vec<[[f64; 3]; 3]>> {
+        let mut starts = Vec::new();
+        let Some(total) = Self::count(&triangles, lo, cell, grid, budget, &mut starts) else {
+            return Err(triangles);
+        };
         for c in 0..grid * grid {
             starts[c + 1] += starts[c];
         }
         let mut fill = starts.clone();
-        let mut entries = vec![0u32; starts[grid * grid]];
-        for (t, tri) in triangles.iter().enumerate() {
-            Self::rows(vertices, tri, lo, cell, grid, |a, b0, b1| {
-                for b in b0..=b1 {
-                    entries[fill[a * grid + b]] = t as u32;
-                    fill[a * grid + b] += 1;
+        let mut entries = vec![0u32; total];
+        for (i, t) in triangles.iter().enumerate() {
+            Self::rows(t, lo, cell, grid, |a, b0, b1| {
+                for f in &mut fill[a * grid + b0..=a * grid + b1] {
+                    entries[*f] = i as u32;
+                    *f += 1;
                 }
             });
         }
-        MeshLocator {
-            vertices: vertices.clone(),
-            triangles,
+        Ok(MeshLocator {
+            triangles: triangles.iter().map(RayTriangle::new).collect(),
             lo,
             cell,
             grid,
             starts,
             entries,
-        }
+            floor,
+        })
     }
 
     /// Cells per axis of the bucket grid.
@@ -224,60 +437,35 @@ impl MeshLocator {
         self.entries.len()
     }
 
-    /// What one point test costs, in primitive tests: the triangles of an average bucket.
-    fn cost(&self) -> usize {
-        2 + self.entries.len() / (self.grid * self.grid)
-    }
-
     /// Whether `q` (mesh frame) is inside: the number of triangles a ray from `q` along +x crosses is odd.
     pub fn contains(&self, q: [f64; 3]) -> bool {
-        let a = ((q[1] - self.lo[0]) / self.cell[0]).floor();
-        let b = ((q[2] - self.lo[1]) / self.cell[1]).floor();
-        // Points on the far border belong to the last cell.
-        let last = self.grid as f64;
-        let a = if a == last { a - 1.0 } else { a };
-        let b = if b == last { b - 1.0 } else { b };
-        if !(a >= 0.0 && b >= 0.0 && a < last && b < last) {
+        if !(q[1] >= self.floor[0] && q[2] >= self.floor[1]) {
             return false;
         }
-        let c = a as usize * self.grid + b as usize;
+        // Points off the grid go to its border cells, which reach to infinity (see `rows`).
+        let index =
+            |x: f64, k: usize| (((x - self.lo[k]) / self.cell[k]) as usize).min(self.grid - 1);
+        let c = index(q[1], 0) * self.grid + index(q[2], 1);
         let mut crossings = 0usize;
         for &t in &self.entries[self.starts[c]..self.starts[c + 1]] {
-            let [i, j, k] = self.triangles[t as usize];
-            let (p0, p1, p2) = (
-                self.vertices[i as usize],
-                self.vertices[j as usize],
-                self.vertices[k as usize],
-            );
+            let t = &self.triangles[t as usize];
             // Signed areas in the (y, z) plane; the half-open sign rule counts a ray through an edge once.
-            let w0 = orient(p1, p2, q);
-            let w1 = orient(p2, p0, q);
-            let w2 = orient(p0, p1, q);
-            let inside = (w0 > 0.0 || w0 == 0.0 && edge_rule(p1, p2))
-                && (w1 > 0.0 || w1 == 0.0 && edge_rule(p2, p0))
-                && (w2 > 0.0 || w2 == 0.0 && edge_rule(p0, p1))
-                || (w0 < 0.0 || w0 == 0.0 && !edge_rule(p1, p2))
-                    && (w1 < 0.0 || w1 == 0.0 && !edge_rule(p2, p0))
-                    && (w2 < 0.0 || w2 == 0.0 && !edge_rule(p0, p1));
+            let w0 = t.orient(0, q);
+            let w1 = t.orient(1, q);
+            let w2 = t.orient(2, q);
+            let [o0, o1, o2] = t.owns;
+            let inside = (w0 > 0.0 || w0 == 0.0 && o0)
+                && (w1 > 0.0 || w1 == 0.0 && o1)
+                && (w2 > 0.0 || w2 == 0.0 && o2)
+                || (w0 < 0.0 || w0 == 0.0 && !o0)
+                    && (w1 < 0.0 || w1 == 0.0 && !o1)
+                    && (w2 < 0.0 || w2 == 0.0 && !o2);
             let sum = w0 + w1 + w2;
-            if inside && sum != 0.0 && (w0 * p0[0] + w1 * p1[0] + w2 * p2[0]) / sum > q[0] {
+            if inside && sum != 0.0 && (w0 * t.x[0] + w1 * t.x[1] + w2 * t.x[2]) / sum > q[0] {
                 crossings += 1;
             }
         }
         crossings % 2 == 1
-    }
-}
-
-/// Twice the signed area of (a, b, q) projected on the (y, z) plane, evaluated from the edge's own
-/// first end (by [`edge_rule`]) so that the two triangles sharing an edge get exactly opposite values:
-/// rounding must not put a point on that edge inside both or neither.
-fn orient(a: [f64; 3], b: [f64; 3], q: [f64; 3]) -> f64 {
-    let area =
-        |a: [f64; 3], b: [f64; 3]| (b[1] - a[1]) * (q[2] - a[2]) - (b[2] - a[2]) * (q[1] - a[1]);
-    if edge_rule(a, b) {
-        area(a, b)
-    } else {
-        -area(b, a)
     }
 }
 
@@ -321,25 +509,48 @@ impl PlacedPart {
         }
     }
 
-    /// What one point test costs, in primitive tests.
-    fn cost(&self) -> usize {
-        match (&self.shape, &self.locator) {
-            (PartShape::Mesh(_), Some(l)) => l.cost(),
-            (PartShape::Mesh(_), None) => usize::MAX / 4,
-            _ => 1,
-        }
-    }
-
-    /// Builds the mesh locator if this part is a mesh and has none yet, within [`LOCATOR_ENTRIES`].
-    /// False when the mesh has more triangles than that (it cannot be located).
-    pub fn prepare(&mut self) -> bool {
-        if let (PartShape::Mesh(solid), None) = (&self.shape, &self.locator) {
-            match MeshLocator::with_budget(solid, LOCATOR_ENTRIES) {
-                Some(l) => self.locator = Some(Arc::new(l)),
-                None => return false,
+    /// Builds the mesh locator if this part is a mesh, over the triangles that can decide a point of
+    /// `region` (link frame; the only points it will be tested at). Returns a bound on what one point
+    /// test costs, in primitive tests, by the measure [`grid_size`] has always used (the whole-mesh
+    /// locator's, [`MeshLocator::whole_mesh_cost`]; `usize::MAX / 4` when that bound says nothing).
+    /// `None` when the mesh has more triangles than [`LOCATOR_ENTRIES`] (it cannot be located).
+    fn prepare(&mut self, region: &Aabb) -> Option<usize> {
+        let PartShape::Mesh(solid) = &self.shape else {
+            return Some(1);
+        };
+        let rt = transpose(&self.rotation);
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for c in 0..8 {
+            let x = [0, 1, 2].map(|k| {
+                if c >> k & 1 == 0 {
+                    region.0[k]
+                } else {
+                    region.1[k]
+                }
+            });
+            let q = mat_vec(&rt, [0, 1, 2].map(|k| x[k] - self.translation[k]));
+            for k in 0..3 {
+                lo[k] = lo[k].min(q[k]);
+                hi[k] = hi[k].max(q[k]);
             }
         }
-        true
+        // Points are moved into the mesh frame one by one, each with its own rounding (~1e-16 of its
+        // coordinates): a margin far above that keeps every triangle that can decide one of them.
+        let scale = (0..3).fold(0.0f64, |m, k| m.max(lo[k].abs()).max(hi[k].abs()));
+        let pad = 1e-9 * scale;
+        let region = (lo.map(|v| v - pad), hi.map(|v| v + pad));
+        let (locator, bound) = MeshLocator::within(solid, &region)?;
+        self.locator = Some(Arc::new(locator));
+        Some(bound.unwrap_or(usize::MAX / 4))
+    }
+
+    /// What one point test costs, in primitive tests, by the whole-mesh measure (see [`Self::prepare`]).
+    fn exact_cost(&self) -> usize {
+        match &self.shape {
+            PartShape::Mesh(solid) => MeshLocator::whole_mesh_cost(solid),
+            _ => 1,
+        }
     }
 
     /// Whether the link-frame point `p` is inside the part's bounding box.
@@ -461,26 +672,24 @@ fn neighbours(parts: &[PlacedPart]) -> Option<Vec<Vec<usize>>> {
 }
 
 /// The grid size for every part: one size for all that keeps the point tests of every part and its
-/// neighbours within the budget.
-fn grid_size(parts: &[PlacedPart], nb: &[Vec<usize>], involved: &[usize]) -> usize {
+/// neighbours within the budget, with `cost[i]` what one point test of part `i` costs.
+fn grid_size(cost: &[usize], nb: &[Vec<usize>], involved: &[usize]) -> usize {
     let cost: usize = involved
         .iter()
         .map(|&i| {
             nb[i]
                 .iter()
-                .fold(parts[i].cost(), |c, &j| c.saturating_add(parts[j].cost()))
+                .fold(cost[i], |c, &j| c.saturating_add(cost[j]))
         })
         .fold(0usize, usize::saturating_add);
     let samples = POINT_TEST_BUDGET / cost.max(1);
     ((samples as f64).cbrt().floor() as usize).clamp(MIN_GRID, GRID)
 }
 
-/// Samples part `i` on an `n`³ grid over where its box meets its neighbours': the volume it shares
-/// (each point covered k times counts 1 - 1/k), whether any point is shared, and the most parts
-/// covering one point.
-fn sample_part(parts: &[PlacedPart], nb: &[Vec<usize>], i: usize, n: usize) -> (f64, bool, usize) {
+/// Where part `i`'s box meets its neighbours' (the box around those meetings): the only place a
+/// point can be covered twice, so the only place the part is sampled or tested.
+fn region(parts: &[PlacedPart], nb: &[Vec<usize>], i: usize) -> Aabb {
     let p = &parts[i];
-    // Only where the part's box meets a neighbour's can a point be covered twice.
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for &j in &nb[i] {
@@ -490,9 +699,18 @@ fn sample_part(parts: &[PlacedPart], nb: &[Vec<usize>], i: usize, n: usize) -> (
             hi[k] = hi[k].max(p.bbox.1[k].min(q.bbox.1[k]));
         }
     }
+    (lo, hi)
+}
+
+/// Samples part `i` on an `n`³ grid over its [`region`]: the volume it shares (each point covered k
+/// times counts 1 - 1/k), whether any point is shared, and the most parts covering one point.
+fn sample_part(parts: &[PlacedPart], nb: &[Vec<usize>], i: usize, n: usize) -> (f64, bool, usize) {
+    let p = &parts[i];
+    let (lo, hi) = region(parts, nb, i);
     let cell_volume = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]) / (n * n * n) as f64;
     let mut sum = 0.0;
     let mut most = 1usize;
+    let mut near: Vec<usize> = Vec::with_capacity(nb[i].len());
     for a in 0..n {
         for b in 0..n {
             for c in 0..n {
@@ -501,13 +719,14 @@ fn sample_part(parts: &[PlacedPart], nb: &[Vec<usize>], i: usize, n: usize) -> (
                     lo[1] + (hi[1] - lo[1]) * (b as f64 + 0.5) / n as f64,
                     lo[2] + (hi[2] - lo[2]) * (c as f64 + 0.5) / n as f64,
                 ];
-                if !p.contains(x) {
+                // A point in no neighbour's box is covered once at most and adds nothing: skip the
+                // part's own (costlier) test there.
+                near.clear();
+                near.extend(nb[i].iter().filter(|&&j| parts[j].in_bbox(x)));
+                if near.is_empty() || !p.contains(x) {
                     continue;
                 }
-                let k = 1 + nb[i]
-                    .iter()
-                    .filter(|&&j| parts[j].in_bbox(x) && parts[j].contains(x))
-                    .count();
+                let k = 1 + near.iter().filter(|&&j| parts[j].contains(x)).count();
                 most = most.max(k);
                 sum += 1.0 - 1.0 / k as f64;
             }
@@ -528,17 +747,36 @@ pub fn estimate(parts: &mut [PlacedPart]) -> Overlap {
     if involved.is_empty() {
         return Overlap::None;
     }
-    for &i in &involved {
-        if !parts[i].prepare() {
-            return Overlap::Skipped(format!(
-                "part {} has more than {LOCATOR_ENTRIES} triangles",
-                i + 1
-            ));
-        }
-    }
-    let n = grid_size(parts, &nb, &involved);
-    let parts: &[PlacedPart] = parts;
     use rayon::prelude::*;
+    let regions: Vec<Option<Aabb>> = (0..parts.len())
+        .map(|i| (!nb[i].is_empty()).then(|| region(parts, &nb, i)))
+        .collect();
+    let bounds: Vec<Option<usize>> = parts
+        .par_iter_mut()
+        .zip(&regions)
+        .map(|(p, r)| r.as_ref().map_or(Some(1), |r| p.prepare(r)))
+        .collect();
+    if let Some(i) = bounds.iter().position(Option::is_none) {
+        return Overlap::Skipped(format!(
+            "part {} has more than {LOCATOR_ENTRIES} triangles",
+            i + 1
+        ));
+    }
+    let bounds: Vec<usize> = bounds.into_iter().flatten().collect();
+    // The grid size is the whole-mesh locators' (outputs must not depend on how points are located).
+    // Their cost is bounded from the pass that picks the triangles; only if the bound allows a
+    // coarser grid than the finest is it counted exactly (never in example-robot-data: all 52
+    // estimates are on the finest grid).
+    let mut n = grid_size(&bounds, &nb, &involved);
+    if n < GRID {
+        let exact: Vec<usize> = parts
+            .par_iter()
+            .zip(&regions)
+            .map(|(p, r)| if r.is_some() { p.exact_cost() } else { 1 })
+            .collect();
+        n = grid_size(&exact, &nb, &involved);
+    }
+    let parts: &[PlacedPart] = parts;
     let results: Vec<(f64, bool, usize)> = involved
         .par_iter()
         .map(|&i| sample_part(parts, &nb, i, n))
@@ -746,6 +984,39 @@ mod tests {
             // On the diagonal, level with shared edges (vertex 512 is at 45°).
             assert!(l.contains([0.3, 0.1, 0.1]) && l.contains([0.3, -0.2, -0.2]));
         }
+    }
+
+    /// Issue 14: a locator over only the triangles that can decide points of a region answers as the
+    /// whole-mesh one and as the winding number at many random points of that region, and the cost
+    /// bound from its pass bounds the whole-mesh locator's cost (the grid size depends on it).
+    #[test]
+    fn a_region_locator_agrees_with_the_winding_number() {
+        let solid = cone(500);
+        let whole = MeshLocator::new(&solid);
+        let region = ([0.1, -0.3, 0.05], [0.7, 0.6, 0.5]);
+        let (part, bound) = MeshLocator::within(&solid, &region).expect("fits");
+        assert!(part.triangles.len() < whole.triangles.len() / 2);
+        let exact = MeshLocator::whole_mesh_cost(&solid);
+        assert!(bound.is_some_and(|b| b >= exact), "{bound:?} < {exact}");
+        let mut seed = 14u64;
+        let mut unit = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut inside = 0;
+        for _ in 0..4000 {
+            let q = [0, 1, 2].map(|k| region.0[k] + (region.1[k] - region.0[k]) * unit());
+            let w = winding_number(&solid, q);
+            assert_eq!(part.contains(q), whole.contains(q), "{q:?}");
+            if w.abs() > 1e-6 && (w - 1.0).abs() > 1e-6 {
+                continue; // on the surface
+            }
+            assert_eq!(part.contains(q), w > 0.5, "{q:?}");
+            inside += usize::from(w > 0.5);
+        }
+        assert!(inside > 400, "{inside}");
     }
 
     #[test]
