@@ -14,6 +14,7 @@
 //! * `end-to-end`: read + heal, what `urdf-inertia mesh` does after the file is in memory.
 
 // The allocator of the `urdf-inertia` binary (see src/main.rs), so that timings are the binary's.
+#[cfg(feature = "mimalloc")]
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 

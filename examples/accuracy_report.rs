@@ -11,6 +11,7 @@
 //! Every error is against exact rational arithmetic on the stored mesh (tests/common's reference).
 
 // The allocator of the `urdf-inertia` binary (see src/main.rs), so that timings are the binary's.
+#[cfg(feature = "mimalloc")]
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 

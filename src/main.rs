@@ -13,6 +13,7 @@ mod cli;
 /// 37,400 and took 0.16–0.18 s instead of 0.19–0.22 s (15 runs each). Its transparent huge pages
 /// (cargo feature `no_thp` off) were faster still, 0.13 s with 237 faults, but a run now and then
 /// stalled in the kernel's page compaction (0.36 s, 0.25 s of it system time): predictable wins.
+#[cfg(feature = "mimalloc")]
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
