@@ -219,36 +219,14 @@ fn add_text(top: &mut El, piece: &[u8], pos: usize, bytes: &[u8]) {
 /// text: an invalid byte is never whitespace, and its word is no number either way); a short decimal
 /// is scanned where it stands, anything else is cut out and parsed by `str::parse`. go1's trunk.dae
 /// (28 MB, 2.6 M numbers): reading its geometry took 941 M instructions with `from_utf8_lossy`,
-/// `split_ascii_whitespace` and `str::parse`, 562 M so.
+/// `split_ascii_whitespace` and `str::parse`, 533 M so.
 fn each_number<'a>(
     el: &'a El,
     text: &'a [u8],
     path: &'a Path,
 ) -> impl Iterator<Item = Result<f64, MeshError>> + 'a {
-    let mut rest = text;
-    std::iter::from_fn(move || {
-        let start = rest.iter().position(|b| !b.is_ascii_whitespace())?;
-        rest = &rest[start..];
-        if let Some((x, n)) = short_decimal(rest) {
-            match rest.get(n) {
-                None => {
-                    rest = &[];
-                    return Some(Ok(x));
-                }
-                Some(b) if b.is_ascii_whitespace() => {
-                    rest = &rest[n..];
-                    return Some(Ok(x));
-                }
-                Some(_) => {}
-            }
-        }
-        let len = rest
-            .iter()
-            .position(u8::is_ascii_whitespace)
-            .unwrap_or(rest.len());
-        let (w, after) = rest.split_at(len);
-        rest = after;
-        Some(parse_f64_bytes(w).ok_or_else(|| {
+    Numbers { rest: text }.map(move |n| {
+        n.map_err(|w| {
             MeshError::new(
                 path,
                 Some(el.line),
@@ -258,8 +236,53 @@ fn each_number<'a>(
                     el.name
                 )),
             )
-        }))
+        })
     })
+}
+
+/// The words of a text as numbers, `Err` a word that is none (see [`each_number`]).
+struct Numbers<'a> {
+    rest: &'a [u8],
+}
+
+impl<'a> Iterator for Numbers<'a> {
+    type Item = Result<f64, &'a [u8]>;
+
+    #[inline]
+    fn next(&mut self) -> Option<Self::Item> {
+        let mut r = self.rest;
+        while let [b, tail @ ..] = r {
+            if !b.is_ascii_whitespace() {
+                break;
+            }
+            r = tail;
+        }
+        if r.is_empty() {
+            self.rest = r;
+            return None;
+        }
+        if let Some((x, n)) = short_decimal(r) {
+            match r.get(n) {
+                None => {
+                    self.rest = &[];
+                    return Some(Ok(x));
+                }
+                // The separator is passed over with the number.
+                Some(b) if b.is_ascii_whitespace() => {
+                    self.rest = &r[n + 1..];
+                    return Some(Ok(x));
+                }
+                Some(_) => {}
+            }
+        }
+        let len = r
+            .iter()
+            .position(u8::is_ascii_whitespace)
+            .unwrap_or(r.len());
+        let (w, after) = r.split_at(len);
+        self.rest = after;
+        Some(parse_f64_bytes(w).ok_or(w))
+    }
 }
 
 fn numbers(el: &El, bytes: &[u8], path: &Path) -> Result<Vec<f64>, MeshError> {

@@ -382,7 +382,8 @@ pub(crate) fn short_decimal(w: &[u8]) -> Option<(f64, usize)> {
 }
 
 /// Appends the leading decimal digits of `w` to `mantissa` (wrapping: a caller refuses more than 19
-/// digits) and returns how many there were.
+/// digits) and returns how many there were. (Four digits at a time by SWAR, as fast_float does eight,
+/// cost more on ERD's 5- and 6-digit indices: go1's trunk.dae 533 M -> 567 M instructions.)
 fn accumulate_digits(w: &[u8], mantissa: &mut u64) -> usize {
     let mut n = 0;
     for &d in w {
