@@ -245,7 +245,9 @@ pub fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
 }
 
 pub fn mat_vec(a: &Mat3, v: [f64; 3]) -> [f64; 3] {
-    [0, 1, 2].map(|i| a[i][0] * v[0] + a[i][1] * v[1] + a[i][2] * v[2])
+    // Written out: `[0, 1, 2].map(..)` was a call per vector in profiles (core::array::try_map).
+    let row = |r: &[f64; 3]| r[0] * v[0] + r[1] * v[1] + r[2] * v[2];
+    [row(&a[0]), row(&a[1]), row(&a[2])]
 }
 
 pub fn transpose(a: &Mat3) -> Mat3 {
