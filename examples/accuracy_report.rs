@@ -926,23 +926,18 @@ fn svg(points: &[(usize, f64, f64)]) -> String {
     s
 }
 
-/// A binary STL of the icosphere `level` (radius 0.1 m, moved off the origin as real parts are).
-/// The 1.3 M-face sphere of the whole-process measurement (icosphere level 9), as binary STL.
+/// The 1.3 M-face sphere of the whole-process measurement (icosphere `level` 9), as binary STL.
 fn pipeline_stl(level: u32) -> (Vec<u8>, usize) {
-    let (v, f) = icosphere(level);
-    let v: Vec<[f64; 3]> = v
-        .iter()
-        .map(|p| [0.1 * p[0] + 0.3, 0.1 * p[1] - 0.1, 0.1 * p[2] + 0.05])
-        .collect();
-    (
-        urdf_inertia::mesh::stl::write_binary(b"pipeline", &v, &f),
-        f.len(),
-    )
+    pipeline_bytes(icosphere(level))
 }
 
 /// A torus of 2k × k quads (4k² faces), 0.14 m across and away from the origin, as binary STL.
 fn pipeline_torus(k: u32) -> (Vec<u8>, usize) {
-    let (v, f) = common::wild::torus(1.0, 0.4, 2 * k, k);
+    pipeline_bytes(common::wild::torus(1.0, 0.4, 2 * k, k))
+}
+
+/// A mesh shrunk to a tenth and moved off the origin, as real parts are: binary STL bytes and faces.
+fn pipeline_bytes((v, f): Mesh) -> (Vec<u8>, usize) {
     let v: Vec<[f64; 3]> = v
         .iter()
         .map(|p| [0.1 * p[0] + 0.3, 0.1 * p[1] - 0.1, 0.1 * p[2] + 0.05])

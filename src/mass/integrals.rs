@@ -472,20 +472,15 @@ impl KernelLoop for TriangleLoop<'_> {
         let mut acc = Accumulator::new(self.options.summation);
         let mut batch = Batch::new();
         for t in self.triangles {
-            batch.push(
+            batch.add::<FMA>(
                 shifted[t[0] as usize],
                 shifted[t[1] as usize],
                 shifted[t[2] as usize],
+                &mut acc,
+                accurate,
             );
-            if batch.len == LANES {
-                acc.add_batch(&batch.terms::<FMA>(accurate), LANES);
-                batch.len = 0;
-            }
         }
-        if batch.len > 0 {
-            acc.add_batch(&batch.terms::<FMA>(accurate), batch.len);
-        }
-        acc.total()
+        batch.finish::<FMA>(acc, accurate)
     }
 }
 
@@ -518,6 +513,32 @@ impl Batch {
             self.p[2][k][l] = c[k];
         }
         self.len += 1;
+    }
+
+    /// Adds a triangle; a full batch goes into `acc`.
+    #[inline(always)]
+    fn add<const FMA: bool>(
+        &mut self,
+        a: [f64; 3],
+        b: [f64; 3],
+        c: [f64; 3],
+        acc: &mut Accumulator,
+        accurate: bool,
+    ) {
+        self.push(a, b, c);
+        if self.len == LANES {
+            acc.add_batch(&self.terms::<FMA>(accurate), LANES);
+            self.len = 0;
+        }
+    }
+
+    /// The sums, with the triangles still in the batch.
+    #[inline(always)]
+    fn finish<const FMA: bool>(&self, mut acc: Accumulator, accurate: bool) -> RawSums {
+        if self.len > 0 {
+            acc.add_batch(&self.terms::<FMA>(accurate), self.len);
+        }
+        acc.total()
     }
 
     /// [`accurate_triple`] for every lane, written lane-wise so that it vectorises: the same
@@ -890,17 +911,10 @@ impl<'f, I: Iterator<Item = &'f [u32]>> KernelLoop for FanLoop<'_, I> {
             for k in 1..face.len() - 1 {
                 let b = sub(vertices[face[k] as usize], reference);
                 let c = sub(vertices[face[k + 1] as usize], reference);
-                batch.push(a, b, c);
-                if batch.len == LANES {
-                    acc.add_batch(&batch.terms::<FMA>(accurate), LANES);
-                    batch.len = 0;
-                }
+                batch.add::<FMA>(a, b, c, &mut acc, accurate);
             }
         }
-        if batch.len > 0 {
-            acc.add_batch(&batch.terms::<FMA>(accurate), batch.len);
-        }
-        acc.total()
+        batch.finish::<FMA>(acc, accurate)
     }
 }
 
