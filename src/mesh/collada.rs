@@ -120,28 +120,6 @@ fn element(e: &quick_xml::events::BytesStart<'_>, line: usize) -> El {
     el
 }
 
-/// Line numbers of increasing byte positions, as [`crate::text::LineCounter`] gives them, with the
-/// newlines counted by memchr: the byte sum there takes 2.5 instructions a byte, 130 of the 707 M
-/// instructions go1's trunk.dae (28 MB) took to read.
-struct Lines<'a> {
-    bytes: &'a [u8],
-    pos: usize,
-    line: usize,
-}
-
-impl Lines<'_> {
-    /// The line (1-based) of byte offset `pos`.
-    fn at(&mut self, pos: usize) -> usize {
-        let pos = pos.min(self.bytes.len());
-        if pos < self.pos {
-            return line_of(self.bytes, pos);
-        }
-        self.line += memchr::memchr_iter(b'\n', &self.bytes[self.pos..pos]).count();
-        self.pos = pos;
-        self.line
-    }
-}
-
 /// Reads the document into a tree of elements, with each element's text kept as a span of the file
 /// where it can be.
 fn parse_tree(bytes: &[u8], path: &Path) -> Result<El, MeshError> {
@@ -151,11 +129,7 @@ fn parse_tree(bytes: &[u8], path: &Path) -> Result<El, MeshError> {
         name: "#document".into(),
         ..Default::default()
     }];
-    let mut lines = Lines {
-        bytes,
-        pos: 0,
-        line: 1,
-    };
+    let mut lines = crate::text::LineCounter::new(bytes);
     let syntax = |pos: usize, msg: String| {
         MeshError::new(path, Some(line_of(bytes, pos)), MeshErrorKind::Syntax(msg))
     };
@@ -611,16 +585,15 @@ fn read_triangles(
     let Some(p) = prim.child("p") else {
         return Ok(());
     };
-    // One triangle's numbers at a time; only each corner's VERTEX index is kept, and a
-    // trailing incomplete triangle is ignored.
-    // As many triangles as `count` says, if `<p>` can hold that many numbers.
+    // Room for as many triangles as `count` says, if `<p>` can hold that many numbers.
     let text = p.raw_text(bytes);
     let count = prim.attr("count").and_then(|c| c.parse::<usize>().ok());
     let room = text.len().div_ceil(2) / (3 * input.stride);
     faces.indices.reserve(3 * count.unwrap_or(0).min(room));
     faces.starts.reserve(count.unwrap_or(0).min(room));
     // Where in the triangle a number falls: its corner, and its input within the corner (counted,
-    // not divided out).
+    // not divided out). Only each corner's VERTEX index is kept; a trailing incomplete triangle is
+    // ignored.
     let mut corner = [0.0; 3];
     let (mut at, mut slot) = (0usize, 0usize);
     for x in each_number(p, text, path) {

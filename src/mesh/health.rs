@@ -763,8 +763,10 @@ impl<'a> Ladder<'a> {
             Some(t) => MassProperties::from_integrals(&t, 1.0),
             None => unit_props(&vertices, &faces, None),
         };
-        check_volume(&vertices, &faces, unit.mass, self.path)?;
-        let round_off = round_off(&vertices, &faces, &unit);
+        // One pass for the box both checks use.
+        let bounds = bbox(&vertices);
+        check_volume(&vertices, &faces, bounds, unit.mass, self.path)?;
+        let round_off = round_off(&vertices, &faces, bounds.0, &unit);
         let model = model.into();
         let source = model.source;
         let bound = model.bound(&unit, &vertices);
@@ -1516,8 +1518,7 @@ fn bbox(vertices: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
 
 /// The round-off estimate: the relative disagreement of volume and central inertia integrated about
 /// two reference points (bounding-box centre and corner), never below [`ROUND_OFF_FLOOR`].
-fn round_off(vertices: &[[f64; 3]], faces: &Polygons, base: &MassProperties) -> f64 {
-    let (lo, _) = bbox(vertices);
+fn round_off(vertices: &[[f64; 3]], faces: &Polygons, lo: [f64; 3], base: &MassProperties) -> f64 {
     let other = unit_props(vertices, faces, Some(lo));
     let mut d = [[0.0; 3]; 3];
     for i in 0..3 {
@@ -1541,10 +1542,10 @@ fn round_off(vertices: &[[f64; 3]], faces: &Polygons, base: &MassProperties) -> 
 fn check_volume(
     vertices: &[[f64; 3]],
     faces: &Polygons,
+    (lo, hi): ([f64; 3], [f64; 3]),
     volume: f64,
     path: &Path,
 ) -> Result<(), MeshError> {
-    let (lo, hi) = bbox(vertices);
     let area: f64 = faces.iter().map(|f| polygon_area(vertices, f)).sum();
     let floor = ZERO_VOLUME_ROUNDOFFS * f64::EPSILON * area * dist(lo, hi);
     if volume.is_nan() || volume <= floor {
