@@ -463,7 +463,6 @@ fn geometry_part(link: &Link, c: &Collision, ctx: &mut Context<'_>) -> Result<Pa
 /// What every stage of a robot's computation reads.
 struct Context<'a> {
     robot: &'a Robot,
-    map: &'a DensityMap,
     resolver: &'a PackageResolver,
     opts: &'a FillOptions,
     cache: &'a mut MeshCache,
@@ -494,7 +493,6 @@ pub fn compute_with(
     let (load0, integrate0, files0) = (cache.load_time, cache.integrate_time, cache.files());
     let mut ctx = Context {
         robot,
-        map,
         resolver,
         opts,
         cache,
@@ -504,6 +502,10 @@ pub fn compute_with(
     let mut missing_density: Vec<(String, usize)> = Vec::new();
     // Links whose mass follows from densities (scaled by total_mass), as indices into report.links.
     let mut density_links: Vec<usize> = Vec::new();
+    // Each selected link's parts, in order (they come from the cache, so this is serial and cheap);
+    // then the links' densities, bodies and overlap estimates in parallel (the estimate is most of a
+    // link's time, and one link's parts alone rarely fill the cores); then the report, in order.
+    let mut gathered: Vec<(usize, &Link, Result<Vec<Part>, LinkError>)> = Vec::new();
     for (li, link) in robot.links.iter().enumerate() {
         // Links without collision geometry, or whose only parts are zero-size primitives, are left as
         // they are (the scan notes the latter).
@@ -515,7 +517,20 @@ pub fn compute_with(
             report.not_selected += 1;
             continue;
         }
-        match compute_link(li, link, &mut ctx) {
+        gathered.push((li, link, link_parts(link, &mut ctx)));
+    }
+    let computed: Vec<_> = {
+        use rayon::prelude::*;
+        gathered
+            .into_par_iter()
+            .map(|(li, link, parts)| {
+                let result = parts.and_then(|parts| compute_link(li, link, parts, map, opts));
+                (link, result)
+            })
+            .collect()
+    };
+    for (link, result) in computed {
+        match result {
             Ok(Some((l, density_based))) => {
                 if density_based {
                     density_links.push(report.links.len());
@@ -577,21 +592,26 @@ struct ComputedLink {
     faces: usize,
 }
 
+/// A link's parts (its collisions but the zero-size ones), or the first that fails.
+fn link_parts(link: &Link, ctx: &mut Context<'_>) -> Result<Vec<Part>, LinkError> {
+    link.collisions
+        .iter()
+        .filter(|c| !c.geometry.is_zero_size())
+        .map(|c| geometry_part(link, c, ctx))
+        .collect()
+}
+
 /// One link: its parts, their densities, the body, the overlap estimate. `Ok(None)` when the link has
 /// no density from anywhere (reported for all such links at once); the flag says whether the link's
 /// mass follows from densities alone (what `total_mass` scales).
 fn compute_link(
     index: usize,
     link: &Link,
-    ctx: &mut Context<'_>,
+    mut parts: Vec<Part>,
+    map: &DensityMap,
+    opts: &FillOptions,
 ) -> Result<Option<(ComputedLink, bool)>, LinkError> {
-    let mut parts = link
-        .collisions
-        .iter()
-        .filter(|c| !c.geometry.is_zero_size())
-        .map(|c| geometry_part(link, c, ctx))
-        .collect::<Result<Vec<Part>, LinkError>>()?;
-    let Some(densities) = densities(link, &parts, ctx.map, ctx.opts)? else {
+    let Some(densities) = densities(link, &parts, map, opts)? else {
         return Ok(None);
     };
     let (computed, part_reports) = body(&parts, &densities);
