@@ -463,6 +463,7 @@ fn geometry_part(link: &Link, c: &Collision, ctx: &mut Context<'_>) -> Result<Pa
 /// What every stage of a robot's computation reads.
 struct Context<'a> {
     robot: &'a Robot,
+    map: &'a DensityMap,
     resolver: &'a PackageResolver,
     opts: &'a FillOptions,
     cache: &'a mut MeshCache,
@@ -493,6 +494,7 @@ pub fn compute_with(
     let (load0, integrate0, files0) = (cache.load_time, cache.integrate_time, cache.files());
     let mut ctx = Context {
         robot,
+        map,
         resolver,
         opts,
         cache,
@@ -502,34 +504,7 @@ pub fn compute_with(
     let mut missing_density: Vec<(String, usize)> = Vec::new();
     // Links whose mass follows from densities (scaled by total_mass), as indices into report.links.
     let mut density_links: Vec<usize> = Vec::new();
-    // Each selected link's parts, in order (they come from the cache, so this is serial and cheap);
-    // then the links' densities, bodies and overlap estimates in parallel (the estimate is most of a
-    // link's time, and one link's parts alone rarely fill the cores); then the report, in order.
-    let mut gathered: Vec<(usize, &Link, Result<Vec<Part>, LinkError>)> = Vec::new();
-    for (li, link) in robot.links.iter().enumerate() {
-        // Links without collision geometry, or whose only parts are zero-size primitives, are left as
-        // they are (the scan notes the latter).
-        if !link.has_collision_geometry() {
-            report.without_geometry += 1;
-            continue;
-        }
-        if !is_target(link, opts) {
-            report.not_selected += 1;
-            continue;
-        }
-        gathered.push((li, link, link_parts(link, &mut ctx)));
-    }
-    let computed: Vec<_> = {
-        use rayon::prelude::*;
-        gathered
-            .into_par_iter()
-            .map(|(li, link, parts)| {
-                let result = parts.and_then(|parts| compute_link(li, link, parts, map, opts));
-                (link, result)
-            })
-            .collect()
-    };
-    for (link, result) in computed {
+    for (link, result) in compute_links(&mut ctx, &mut report) {
         match result {
             Ok(Some((l, density_based))) => {
                 if density_based {
@@ -558,6 +533,43 @@ pub fn compute_with(
         integrate: ctx.cache.integrate_time.saturating_sub(integrate0),
     };
     report
+}
+
+/// A link's result: computed (with whether its mass follows from densities alone), without a density
+/// (`None`), or failed.
+type LinkResult = Result<Option<(ComputedLink, bool)>, LinkError>;
+
+/// Every selected link computed, in link order; counts the links left alone into `report`. Each
+/// selected link's parts are gathered in order (they come from the cache, so this is serial and
+/// cheap); then the links' densities, bodies and overlap estimates run in parallel (the estimate is
+/// most of a link's time, and one link's parts alone rarely fill the cores).
+fn compute_links<'r>(
+    ctx: &mut Context<'r>,
+    report: &mut FillReport,
+) -> Vec<(&'r Link, LinkResult)> {
+    let (robot, map, opts) = (ctx.robot, ctx.map, ctx.opts);
+    let mut gathered = Vec::new();
+    for (li, link) in robot.links.iter().enumerate() {
+        // Links without collision geometry, or whose only parts are zero-size primitives, are left as
+        // they are (the scan notes the latter).
+        if !link.has_collision_geometry() {
+            report.without_geometry += 1;
+            continue;
+        }
+        if !is_target(link, opts) {
+            report.not_selected += 1;
+            continue;
+        }
+        gathered.push((li, link, link_parts(link, ctx)));
+    }
+    use rayon::prelude::*;
+    gathered
+        .into_par_iter()
+        .map(|(li, link, parts)| {
+            let result = parts.and_then(|parts| compute_link(li, link, parts, map, opts));
+            (link, result)
+        })
+        .collect()
 }
 
 /// Every mesh the selected links need, read and healed in parallel up front (a path that does not

@@ -970,6 +970,68 @@ fn diff_names_origin_and_mirror_mistakes() {
 
 /// Regression: `-i` on a symlinked URDF once replaced the link with a regular file.
 #[cfg(unix)]
+/// What a pre-commit fixing hook runs: several URDFs in place in one process. Each file ends as a
+/// fill of it alone would leave it; a file that cannot be read fails alone (exit 2), the rest are
+/// written; without -i, or with --format json, several files are refused before anything is read.
+#[test]
+fn several_urdfs_fill_in_place_in_one_process() {
+    let (_tmp, urdf, map) = demo_copy();
+    let (_tmp2, alone, _) = demo_copy();
+    let second = urdf.with_file_name("second.urdf");
+    std::fs::copy(&urdf, &second).unwrap();
+    let original = std::fs::read(&urdf).unwrap();
+    let out = run(&[
+        "fill",
+        alone.to_str().unwrap(),
+        "--density-map",
+        map.to_str().unwrap(),
+        "-i",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let want = std::fs::read(&alone).unwrap();
+    for extra in [None, Some("/nonexistent/robot.urdf")] {
+        std::fs::write(&urdf, &original).unwrap();
+        std::fs::write(&second, &original).unwrap();
+        let mut args = vec!["fill", urdf.to_str().unwrap(), second.to_str().unwrap()];
+        args.extend(extra);
+        args.extend(["--density-map", map.to_str().unwrap(), "-i"]);
+        let out = run(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(
+            out.status.code(),
+            Some(if extra.is_some() { 2 } else { 0 }),
+            "{stderr}"
+        );
+        assert_eq!(std::fs::read(&urdf).unwrap(), want);
+        assert_eq!(std::fs::read(&second).unwrap(), want);
+        // Each summary names its file.
+        assert!(
+            stderr.contains(&format!(
+                "urdf-inertia: {}: robot `demo_arm`: filled 6 link(s)",
+                second.display()
+            )),
+            "{stderr}"
+        );
+    }
+    for refused in [
+        vec!["--density", "1000"],
+        vec!["--density", "1000", "-i", "--format", "json"],
+    ] {
+        std::fs::write(&urdf, &original).unwrap();
+        let mut args = vec!["fill", urdf.to_str().unwrap(), second.to_str().unwrap()];
+        args.extend(refused);
+        let out = run(&args);
+        assert_eq!(out.status.code(), Some(2));
+        assert!(String::from_utf8_lossy(&out.stderr).starts_with("error: "));
+        assert!(out.stdout.is_empty());
+        assert_eq!(std::fs::read(&urdf).unwrap(), original);
+    }
+}
+
 #[test]
 fn in_place_through_a_symlink_keeps_the_link() {
     let (_tmp, urdf, map) = demo_copy();

@@ -62,8 +62,10 @@ pub struct SourceArgs {
 
 #[derive(Debug, Clone, ClapArgs)]
 pub struct FillArgs {
-    /// The URDF to fill.
-    pub urdf: PathBuf,
+    /// The URDF to fill; several with -i (what a pre-commit hook passes: one process, each mesh read
+    /// once).
+    #[arg(required = true)]
+    pub urdf: Vec<PathBuf>,
     #[command(flatten)]
     pub source: SourceArgs,
     /// Write the result to this file instead of stdout (`-` is stdout; devices and FIFOs are written

@@ -81,8 +81,12 @@ fn validated_tolerance(tolerance: f64) -> Result<f64, String> {
 
 /// Where and how `fill` writes.
 pub struct WriteConfig {
-    /// `None`: stdout.
+    /// `-o OUT` (`None`: stdout, unless in place).
     target: Option<PathBuf>,
+    /// `-i`: each URDF is its own target.
+    in_place: bool,
+    /// Several URDFs (in place): each summary names its file.
+    several: bool,
     keep_going: bool,
     digits: Digits,
     principal: bool,
@@ -115,15 +119,24 @@ impl Config {
         if a.format == Format::Json && to_stdout {
             return Err("--format json prints the summary on stdout, where the URDF goes without -o OUT or -i".into());
         }
+        if a.urdf.len() > 1 && !a.in_place {
+            return Err(format!(
+                "{} URDFs given: several are filled in place only (-i); stdout and -o OUT take one",
+                a.urdf.len()
+            ));
+        }
+        if a.urdf.len() > 1 && a.format == Format::Json {
+            return Err(
+                "--format json summarises one URDF: fill several without it, or one at a time"
+                    .into(),
+            );
+        }
         let mut src = sources_with_densities(&a.source, "fill")?;
         src.options.missing_only = a.missing_only;
-        let target = if a.in_place {
-            Some(a.urdf.clone())
-        } else {
-            a.output.clone().filter(|p| p.as_os_str() != "-")
-        };
         let write = WriteConfig {
-            target,
+            target: a.output.clone().filter(|p| p.as_os_str() != "-"),
+            in_place: a.in_place,
+            several: a.urdf.len() > 1,
             keep_going: a.keep_going,
             digits: a.digits,
             principal: a.principal,
@@ -131,7 +144,7 @@ impl Config {
         };
         Ok(Config {
             mode: Mode::Write(write),
-            files: vec![a.urdf.clone()],
+            files: a.urdf.clone(),
             src,
             tolerance: 0.05,
             verbose: a.verbose,
@@ -314,10 +327,12 @@ fn write_robot(
 ) -> Result<(), ExitStatus> {
     let t_write = Instant::now();
     let text = spliced(robot, report, w)?;
-    let where_to = w
-        .target
-        .as_ref()
-        .map_or_else(|| "stdout".to_string(), |p| p.display().to_string());
+    let file = if w.in_place {
+        Some(robot.path.as_path())
+    } else {
+        w.target.as_deref()
+    };
+    let where_to = file.map_or_else(|| "stdout".to_string(), |p| p.display().to_string());
     let failed = report.error_count();
     if failed > 0 && !w.keep_going {
         errln!(
@@ -325,15 +340,15 @@ fn write_robot(
         );
         return Err(ExitStatus::Error);
     }
-    let target = w.target.as_deref().unwrap_or(Path::new("-"));
+    let target = file.unwrap_or(Path::new("-"));
     if let Err(e) = write::write_output(target, &text) {
         // A failing stdout was reported where it failed.
-        if w.target.is_some() {
+        if file.is_some() {
             errln!("error: {e}");
         }
         return Err(ExitStatus::Error);
     }
-    if w.target.is_some() {
+    if file.is_some() {
         super::output::stdout_is_summary();
     }
     let times = summary::Times {
@@ -341,10 +356,10 @@ fn write_robot(
         write: t_write.elapsed().as_secs_f64(),
     };
     let run = run_diagnostics(robot, report);
-    if w.json && w.target.is_some() {
+    if w.json && file.is_some() {
         summary::fill_json(robot, report, &run, w.digits, times.seconds);
     } else {
-        summary::fill_text(robot, report, &run, verbose, times);
+        summary::fill_text(robot, report, &run, verbose, times, w.several);
     }
     Ok(())
 }

@@ -60,11 +60,23 @@ fn link_lines(l: &LinkReport, verbose: bool) -> Vec<String> {
     out
 }
 
-/// The text summary of `fill` on stderr.
-pub fn fill_text(robot: &Robot, report: &FillReport, run: &[Diagnostic], verbose: bool, t: Times) {
+/// The text summary of `fill` on stderr; `name_file` when several URDFs were filled.
+pub fn fill_text(
+    robot: &Robot,
+    report: &FillReport,
+    run: &[Diagnostic],
+    verbose: bool,
+    t: Times,
+    name_file: bool,
+) {
     let parts: usize = report.links.iter().map(|l| l.parts.len()).sum();
+    let file = if name_file {
+        format!("{}: ", robot.path.display())
+    } else {
+        String::new()
+    };
     errln!(
-        "urdf-inertia: robot `{}`: filled {} link(s) ({} parts, {} mesh files, {} faces) in {:.3} s (CPU time over all cores: mesh loading {:.3} s, healing and integration {:.3} s; writing {:.3} s)",
+        "urdf-inertia: {file}robot `{}`: filled {} link(s) ({} parts, {} mesh files, {} faces) in {:.3} s (CPU time over all cores: mesh loading {:.3} s, healing and integration {:.3} s; writing {:.3} s)",
         robot.name,
         report.links.len(),
         parts,
