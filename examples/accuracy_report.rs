@@ -724,9 +724,10 @@ fn corpus(md: &mut String, share: &std::path::Path) {
     trimesh_filler(md, share, &urdfs);
 }
 
-/// The whole corpus filled by `urdf-inertia fill`, one process per URDF as a user runs it, against
-/// validation/trimesh_fill.py (one Python process for all URDFs, so trimesh's import is paid once), in
-/// the same run; only with `PEERS_PYTHON` set (it needs trimesh, pinned in
+/// The whole corpus filled by `urdf-inertia fill`, one process per URDF as a user runs it and one
+/// process for all (`fill -i` of copies, one mesh cache), against validation/trimesh_fill.py (one
+/// Python process for all URDFs, so trimesh's import is paid once; a fresh mesh cache per URDF, and
+/// one shared cache), in the same run; only with `PEERS_PYTHON` set (it needs trimesh, pinned in
 /// validation/trimesh-requirements.txt).
 fn trimesh_filler(md: &mut String, share: &std::path::Path, urdfs: &[std::path::PathBuf]) {
     let Ok(python) = std::env::var("PEERS_PYTHON") else {
@@ -744,65 +745,138 @@ fn trimesh_filler(md: &mut String, share: &std::path::Path, urdfs: &[std::path::
         .ok();
         return;
     };
-    let out = std::env::temp_dir().join(format!("urdf-inertia-erd-{}.urdf", std::process::id()));
     let package = format!(
         "example-robot-data={}",
         share.join("example-robot-data").display()
     );
-    let ours_once = || {
-        let t0 = Instant::now();
-        let failed = urdfs
-            .iter()
-            .filter(|u| {
-                let status = std::process::Command::new(&exe)
-                    .arg("fill")
-                    .arg(u)
-                    .args(["--density", "1000", "--package-path", &package, "-o"])
-                    .arg(&out)
-                    .stderr(std::process::Stdio::null())
-                    .status();
-                !status.is_ok_and(|s| s.success())
-            })
-            .count();
-        (t0.elapsed().as_secs_f64(), failed)
-    };
-    let mut ours: Vec<(f64, usize)> = (0..3).map(|_| ours_once()).collect();
-    ours.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let (ours_s, ours_failed) = ours[1];
-    let _ = std::fs::remove_file(&out);
-    let t0 = Instant::now();
-    let run = std::process::Command::new(&python)
-        .arg("validation/trimesh_fill.py")
-        .arg("--share")
-        .arg(share)
-        .output();
-    let wall = t0.elapsed().as_secs_f64();
-    let parsed = run
-        .ok()
-        .filter(|o| o.status.success())
-        .and_then(|o| serde_json::from_slice::<serde_json::Value>(&o.stdout).ok());
-    let Some(json) = parsed else {
+    let (per_process, per_failed) = median_of_3(|| ours_per_process(&exe, &package, urdfs));
+    let (one_process, one_failed) = median_of_3(|| ours_one_process(&exe, &package, urdfs));
+    let (Some(fresh), Some(shared)) = (
+        trimesh_run(&python, share, false),
+        trimesh_run(&python, share, true),
+    ) else {
         writeln!(md, "\nThe trimesh filler (validation/trimesh_fill.py) did not run with `{python}`: it needs trimesh (validation/trimesh-requirements.txt).").ok();
         return;
     };
-    let inner = json["seconds"].as_f64().unwrap_or(f64::NAN);
-    let failures = json["failures"].as_array().map_or(0, Vec::len);
     writeln!(md, "\n### The whole corpus against a trimesh filler\n").ok();
-    writeln!(md, "All {} URDFs filled at 1000 kg/m³, same machine, same run. Ours: `urdf-inertia fill` once per URDF (a new process each, as a user runs it; median of 3 passes). trimesh {}: validation/trimesh_fill.py, which parses each URDF, loads every collision mesh with its scale and origin (`trimesh.load`), takes the primitives analytically, sums the parts per link and writes the inertials, with no mesh healing; one Python process for all URDFs, so its imports are paid once.\n", urdfs.len(), json["trimesh"].as_str().unwrap_or("?")).ok();
+    writeln!(md, "All {} URDFs filled at 1000 kg/m³, same machine, same run. Ours: `urdf-inertia fill` once per URDF (a new process each, as a user runs it, each with its own mesh cache), and `urdf-inertia fill -i` of copies of all of them in one process (as a pre-commit hook passes files; one mesh cache), medians of 3 passes. trimesh {}: validation/trimesh_fill.py, which parses each URDF, loads every collision mesh with its scale and origin (`trimesh.load`), takes the primitives analytically, sums the parts per link and writes the inertials, with no mesh healing; one Python process for all URDFs, so its imports are paid once, with a fresh mesh cache per URDF and (`--shared-cache`) with one cache for all.\n", urdfs.len(), fresh.3).ok();
     writeln!(md, "| filler | whole corpus s | failed |\n|---|---|---|").ok();
+    let n = urdfs.len();
     writeln!(
         md,
-        "| urdf-inertia fill, {} processes | {ours_s:.2} | {ours_failed} URDFs |",
-        urdfs.len()
+        "| urdf-inertia fill, {n} processes | {per_process:.2} | {per_failed} URDFs |"
     )
     .ok();
-    writeln!(md, "| trimesh filler, one process (its own clock, imports excluded) | {inner:.2} | {failures} parts or URDFs |").ok();
+    writeln!(md, "| trimesh filler, fresh cache per URDF (its own clock, imports excluded) | {:.2} | {} parts or URDFs |", fresh.0, fresh.2).ok();
     writeln!(
         md,
-        "| trimesh filler, one process (wall, imports included) | {wall:.2} | |"
+        "| trimesh filler, fresh cache per URDF (wall, imports included) | {:.2} | |",
+        fresh.1
     )
     .ok();
-    writeln!(md, "\nurdf-inertia is {:.0}× faster than the trimesh filler's own clock ({:.0}× against its whole process).", inner / ours_s, wall / ours_s).ok();
+    writeln!(
+        md,
+        "| urdf-inertia fill -i, one process for all {n} | {one_process:.2} | exit {one_failed} |"
+    )
+    .ok();
+    writeln!(md, "| trimesh filler, one cache (its own clock, imports excluded) | {:.2} | {} parts or URDFs |", shared.0, shared.2).ok();
+    writeln!(
+        md,
+        "| trimesh filler, one cache (wall, imports included) | {:.2} | |",
+        shared.1
+    )
+    .ok();
+    writeln!(md, "\nA process per URDF: urdf-inertia is {:.0}× faster than the trimesh filler's own clock ({:.0}× against its whole process). One process with one cache: {:.0}× ({:.0}×).", fresh.0 / per_process, fresh.1 / per_process, shared.0 / one_process, shared.1 / one_process).ok();
+}
+
+/// The median by time of three runs of `f` (seconds, and what failed).
+fn median_of_3(f: impl Fn() -> (f64, usize)) -> (f64, usize) {
+    let mut runs: Vec<(f64, usize)> = (0..3).map(|_| f()).collect();
+    runs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    runs[1]
+}
+
+/// `urdf-inertia fill` once per URDF: seconds, and the URDFs that failed.
+fn ours_per_process(
+    exe: &std::path::Path,
+    package: &str,
+    urdfs: &[std::path::PathBuf],
+) -> (f64, usize) {
+    let out = std::env::temp_dir().join(format!("urdf-inertia-erd-{}.urdf", std::process::id()));
+    let t0 = Instant::now();
+    let failed = urdfs
+        .iter()
+        .filter(|u| {
+            let status = std::process::Command::new(exe)
+                .arg("fill")
+                .arg(u)
+                .args(["--density", "1000", "--package-path", package, "-o"])
+                .arg(&out)
+                .stderr(std::process::Stdio::null())
+                .status();
+            !status.is_ok_and(|s| s.success())
+        })
+        .count();
+    let seconds = t0.elapsed().as_secs_f64();
+    let _ = std::fs::remove_file(&out);
+    (seconds, failed)
+}
+
+/// `urdf-inertia fill -i` of fresh copies of all URDFs in one process: seconds (the copying not
+/// counted), and the exit code (0 when every URDF was filled).
+fn ours_one_process(
+    exe: &std::path::Path,
+    package: &str,
+    urdfs: &[std::path::PathBuf],
+) -> (f64, usize) {
+    let dir = std::env::temp_dir().join(format!("urdf-inertia-erd-{}", std::process::id()));
+    let _ = std::fs::create_dir_all(&dir);
+    let copies: Vec<std::path::PathBuf> = urdfs
+        .iter()
+        .enumerate()
+        .map(|(i, u)| {
+            let copy = dir.join(format!("{i:02}.urdf"));
+            let _ = std::fs::copy(u, &copy);
+            copy
+        })
+        .collect();
+    let t0 = Instant::now();
+    let status = std::process::Command::new(exe)
+        .arg("fill")
+        .args(&copies)
+        .args(["--density", "1000", "--package-path", package, "-i"])
+        .stderr(std::process::Stdio::null())
+        .status();
+    let seconds = t0.elapsed().as_secs_f64();
+    let _ = std::fs::remove_dir_all(&dir);
+    let code = status.ok().and_then(|s| s.code()).unwrap_or(-1);
+    (seconds, usize::try_from(code).unwrap_or(usize::MAX))
+}
+
+/// validation/trimesh_fill.py on the whole corpus: its own seconds, the wall seconds, its failures
+/// and trimesh's version.
+fn trimesh_run(
+    python: &str,
+    share: &std::path::Path,
+    shared_cache: bool,
+) -> Option<(f64, f64, usize, String)> {
+    let t0 = Instant::now();
+    let mut cmd = std::process::Command::new(python);
+    cmd.arg("validation/trimesh_fill.py")
+        .arg("--share")
+        .arg(share);
+    if shared_cache {
+        cmd.arg("--shared-cache");
+    }
+    let run = cmd.output().ok().filter(|o| o.status.success())?;
+    let wall = t0.elapsed().as_secs_f64();
+    let json = serde_json::from_slice::<serde_json::Value>(&run.stdout).ok()?;
+    Some((
+        json["seconds"].as_f64().unwrap_or(f64::NAN),
+        wall,
+        json["failures"].as_array().map_or(0, Vec::len),
+        json["trimesh"].as_str().unwrap_or("?").to_string(),
+    ))
 }
 
 type PeerResults = std::collections::HashMap<(usize, String), Result<([[f64; 3]; 3], f64), String>>;

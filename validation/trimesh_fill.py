@@ -8,10 +8,11 @@ volume, centre of mass and inertia of each part at the density, sum them per lin
 write the link's `<inertial>`. It does not heal meshes (no welding of cracks, caps or hulls): open or
 inward-wound meshes give whatever trimesh's signed integrals give.
 
-Usage: trimesh_fill.py --share SHARE [--density 1000] [--out DIR] [URDF ...]
+Usage: trimesh_fill.py --share SHARE [--density 1000] [--out DIR] [--shared-cache] [URDF ...]
   SHARE is the `cmeel.prefix/share` directory of example-robot-data; without URDFs, every `.urdf` under
   SHARE/example-robot-data/robots is filled. Each URDF gets a fresh mesh cache (as one `urdf-inertia fill`
-  process per URDF has), in one Python process (imports paid once). Prints JSON: seconds for all URDFs
+  process per URDF has), or with --shared-cache one cache for all (as one `urdf-inertia fill -i` of all
+  URDFs has), in one Python process (imports paid once). Prints JSON: seconds for all URDFs
   (parsing, loading, mass properties, writing), counts and failures.
 Pinned in validation/trimesh-requirements.txt.
 """
@@ -120,9 +121,8 @@ def link_body(link, urdf, share, density, cache, failures):
     return mass, com, inertia
 
 
-def fill(urdf, share, density, out, failures):
+def fill(urdf, share, density, out, failures, cache):
     tree = ET.parse(urdf)
-    cache = {}
     links = 0
     for link in tree.getroot().findall("link"):
         body = link_body(link, urdf, share, density, cache, failures)
@@ -149,6 +149,8 @@ def main():
     ap.add_argument("--share", type=Path, required=True)
     ap.add_argument("--density", type=float, default=1000.0)
     ap.add_argument("--out", type=Path)
+    ap.add_argument("--shared-cache", action="store_true",
+                    help="one mesh cache for all URDFs (as `urdf-inertia fill -i a.urdf b.urdf ...` has)")
     ap.add_argument("urdfs", nargs="*", type=Path)
     args = ap.parse_args()
     urdfs = args.urdfs or sorted((args.share / "example-robot-data" / "robots").rglob("*.urdf"))
@@ -157,14 +159,18 @@ def main():
     failures = []
     links = meshes = 0
     t0 = time.perf_counter()
+    shared = {}
     for urdf in urdfs:
         try:
-            n, files = fill(urdf, args.share, args.density, args.out, failures)
+            cache = shared if args.shared_cache else {}
+            n, files = fill(urdf, args.share, args.density, args.out, failures, cache)
             links += n
             meshes += files
         except Exception as e:  # noqa: BLE001 - a URDF that does not parse is reported
             failures.append(f"{urdf.name}: {type(e).__name__}: {e}")
     seconds = time.perf_counter() - t0
+    if args.shared_cache:
+        meshes = len([k for k in shared if isinstance(k, Path)])
     json.dump({"seconds": seconds, "urdfs": len(urdfs), "links": links, "mesh_files": meshes,
                "trimesh": trimesh.__version__, "failures": failures}, sys.stdout)
     print()
