@@ -42,6 +42,22 @@ fn demo_copy() -> (tempfile::TempDir, PathBuf, PathBuf) {
     (tmp, urdf, map)
 }
 
+/// `fill URDF --density-map MAP -i`, which must succeed.
+fn fill_in_place(urdf: &Path, map: &Path) {
+    let out = run(&[
+        "fill",
+        urdf.to_str().unwrap(),
+        "--density-map",
+        map.to_str().unwrap(),
+        "-i",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// Parsed `<inertial>` of one link from URDF text: (mass, com, [ixx, ixy, ixz, iyy, iyz, izz]).
 fn inertial_of(text: &str, link: &str) -> Option<(f64, [f64; 3], [f64; 6])> {
     let start = text.find(&format!("<link name=\"{link}\""))?;
@@ -277,18 +293,7 @@ fn strip_inertials(text: &str) -> String {
 fn only_inertials_change_and_fill_is_idempotent() {
     let (_tmp, urdf, map) = demo_copy();
     let original = std::fs::read_to_string(&urdf).expect("read");
-    let out = run(&[
-        "fill",
-        urdf.to_str().unwrap(),
-        "--density-map",
-        map.to_str().unwrap(),
-        "-i",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    fill_in_place(&urdf, &map);
     let once = std::fs::read_to_string(&urdf).expect("read");
     // Outside <inertial>, every byte is the same (the original's one stale block is removed on both sides).
     assert_eq!(strip_inertials(&once), strip_inertials(&original));
@@ -980,18 +985,7 @@ fn several_urdfs_fill_in_place_in_one_process() {
     let second = urdf.with_file_name("second.urdf");
     std::fs::copy(&urdf, &second).unwrap();
     let original = std::fs::read(&urdf).unwrap();
-    let out = run(&[
-        "fill",
-        alone.to_str().unwrap(),
-        "--density-map",
-        map.to_str().unwrap(),
-        "-i",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    fill_in_place(&alone, &map);
     let want = std::fs::read(&alone).unwrap();
     for extra in [None, Some("/nonexistent/robot.urdf")] {
         std::fs::write(&urdf, &original).unwrap();
@@ -1037,18 +1031,7 @@ fn in_place_through_a_symlink_keeps_the_link() {
     let (_tmp, urdf, map) = demo_copy();
     let link = urdf.with_file_name("linked.urdf");
     std::os::unix::fs::symlink(&urdf, &link).unwrap();
-    let out = run(&[
-        "fill",
-        link.to_str().unwrap(),
-        "--density-map",
-        map.to_str().unwrap(),
-        "-i",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    fill_in_place(&link, &map);
     assert!(std::fs::symlink_metadata(&link)
         .unwrap()
         .file_type()
