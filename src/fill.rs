@@ -562,14 +562,17 @@ fn compute_links<'r>(
         }
         gathered.push((li, link, link_parts(link, ctx)));
     }
+    let compute = |(li, link, parts): (usize, &'r Link, Result<Vec<Part>, LinkError>)| {
+        let result = parts.and_then(|parts| compute_link(li, link, parts, map, opts));
+        (link, result)
+    };
+    // One link (or none) runs here: rayon's first use starts its pool, a fixed cost per process
+    // (see `cache::in_order_of_need`).
+    if gathered.len() <= 1 {
+        return gathered.into_iter().map(compute).collect();
+    }
     use rayon::prelude::*;
-    gathered
-        .into_par_iter()
-        .map(|(li, link, parts)| {
-            let result = parts.and_then(|parts| compute_link(li, link, parts, map, opts));
-            (link, result)
-        })
-        .collect()
+    gathered.into_par_iter().map(compute).collect()
 }
 
 /// Every mesh the selected links need, read and healed in parallel up front (a path that does not
