@@ -229,9 +229,18 @@ pub fn apply_scale(mesh: &RawMesh, scale: [f64; 3], path: &Path) -> Result<RawMe
         return Err(MeshError::new(path, None, MeshErrorKind::BadScale(scale)));
     }
     let mut out = mesh.clone();
-    // A product can round two distinct coordinates to one value, or give −0.0: weld again.
-    out.welded &= scale == [1.0; 3];
-    if scale != [1.0, 1.0, 1.0] {
+    if scale.iter().all(|s| s.abs() == 1.0) {
+        // A mirror (or no scale): negation is exact, so distinct vertices stay distinct and a welded
+        // mesh stays welded once −0.0 is folded into 0.0 (+ 0.0, as the weld itself does). 137 of
+        // example-robot-data's mesh references are mirrored.
+        if scale != [1.0; 3] {
+            for v in out.vertices.iter_mut() {
+                *v = [0, 1, 2].map(|k| v[k] * scale[k] + 0.0);
+            }
+        }
+    } else {
+        // Any other product can round two distinct coordinates to one value: weld again.
+        out.welded = false;
         for v in out.vertices.iter_mut() {
             *v = [v[0] * scale[0], v[1] * scale[1], v[2] * scale[2]];
         }
