@@ -229,17 +229,17 @@ pub fn apply_scale(mesh: &RawMesh, scale: [f64; 3], path: &Path) -> Result<RawMe
         return Err(MeshError::new(path, None, MeshErrorKind::BadScale(scale)));
     }
     let mut out = mesh.clone();
-    if scale.iter().all(|s| s.abs() == 1.0) {
-        // A mirror (or no scale): negation is exact, so distinct vertices stay distinct and a welded
-        // mesh stays welded once −0.0 is folded into 0.0 (+ 0.0, as the weld itself does). 137 of
-        // example-robot-data's mesh references are mirrored.
-        if scale != [1.0; 3] {
-            for v in out.vertices.iter_mut() {
-                *v = [0, 1, 2].map(|k| v[k] * scale[k] + 0.0);
-            }
+    if scale == [1.0; 3] {
+        // Nothing to do.
+    } else if out.welded && scale_keeps_distinct(&out.vertices, scale) {
+        // Distinct vertices stay distinct, so the mesh stays welded once −0.0 is folded into 0.0
+        // (+ 0.0, as the weld itself does) and is not welded again. Of example-robot-data's mesh
+        // references, 137 are mirrored and 82 are millimetre binary STLs at 0.001.
+        for v in out.vertices.iter_mut() {
+            *v = [0, 1, 2].map(|k| v[k] * scale[k] + 0.0);
         }
     } else {
-        // Any other product can round two distinct coordinates to one value: weld again.
+        // A product can round two distinct coordinates to one value: weld again.
         out.welded = false;
         for v in out.vertices.iter_mut() {
             *v = [v[0] * scale[0], v[1] * scale[1], v[2] * scale[2]];
@@ -251,6 +251,18 @@ pub fn apply_scale(mesh: &RawMesh, scale: [f64; 3], path: &Path) -> Result<RawMe
         }
     }
     Ok(out)
+}
+
+/// Whether scaling keeps distinct coordinates distinct: always for a mirror (negation is exact); and for
+/// coordinates that are all f32 values (binary STL) at a scale within [1e-200, 1e200] in magnitude,
+/// since two distinct f32 values differ by at least 2⁻²⁴ of the larger, far above the 2⁻⁵³ each
+/// rounded product may move, and no product can underflow or overflow.
+fn scale_keeps_distinct(vertices: &[[f64; 3]], scale: [f64; 3]) -> bool {
+    if scale.iter().all(|s| s.abs() == 1.0) {
+        return true;
+    }
+    scale.iter().all(|s| (1e-200..=1e200).contains(&s.abs()))
+        && vertices.iter().flatten().all(|&x| f64::from(x as f32) == x)
 }
 
 /// Reads, scales and heals a mesh file: the solid the mass core integrates, with its provenance.
@@ -421,5 +433,69 @@ mod tests {
             r.unwrap_err().kind,
             MeshErrorKind::Internal("formatted 1".into())
         );
+    }
+
+    /// A welded mesh stays welded under a scale only when no two of its vertices can become one: the
+    /// kept flag is checked against the scaled vertices' bits themselves (distinct, no −0.0), on f32
+    /// coordinates packed as tightly as f32 allows (neighbouring values, ±0, tiny and huge ones).
+    #[test]
+    fn a_scale_keeps_a_mesh_welded_only_when_vertices_stay_distinct() {
+        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            rng
+        };
+        let mut coords: Vec<f32> = vec![0.0, -0.0, 1e-45, -1e-45, 3.0e38, f32::MIN_POSITIVE];
+        for _ in 0..3000 {
+            let x = f32::from_bits(next() as u32);
+            if x.is_finite() {
+                // A value and its neighbour: the closest two distinct f32 can be.
+                coords.extend([x, f32::from_bits(x.to_bits() + 1)]);
+            }
+        }
+        let all: Vec<[f64; 3]> = coords
+            .chunks_exact(3)
+            .map(|c| [0, 1, 2].map(|k| f64::from(c[k]) + 0.0))
+            .collect();
+        // Distinct vertices (as a welding reader leaves them).
+        let mut seen = std::collections::HashSet::new();
+        let vertices: Vec<[f64; 3]> = all
+            .into_iter()
+            .filter(|v| seen.insert(v.map(f64::to_bits)))
+            .collect();
+        let mesh = RawMesh {
+            vertices,
+            faces: Polygons::new(),
+            notes: vec![],
+            warnings: vec![],
+            welded: true,
+        };
+        let p = Path::new("m.stl");
+        for scale in [
+            [0.001, -0.001, 0.001],
+            [1.0, -1.0, 1.0],
+            [1e-200, 7.3, -1e200],
+            [0.1; 3],
+        ] {
+            let out = apply_scale(&mesh, scale, p).unwrap();
+            assert!(out.welded, "{scale:?}");
+            let bits: std::collections::HashSet<[u64; 3]> =
+                out.vertices.iter().map(|v| v.map(f64::to_bits)).collect();
+            assert_eq!(bits.len(), out.vertices.len(), "{scale:?}: merged");
+            assert!(out
+                .vertices
+                .iter()
+                .flatten()
+                .all(|x| x.to_bits() != (-0.0f64).to_bits()));
+        }
+        // Coordinates that are not f32 values (a decimal OBJ) are welded again.
+        let mut f64_mesh = mesh.clone();
+        f64_mesh.vertices.push([0.1, 0.2, 0.3]);
+        assert!(!apply_scale(&f64_mesh, [0.001; 3], p).unwrap().welded);
+        assert!(apply_scale(&f64_mesh, [-1.0, 1.0, 1.0], p).unwrap().welded);
+        // Beyond the bounded range a product may underflow: welded again.
+        assert!(!apply_scale(&mesh, [1e-300, 1.0, 1.0], p).unwrap().welded);
     }
 }
