@@ -141,6 +141,8 @@ pub struct FillReport {
     pub without_geometry: usize,
     /// Links not selected (--only/--skip/--missing-only).
     pub not_selected: usize,
+    /// Distinct mesh files the selected links use (read by this call, or before it with a shared
+    /// cache).
     pub mesh_files: usize,
     pub faces: usize,
     pub timing: Timing,
@@ -480,7 +482,8 @@ pub fn compute(
 }
 
 /// [`compute`] with a mesh cache shared across calls (several URDFs of one robot, or a whole corpus).
-/// The report's timing and file counts are this call's share.
+/// The report's timings are this call's share (a mesh read before is not read again); its file count is
+/// the distinct mesh files the robot uses.
 ///
 /// The stages: preload the meshes → each link's parts → their densities → the link's body → the
 /// overlap estimate → `total_mass` scaling → the overflow backstop.
@@ -491,7 +494,7 @@ pub fn compute_with(
     opts: &FillOptions,
     cache: &mut MeshCache,
 ) -> FillReport {
-    let (load0, integrate0, files0) = (cache.load_time, cache.integrate_time, cache.files());
+    let (load0, integrate0) = (cache.load_time, cache.integrate_time);
     let mut ctx = Context {
         robot,
         map,
@@ -499,7 +502,7 @@ pub fn compute_with(
         opts,
         cache,
     };
-    preload(&mut ctx);
+    let mesh_files = preload(&mut ctx);
     let mut report = FillReport::default();
     let mut missing_density: Vec<(String, usize)> = Vec::new();
     // Links whose mass follows from densities (scaled by total_mass), as indices into report.links.
@@ -526,7 +529,7 @@ pub fn compute_with(
         scale_to_total_mass(&mut report, &density_links, total);
     }
     reject_unrepresentable(&mut report);
-    report.mesh_files = ctx.cache.files() - files0;
+    report.mesh_files = mesh_files;
     // The cache's clocks only accumulate, so these never saturate.
     report.timing = Timing {
         load: ctx.cache.load_time.saturating_sub(load0),
@@ -576,8 +579,8 @@ fn compute_links<'r>(
 }
 
 /// Every mesh the selected links need, read and healed in parallel up front (a path that does not
-/// resolve is reported by the per-link pass).
-fn preload(ctx: &mut Context<'_>) {
+/// resolve is reported by the per-link pass); the number of distinct files, read now or before.
+fn preload(ctx: &mut Context<'_>) -> usize {
     let wanted: Vec<(PathBuf, [f64; 3])> = ctx
         .robot
         .links
@@ -599,6 +602,8 @@ fn preload(ctx: &mut Context<'_>) {
             strict: ctx.opts.strict,
         },
     );
+    let files: std::collections::HashSet<&PathBuf> = wanted.iter().map(|w| &w.0).collect();
+    files.len()
 }
 
 /// A computed link and its face count.
