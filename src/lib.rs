@@ -15,3 +15,12 @@ pub mod mesh;
 pub mod overlap;
 pub mod text;
 pub mod urdf;
+
+/// A small deterministic generator for the unit tests (xorshift64; the same sequence on every run).
+#[cfg(test)]
+pub(crate) fn xorshift(state: &mut u64) -> u64 {
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    *state
+}

@@ -250,12 +250,7 @@ mod tests {
     #[test]
     fn within_is_the_formatting_scan() {
         let mut rng = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            rng
-        };
+        let mut next = || crate::xorshift(&mut rng);
         let mut xs: Vec<f64> = vec![
             0.125,
             2.5,

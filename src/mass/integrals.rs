@@ -1219,13 +1219,8 @@ mod tests {
     #[test]
     fn accurate_triples_match_scalar_per_lane() {
         let mut x = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            // Mixed magnitudes and signs: near-cancelling triples come from the shared offset.
-            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        // Mixed magnitudes and signs: near-cancelling triples come from the shared offset.
+        let mut next = || (crate::xorshift(&mut x) >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
         let mut batch = Batch::new();
         for round in 0..100 {
             let offset = [next(), next(), next()].map(|o| o * 1e4);

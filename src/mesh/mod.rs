@@ -441,12 +441,7 @@ mod tests {
     #[test]
     fn a_scale_keeps_a_mesh_welded_only_when_vertices_stay_distinct() {
         let mut rng = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            rng
-        };
+        let mut next = || crate::xorshift(&mut rng);
         let mut coords: Vec<f32> = vec![0.0, -0.0, 1e-45, -1e-45, 3.0e38, f32::MIN_POSITIVE];
         for _ in 0..3000 {
             let x = f32::from_bits(next() as u32);

@@ -406,12 +406,7 @@ mod number_tests {
     fn words() -> Vec<String> {
         let mut words: Vec<String> = SPELLINGS.iter().map(|s| s.to_string()).collect();
         let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = move || crate::xorshift(&mut state);
         for _ in 0..200_000 {
             let r = next();
             let digits = (r % 21) as usize;

@@ -589,12 +589,7 @@ mod tests {
     fn digit_counts_agree_with_formatting() {
         // Decimals of 1 to 17 digits over 40 decades, their neighbours one ulp away, and f32 values.
         let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut rand = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut rand = move || crate::xorshift(&mut state);
         for _ in 0..200_000 {
             let digits = (rand() % 17 + 1) as i32;
             let mantissa = (rand() % 10u64.pow(digits as u32)) as f64;
@@ -652,12 +647,7 @@ mod tests {
         // Clusters of points on a lattice a fraction of the tolerance apart: many ties in distance,
         // representatives in neighbouring cells, blocks and cells crossing zero.
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rand = move |m: u64| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state % m
-        };
+        let mut rand = move |m: u64| crate::xorshift(&mut state) % m;
         for step in [0.25, 0.5, 0.7, 1.0] {
             let tol = Tolerance {
                 base: 1.0,
