@@ -687,7 +687,7 @@ fn read_polylist(
     let text = p.raw_text(bytes);
     // The bound is the length of the decoded text, which is the bytes' unless one is not UTF-8.
     let within = |n: f64| n <= text.len() as f64 || n <= p.text(bytes).len() as f64;
-    let mut idx = each_number(p, text, path);
+    let mut words = Numbers { rest: text };
     for n in vcount {
         if !(n >= 0.0 && n.fract() == 0.0 && within(n)) {
             return Err(more());
@@ -696,9 +696,13 @@ fn read_polylist(
         for _ in 0..n as usize {
             let mut vertex = None;
             for k in 0..input.stride {
-                let x = idx.next().ok_or_else(more)??;
+                // Only the VERTEX index is converted (see `read_triangles`).
                 if k == input.voff {
-                    vertex = Some(x);
+                    let x = words.next().ok_or_else(more)?;
+                    vertex = Some(x.map_err(|w| not_a_number(p, w, path))?);
+                } else {
+                    let x = words.pass_word().ok_or_else(more)?;
+                    x.map_err(|w| not_a_number(p, w, path))?;
                 }
             }
             face.push(input.index(vertex.unwrap_or(-1.0), p.line, path)?);
