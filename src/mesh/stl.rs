@@ -136,15 +136,15 @@ const PIECE: usize = 4;
 /// A binary STL reader fed whole 50-byte records.
 ///
 /// Records are welded in two steps. Each chunk of [`CHUNK`] records is welded on its own first, in
-/// parallel (rayon), into a table small enough for the L2 cache; then the chunks' distinct vertices
-/// are added to the mesh's table in chunk order. A vertex is numbered where it first appears in the
-/// file either way, so the result is the sequential weld's, bit for bit, for any number of threads;
-/// and the big table, whose every probe is a cache miss, sees each vertex about once instead of at
-/// each of its six or so corners. Measured on a 1.3 M-face sphere (whole process, one thread, fastest
-/// of 15 runs on a loaded machine): 0.20 s CPU against 0.21 s for the one-table weld, so no cost on one
-/// core; what it buys is the weld's share of a second core.
+/// parallel (rayon), into a table small enough for the L2 cache; the chunks' distinct vertices are
+/// then welded across chunks once the file is read ([`super::weld::join`]). A vertex is numbered where it
+/// first appears in the file either way, so the result is the sequential weld's, bit for bit, for any
+/// number of threads; and the cross-chunk weld sees each vertex about once instead of at each of its
+/// six or so corners.
 struct Binary {
-    table: VertexTable,
+    /// The chunks' distinct vertices, one chunk after the other.
+    vertices: Vec<[f64; 3]>,
+    /// Corners as indices into `vertices`.
     indices: Vec<u32>,
 }
 
@@ -179,8 +179,9 @@ fn weld_chunk(records: &[u8]) -> (Vec<[f64; 3]>, Vec<u32>) {
 impl Binary {
     fn new(n: usize) -> Self {
         Binary {
-            // A closed triangle mesh has about half as many vertices as faces.
-            table: VertexTable::with_capacity(n / 2 + 16),
+            // A closed triangle mesh has about half as many vertices as faces; chunks repeat the
+            // ones on their borders.
+            vertices: Vec::with_capacity(n / 2 + n / 16 + 16),
             indices: Vec::with_capacity(3 * n),
         }
     }
@@ -188,22 +189,20 @@ impl Binary {
     /// Reads whole records, [`PIECE`] chunks at a time.
     fn feed(&mut self, records: &[u8]) {
         use rayon::prelude::*;
-        let mut map: Vec<u32> = Vec::new();
         for piece in records.chunks(50 * CHUNK * PIECE) {
             let welded: Vec<(Vec<[f64; 3]>, Vec<u32>)> =
                 piece.par_chunks(50 * CHUNK).map(weld_chunk).collect();
             for (vertices, indices) in welded {
-                map.clear();
-                self.table.extend(&vertices, &mut map);
-                self.indices
-                    .extend(indices.iter().map(|&i| map[i as usize]));
+                let base = self.vertices.len() as u32;
+                self.vertices.extend(vertices);
+                self.indices.extend(indices.iter().map(|&i| base + i));
             }
         }
     }
 
-    fn finish(self, header_count: Option<usize>) -> RawMesh {
+    fn finish(mut self, header_count: Option<usize>) -> RawMesh {
         let n = self.indices.len() / 3;
-        let vertices = self.table.into_vertices();
+        let vertices = super::weld::join(self.vertices, &mut self.indices);
         let starts = (0..=n as u32).map(|i| 3 * i).collect();
         let mut notes = Vec::new();
         if let Some(h) = header_count {
