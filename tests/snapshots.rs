@@ -100,6 +100,7 @@ fn readme_fill_demo_to_stdout() {
 fn readme_commands() {
     let cases = [
         ("fill_in_place", "urdf-inertia fill robot.urdf --density-map densities.toml -i", Some("robot.urdf")),
+        ("fill_two_in_place", "urdf-inertia fill robot.urdf other.urdf --density-map densities.toml -i", Some("other.urdf")),
         ("fill_uniform_density_to_file", "urdf-inertia fill robot.urdf --density 2700 -o filled.urdf", Some("filled.urdf")),
         ("fill_keep_mass", "urdf-inertia fill robot.urdf --keep-mass --density-map densities.toml -i", Some("robot.urdf")),
         ("diff", "urdf-inertia diff robot.urdf --density-map densities.toml", None),
