@@ -630,7 +630,7 @@ fn compute_link(
     mut parts: Vec<Part>,
     map: &DensityMap,
     opts: &FillOptions,
-) -> Result<Option<(ComputedLink, bool)>, LinkError> {
+) -> LinkResult {
     let Some(densities) = densities(link, &parts, map, opts)? else {
         return Ok(None);
     };

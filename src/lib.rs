@@ -24,3 +24,12 @@ pub(crate) fn xorshift(state: &mut u64) -> u64 {
     *state ^= *state << 17;
     *state
 }
+
+/// A uniform f64 in [0, 1) for the unit tests, from a 64-bit LCG (Knuth's MMIX constants).
+#[cfg(test)]
+pub(crate) fn lcg_unit(state: &mut u64) -> f64 {
+    *state = state
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    (*state >> 11) as f64 / (1u64 << 53) as f64
+}

@@ -48,8 +48,7 @@ pub enum PartShape {
     Mesh(Arc<Solid>),
 }
 
-/// A box `(lo, hi)`.
-pub type Aabb = ([f64; 3], [f64; 3]);
+pub use crate::mesh::health::Aabb;
 
 /// A closed triangle mesh's triangles bucketed on a (y, z) grid for point-in-solid tests by ray parity:
 /// all of them, or (for the overlap estimate) only those that can decide a point in a given region.
@@ -1041,12 +1040,7 @@ mod tests {
         let exact = MeshLocator::whole_mesh_cost(&solid);
         assert!(bound.is_some_and(|b| b >= exact), "{bound:?} < {exact}");
         let mut seed = 14u64;
-        let mut unit = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut unit = || crate::lcg_unit(&mut seed);
         let mut inside = 0;
         for _ in 0..4000 {
             let q = [0, 1, 2].map(|k| region.0[k] + (region.1[k] - region.0[k]) * unit());

@@ -246,12 +246,9 @@ struct Numbers<'a> {
 }
 
 impl<'a> Numbers<'a> {
-    /// Passes over the next word as [`Iterator::next`] would, without converting it when it is plain
-    /// digits (a number, whatever its value); any other word is parsed, so a word that is no number
-    /// is the same error. The index lists of `<p>` hold a normal and a texture coordinate index for
-    /// every vertex index, and only the vertex's is used.
+    /// The text from the next word on (leading whitespace skipped).
     #[inline]
-    fn pass_word(&mut self) -> Option<Result<(), &'a [u8]>> {
+    fn word_start(&self) -> &'a [u8] {
         let mut r = self.rest;
         while let [b, tail @ ..] = r {
             if !b.is_ascii_whitespace() {
@@ -259,18 +256,31 @@ impl<'a> Numbers<'a> {
             }
             r = tail;
         }
+        r
+    }
+
+    /// Takes the first `n` bytes of `r` (from [`Self::word_start`]) as a word if the word ends there:
+    /// at the end of the text, or at whitespace, which is passed over with it.
+    #[inline]
+    fn take_word(&mut self, r: &'a [u8], n: usize) -> bool {
+        match r.get(n) {
+            None => self.rest = &[],
+            Some(b) if b.is_ascii_whitespace() => self.rest = &r[n + 1..],
+            Some(_) => return false,
+        }
+        true
+    }
+
+    /// Passes over the next word as [`Iterator::next`] would, without converting it when it is plain
+    /// digits (a number, whatever its value); any other word is parsed, so a word that is no number
+    /// is the same error. The index lists of `<p>` hold a normal and a texture coordinate index for
+    /// every vertex index, and only the vertex's is used.
+    #[inline]
+    fn pass_word(&mut self) -> Option<Result<(), &'a [u8]>> {
+        let r = self.word_start();
         let digits = r.iter().take_while(|b| b.is_ascii_digit()).count();
-        match r.get(digits) {
-            _ if digits == 0 => {}
-            None => {
-                self.rest = &[];
-                return Some(Ok(()));
-            }
-            Some(b) if b.is_ascii_whitespace() => {
-                self.rest = &r[digits + 1..];
-                return Some(Ok(()));
-            }
-            Some(_) => {}
+        if digits > 0 && self.take_word(r, digits) {
+            return Some(Ok(()));
         }
         self.rest = r;
         self.next().map(|n| n.map(|_| ()))
@@ -282,29 +292,14 @@ impl<'a> Iterator for Numbers<'a> {
 
     #[inline]
     fn next(&mut self) -> Option<Self::Item> {
-        let mut r = self.rest;
-        while let [b, tail @ ..] = r {
-            if !b.is_ascii_whitespace() {
-                break;
-            }
-            r = tail;
-        }
+        let r = self.word_start();
         if r.is_empty() {
             self.rest = r;
             return None;
         }
         if let Some((x, n)) = short_decimal(r) {
-            match r.get(n) {
-                None => {
-                    self.rest = &[];
-                    return Some(Ok(x));
-                }
-                // The separator is passed over with the number.
-                Some(b) if b.is_ascii_whitespace() => {
-                    self.rest = &r[n + 1..];
-                    return Some(Ok(x));
-                }
-                Some(_) => {}
+            if self.take_word(r, n) {
+                return Some(Ok(x));
             }
         }
         let len = r

@@ -333,26 +333,14 @@ fn edges(faces: &Polygons) -> Edges {
 /// sort of all (key, face) records took 24% of healing the 48 k-face borinot base.
 fn for_each_edge(faces: &Polygons, mut visit: impl FnMut(&[(u32, u32, bool)], u32)) {
     let n = faces.indices.iter().max().map_or(0, |&m| m as usize + 1);
-    let mut start = vec![0u32; n + 1];
-    let each = |visit: &mut dyn FnMut(u32, u32, u32)| {
+    let (start, mut rec) = grouped(n, |put| {
         for (fi, face) in faces.iter().enumerate() {
             for k in 0..face.len() {
-                visit(face[k], face[(k + 1) % face.len()], fi as u32);
+                let (u, v) = (face[k], face[(k + 1) % face.len()]);
+                put(u.min(v) as usize, (u.max(v), fi as u32, u < v));
             }
         }
-    };
-    each(&mut |u, v, _| start[u.min(v) as usize + 1] += 1);
-    for i in 0..n {
-        start[i + 1] += start[i];
-    }
-    let mut fill = start[..n].to_vec();
-    let mut rec = vec![(0u32, 0u32, false); faces.indices.len()];
-    each(&mut |u, v, f| {
-        let s = &mut fill[u.min(v) as usize];
-        rec[*s as usize] = (u.max(v), f, u < v);
-        *s += 1;
     });
-    drop(fill);
     for lo in 0..n {
         let bucket = &mut rec[start[lo] as usize..start[lo + 1] as usize];
         // Stable, so the half-edges of an edge keep their face order.
@@ -361,6 +349,28 @@ fn for_each_edge(faces: &Polygons, mut visit: impl FnMut(&[(u32, u32, bool)], u3
             visit(half, lo as u32);
         }
     }
+}
+
+/// Items grouped by a key below `groups` (a counting sort), in the order `each` gives them within a
+/// group: key k's items are `items[starts[k]..starts[k + 1]]`. `each` hands every (key, item) to its
+/// argument; it is called twice, to count and then to place.
+fn grouped<T: Copy + Default>(
+    groups: usize,
+    each: impl Fn(&mut dyn FnMut(usize, T)),
+) -> (Vec<u32>, Vec<T>) {
+    let mut starts = vec![0u32; groups + 1];
+    each(&mut |k, _| starts[k + 1] += 1);
+    for i in 0..groups {
+        starts[i + 1] += starts[i];
+    }
+    let mut fill = starts[..groups].to_vec();
+    let mut items = vec![T::default(); starts[groups] as usize];
+    each(&mut |k, t| {
+        let s = &mut fill[k];
+        items[*s as usize] = t;
+        *s += 1;
+    });
+    (starts, items)
 }
 
 /// The face components (as [`components`] numbers them) when every directed edge `u → v` of `faces`
@@ -495,22 +505,12 @@ struct Orientation {
 fn orient(nfaces: usize, pairs: &[(u32, u32, bool)]) -> Option<Orientation> {
     // Neighbours in one flat array (`adj[at[f]..at[f + 1]]`) instead of a Vec per face: the
     // per-face allocations and frees took half of this function on the 48 k-face borinot base.
-    let mut at = vec![0u32; nfaces + 1];
-    for &(a, b, _) in pairs {
-        at[a as usize + 1] += 1;
-        at[b as usize + 1] += 1;
-    }
-    for i in 0..nfaces {
-        at[i + 1] += at[i];
-    }
-    let mut fill = at[..nfaces].to_vec();
-    let mut adj = vec![(0u32, false); 2 * pairs.len()];
-    for &(a, b, same) in pairs {
-        for (x, y) in [(a, b), (b, a)] {
-            adj[fill[x as usize] as usize] = (y, same);
-            fill[x as usize] += 1;
+    let (at, adj) = grouped(nfaces, |put| {
+        for &(a, b, same) in pairs {
+            put(a as usize, (b, same));
+            put(b as usize, (a, same));
         }
-    }
+    });
     let adj = |f: usize| &adj[at[f] as usize..at[f + 1] as usize];
     let mut flip = vec![false; nfaces];
     let mut comp = vec![u32::MAX; nfaces];
@@ -674,20 +674,11 @@ fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize, usize) {
 /// sort of all keys took 6% of healing the 381 ERD meshes.
 fn sort_by_first_vertex(keys: &mut Vec<([u32; 3], bool, u32)>) {
     let n = keys.iter().map(|k| k.0[0] as usize + 1).max().unwrap_or(0);
-    let mut start = vec![0u32; n + 1];
-    for k in keys.iter() {
-        start[k.0[0] as usize + 1] += 1;
-    }
-    for i in 0..n {
-        start[i + 1] += start[i];
-    }
-    let mut fill = start[..n].to_vec();
-    let mut sorted = vec![([0u32; 3], false, 0u32); keys.len()];
-    for k in keys.iter() {
-        let s = &mut fill[k.0[0] as usize];
-        sorted[*s as usize] = *k;
-        *s += 1;
-    }
+    let (start, mut sorted) = grouped(n, |put| {
+        for k in keys.iter() {
+            put(k.0[0] as usize, *k);
+        }
+    });
     for w in start.windows(2) {
         sorted[w[0] as usize..w[1] as usize].sort_unstable();
     }
@@ -891,25 +882,15 @@ fn reach(unit: &MassProperties, vertices: &[[f64; 3]]) -> f64 {
 }
 
 /// Turns a scaled mesh into a solid by the ladder in the module docs, its coordinates taken as f64
-/// values (see [`make_solid_stored_as`] for meshes stored in f32).
+/// values (see [`heal`] for meshes stored in f32 or as decimals).
 pub fn make_solid(mesh: &RawMesh, path: &Path, options: HealthOptions) -> Result<Solid, MeshError> {
     heal(Cow::Borrowed(mesh), path, options, |_| weld::Precision::F64)
 }
 
-/// Turns a scaled mesh into a solid; `precision` tells how its file stored the coordinates, which sets
-/// the tolerance of the second welding pass (asked only when that pass runs).
-pub fn make_solid_stored_as(
-    mesh: &RawMesh,
-    path: &Path,
-    options: HealthOptions,
-    precision: impl FnOnce() -> weld::Precision,
-) -> Result<Solid, MeshError> {
-    heal(Cow::Borrowed(mesh), path, options, |_| precision())
-}
-
-/// [`make_solid_stored_as`] on a mesh that may be owned: a mesh its reader welded
+/// Turns a scaled mesh into a solid by the ladder in the module docs. `precision` tells how its file
+/// stored the coordinates, which sets the tolerance of the second welding pass: it gets the (scaled,
+/// welded) vertices and is asked only when that pass runs. A mesh its reader welded
 /// ([`RawMesh::welded`]) and that is owned becomes the solid without a copy and without a second weld.
-/// `precision` gets the (scaled, welded) vertices and is asked only when the tolerant pass runs.
 pub fn heal(
     mesh: Cow<'_, RawMesh>,
     path: &Path,
@@ -1504,7 +1485,7 @@ fn signed_volume(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
     volume_integrals(vertices, faces, &IntegrationOptions::accurate()).t1
 }
 
-fn bbox(vertices: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
+fn bbox(vertices: &[[f64; 3]]) -> Aabb {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for v in vertices {
@@ -1581,7 +1562,8 @@ fn component_volumes(
     vol
 }
 
-type Aabb = ([f64; 3], [f64; 3]);
+/// A box `(lo, hi)`.
+pub type Aabb = ([f64; 3], [f64; 3]);
 
 fn component_boxes(
     vertices: &[[f64; 3]],

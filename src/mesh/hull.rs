@@ -215,12 +215,7 @@ mod tests {
     fn many_points_inside_are_filtered_and_many_on_the_hull_refused() {
         // 20,000 points in a cube plus its corners: the hull is the cube.
         let mut rng = 1u64;
-        let mut next = || {
-            rng = rng
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = || crate::lcg_unit(&mut rng);
         let mut pts: Vec<[f64; 3]> = (0..20_000).map(|_| [next(), next(), next()]).collect();
         pts.extend((0..8).map(|i| {
             [

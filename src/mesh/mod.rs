@@ -334,8 +334,8 @@ pub(crate) fn parse_f64_bytes(w: &[u8]) -> Option<f64> {
     }
 }
 
-/// The powers of ten an f64 holds exactly.
-const EXACT_POWERS_OF_TEN: [f64; 23] = [
+/// The powers of ten an f64 holds exactly (Clinger's fast path, here and in `weld`).
+pub(crate) const EXACT_POWERS_OF_TEN: [f64; 23] = [
     1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
     1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
 ];

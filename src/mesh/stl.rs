@@ -137,10 +137,10 @@ const PIECE: usize = 4;
 ///
 /// Records are welded in two steps. Each chunk of [`CHUNK`] records is welded on its own first, in
 /// parallel (rayon), into a table small enough for the L2 cache; the chunks' distinct vertices are
-/// then welded across chunks once the file is read ([`super::weld::join`]). A vertex is numbered where it
-/// first appears in the file either way, so the result is the sequential weld's, bit for bit, for any
-/// number of threads; and the cross-chunk weld sees each vertex about once instead of at each of its
-/// six or so corners.
+/// then welded across chunks once the file is read ([`super::weld::join`]). A vertex is numbered
+/// where it first appears in the file either way, so the result is the sequential weld's, bit for
+/// bit, for any number of threads; and the cross-chunk weld sees each vertex about once instead of
+/// at each of its six or so corners.
 struct Binary {
     /// The chunks' distinct vertices, one chunk after the other.
     vertices: Vec<[f64; 3]>,
@@ -148,8 +148,9 @@ struct Binary {
     indices: Vec<u32>,
 }
 
-/// Records welded on their own before joining the mesh's table: 16 Ki faces make about 8 Ki
-/// vertices, a table of 128 KiB.
+/// Records welded on their own before the cross-chunk join: 16 Ki faces make about 8 Ki vertices, a
+/// table of 128 KiB (in L2, so each insert is one probe; grouping inserts to overlap their misses,
+/// which the one big table of all vertices needed, measured no faster here).
 const CHUNK: usize = 16 * 1024;
 
 /// The distinct vertices of a chunk of records in order of first appearance, and its corners as
@@ -158,20 +159,14 @@ fn weld_chunk(records: &[u8]) -> (Vec<[f64; 3]>, Vec<u32>) {
     let n = records.len() / 50;
     let mut table = VertexTable::with_capacity(n / 2 + 16);
     let mut indices = Vec::with_capacity(3 * n);
-    let mut corners: Vec<[f64; 3]> = Vec::with_capacity(3 * 16);
-    for group in records.chunks(50 * 16) {
-        corners.clear();
-        for r in group.chunks_exact(50) {
-            // + 0.0 folds −0.0 into 0.0, so that both weld (`RawMesh::welded`).
-            let f = |o: usize| {
-                f64::from(f32::from_le_bytes([r[o], r[o + 1], r[o + 2], r[o + 3]])) + 0.0
-            };
-            // Skip the normal (bytes 0..12); the corners follow.
-            for o in [12, 24, 36] {
-                corners.push([f(o), f(o + 4), f(o + 8)]);
-            }
+    for r in records.chunks_exact(50) {
+        // + 0.0 folds −0.0 into 0.0, so that both weld (`RawMesh::welded`).
+        let f =
+            |o: usize| f64::from(f32::from_le_bytes([r[o], r[o + 1], r[o + 2], r[o + 3]])) + 0.0;
+        // Skip the normal (bytes 0..12); the corners follow.
+        for o in [12, 24, 36] {
+            indices.push(table.insert([f(o), f(o + 4), f(o + 8)]));
         }
-        table.extend(&corners, &mut indices);
     }
     (table.into_vertices(), indices)
 }

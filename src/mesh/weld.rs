@@ -90,35 +90,8 @@ impl VertexTable {
     /// The index of the vertex with exactly the bits of `p`, added if new.
     #[inline]
     pub fn insert(&mut self, p: [f64; 3]) -> u32 {
-        self.insert_hashed(p, hash(&p.map(f64::to_bits)))
-    }
-
-    /// [`VertexTable::insert`] of every point in order, their indices appended to `out`.
-    ///
-    /// The slots of a big table are scattered over more memory than the caches hold, so nearly every
-    /// insert waits for one miss. Here each group of points has its slots loaded first, all at once
-    /// (independent loads whose misses overlap), and is inserted after: a prefetch without `unsafe`
-    /// (`_mm_prefetch` needs it). Reading a 1.3 M-face binary STL from memory (bench pipeline/read,
-    /// one group per point against groups of 32, a loaded machine): 163 → 141 ms.
-    pub fn extend(&mut self, points: &[[f64; 3]], out: &mut Vec<u32>) {
-        const GROUP: usize = 32;
-        for group in points.chunks(GROUP) {
-            let mut hashes = [0u64; GROUP];
-            let mut touched = 0u64;
-            for (h, p) in hashes.iter_mut().zip(group) {
-                *h = hash(&p.map(f64::to_bits));
-                touched ^= self.slots[(*h >> self.shift) as usize];
-            }
-            std::hint::black_box(touched);
-            for (&h, &p) in hashes.iter().zip(group) {
-                out.push(self.insert_hashed(p, h));
-            }
-        }
-    }
-
-    #[inline]
-    fn insert_hashed(&mut self, p: [f64; 3], h: u64) -> u32 {
         let bits = p.map(f64::to_bits);
+        let h = hash(&bits);
         let tag = h << 32;
         let mask = self.slots.len() - 1;
         let mut s = (h >> self.shift) as usize;
@@ -166,10 +139,11 @@ impl VertexTable {
 ///
 /// One table over all vertices is what this replaces: on the 1.3 M-face binary STL (32 MB of table
 /// and vertices against a 32 MB L3 shared by the machine) its inserts were DRAM and TLB misses,
-/// 55–65 ms of a 0.26 s run, and 0.77 s at 10 M faces; this takes 18–23 ms and 0.52 s. Here the vertices are first partitioned by
-/// the top bits of their hash into at most 256 runs (8 bytes each: the hash's low half and the
-/// position), so each run is welded in its own small table (in parallel); a run keeps file order, so
-/// its first copy of a vertex is the first in the file. Numbers then follow in one pass in file order.
+/// 55–65 ms of a 0.26 s run, and 0.77 s at 10 M faces; this takes 18–23 ms and 0.52 s. Here the
+/// vertices are first partitioned by the top bits of their hash into at most 256 runs (8 bytes each:
+/// the hash's low half and the position), so each run is welded in its own small table (in
+/// parallel); a run keeps file order, so its first copy of a vertex is the first in the file.
+/// Numbers then follow in one pass in file order.
 pub fn join(vertices: Vec<[f64; 3]>, indices: &mut [u32]) -> Vec<[f64; 3]> {
     use rayon::prelude::*;
     let n = vertices.len();
@@ -441,10 +415,7 @@ fn digits_up_to_ten(x: f64) -> usize {
 /// exponent is within one of the one giving `x` 9 digits, and its mantissa within one of `x`/10^k
 /// rounded.
 fn nine_digits(x: f64) -> Option<Option<u64>> {
-    const POW10: [f64; 23] = [
-        1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
-        1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
-    ];
+    use super::EXACT_POWERS_OF_TEN as POW10;
     let x = x.abs();
     // floor(log10 x) is e or e + 1 for e = floor(e2·log10 2), e2 the binary exponent (78913/2^18 is
     // log10 2 to 1e-7; the shift floors): no log10, floor or round calls, which are library calls on
