@@ -306,6 +306,11 @@ fn edges(faces: &Polygons) -> Edges {
             ..Edges::default()
         };
     }
+    edge_analysis(faces)
+}
+
+/// [`edges`] without the proof, for faces already known not to be a clean surface.
+fn edge_analysis(faces: &Polygons) -> Edges {
     let mut e = Edges::default();
     for_each_edge(faces, |half: &[(u32, u32, bool)], lo: u32| match half {
         [(hi, face, forward)] => {
@@ -931,7 +936,14 @@ pub fn heal(
     }
     let precision = precision(&exact.vertices);
     let w = tolerant_welding(exact, precision);
-    let mut te = edges(&w.topology);
+    // Nothing merged or dropped: the topology is the exact weld's faces, which just failed the proof.
+    let unchanged =
+        w.tolerant.merged == 0 && w.collapsed == 0 && w.duplicates == 0 && w.cancelled == 0;
+    let mut te = if unchanged {
+        edge_analysis(&w.topology)
+    } else {
+        edges(&w.topology)
+    };
     if w.duplicates > 0 {
         ladder.warn(
             HealthKind::FacesDropped,
