@@ -12,6 +12,7 @@ use crate::diagnostic::{
 };
 use crate::mass::{mat_vec, primitives, rpy_matrix, validity, MassProperties};
 pub use crate::mesh::cache::MeshCache;
+use crate::mesh::cache::Solids;
 use crate::mesh::health::{ErrorEstimate, HealthOptions, ModelError, Solid, ROUND_OFF_FLOOR};
 use crate::overlap::{self, Overlap, PartShape, PlacedPart};
 use crate::urdf::resolve::PackageResolver;
@@ -372,7 +373,8 @@ fn mesh_part(
     link: &Link,
     c: &Collision,
     (filename, scale): (&str, [f64; 3]),
-    ctx: &mut Context<'_>,
+    ctx: &Context<'_>,
+    solids: &Solids<'_>,
 ) -> Result<Part, LinkError> {
     let path = ctx
         .resolver
@@ -385,12 +387,8 @@ fn mesh_part(
             };
             link_error(link, c, kind)
         })?;
-    let health = HealthOptions {
-        strict: ctx.opts.strict,
-    };
-    let solid = ctx
-        .cache
-        .solid(&path, scale, health)
+    let solid = solids
+        .get(&path, scale)
         .map_err(|e| link_error(link, c, LinkErrorKind::Mesh(e)))?;
     let mut diagnostics = diagnostic::mesh_health(&solid);
     if let Some(m) = millimetre_slip(&solid, scale) {
@@ -424,7 +422,12 @@ fn mesh_part(
 }
 
 /// One collision as a part, or the link's error.
-fn geometry_part(link: &Link, c: &Collision, ctx: &mut Context<'_>) -> Result<Part, LinkError> {
+fn geometry_part(
+    link: &Link,
+    c: &Collision,
+    ctx: &Context<'_>,
+    solids: &Solids<'_>,
+) -> Result<Part, LinkError> {
     let fmt3 = |v: [f64; 3]| format!("{} {} {}", v[0], v[1], v[2]);
     Ok(match &c.geometry {
         Geometry::Invalid { line, message } => {
@@ -458,7 +461,7 @@ fn geometry_part(link: &Link, c: &Collision, ctx: &mut Context<'_>) -> Result<Pa
             primitives::sphere(*radius, 1.0),
             PartShape::Sphere(*radius),
         ),
-        Geometry::Mesh { filename, scale } => mesh_part(link, c, (filename, *scale), ctx)?,
+        Geometry::Mesh { filename, scale } => mesh_part(link, c, (filename, *scale), ctx, solids)?,
     })
 }
 
@@ -468,7 +471,6 @@ struct Context<'a> {
     map: &'a DensityMap,
     resolver: &'a PackageResolver,
     opts: &'a FillOptions,
-    cache: &'a mut MeshCache,
 }
 
 /// Computes every selected link with collision geometry.
@@ -495,19 +497,18 @@ pub fn compute_with(
     cache: &mut MeshCache,
 ) -> FillReport {
     let (load0, integrate0) = (cache.load_time, cache.integrate_time);
-    let mut ctx = Context {
+    let ctx = Context {
         robot,
         map,
         resolver,
         opts,
-        cache,
     };
-    let mesh_files = preload(&mut ctx);
     let mut report = FillReport::default();
+    let (mesh_files, results) = compute_links(&ctx, cache, &mut report);
     let mut missing_density: Vec<(String, usize)> = Vec::new();
     // Links whose mass follows from densities (scaled by total_mass), as indices into report.links.
     let mut density_links: Vec<usize> = Vec::new();
-    for (link, result) in compute_links(&mut ctx, &mut report) {
+    for (link, result) in results {
         match result {
             Ok(Some((l, density_based))) => {
                 if density_based {
@@ -532,8 +533,8 @@ pub fn compute_with(
     report.mesh_files = mesh_files;
     // The cache's clocks only accumulate, so these never saturate.
     report.timing = Timing {
-        load: ctx.cache.load_time.saturating_sub(load0),
-        integrate: ctx.cache.integrate_time.saturating_sub(integrate0),
+        load: cache.load_time.saturating_sub(load0),
+        integrate: cache.integrate_time.saturating_sub(integrate0),
     };
     report
 }
@@ -542,16 +543,18 @@ pub fn compute_with(
 /// (`None`), or failed.
 type LinkResult = Result<Option<(ComputedLink, bool)>, LinkError>;
 
-/// Every selected link computed, in link order; counts the links left alone into `report`. Each
-/// selected link's parts are gathered in order (they come from the cache, so this is serial and
-/// cheap); then the links' densities, bodies and overlap estimates run in parallel (the estimate is
-/// most of a link's time, and one link's parts alone rarely fill the cores).
+/// Every selected link computed, in link order, and the number of distinct mesh files they use (read
+/// now or before); counts the links left alone into `report`. The meshes are read and healed in
+/// parallel, largest first, and each link is computed (its parts, densities, body and overlap
+/// estimate) as soon as its meshes are healed, on the same threads: a link waits only for its own
+/// meshes. A path that does not resolve is the link's error.
 fn compute_links<'r>(
-    ctx: &mut Context<'r>,
+    ctx: &Context<'r>,
+    cache: &mut MeshCache,
     report: &mut FillReport,
-) -> Vec<(&'r Link, LinkResult)> {
+) -> (usize, Vec<(&'r Link, LinkResult)>) {
     let (robot, map, opts) = (ctx.robot, ctx.map, ctx.opts);
-    let mut gathered = Vec::new();
+    let mut targets = Vec::new();
     for (li, link) in robot.links.iter().enumerate() {
         // Links without collision geometry, or whose only parts are zero-size primitives, are left as
         // they are (the scan notes the latter).
@@ -563,47 +566,35 @@ fn compute_links<'r>(
             report.not_selected += 1;
             continue;
         }
-        gathered.push((li, link, link_parts(link, ctx)));
+        targets.push((li, link));
     }
-    let compute = |(li, link, parts): (usize, &'r Link, Result<Vec<Part>, LinkError>)| {
-        let result = parts.and_then(|parts| compute_link(li, link, parts, map, opts));
-        (link, result)
-    };
-    // One link (or none) runs here: rayon's first use starts its pool, a fixed cost per process
-    // (see `cache::in_order_of_need`).
-    if gathered.len() <= 1 {
-        return gathered.into_iter().map(compute).collect();
-    }
-    use rayon::prelude::*;
-    gathered.into_par_iter().map(compute).collect()
-}
-
-/// Every mesh the selected links need, read and healed in parallel up front (a path that does not
-/// resolve is reported by the per-link pass); the number of distinct files, read now or before.
-fn preload(ctx: &mut Context<'_>) -> usize {
-    let wanted: Vec<(PathBuf, [f64; 3])> = ctx
-        .robot
-        .links
+    let needs: Vec<Vec<(PathBuf, [f64; 3])>> = targets
         .iter()
-        .filter(|l| l.has_collision_geometry() && is_target(l, ctx.opts))
-        .flat_map(|l| l.collisions.iter())
-        .filter_map(|c| match &c.geometry {
-            Geometry::Mesh { filename, scale } => ctx
-                .resolver
-                .resolve(filename, &ctx.robot.path)
-                .ok()
-                .map(|p| (p, *scale)),
-            _ => None,
+        .map(|(_, link)| {
+            link.collisions
+                .iter()
+                .filter_map(|c| match &c.geometry {
+                    Geometry::Mesh { filename, scale } => ctx
+                        .resolver
+                        .resolve(filename, &robot.path)
+                        .ok()
+                        .map(|p| (p, *scale)),
+                    _ => None,
+                })
+                .collect()
         })
         .collect();
-    ctx.cache.preload(
-        &wanted,
-        HealthOptions {
-            strict: ctx.opts.strict,
-        },
-    );
-    let files: std::collections::HashSet<&PathBuf> = wanted.iter().map(|w| &w.0).collect();
-    files.len()
+    let files: std::collections::HashSet<&PathBuf> = needs.iter().flatten().map(|n| &n.0).collect();
+    let mesh_files = files.len();
+    let health = HealthOptions {
+        strict: opts.strict,
+    };
+    let results = cache.load_and_run(&needs, health, |t, solids| {
+        let (li, link) = targets[t];
+        link_parts(link, ctx, solids).and_then(|parts| compute_link(li, link, parts, map, opts))
+    });
+    let links = targets.iter().map(|(_, link)| *link).zip(results).collect();
+    (mesh_files, links)
 }
 
 /// A computed link and its face count.
@@ -613,11 +604,11 @@ struct ComputedLink {
 }
 
 /// A link's parts (its collisions but the zero-size ones), or the first that fails.
-fn link_parts(link: &Link, ctx: &mut Context<'_>) -> Result<Vec<Part>, LinkError> {
+fn link_parts(link: &Link, ctx: &Context<'_>, solids: &Solids<'_>) -> Result<Vec<Part>, LinkError> {
     link.collisions
         .iter()
         .filter(|c| !c.geometry.is_zero_size())
-        .map(|c| geometry_part(link, c, ctx))
+        .map(|c| geometry_part(link, c, ctx, solids))
         .collect()
 }
 

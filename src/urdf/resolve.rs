@@ -15,7 +15,26 @@ pub struct PackageResolver {
     explicit: HashMap<String, PathBuf>,
     ros_package_path: Vec<PathBuf>,
     ament_prefix_path: Vec<PathBuf>,
-    cache: std::cell::RefCell<HashMap<(String, PathBuf), Option<PathBuf>>>,
+    cache: Found,
+}
+
+/// The package directories found by walking up, per (package, directory): shared by the threads that
+/// compute links (a lock, as a lookup is rare next to their work).
+#[derive(Debug, Default)]
+struct Found(std::sync::Mutex<HashMap<(String, PathBuf), Option<PathBuf>>>);
+
+impl Found {
+    fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<(String, PathBuf), Option<PathBuf>>> {
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+}
+
+impl Clone for Found {
+    fn clone(&self) -> Self {
+        Found(std::sync::Mutex::new(self.lock().clone()))
+    }
 }
 
 /// A mesh URI that names no existing file.
@@ -154,12 +173,12 @@ impl PackageResolver {
             }
         }
         let key = (pkg.to_string(), base.to_path_buf());
-        let found = self.cache.borrow().get(&key).cloned();
+        let found = self.cache.lock().get(&key).cloned();
         let found = match found {
             Some(f) => f,
             None => {
                 let f = walk_up(base, pkg);
-                self.cache.borrow_mut().insert(key, f.clone());
+                self.cache.lock().insert(key, f.clone());
                 f
             }
         };
