@@ -101,7 +101,7 @@ pub fn open_file(path: &Path) -> Result<(File, u64), String> {
 
 /// Appends the rest of `file` to `bytes`, up to [`max_file_size`] in all (a file can grow after its
 /// size was checked).
-pub fn read_rest(file: File, mut bytes: Vec<u8>) -> Result<Vec<u8>, String> {
+pub fn read_rest(file: impl Read, mut bytes: Vec<u8>) -> Result<Vec<u8>, String> {
     let limit = max_file_size();
     let room = limit.saturating_sub(bytes.len() as u64);
     file.take(room.saturating_add(1))

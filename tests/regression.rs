@@ -4,6 +4,9 @@
 mod common;
 #[path = "common/gltf_gen.rs"]
 mod gltf_gen;
+// The stl_stream fuzz target's differential check itself, so that its seeds and corpus replay through it.
+#[path = "../fuzz/fuzz_targets/stl_stream_check.rs"]
+mod stl_stream_check;
 
 use std::fmt::Write as _;
 use std::io::{BufRead, BufReader, Read, Write};
@@ -964,6 +967,7 @@ fn fuzz_one(target: &str, data: &[u8]) -> Result<(), String> {
             mesh::stl::parse(data, &dir.join("f.stl")),
             &dir.join("f.stl"),
         ),
+        "stl_stream" => stl_stream_check::check(data),
         "obj" => heal(
             mesh::obj::parse(data, &dir.join("f.obj")),
             &dir.join("f.obj"),
@@ -1006,7 +1010,15 @@ fn fuzz_one(target: &str, data: &[u8]) -> Result<(), String> {
 /// Replays every file of `root/TARGET/` through [`fuzz_one`]; returns how many.
 fn replay(root: &Path) -> usize {
     let mut n = 0;
-    for target in ["stl", "obj", "collada", "gltf", "urdf", "density"] {
+    for target in [
+        "stl",
+        "stl_stream",
+        "obj",
+        "collada",
+        "gltf",
+        "urdf",
+        "density",
+    ] {
         let Ok(dir) = std::fs::read_dir(root.join(target)) else {
             continue;
         };
@@ -1085,6 +1097,48 @@ fn write_fuzz_seeds() {
     for m in ["shoulder.STL", "battery.stl", "wrist_wedge.stl"] {
         put("stl", &m.to_lowercase(), &read(&format!("meshes/{m}")));
     }
+    // stl_stream: three bytes (chunk of 1 + b % 64 records, 1 + b runs, header made to fit unless
+    // b & 7 is 0) before a binary STL. Spheres up to the largest that fits 64 KiB (1,280 faces), the
+    // demo's `solid`-headed binary file, a torus whose shared corners are written as 0.0 by some faces
+    // and −0.0 by others, in reversed order and with collapsed faces, and a miscounted header.
+    let streamed = |name: &str, prefix: [u8; 3], stl: &[u8]| {
+        put("stl_stream", name, &[&prefix[..], stl].concat());
+    };
+    let binary = urdf_inertia::mesh::stl::write_binary;
+    streamed("box_chunk1.bin", [0, 0, 1], &binary(b"solid box", &bv, &bf));
+    let (sv2, sf2) = common::icosphere(2);
+    streamed(
+        "sphere80_chunk7_runs256.bin",
+        [6, 255, 1],
+        &binary(b"", &sv2, &sf2),
+    );
+    let (sv4, sf4) = common::icosphere(4);
+    streamed(
+        "sphere1280_chunk64_runs3.bin",
+        [63, 2, 1],
+        &binary(b"", &sv4, &sf4),
+    );
+    streamed(
+        "shoulder_chunk5_runs16.bin",
+        [4, 15, 1],
+        &read("meshes/shoulder.STL"),
+    );
+    let (tv, tf) = torus(16, 8);
+    let n = tv.len() as u32;
+    let negated: Vec<[f64; 3]> = (tv.iter())
+        .map(|p| p.map(|x| if x.abs() < 1e-9 { -0.0 } else { x }))
+        .collect();
+    let mut faces: Vec<[u32; 3]> = (tf.iter().enumerate())
+        .map(|(i, t)| if i % 2 == 1 { t.map(|k| k + n) } else { *t })
+        .rev()
+        .collect();
+    faces.insert(100, [0, 0, 1]);
+    faces.push([5, 5 + n, 6]);
+    let torus_stl = binary(b"torus", &[tv, negated].concat(), &faces);
+    streamed("torus_signed_zeros_chunk3_runs5.bin", [2, 4, 1], &torus_stl);
+    let mut miscounted = binary(b"", &bv, &bf);
+    miscounted[80..84].copy_from_slice(&99u32.to_le_bytes());
+    streamed("box_miscounted_unfitted.bin", [1, 1, 0], &miscounted);
     // OBJ: the demo mesh; objects, negative and slashed indices, continuation lines, a quad and a
     // two-vertex face.
     put("obj", "upper_arm.obj", &read("meshes/upper_arm.obj"));

@@ -84,7 +84,7 @@ fn is_text(bytes: &[u8]) -> bool {
 }
 
 fn binary(bytes: &[u8], n: usize, header_count: Option<usize>) -> RawMesh {
-    let mut reader = Binary::new(n);
+    let mut reader = Binary::new(n, CHUNK, None);
     reader.feed(&bytes[84..84 + 50 * n]);
     reader.finish(header_count)
 }
@@ -94,27 +94,47 @@ fn binary(bytes: &[u8], n: usize, header_count: Option<usize>) -> RawMesh {
 /// on a 1.3 M-face file (65.5 MB) that saves the 65.5 MB buffer, and the page faults of filling it.
 /// Anything else is read whole and given to [`parse`].
 pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
-    use std::io::Read;
+    let (file, len) = crate::input::open_file(path)
+        .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e)))?;
+    read_split(file, len, path, CHUNK, None)
+}
+
+/// [`read`] from `source`, `len` bytes long, welding chunks of `chunk` records and joining them in
+/// `runs` runs (`None`: as many as [`super::weld::join`] picks for the vertex count; chunks of at
+/// least 1 record, 1 to 256 runs).
+/// [`read`] passes [`CHUNK`] and `None`. It exists for the `stl_stream` fuzz target and the tests:
+/// with a chunk of 16 Ki records, no input the fuzzer makes (64 KiB at most) crosses a chunk or a
+/// run border; with a few records and a forced run count, every one does, and the result must still
+/// be [`parse`]'s, bit for bit.
+#[doc(hidden)]
+pub fn read_split(
+    mut source: impl std::io::Read,
+    len: u64,
+    path: &Path,
+    chunk: usize,
+    runs: Option<usize>,
+) -> Result<RawMesh, MeshError> {
     let io = |e: String| MeshError::new(path, None, MeshErrorKind::Io(e));
-    let (mut file, len) = crate::input::open_file(path).map_err(io)?;
+    let chunk = chunk.max(1);
     let mut header = vec![0u8; 84.min(len as usize)];
-    file.read_exact(&mut header)
+    source
+        .read_exact(&mut header)
         .map_err(|e| io(e.to_string()))?;
     let n = header.get(80..84).map_or(0, |c| {
         u64::from(u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
     });
     if n == 0 || 84 + 50 * n != len {
-        let bytes = crate::input::read_rest(file, header).map_err(io)?;
+        let bytes = crate::input::read_rest(source, header).map_err(io)?;
         return parse(&bytes, path);
     }
     let n = n as usize;
-    let mut reader = Binary::new(n);
+    let mut reader = Binary::new(n, chunk, runs);
     // No bigger than the file: zeroing a 3.3 MB buffer for every small STL was 2.5% of filling ERD.
-    let mut buf = vec![0u8; 50 * n.min(CHUNK * PIECE)];
+    let mut buf = vec![0u8; 50 * n.min(chunk * PIECE)];
     let mut left = n;
     while left > 0 {
-        let m = left.min(CHUNK * PIECE);
-        file.read_exact(&mut buf[..50 * m]).map_err(|e| {
+        let m = left.min(chunk * PIECE);
+        source.read_exact(&mut buf[..50 * m]).map_err(|e| {
             MeshError::new(
                 path,
                 None,
@@ -135,17 +155,21 @@ const PIECE: usize = 4;
 
 /// A binary STL reader fed whole 50-byte records.
 ///
-/// Records are welded in two steps. Each chunk of [`CHUNK`] records is welded on its own first, in
-/// parallel (rayon), into a table small enough for the L2 cache; the chunks' distinct vertices are
-/// then welded across chunks once the file is read ([`super::weld::join`]). A vertex is numbered
-/// where it first appears in the file either way, so the result is the sequential weld's, bit for
-/// bit, for any number of threads; and the cross-chunk weld sees each vertex about once instead of
-/// at each of its six or so corners.
+/// Records are welded in two steps. Each chunk of [`CHUNK`] records (fewer for [`read_split`]'s
+/// tests) is welded on its own first, in parallel (rayon), into a table small enough for the L2
+/// cache; the chunks' distinct vertices are then welded across chunks once the file is read
+/// ([`super::weld::join`]). A vertex is numbered where it first appears in the file either way, so
+/// the result is the sequential weld's, bit for bit, for any number of threads; and the cross-chunk
+/// weld sees each vertex about once instead of at each of its six or so corners.
 struct Binary {
     /// The chunks' distinct vertices, one chunk after the other.
     vertices: Vec<[f64; 3]>,
     /// Corners as indices into `vertices`.
     indices: Vec<u32>,
+    /// Records in a chunk: [`CHUNK`], but for [`read_split`].
+    chunk: usize,
+    /// Runs of the cross-chunk join: `None` (the join's choice), but for [`read_split`].
+    runs: Option<usize>,
 }
 
 /// Records welded on their own before the cross-chunk join: 16 Ki faces make about 8 Ki vertices, a
@@ -172,8 +196,10 @@ fn weld_chunk(records: &[u8]) -> (Vec<[f64; 3]>, Vec<u32>) {
 }
 
 impl Binary {
-    fn new(n: usize) -> Self {
+    fn new(n: usize, chunk: usize, runs: Option<usize>) -> Self {
         Binary {
+            chunk,
+            runs,
             // A closed triangle mesh has about half as many vertices as faces; chunks repeat the
             // ones on their borders.
             vertices: Vec::with_capacity(n / 2 + n / 16 + 16),
@@ -184,9 +210,9 @@ impl Binary {
     /// Reads whole records, [`PIECE`] chunks at a time.
     fn feed(&mut self, records: &[u8]) {
         use rayon::prelude::*;
-        for piece in records.chunks(50 * CHUNK * PIECE) {
+        for piece in records.chunks(50 * self.chunk * PIECE) {
             let welded: Vec<(Vec<[f64; 3]>, Vec<u32>)> =
-                piece.par_chunks(50 * CHUNK).map(weld_chunk).collect();
+                piece.par_chunks(50 * self.chunk).map(weld_chunk).collect();
             for (vertices, indices) in welded {
                 let base = self.vertices.len() as u32;
                 self.vertices.extend(vertices);
@@ -197,7 +223,7 @@ impl Binary {
 
     fn finish(mut self, header_count: Option<usize>) -> RawMesh {
         let n = self.indices.len() / 3;
-        let vertices = super::weld::join(self.vertices, &mut self.indices);
+        let vertices = super::weld::join(self.vertices, &mut self.indices, self.runs);
         let starts = (0..=n as u32).map(|i| 3 * i).collect();
         let mut notes = Vec::new();
         if let Some(h) = header_count {

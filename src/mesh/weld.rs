@@ -144,11 +144,17 @@ impl VertexTable {
 /// the hash's low half and the position), so each run is welded in its own small table (in
 /// parallel); a run keeps file order, so its first copy of a vertex is the first in the file.
 /// Numbers then follow in one pass in file order.
-pub fn join(vertices: Vec<[f64; 3]>, indices: &mut [u32]) -> Vec<[f64; 3]> {
+///
+/// `runs` forces the number of runs (clamped to 1–256), for tests and the `stl_stream` fuzz target:
+/// the inputs they can afford have a few thousand vertices at most, one run by the choice here.
+pub fn join(vertices: Vec<[f64; 3]>, indices: &mut [u32], runs: Option<usize>) -> Vec<[f64; 3]> {
     use rayon::prelude::*;
     let n = vertices.len();
     // About 2 Ki vertices a run; at most 256 runs, each written as one stream.
-    let runs = (n / 2048).next_power_of_two().clamp(1, 256);
+    let runs = runs.map_or_else(
+        || (n / 2048).next_power_of_two().clamp(1, 256),
+        |r| r.clamp(1, 256),
+    );
     let run_of = |h: u64| ((h >> 32) as usize * runs) >> 32;
     let hashes: Vec<u64> = vertices
         .par_iter()
@@ -759,31 +765,41 @@ mod tests {
 
     /// Chunks welded on their own and then joined number every vertex as one weld of all corners in
     /// order does: corners drawn from a small pool (so most repeat, within and across chunks), in
-    /// chunks of several sizes, from one run of entries to the most.
+    /// chunks of several sizes, from one run of entries to the most, and with run counts forced
+    /// (powers of two or not) on the smaller cases.
     #[test]
     fn joined_chunks_are_the_sequential_weld() {
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
         let pool: Vec<[f64; 3]> = (0..40_000)
             .map(|_| [0; 3].map(|_| f64::from(crate::xorshift(&mut state) as u32 as f32) * 1e-6))
             .collect();
-        for (corners, chunk) in [(300, 7), (50_000, 1_000), (1_500_000, 65_536)] {
+        let cases: [(usize, usize, &[Option<usize>]); 3] = [
+            (300, 7, &[None, Some(1), Some(3), Some(256)]),
+            (50_000, 1_000, &[None, Some(5), Some(256)]),
+            (1_500_000, 65_536, &[None]),
+        ];
+        for (corners, chunk, runs) in cases {
             let picks: Vec<[f64; 3]> = (0..corners)
                 .map(|_| pool[(crate::xorshift(&mut state) % pool.len() as u64) as usize])
                 .collect();
             let mut reference = VertexTable::with_capacity(16);
             let want: Vec<u32> = picks.iter().map(|&p| reference.insert(p)).collect();
-            let (mut vertices, mut indices) = (Vec::new(), Vec::new());
-            for c in picks.chunks(chunk) {
-                let mut table = VertexTable::with_capacity(16);
-                let local: Vec<u32> = c.iter().map(|&p| table.insert(p)).collect();
-                let base = vertices.len() as u32;
-                vertices.extend(table.into_vertices());
-                indices.extend(local.iter().map(|&i| base + i));
-            }
-            let joined = join(vertices, &mut indices);
-            assert_eq!(indices, want, "{corners} corners in chunks of {chunk}");
             let bits = |v: &[[f64; 3]]| v.iter().map(|p| p.map(f64::to_bits)).collect::<Vec<_>>();
-            assert_eq!(bits(&joined), bits(&reference.into_vertices()));
+            let reference = bits(&reference.into_vertices());
+            for &runs in runs {
+                let (mut vertices, mut indices) = (Vec::new(), Vec::new());
+                for c in picks.chunks(chunk) {
+                    let mut table = VertexTable::with_capacity(16);
+                    let local: Vec<u32> = c.iter().map(|&p| table.insert(p)).collect();
+                    let base = vertices.len() as u32;
+                    vertices.extend(table.into_vertices());
+                    indices.extend(local.iter().map(|&i| base + i));
+                }
+                let joined = join(vertices, &mut indices, runs);
+                let case = format!("{corners} corners in chunks of {chunk}, runs {runs:?}");
+                assert_eq!(indices, want, "{case}");
+                assert_eq!(bits(&joined), reference, "{case}");
+            }
         }
     }
 
