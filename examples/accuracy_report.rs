@@ -665,7 +665,7 @@ fn corpus(md: &mut String, share: &std::path::Path) {
     )]);
     let map = DensityMap::uniform(1000.0);
     writeln!(md, "\n## 6. End to end on example-robot-data\n").ok();
-    writeln!(md, "Each URDF filled with a fresh cache, as the command does (the median of three fills by total time): meshes are read and healed in parallel on all cores, and the links' overlap estimates run in parallel, so the load and heal+integrate columns are CPU time summed over threads; parse, write and total are wall time.\n").ok();
+    writeln!(md, "Each URDF filled with a fresh cache, as the command does (the median of three fills by total time): meshes are read and healed in parallel on all cores, largest first, and each link (its overlap estimate) is computed as soon as its own meshes are healed, so the load and heal+integrate columns are CPU time summed over threads; parse, write and total are wall time.\n").ok();
     writeln!(md, "| URDF | links | faces | parse ms | load ms | heal+integrate ms | write ms | total ms | M faces/s |\n|---|---|---|---|---|---|---|---|---|").ok();
     let mut shared = MeshCache::default();
     let mut shared_faces = 0usize;
