@@ -3,17 +3,18 @@
 
 use super::health::{HealthOptions, Solid};
 use super::{read, solid_from_owned, solid_from_raw, MeshError, RawMesh};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Reads each file once and heals each (file, scale) once. A raw mesh lives only until its scales are
-/// healed: the cache keeps the solids, and of each file read only whether it failed (a file asked for
-/// again with a new scale, by a later call sharing the cache, is read again).
+/// healed: the cache keeps the solids (a read error as the error of each scale asked for), and of the
+/// files only which were read (a file asked for again with a new scale, by a later call sharing the
+/// cache, is read again).
 #[derive(Debug, Default)]
 pub struct MeshCache {
-    read: HashMap<PathBuf, Option<MeshError>>,
+    read: HashSet<PathBuf>,
     solids: SolidMap,
     pub load_time: Duration,
     pub integrate_time: Duration,
@@ -153,14 +154,14 @@ impl MeshCache {
 
     /// Files read and healed, into the cache in the order given.
     fn insert(&mut self, loaded: Vec<LoadedFile>) {
-        for (path, raw, solids, load, integrate) in loaded {
+        for (path, solids, load, integrate) in loaded {
             self.load_time += load;
             self.integrate_time += integrate;
             for (scale, solid) in solids {
                 self.solids
                     .insert((path.clone(), scale.map(f64::to_bits)), solid);
             }
-            self.read.insert(path, raw);
+            self.read.insert(path);
         }
     }
 
@@ -170,23 +171,20 @@ impl MeshCache {
     }
 }
 
-/// The solids of one read mesh at each of its scales, and the read error if there was one. The last
+/// The solids of one read mesh at each of its scales (the read error for each, if it failed). The last
 /// scale takes the mesh itself, so a file used at one scale (the common case) is not copied.
 fn heal_scales(
     raw: Result<RawMesh, MeshError>,
     scales: &[[f64; 3]],
     path: &Path,
     options: HealthOptions,
-) -> (SolidsByScale, Option<MeshError>) {
+) -> SolidsByScale {
     let raw = match raw {
         Ok(raw) => raw,
-        Err(e) => {
-            let solids = scales.iter().map(|&s| (s, Err(e.clone()))).collect();
-            return (solids, Some(e));
-        }
+        Err(e) => return scales.iter().map(|&s| (s, Err(e.clone()))).collect(),
     };
     let Some((&last, rest)) = scales.split_last() else {
-        return (Vec::new(), None);
+        return Vec::new();
     };
     let mut solids: SolidsByScale = rest
         .iter()
@@ -196,7 +194,7 @@ fn heal_scales(
         last,
         solid_from_owned(raw, last, path, options).map(Arc::new),
     ));
-    (solids, None)
+    solids
 }
 
 /// Each (file, scale bits) healed, or why not.
@@ -221,30 +219,24 @@ impl Solids<'_> {
         let bits = scale.map(f64::to_bits);
         let healed = self.index.get(path).and_then(|&w| self.done[w].get());
         let found = healed
-            .and_then(|l| l.2.iter().find(|(s, _)| s.map(f64::to_bits) == bits))
+            .and_then(|l| l.1.iter().find(|(s, _)| s.map(f64::to_bits) == bits))
             .map(|(_, solid)| solid)
             .or_else(|| self.cached.get(&(path.clone(), bits)));
         match found {
             Some(solid) => solid.clone(),
-            None => load_file(path, &[scale], self.options).2.remove(0).1,
+            None => load_file(path, &[scale], self.options).1.remove(0).1,
         }
     }
 }
 
-/// A file read and its scales healed: the path, the read error, the solids, read and heal times.
-type LoadedFile = (
-    PathBuf,
-    Option<MeshError>,
-    SolidsByScale,
-    Duration,
-    Duration,
-);
+/// A file read and its scales healed: the path, the solids, read and heal times.
+type LoadedFile = (PathBuf, SolidsByScale, Duration, Duration);
 
 fn load_file(path: &Path, scales: &[[f64; 3]], options: HealthOptions) -> LoadedFile {
     let t0 = Instant::now();
     let raw = read(path);
     let t1 = Instant::now();
-    let (solids, error) = heal_scales(raw, scales, path, options);
+    let solids = heal_scales(raw, scales, path, options);
     // The raw mesh has ended, before the next file of this thread is read.
-    (path.to_path_buf(), error, solids, t1 - t0, t1.elapsed())
+    (path.to_path_buf(), solids, t1 - t0, t1.elapsed())
 }

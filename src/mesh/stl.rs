@@ -102,6 +102,7 @@ pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
 /// [`read`] from `source`, `len` bytes long, welding chunks of `chunk` records and joining them in
 /// `runs` runs (`None`: as many as [`super::weld::join`] picks for the vertex count; chunks of at
 /// least 1 record, 1 to 256 runs).
+///
 /// [`read`] passes [`CHUNK`] and `None`. It exists for the `stl_stream` fuzz target and the tests:
 /// with a chunk of 16 Ki records, no input the fuzzer makes (64 KiB at most) crosses a chunk or a
 /// run border; with a few records and a forced run count, every one does, and the result must still
