@@ -768,7 +768,7 @@ fn density_map_rule_order_is_file_order_however_written() {
     let dotted = "links.\"b_*\" = 1.0\nlinks.\"*_x\" = 2.0\n";
     for text in [section, dotted] {
         let m = DensityMap::parse(text, p).unwrap();
-        let order: Vec<&str> = m.links.iter().map(|(k, _)| k.as_str()).collect();
+        let order: Vec<&str> = m.links.rules().iter().map(|r| r.pattern.as_str()).collect();
         assert_eq!(order, ["b_*", "*_x"], "{text}");
         // Equal length: the first written wins.
         assert_eq!(
@@ -793,9 +793,10 @@ fn density_map_with_thousands_of_rules() {
         let _ = writeln!(text, "\"link_{i}\" = {}.0", 1000 + i);
     }
     let m = DensityMap::parse(&text, Path::new("d.toml")).unwrap();
-    assert_eq!(m.links.len(), n);
-    assert_eq!(m.links[0].0, format!("link_{}", n - 1));
-    assert_eq!(m.links[n - 1].0, "link_0");
+    let rules = m.links.rules();
+    assert_eq!(rules.len(), n);
+    assert_eq!(rules[0].pattern, format!("link_{}", n - 1));
+    assert_eq!(rules[n - 1].pattern, "link_0");
     text.push_str("bad = \"unobtainium\"\n");
     let e = DensityMap::parse(&text, Path::new("d.toml")).unwrap_err();
     assert_eq!(e.line, Some(n + 2));
@@ -1855,4 +1856,42 @@ fn write_reliability_table() {
     for row in &rows {
         assert_ne!(row.out.status.code(), Some(101), "{} panicked", row.what);
     }
+}
+
+/// Globs are compiled once into the density map and the selection (`--only`/`--skip`): a lookup is one
+/// pass of a glob set over the name. 300 glob rules over 300 links give every link the rule a
+/// hand-written longest-match scan gives, and a 400 KB key is an error naming its line (globset
+/// panicked compiling it).
+#[test]
+fn density_globs_compiled_once_agree_with_a_plain_scan() {
+    use urdf_inertia::density::{DensityMap, Glob, Spec};
+    let mut text = String::from("[links]\n");
+    let mut patterns = Vec::new();
+    for i in 0..300 {
+        // Prefix, suffix, infix and class patterns of growing length, some matching nothing.
+        let p = match i % 4 {
+            0 => format!("link_{i}*"),
+            1 => format!("*_{i}"),
+            2 => format!("*k_{}{}*{}", i % 10, "?".repeat(i % 3), i),
+            _ => format!("link_[0-{}]*{}", i % 10, i),
+        };
+        let _ = writeln!(text, "\"{p}\" = {}.0", 1 + i);
+        patterns.push((p, (1 + i) as f64));
+    }
+    let m = DensityMap::parse(&text, Path::new("d.toml")).unwrap();
+    for l in 0..300 {
+        let link = format!("link_{l}");
+        let mut want: Option<(&str, f64)> = None;
+        for (p, d) in &patterns {
+            if Glob::new(p).unwrap().is_match(&link) && want.is_none_or(|w| p.len() > w.0.len()) {
+                want = Some((p, *d));
+            }
+        }
+        let got = m.link_rule(&link);
+        assert_eq!(got, want.map(|(p, d)| (p, Spec::Density(d))), "{link}");
+    }
+    let long = format!("[links]\nbase = 1\n\"{}\" = 2\n", "a".repeat(400_000));
+    let e = DensityMap::parse(&long, Path::new("d.toml")).unwrap_err();
+    assert_eq!(e.line, Some(3), "{e}");
+    assert!(e.message.contains("longer than the 4096"), "{e}");
 }

@@ -8,7 +8,7 @@ use super::summary;
 use super::{write, ExitStatus};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use urdf_inertia::density::DensityMap;
+use urdf_inertia::density::{DensityMap, Glob};
 use urdf_inertia::diagnostic::{Code, Diagnostic, Location};
 use urdf_inertia::fill::{self, existing_problems, existing_props, FillOptions, FillReport};
 use urdf_inertia::fill::{LinkReport, MeshCache};
@@ -41,9 +41,12 @@ fn density_map(s: &SourceArgs) -> Result<Option<DensityMap>, String> {
 
 fn sources(s: &SourceArgs) -> Result<Sources, String> {
     let map = density_map(s)?;
-    for g in s.only.iter().chain(&s.skip) {
-        urdf_inertia::density::glob(g).map_err(|e| format!("--only/--skip: {e}"))?;
-    }
+    let globs = |patterns: &[String]| {
+        patterns
+            .iter()
+            .map(|g| Glob::new(g).map_err(|e| format!("--only/--skip: {e}")))
+            .collect::<Result<Vec<_>, String>>()
+    };
     let pkgs = s
         .package_path
         .iter()
@@ -54,8 +57,8 @@ fn sources(s: &SourceArgs) -> Result<Sources, String> {
         resolver: PackageResolver::new(&pkgs),
         options: FillOptions {
             strict: s.strict,
-            only: s.only.clone(),
-            skip: s.skip.clone(),
+            only: globs(&s.only)?,
+            skip: globs(&s.skip)?,
             missing_only: false,
             keep_mass: s.keep_mass,
         },

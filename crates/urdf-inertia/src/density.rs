@@ -100,9 +100,111 @@ struct RawMap {
 pub struct DensityMap {
     pub default: Option<f64>,
     pub total_mass: Option<f64>,
-    /// (pattern, spec), in file order.
-    pub links: Vec<(String, Spec)>,
-    pub meshes: Vec<(String, Spec)>,
+    /// The `[links]` rules, matched against link names.
+    pub links: RuleSet,
+    /// The `[meshes]` rules, matched against a part's mesh URI (patterns with a `/`) or file name.
+    pub meshes: RuleSet,
+}
+
+/// One rule of a density map: its key as written and what it gives.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rule {
+    pub pattern: String,
+    pub spec: Spec,
+}
+
+/// The rules of one section, compiled once: exact keys in a hash map, the globs in two
+/// `globset::GlobSet`s (keys with a `/`, matched against a whole URI, and the others), so that a lookup
+/// costs one pass over the name whatever the number of rules (a map of 300 rules over 300 links was
+/// quadratic when each lookup compiled each pattern).
+#[derive(Debug, Clone, Default)]
+pub struct RuleSet {
+    rules: Vec<Rule>,
+    /// The first rule (file order) of each key.
+    exact: std::collections::HashMap<String, usize>,
+    whole: Matcher,
+    name: Matcher,
+}
+
+/// A glob set and the index into [`RuleSet::rules`] of each of its patterns.
+#[derive(Debug, Clone, Default)]
+struct Matcher {
+    set: globset::GlobSet,
+    rule: Vec<usize>,
+}
+
+impl PartialEq for RuleSet {
+    fn eq(&self, other: &Self) -> bool {
+        self.rules == other.rules
+    }
+}
+
+impl RuleSet {
+    /// Compiles `rules` (file order). With `by_uri`, keys holding a `/` are matched against the whole
+    /// URI and the others against the file name; without it every key is matched against the name.
+    pub fn new(rules: Vec<Rule>, by_uri: bool) -> Result<Self, String> {
+        let mut exact = std::collections::HashMap::new();
+        let (mut whole, mut name) = (
+            globset::GlobSetBuilder::new(),
+            globset::GlobSetBuilder::new(),
+        );
+        let (mut whole_rule, mut name_rule) = (Vec::new(), Vec::new());
+        for (i, r) in rules.iter().enumerate() {
+            exact.entry(r.pattern.clone()).or_insert(i);
+            let g = parse_glob(&r.pattern)?;
+            if by_uri && r.pattern.contains('/') {
+                whole.add(g);
+                whole_rule.push(i);
+            } else {
+                name.add(g);
+                name_rule.push(i);
+            }
+        }
+        let build = |b: globset::GlobSetBuilder, rule: Vec<usize>| {
+            b.build()
+                .map(|set| Matcher { set, rule })
+                .map_err(|e| format!("the patterns cannot be compiled together: {e}"))
+        };
+        Ok(RuleSet {
+            rules,
+            exact,
+            whole: build(whole, whole_rule)?,
+            name: build(name, name_rule)?,
+        })
+    }
+
+    /// The rules in file order.
+    pub fn rules(&self) -> &[Rule] {
+        &self.rules
+    }
+
+    /// The rule for `name` (and, for mesh rules, its `uri`): an exact key first (the first written of
+    /// the two kinds), then the longest matching glob (the first written on ties).
+    fn best(&self, uri: &str, name: &str) -> Option<(&str, Spec)> {
+        let exact = [uri, name]
+            .iter()
+            .filter_map(|k| self.exact.get(*k).copied())
+            .filter(|&i| {
+                let r = &self.rules[i].pattern;
+                // A key with a `/` names a URI, one without a file name (for links both are the name).
+                r == name || (r.contains('/') && r == uri)
+            })
+            .min();
+        let hit = exact.or_else(|| {
+            let len = |i: usize| self.rules[i].pattern.len();
+            let mut best: Option<usize> = None;
+            for (m, target) in [(&self.whole, uri), (&self.name, name)] {
+                for j in m.set.matches(target) {
+                    let i = m.rule[j];
+                    if best.is_none_or(|b| len(i) > len(b) || (len(i) == len(b) && i < b)) {
+                        best = Some(i);
+                    }
+                }
+            }
+            best
+        });
+        hit.map(|i| (self.rules[i].pattern.as_str(), self.rules[i].spec))
+    }
 }
 
 impl DensityMap {
@@ -169,36 +271,15 @@ impl DensityMap {
 
     /// The rule for a link: exact name, then the longest matching glob, then `None` (the default applies).
     pub fn link_rule(&self, link: &str) -> Option<(&str, Spec)> {
-        if let Some((k, s)) = self.links.iter().find(|(k, _)| k == link) {
-            return Some((k, *s));
-        }
-        best_glob(&self.links, |_| link)
+        self.links.best(link, link)
     }
 
     /// The rule for a part's mesh, if any: `uri` is the URDF's filename attribute. A pattern with a `/`
     /// is matched against the whole URI, any other against the file name.
     pub fn mesh_rule(&self, uri: &str) -> Option<(&str, Spec)> {
         let file = uri.rsplit('/').next().unwrap_or(uri);
-        let target = |k: &str| if k.contains('/') { uri } else { file };
-        if let Some((k, s)) = self.meshes.iter().find(|(k, _)| k == target(k)) {
-            return Some((k, *s));
-        }
-        best_glob(&self.meshes, target)
+        self.meshes.best(uri, file)
     }
-}
-
-/// The longest pattern that matches (the first written on ties).
-fn best_glob<'a, 'b>(
-    rules: &'a [(String, Spec)],
-    target: impl Fn(&str) -> &'b str,
-) -> Option<(&'a str, Spec)> {
-    let mut best: Option<&(String, Spec)> = None;
-    for r in rules {
-        if glob_match(&r.0, target(&r.0)) && best.is_none_or(|b| r.0.len() > b.0.len()) {
-            best = Some(r);
-        }
-    }
-    best.map(|(k, s)| (k.as_str(), *s))
 }
 
 /// The built-in materials with the map's `[materials]` added (names compare case-insensitively). An
@@ -301,24 +382,29 @@ fn table_spec(
     }
 }
 
-/// The rules of `[section]` in file order (for tie-breaking), each error on its entry's line.
+/// The rules of `[section]` in file order (for tie-breaking), compiled once; each error on its entry's
+/// line.
 fn rules(
     materials: &BTreeMap<String, f64>,
     section: &str,
     table: &BTreeMap<String, Spanned<toml::Value>>,
     err: &impl Fn(Option<Range<usize>>, String) -> MapError,
-) -> Result<Vec<(String, Spec)>, MapError> {
+) -> Result<RuleSet, MapError> {
     let mut entries: Vec<(&String, &Spanned<toml::Value>)> = table.iter().collect();
     entries.sort_by_key(|(_, v)| v.span().start);
-    entries
+    let rules = entries
         .into_iter()
         .map(|(k, v)| {
-            glob(k).map_err(|m| err(Some(v.span()), format!("[{section}] {m}")))?;
+            parse_glob(k).map_err(|m| err(Some(v.span()), format!("[{section}] {m}")))?;
             spec(materials, v.get_ref(), true, &format!("[{section}] `{k}`"))
-                .map(|s| (k.clone(), s))
+                .map(|spec| Rule {
+                    pattern: k.clone(),
+                    spec,
+                })
                 .map_err(|m| err(Some(v.span()), m))
         })
-        .collect()
+        .collect::<Result<Vec<_>, _>>()?;
+    RuleSet::new(rules, section == "meshes").map_err(|m| err(None, format!("[{section}] {m}")))
 }
 
 fn check_positive(x: f64, what: &str) -> Result<(), String> {
@@ -329,20 +415,56 @@ fn check_positive(x: f64, what: &str) -> Result<(), String> {
     }
 }
 
-/// A glob pattern, compiled with the `globset` crate: `*` and `?` (which also match `/`), `[abc]`,
-/// `[!a-z]`, `{a,b}` and `**`. Used by `--only`, `--skip` and the density map's keys.
-pub fn glob(pattern: &str) -> Result<globset::GlobMatcher, String> {
+/// The longest glob pattern accepted, in bytes. globset compiles a pattern into a regular expression
+/// and panics on one past its size limit (a 400 KB key did); no link or mesh name needs a pattern this
+/// long.
+pub const MAX_GLOB_LEN: usize = 4096;
+
+/// A glob pattern compiled once (the `globset` crate): `*` and `?` (which also match `/`), `[abc]`,
+/// `[!a-z]`, `{a,b}` and `**`, with its text for messages. Used by `--only`, `--skip` and the density
+/// map's keys.
+#[derive(Debug, Clone)]
+pub struct Glob {
+    glob: globset::Glob,
+    matcher: globset::GlobMatcher,
+}
+
+impl Glob {
+    /// Compiles `pattern`; an invalid or over-long pattern is an error saying why.
+    pub fn new(pattern: &str) -> Result<Glob, String> {
+        let glob = parse_glob(pattern)?;
+        let matcher = glob.compile_matcher();
+        Ok(Glob { glob, matcher })
+    }
+
+    /// The pattern as written.
+    pub fn as_str(&self) -> &str {
+        self.glob.glob()
+    }
+
+    pub fn is_match(&self, name: &str) -> bool {
+        self.matcher.is_match(name)
+    }
+}
+
+/// Parses a pattern without compiling its matcher (a glob set compiles its patterns together).
+fn parse_glob(pattern: &str) -> Result<globset::Glob, String> {
+    if pattern.len() > MAX_GLOB_LEN {
+        return Err(format!(
+            "a pattern of {} bytes is longer than the {MAX_GLOB_LEN} accepted",
+            pattern.len()
+        ));
+    }
     globset::GlobBuilder::new(pattern)
         .backslash_escape(true)
         .build()
-        .map(|g| g.compile_matcher())
         .map_err(|e| format!("`{pattern}` is not a valid glob: {}", e.kind()))
 }
 
-/// Whether `name` matches the glob `pattern` (an invalid pattern matches nothing; patterns from the
-/// user are checked with [`glob`] when they are read).
-pub fn glob_match(pattern: &str, name: &str) -> bool {
-    glob(pattern).is_ok_and(|g| g.is_match(name))
+impl PartialEq for Glob {
+    fn eq(&self, other: &Self) -> bool {
+        self.as_str() == other.as_str()
+    }
 }
 
 #[cfg(test)]
@@ -418,6 +540,7 @@ base_link = "aluminum"
 
     #[test]
     fn globs() {
+        let glob_match = |p: &str, name: &str| Glob::new(p).expect("valid").is_match(name);
         assert!(glob_match("*_finger*", "l_finger_tip"));
         assert!(glob_match("a?c", "abc"));
         assert!(!glob_match("a?c", "ac"));

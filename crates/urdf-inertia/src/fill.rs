@@ -35,8 +35,9 @@ const PRIMITIVE_ERROR: ErrorEstimate = ErrorEstimate {
 #[derive(Debug, Clone, Default)]
 pub struct FillOptions {
     pub strict: bool,
-    pub only: Vec<String>,
-    pub skip: Vec<String>,
+    /// `--only` / `--skip`: links selected by name, compiled once.
+    pub only: Vec<crate::density::Glob>,
+    pub skip: Vec<crate::density::Glob>,
     /// Only links whose inertial is absent or invalid.
     pub missing_only: bool,
     /// Each link's existing `<mass>` is its mass target.
@@ -157,15 +158,8 @@ fn is_target(link: &Link, opts: &FillOptions) -> bool {
 
 /// Whether a link is selected by `--only` / `--skip` globs.
 pub fn selected(name: &str, opts: &FillOptions) -> bool {
-    let only = opts.only.is_empty()
-        || opts
-            .only
-            .iter()
-            .any(|g| crate::density::glob_match(g, name));
-    only && !opts
-        .skip
-        .iter()
-        .any(|g| crate::density::glob_match(g, name))
+    let only = opts.only.is_empty() || opts.only.iter().any(|g| g.is_match(name));
+    only && !opts.skip.iter().any(|g| g.is_match(name))
 }
 
 /// An existing inertial as mass properties in link coordinates (tensor rotated out of its origin frame).
