@@ -1,8 +1,10 @@
 //! glTF 2.0 (.glb and .gltf): known solids written by the test's own generator, checked against analytic
 //! mass, COM and inertia; refused extensions and broken files give named errors, never panics.
 
+// The test helpers are the library tests' own (exact integrals, mesh generators).
+#[path = "../crates/urdf-inertia/tests/common/mod.rs"]
 mod common;
-#[path = "common/gltf_gen.rs"]
+#[path = "../crates/urdf-inertia/tests/common/gltf_gen.rs"]
 mod gltf_gen;
 
 use common::Rng;

@@ -1,6 +1,8 @@
 //! Mesh truth (issue: closed meshes with float-noise cracks keep their exact numbers, and every error
 //! estimate bounds the real error), against exact rational integrals of the stored triangles.
 
+// The test helpers are the library tests' own (exact integrals, mesh generators).
+#[path = "../crates/urdf-inertia/tests/common/mod.rs"]
 mod common;
 
 use common::wild::{self, Expect};

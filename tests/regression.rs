@@ -1,8 +1,10 @@
 //! Regression tests for issue 13 ("Hardening"), each named after what it covers. The real binary runs in
 //! a temp dir on inputs generated here; nothing depends on timing, and everything holds when run as root.
 
+// The test helpers are the library tests' own (exact integrals, mesh generators).
+#[path = "../crates/urdf-inertia/tests/common/mod.rs"]
 mod common;
-#[path = "common/gltf_gen.rs"]
+#[path = "../crates/urdf-inertia/tests/common/gltf_gen.rs"]
 mod gltf_gen;
 // The stl_stream fuzz target's differential check itself, so that its seeds and corpus replay through it.
 #[path = "../fuzz/fuzz_targets/stl_stream_check.rs"]

@@ -10,8 +10,7 @@
 //!
 //! Every error is against exact rational arithmetic on the stored mesh (tests/common's reference).
 
-// The allocator of the `urdf-inertia` binary (see src/main.rs), so that timings are the binary's.
-#[cfg(feature = "mimalloc")]
+// The allocator of the `urdf-inertia` binary (see the binary's src/main.rs), so that timings are the binary's.
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 

@@ -13,8 +13,7 @@
 //! * `heal`: `make_solid`, everything after reading: edge analysis, ladder and integrations;
 //! * `end-to-end`: read + heal, what `urdf-inertia mesh` does after the file is in memory.
 
-// The allocator of the `urdf-inertia` binary (see src/main.rs), so that timings are the binary's.
-#[cfg(feature = "mimalloc")]
+// The allocator of the `urdf-inertia` binary (see the binary's src/main.rs), so that timings are the binary's.
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 

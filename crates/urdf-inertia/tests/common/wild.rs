@@ -228,8 +228,7 @@ pub fn bases() -> Vec<(String, Mesh)> {
         ),
         ("bracket".to_string(), inverted(&bracket())),
     ];
-    let demo =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("robots/demo_arm_description/meshes");
+    let demo = super::workspace_root().join("robots/demo_arm_description/meshes");
     for name in [
         "shoulder.STL",
         "battery.stl",

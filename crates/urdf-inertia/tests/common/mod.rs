@@ -12,6 +12,17 @@ use std::collections::HashMap;
 
 pub mod wild;
 
+/// The workspace's root: these helpers serve the library's tests (manifest at the root) and the
+/// command line's (manifest in `cli/`).
+pub fn workspace_root() -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    if dir.join("robots").is_dir() {
+        dir.to_path_buf()
+    } else {
+        dir.join("../..")
+    }
+}
+
 pub type Mesh = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 
 /// Decomposes a finite f64 into (mantissa, exponent) with value = mantissa · 2^exponent.

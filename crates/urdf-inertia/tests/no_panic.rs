@@ -50,7 +50,7 @@ fn mesh_readers_never_panic() {
         b"o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\no b\nf 1 4 3\nf -3 -2 -1\n"
             .to_vec();
     let dae = std::fs::read(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
+        Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
             .join("robots/demo_arm_description/meshes/forearm.dae"),
     )
     .expect("demo dae");
@@ -85,7 +85,7 @@ fn mesh_readers_never_panic() {
 fn urdf_scan_and_splice_never_panic() {
     let mut rng = Rng(12);
     let urdf = std::fs::read(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
+        Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
             .join("robots/demo_arm_description/urdf/demo_arm.urdf"),
     )
     .expect("demo urdf");
