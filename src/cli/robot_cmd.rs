@@ -502,6 +502,8 @@ fn write_into_sources(
             ),
         }
     }
+    let written: usize = per_file.values().map(Vec::len).sum();
+    let files = per_file.len();
     for (file, links) in per_file {
         let path = &x.files[file].path;
         let spans: Vec<(usize, usize)> = links.iter().map(|(s, e, _)| (*s, *e)).collect();
@@ -542,6 +544,11 @@ fn write_into_sources(
             return Err(ExitStatus::Error);
         }
     }
+    errln!(
+        "urdf-inertia: {}: wrote {written} of {} computed link(s) into {files} xacro source file(s)",
+        robot.path.display(),
+        report.links.len()
+    );
     Ok(())
 }
 
