@@ -226,26 +226,6 @@ fn fill_in_place_writes_literal_links_into_their_files() {
         std::fs::read_to_string(dir.join("robots/robot.urdf.xacro")).expect("read"),
         top
     );
-    // -o writes the filled expansion, the macro's link included.
-    let out = run_in(
-        dir,
-        &[
-            "fill",
-            "robots/robot.urdf.xacro",
-            "--arg",
-            "m:=2",
-            "--density",
-            "1000",
-            "-o",
-            "filled.urdf",
-        ],
-    );
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    let f = std::fs::read_to_string(dir.join("filled.urdf")).expect("read");
-    assert_eq!(
-        inertial_of(&f, "left_shoulder_link"),
-        inertial_of(&filled, "left_shoulder_link")
-    );
 }
 
 #[test]
@@ -329,4 +309,43 @@ fn a_urdf_is_read_from_stdin() {
     assert!(text(&out.stdout).contains("<mass value=\"1000\"/>"));
     let out = run_stdin(&["fill", "-", "--density", "1000", "-i"]);
     assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn fill_to_a_file_writes_the_filled_expansion() {
+    let tmp = robot();
+    let dir = tmp.path();
+    let out = run_in(dir, &["xacro", "robots/robot.urdf.xacro", "m:=2"]);
+    std::fs::write(dir.join("expanded.urdf"), &out.stdout).expect("write");
+    let out = run_in(dir, &["fill", "expanded.urdf", "--density", "1000"]);
+    let filled = text(&out.stdout);
+    // -o writes the filled expansion, the macro's link included.
+    let out = run_in(
+        dir,
+        &[
+            "fill",
+            "robots/robot.urdf.xacro",
+            "--arg",
+            "m:=2",
+            "--density",
+            "1000",
+            "-o",
+            "filled.urdf",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let f = std::fs::read_to_string(dir.join("filled.urdf")).expect("read");
+    assert_eq!(
+        inertial_of(&f, "left_shoulder_link"),
+        inertial_of(&filled, "left_shoulder_link")
+    );
+    assert_eq!(
+        inertial_of(&f, "base_link"),
+        inertial_of(&filled, "base_link")
+    );
+    // The sources are untouched.
+    assert_eq!(
+        std::fs::read_to_string(dir.join("robots/robot.urdf.xacro")).expect("read"),
+        TOP
+    );
 }

@@ -1058,7 +1058,7 @@ mod tests {
         assert_eq!(pct("%d", Value::Int(42)), "42");
         assert_eq!(pct("%05d", Value::Int(42)), "00042");
         assert_eq!(pct("%-4d|", Value::Int(7)), "7   |");
-        assert_eq!(pct("%+.2f", Value::Float(3.14159)), "+3.14");
+        assert_eq!(pct("%+.2f", Value::Float(1.23456)), "+1.23");
         assert_eq!(pct("%f", Value::Float(0.5)), "0.500000");
         assert_eq!(pct("%e", Value::Float(12345.678)), "1.234568e+04");
         assert_eq!(pct("%g", Value::Float(0.0001)), "0.0001");

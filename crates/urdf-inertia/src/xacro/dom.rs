@@ -105,6 +105,9 @@ fn attrs(e: &BytesStart<'_>) -> Result<Vec<(String, String)>, (usize, String)> {
     Ok(out)
 }
 
+/// Deepest element nesting read (the expansion recurses along it).
+const MAX_DEPTH: usize = 1000;
+
 struct Open {
     el: Element,
     in_macro: bool,
@@ -177,6 +180,13 @@ pub fn parse(text: &str, file: usize) -> Result<Rc<Element>, ParseError> {
         };
         if root.is_some() {
             return Err(err(&mut lines, pos, "a second root element".into()));
+        }
+        if stack.len() >= MAX_DEPTH {
+            return Err(err(
+                &mut lines,
+                pos,
+                format!("elements nested deeper than {MAX_DEPTH} levels"),
+            ));
         }
         let open = open_element(&start, pos, end, file, &mut lines, &stack)?;
         if empty {

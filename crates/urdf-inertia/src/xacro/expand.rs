@@ -152,6 +152,8 @@ pub(super) struct Expander<'o> {
     here: (usize, usize),
     resolving: Vec<String>,
     pub warnings: Vec<String>,
+    /// Elements produced so far (against [`super::MAX_ELEMENTS`]).
+    elements: usize,
 }
 
 type R<T> = Result<T, XacroError>;
@@ -194,6 +196,7 @@ impl<'o> Expander<'o> {
             here: (0, 0),
             resolving: Vec::new(),
             warnings: Vec::new(),
+            elements: 0,
         }
     }
 
@@ -364,6 +367,9 @@ impl<'o> Expander<'o> {
             return Ok(parts.pop().unwrap_or(Value::None));
         }
         let joined: String = parts.iter().map(Value::to_py_str).collect();
+        if joined.len() > super::MAX_TEXT {
+            return Err(self.err("text too long (over 16 MiB) after expansion"));
+        }
         Ok(Value::str(&joined))
     }
 
@@ -512,6 +518,13 @@ impl<'o> Expander<'o> {
         macros: &Rc<MacroTable>,
         symbols: &Rc<Table>,
     ) -> R<Element> {
+        self.elements += 1;
+        if self.elements > super::MAX_ELEMENTS {
+            return Err(self.err(format!(
+                "the expansion makes more than {} elements (macros multiplying without end?)",
+                super::MAX_ELEMENTS
+            )));
+        }
         let saved = self.here;
         self.here = (el.src.file, el.src.line);
         let mut out = Element {

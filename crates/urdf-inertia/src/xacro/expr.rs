@@ -227,9 +227,14 @@ pub enum Expr {
 /// A call's positional and keyword arguments.
 type CallArgs = (Vec<Expr>, Vec<(String, Expr)>);
 
+/// Deepest nesting of an expression (parentheses, brackets, operators), so that a hostile one
+/// cannot exhaust the stack.
+const MAX_NESTING: usize = 200;
+
 struct Parser {
     toks: Vec<Tok>,
     at: usize,
+    depth: usize,
 }
 
 fn is_kw(t: Option<&Tok>, kw: &str) -> bool {
@@ -292,6 +297,18 @@ impl Parser {
     }
 
     fn test(&mut self) -> Result<Expr, String> {
+        self.depth += 1;
+        if self.depth > MAX_NESTING {
+            return Err(format!(
+                "expression nested deeper than {MAX_NESTING} levels"
+            ));
+        }
+        let r = self.test_inner();
+        self.depth -= 1;
+        r
+    }
+
+    fn test_inner(&mut self) -> Result<Expr, String> {
         if is_kw(self.peek(), "lambda") {
             return Err("lambda is not supported in xacro expressions here".into());
         }
@@ -389,6 +406,18 @@ impl Parser {
     }
 
     fn factor(&mut self) -> Result<Expr, String> {
+        self.depth += 1;
+        if self.depth > MAX_NESTING {
+            return Err(format!(
+                "expression nested deeper than {MAX_NESTING} levels"
+            ));
+        }
+        let r = self.factor_inner();
+        self.depth -= 1;
+        r
+    }
+
+    fn factor_inner(&mut self) -> Result<Expr, String> {
         if self.eat_op("-") {
             return Ok(Expr::Neg(Box::new(self.factor()?)));
         }
@@ -616,7 +645,11 @@ pub fn parse(src: &str) -> Result<Expr, String> {
     if toks.is_empty() {
         return Err("empty expression".into());
     }
-    let mut p = Parser { toks, at: 0 };
+    let mut p = Parser {
+        toks,
+        at: 0,
+        depth: 0,
+    };
     let e = p.testlist()?;
     if p.at < p.toks.len() {
         return Err(format!("unexpected {}", describe(&p.toks[p.at])));
@@ -870,7 +903,12 @@ fn int_op(op: &str, x: i64, y: i64) -> Result<Value, String> {
 fn sequence_op(op: &str, a: &Value, b: &Value) -> Result<Option<Value>, String> {
     use Value::{List, Str, Tuple};
     match (op, a, b) {
-        ("+", Str(x), Str(y)) => return Ok(Some(Value::str(&format!("{x}{y}")))),
+        ("+", Str(x), Str(y)) => {
+            if x.len() + y.len() > super::MAX_TEXT {
+                return Err("string too long (over 16 MiB)".into());
+            }
+            return Ok(Some(Value::str(&format!("{x}{y}"))));
+        }
         ("+", List(x), List(y)) => {
             return Ok(Some(List(Rc::new(
                 x.iter().chain(y.iter()).cloned().collect(),
@@ -883,7 +921,7 @@ fn sequence_op(op: &str, a: &Value, b: &Value) -> Result<Option<Value>, String> 
         }
         ("*", Str(s), n) | ("*", n, Str(s)) if int_of(n).is_some() => {
             let k = int_of(n).unwrap_or(0).max(0) as usize;
-            if s.len().saturating_mul(k) > 1 << 24 {
+            if s.len().saturating_mul(k) > super::MAX_TEXT {
                 return Err("string repetition too large".into());
             }
             return Ok(Some(Value::str(&s.repeat(k))));

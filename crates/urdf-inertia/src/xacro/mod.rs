@@ -49,6 +49,14 @@ use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
 pub use dom::Call;
+
+/// Longest text a value may grow to (a property doubling itself a few dozen times would
+/// otherwise take all memory).
+pub(crate) const MAX_TEXT: usize = 1 << 24;
+
+/// Most elements one expansion may produce (macros calling macros multiply): 1000 times the UR
+/// description's expansion; each element held costs about 600 bytes (docs/xacro.md).
+pub(crate) const MAX_ELEMENTS: usize = 250_000;
 pub use expand::Table;
 
 /// What an expansion reads from the outside: everything is passed in.

@@ -334,3 +334,58 @@ fn xacro_files_are_recognised() {
         b"<robot><link name=\"a\"/></robot>"
     ));
 }
+
+#[test]
+fn hostile_documents_are_errors_not_exhaustion() {
+    let h = HEAD;
+    // Elements nested 5000 deep.
+    let e = error(&format!(
+        "{h}{}{}</robot>",
+        "<a>".repeat(5000),
+        "</a>".repeat(5000)
+    ));
+    assert!(
+        e.message.contains("nested deeper than 1000"),
+        "{}",
+        e.message
+    );
+    // An expression nested 5000 deep.
+    let e = error(&format!(
+        "{h}<a v=\"${{{}1{}}}\"/></robot>",
+        "(".repeat(5000),
+        ")".repeat(5000)
+    ));
+    assert!(
+        e.message.contains("expression nested deeper than 200"),
+        "{}",
+        e.message
+    );
+    // A property doubling itself 40 times (8 TiB of text).
+    let mut doc = format!("{h}<xacro:property name=\"p0\" value=\"abcdefgh\"/>");
+    for i in 1..40 {
+        doc.push_str(&format!(
+            "<xacro:property name=\"p{i}\" value=\"${{p{}}}${{p{}}}\"/>",
+            i - 1,
+            i - 1
+        ));
+    }
+    let e = error(&format!("{doc}<a v=\"${{p39}}\"/></robot>"));
+    assert!(e.message.contains("text too long"), "{}", e.message);
+    // Macros calling macros ten times, eight deep (10^8 elements).
+    let mut doc = h.to_string();
+    for i in 0..8 {
+        let body = if i < 7 {
+            format!("<xacro:m{}/>", i + 1).repeat(10)
+        } else {
+            "<a/>".into()
+        };
+        doc.push_str(&format!("<xacro:macro name=\"m{i}\">{body}</xacro:macro>"));
+    }
+    let e = error(&format!("{doc}<xacro:m0/></robot>"));
+    assert!(
+        e.message.contains("more than 250000 elements"),
+        "{}",
+        e.message
+    );
+    assert_eq!(e.calls.len(), 8);
+}
