@@ -2,6 +2,7 @@
 //! (as ROS 2 xacro 2.1.1 prints it, less its banner).
 
 use super::*;
+use std::fmt::Write as _;
 use std::fs;
 
 struct Files {
@@ -363,11 +364,12 @@ fn hostile_documents_are_errors_not_exhaustion() {
     // A property doubling itself 40 times (8 TiB of text).
     let mut doc = format!("{h}<xacro:property name=\"p0\" value=\"abcdefgh\"/>");
     for i in 1..40 {
-        doc.push_str(&format!(
+        let _ = write!(
+            doc,
             "<xacro:property name=\"p{i}\" value=\"${{p{}}}${{p{}}}\"/>",
             i - 1,
             i - 1
-        ));
+        );
     }
     let e = error(&format!("{doc}<a v=\"${{p39}}\"/></robot>"));
     assert!(e.message.contains("text too long"), "{}", e.message);
@@ -379,7 +381,7 @@ fn hostile_documents_are_errors_not_exhaustion() {
         } else {
             "<a/>".into()
         };
-        doc.push_str(&format!("<xacro:macro name=\"m{i}\">{body}</xacro:macro>"));
+        let _ = write!(doc, "<xacro:macro name=\"m{i}\">{body}</xacro:macro>");
     }
     let e = error(&format!("{doc}<xacro:m0/></robot>"));
     assert!(
