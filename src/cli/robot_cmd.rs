@@ -380,6 +380,14 @@ fn read_input(path: &Path, src: &Sources, verbose: bool) -> Result<Input, String
                 e.message
             ),
         })?;
+    if robot.links.is_empty() && verbose {
+        // A file of macros (what pre-commit passes along with the top-level files): nothing to
+        // check on its own; its links are checked through the files that include it.
+        errln!(
+            "note: {}: expands to no links (a file of macros?): its links are checked through the top-level xacro files that include it",
+            path.display()
+        );
+    }
     let input = Input {
         robot,
         xacro: Some(x),
