@@ -328,7 +328,7 @@ fn only_inertials_change_and_fill_is_idempotent() {
 #[test]
 fn crlf_comments_and_unknown_tags_survive() {
     let tmp = tempfile::tempdir().expect("tempdir");
-    let text = "<?xml version=\"1.0\"?>\r\n<!-- keep me -->\r\n<robot name=\"r\" xmlns:xacro=\"http://ros.org/wiki/xacro\">\r\n   <link name=\"a\"   >\r\n      <collision><geometry><box size=\"1 2 3\"/></geometry></collision>\r\n   </link>\r\n   <xacro:property name=\"x\" value=\"1\"/>\r\n   <mujoco><compiler meshdir=\"m\"/></mujoco>\r\n   <ros2_control name=\"c\" type=\"system\"/>\r\n</robot>\r\n";
+    let text = "<?xml version=\"1.0\"?>\r\n<!-- keep me -->\r\n<robot name=\"r\" xmlns:xacro=\"http://ros.org/wiki/xacro\">\r\n   <link name=\"a\"   >\r\n      <collision><geometry><box size=\"1 2 3\"/></geometry></collision>\r\n   </link>\r\n   <mujoco><compiler meshdir=\"m\"/></mujoco>\r\n   <ros2_control name=\"c\" type=\"system\"/>\r\n</robot>\r\n";
     let path = tmp.path().join("r.urdf");
     std::fs::write(&path, text).expect("write");
     let out = run(&["fill", path.to_str().unwrap(), "--density", "1000"]);

@@ -463,9 +463,10 @@ fn file_uris_are_percent_decoded() {
     close(attr(link_body(&text, "a"), "mass", "value"), 100.0, "mass");
 }
 
-// Issue 11: a file that uses xacro gets one clear note.
+// Issue 21: a xacro source is expanded, so the links of its macros are seen and filled (issue 11
+// only noted that they were not).
 #[test]
-fn xacro_files_get_one_note() {
+fn xacro_sources_are_expanded() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let urdf = write(
         tmp.path(),
@@ -475,12 +476,17 @@ fn xacro_files_get_one_note() {
     let out = run(&["fill", s(&urdf), "--density", "1000"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
-    assert_eq!(stderr.matches("run `xacro").count(), 1, "{stderr}");
-    assert!(
-        stderr.contains("warning: ")
-            && stderr.contains("arm.urdf.xacro:2: this file uses xacro")
-            && stderr.contains("links inside xacro macros are not seen"),
-        "{stderr}"
+    assert!(!stderr.contains("run `xacro"), "{stderr}");
+    let text = String::from_utf8(out.stdout).expect("utf-8");
+    close(
+        attr(link_body(&text, "a"), "mass", "value"),
+        1000.0,
+        "mass of the macro's link",
+    );
+    close(
+        attr(link_body(&text, "base"), "mass", "value"),
+        1000.0,
+        "mass",
     );
     // Only the declaration (xacro's output keeps it): a softer note, still one.
     let urdf = write(

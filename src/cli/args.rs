@@ -21,6 +21,23 @@ pub enum Command {
     Check(CheckArgs),
     /// Mass properties of one mesh file: volume, mass, COM, inertia, principal axes, health.
     Mesh(MeshArgs),
+    /// Expand a xacro file and print the URDF (as the `xacro` tool does).
+    Xacro(XacroArgs),
+}
+
+#[derive(Debug, Clone, ClapArgs)]
+pub struct XacroArgs {
+    /// The xacro file (`robot.urdf.xacro`).
+    pub file: PathBuf,
+    /// xacro arguments, NAME:=VALUE.
+    #[arg(value_name = "NAME:=VALUE")]
+    pub args: Vec<String>,
+    /// Where a ROS package lives, for `$(find NAME)`. Repeatable.
+    #[arg(long, value_name = "NAME=DIR")]
+    pub package_path: Vec<String>,
+    /// Largest input file read: bytes or K/M/G; default 1G, or URDF_INERTIA_MAX_FILE_SIZE.
+    #[arg(long, value_name = "SIZE")]
+    pub max_file_size: Option<String>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
@@ -42,9 +59,13 @@ pub struct SourceArgs {
     /// Use each link's existing <mass> as its mass target (the robot was weighed; the inertia is unknown).
     #[arg(long)]
     pub keep_mass: bool,
-    /// Where a ROS package lives: `package://NAME/a/b` is DIR/a/b. Repeatable.
+    /// Where a ROS package lives: `package://NAME/a/b` is DIR/a/b (and `$(find NAME)` in xacro is
+    /// DIR). Repeatable.
     #[arg(long, value_name = "NAME=DIR")]
     pub package_path: Vec<String>,
+    /// A xacro argument for `.xacro` inputs, NAME:=VALUE. Repeatable.
+    #[arg(long = "arg", value_name = "NAME:=VALUE")]
+    pub xacro_args: Vec<String>,
     /// Treat every repaired mesh (re-wound, flipped, convex hull) as an error.
     #[arg(long)]
     pub strict: bool,

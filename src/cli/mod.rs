@@ -18,6 +18,7 @@ pub mod output;
 mod robot_cmd;
 mod summary;
 pub mod write;
+mod xacro_cmd;
 
 use clap::Parser;
 
@@ -54,6 +55,7 @@ pub fn main() -> i32 {
         Command::Fill(f) => f.source.max_file_size.clone(),
         Command::Diff(d) => d.source.max_file_size.clone(),
         Command::Check(c) => c.source.max_file_size.clone(),
+        Command::Xacro(x) => x.max_file_size.clone(),
     };
     let from_env = std::env::var(urdf_inertia::input::MAX_FILE_SIZE_ENV).ok();
     if let Some((what, s)) = max_size
@@ -73,6 +75,7 @@ pub fn main() -> i32 {
         Command::Fill(f) => robot_cmd::fill(&f),
         Command::Diff(d) => robot_cmd::diff(&d),
         Command::Check(c) => robot_cmd::check(&c),
+        Command::Xacro(x) => xacro_cmd::run(&x),
     };
     if output::stdout_failed() {
         return ExitStatus::Error as i32;

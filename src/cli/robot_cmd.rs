@@ -17,11 +17,14 @@ use urdf_inertia::text::Digits;
 use urdf_inertia::urdf::resolve::PackageResolver;
 use urdf_inertia::urdf::write::{splice, LinkUpdate, WriteOptions};
 use urdf_inertia::urdf::{scan_bytes, Geometry, Robot};
+use urdf_inertia::xacro::{self, Expansion};
 
 /// Validated sources: densities (if any), package paths, link selection.
 struct Sources {
     map: Option<DensityMap>,
     resolver: PackageResolver,
+    /// `--arg NAME:=VALUE` for xacro inputs.
+    xacro_args: Vec<(String, String)>,
     options: FillOptions,
 }
 
@@ -52,9 +55,15 @@ fn sources(s: &SourceArgs) -> Result<Sources, String> {
         .iter()
         .map(|p| PackageResolver::parse_package_arg(p))
         .collect::<Result<Vec<_>, String>>()?;
+    let xacro_args = s
+        .xacro_args
+        .iter()
+        .map(|a| xacro::parse_arg(a))
+        .collect::<Result<Vec<_>, String>>()?;
     Ok(Sources {
         map,
         resolver: PackageResolver::new(&pkgs),
+        xacro_args,
         options: FillOptions {
             strict: s.strict,
             only: globs(&s.only)?,
@@ -132,6 +141,11 @@ impl Config {
             return Err(
                 "--format json summarises one URDF: fill several without it, or one at a time"
                     .into(),
+            );
+        }
+        if a.in_place && a.urdf.iter().any(|p| p.as_os_str() == "-") {
+            return Err(
+                "-i writes files in place: stdin (`-`) has none; use -o OUT or stdout".into(),
             );
         }
         let mut src = sources_with_densities(&a.source, "fill")?;
@@ -254,31 +268,32 @@ fn run(config: &Config) -> Outcome {
 
 fn run_one(config: &Config, path: &Path, cache: &mut MeshCache) -> Outcome {
     let start = Instant::now();
-    let robot = match read_robot(path, config.verbose) {
+    let input = match read_input(path, &config.src, config.verbose) {
         Ok(r) => r,
         Err(e) => {
             errln!("error: {e}");
             return Outcome::error();
         }
     };
+    let robot = &input.robot;
     let mut outcome = Outcome::default();
     if let Mode::Check { all_links } = config.mode {
-        outcome.problems += check_existing(&robot, config, all_links);
+        outcome.problems += check_existing(&input, config, all_links);
     }
     let Some(map) = &config.src.map else {
         // Only `check` runs without densities: nothing is computed, but a collision that cannot be
         // is still an error.
-        outcome.errors += check_collisions(&robot, &config.src);
+        outcome.errors += check_collisions(&input, &config.src);
         return outcome;
     };
     let src = &config.src;
-    let report = fill::compute_with(&robot, map, &src.resolver, &src.options, cache);
-    print_failures(&robot, &report);
+    let report = fill::compute_with(robot, map, &src.resolver, &src.options, cache);
+    print_failures(&input, &report);
     outcome.errors += report.error_count();
-    let rows = compare_all(&robot, &report);
+    let rows = compare_all(robot, &report);
     match &config.mode {
         Mode::Write(w) => {
-            if write_robot(&robot, &report, w, config.verbose, start).is_err() {
+            if write_robot(&input, &report, w, config.verbose, start).is_err() {
                 outcome.errors += 1;
             }
         }
@@ -287,19 +302,102 @@ fn run_one(config: &Config, path: &Path, cache: &mut MeshCache) -> Outcome {
             outcome.problems += rows.iter().filter(|r| r.differs(config.tolerance)).count();
         }
         Mode::Check { .. } => {
-            outcome.problems += check_against_computed(&robot, &rows, config.tolerance);
+            outcome.problems += check_against_computed(&input, &rows, config.tolerance);
         }
     }
     outcome
 }
 
-/// Reads, decodes and scans a URDF, printing the scan's warnings (and notes, if `verbose`) to stderr.
-fn read_robot(path: &Path, verbose: bool) -> Result<Robot, String> {
-    let bytes = urdf_inertia::input::read_file(path)
-        .map_err(|e| format!("{}: cannot read the URDF: {e}", path.display()))?;
-    let robot = scan_bytes(bytes, path).map_err(|e| e.to_string())?;
-    print_diagnostics(&robot.notes, verbose);
-    Ok(robot)
+/// A robot as read: the scanned URDF and, for a xacro source, its expansion (whose source map
+/// turns lines of the expanded text into files and lines of the sources).
+pub struct Input {
+    robot: Robot,
+    xacro: Option<Expansion>,
+}
+
+impl Input {
+    /// `FILE:LINE: link `name`` for an element on `line` of the scanned text; for a xacro source
+    /// the file and line where it was written, and the macro calls that produced it.
+    fn link_at(&self, line: usize, name: &str) -> String {
+        match self.xacro.as_ref().and_then(|x| Some((x, x.origin(line)?))) {
+            Some((x, o)) => format!("{}: link `{name}`{}", x.at(o), x.calls_text(o)),
+            None => format!("{}:{line}: link `{name}`", self.robot.path.display()),
+        }
+    }
+
+    /// A diagnostic's location moved from the expanded text to the source.
+    fn located(&self, d: &Diagnostic) -> Diagnostic {
+        let mut d = d.clone();
+        if let (Some(x), Some(l)) = (&self.xacro, d.location.as_mut()) {
+            if l.file.as_deref() == Some(self.robot.path.as_path()) {
+                if let Some(o) = l.line.and_then(|line| x.origin(line)) {
+                    l.file = Some(x.files[o.file].path.clone());
+                    l.line = Some(o.line);
+                    d.message.push_str(&x.calls_text(o));
+                }
+            }
+        }
+        d
+    }
+}
+
+/// Reads, decodes and scans a URDF (a file, or stdin for `-`), expanding a xacro source first,
+/// and prints the scan's warnings (and notes, if `verbose`) to stderr.
+fn read_input(path: &Path, src: &Sources, verbose: bool) -> Result<Input, String> {
+    let stdin = path.as_os_str() == "-";
+    let bytes = if stdin {
+        urdf_inertia::input::read_rest(std::io::stdin().lock(), Vec::new())
+            .map_err(|e| format!("stdin: cannot read the URDF: {e}"))?
+    } else {
+        urdf_inertia::input::read_file(path)
+            .map_err(|e| format!("{}: cannot read the URDF: {e}", path.display()))?
+    };
+    if stdin {
+        let robot = scan_bytes(bytes, Path::new("<stdin>")).map_err(|e| e.to_string())?;
+        print_diagnostics(&robot.notes, verbose);
+        return Ok(Input { robot, xacro: None });
+    }
+    if !xacro::is_xacro(path, &bytes) {
+        let robot = scan_bytes(bytes, path).map_err(|e| e.to_string())?;
+        print_diagnostics(&robot.notes, verbose);
+        return Ok(Input { robot, xacro: None });
+    }
+    let opts = xacro::Options::from_process(src.xacro_args.clone(), &src.resolver);
+    let x = xacro::expand_file(path, &opts).map_err(|e| e.to_string())?;
+    for w in &x.warnings {
+        errln!("warning: {w}");
+    }
+    let robot =
+        scan_bytes(x.text.clone().into_bytes(), path).map_err(|e| match x.origin(e.line) {
+            Some(o) => format!(
+                "{}: {}{} (in the expansion of {})",
+                x.at(o),
+                e.message,
+                x.calls_text(o),
+                path.display()
+            ),
+            None => format!(
+                "{} (line {} of the expansion): {}",
+                path.display(),
+                e.line,
+                e.message
+            ),
+        })?;
+    if robot.links.is_empty() && verbose {
+        // A file of macros (what pre-commit passes along with the top-level files): nothing to
+        // check on its own; its links are checked through the files that include it.
+        errln!(
+            "note: {}: expands to no links (a file of macros?): its links are checked through the top-level xacro files that include it",
+            path.display()
+        );
+    }
+    let input = Input {
+        robot,
+        xacro: Some(x),
+    };
+    let notes: Vec<Diagnostic> = input.robot.notes.iter().map(|d| input.located(d)).collect();
+    print_diagnostics(&notes, verbose);
+    Ok(input)
 }
 
 /// Warnings always, notes with `--verbose`.
@@ -309,10 +407,10 @@ fn print_diagnostics(diagnostics: &[Diagnostic], verbose: bool) {
     }
 }
 
-fn print_failures(robot: &Robot, report: &FillReport) {
-    let path = robot.path.display();
+fn print_failures(input: &Input, report: &FillReport) {
+    let path = input.robot.path.display();
     for f in &report.failures {
-        errln!("error: {path}:{}: link `{}`: {f}", f.line, f.link);
+        errln!("error: {}: {f}", input.link_at(f.line, &f.link));
     }
     for e in &report.robot_errors {
         errln!("error: {path}: {e}");
@@ -322,14 +420,14 @@ fn print_failures(robot: &Robot, report: &FillReport) {
 /// `fill`'s output: the spliced URDF, written (unless links failed without `--keep-going`), then
 /// the summary. `Err` carries the status of a failure already reported.
 fn write_robot(
-    robot: &Robot,
+    input: &Input,
     report: &FillReport,
     w: &WriteConfig,
     verbose: bool,
     start: Instant,
 ) -> Result<(), ExitStatus> {
+    let robot = &input.robot;
     let t_write = Instant::now();
-    let text = spliced(robot, report, w)?;
     let file = if w.in_place {
         Some(robot.path.as_path())
     } else {
@@ -337,19 +435,32 @@ fn write_robot(
     };
     let where_to = file.map_or_else(|| "stdout".to_string(), |p| p.display().to_string());
     let failed = report.error_count();
-    if failed > 0 && !w.keep_going {
-        errln!(
-            "error: {failed} link(s) could not be computed: nothing written to {where_to} (--keep-going writes the links that worked, and still exits 2)"
-        );
-        return Err(ExitStatus::Error);
-    }
-    let target = file.unwrap_or(Path::new("-"));
-    if let Err(e) = write::write_output(target, &text) {
-        // A failing stdout was reported where it failed.
-        if file.is_some() {
-            errln!("error: {e}");
+    let check_failed = || {
+        if failed > 0 && !w.keep_going {
+            errln!(
+                "error: {failed} link(s) could not be computed: nothing written to {where_to} (--keep-going writes the links that worked, and still exits 2)"
+            );
+            return Err(ExitStatus::Error);
         }
-        return Err(ExitStatus::Error);
+        Ok(())
+    };
+    match (&input.xacro, w.in_place) {
+        (Some(x), true) => {
+            check_failed()?;
+            write_into_sources(input, x, report, w)?;
+        }
+        _ => {
+            let text = spliced(robot, report, w)?;
+            check_failed()?;
+            let target = file.unwrap_or(Path::new("-"));
+            if let Err(e) = write::write_output(target, &text) {
+                // A failing stdout was reported where it failed.
+                if file.is_some() {
+                    errln!("error: {e}");
+                }
+                return Err(ExitStatus::Error);
+            }
+        }
     }
     if file.is_some() {
         super::output::stdout_is_summary();
@@ -364,6 +475,91 @@ fn write_robot(
     } else {
         summary::fill_text(robot, report, &run, verbose, times, w.several);
     }
+    Ok(())
+}
+
+/// `fill -i` on a xacro source: each computed `<inertial>` spliced into the file where its link is
+/// written literally (an included file too), every other byte unchanged, each file replaced
+/// atomically. A link that comes from a macro (or is otherwise not written literally) is named with
+/// the reason and left alone: `-o FILE` writes the filled expansion instead.
+fn write_into_sources(
+    input: &Input,
+    x: &Expansion,
+    report: &FillReport,
+    w: &WriteConfig,
+) -> Result<(), ExitStatus> {
+    let robot = &input.robot;
+    let options = WriteOptions {
+        digits: w.digits,
+        principal: w.principal,
+    };
+    // Per source file: the links written there (span, update).
+    let mut per_file: std::collections::BTreeMap<usize, Vec<(usize, usize, LinkUpdate)>> =
+        Default::default();
+    for l in &report.links {
+        let link = &robot.links[l.index];
+        let Some(o) = x.origin(link.line) else {
+            continue;
+        };
+        match &o.literal {
+            Ok(()) => per_file
+                .entry(o.file)
+                .or_default()
+                .push((o.start, o.end, l.update())),
+            Err(why) => errln!(
+                "warning: {}: not written into the xacro source: {why}; `urdf-inertia fill {} -o filled.urdf` writes the filled expansion",
+                input.link_at(link.line, &link.name),
+                robot.path.display()
+            ),
+        }
+    }
+    let written: usize = per_file.values().map(Vec::len).sum();
+    let files = per_file.len();
+    for (file, links) in per_file {
+        let path = &x.files[file].path;
+        let spans: Vec<(usize, usize)> = links.iter().map(|(s, e, _)| (*s, *e)).collect();
+        let source = x.source_robot(file, &spans).map_err(|e| {
+            errln!(
+                "error: {}: cannot write into this file: {e}",
+                path.display()
+            );
+            ExitStatus::Error
+        })?;
+        let updates: Vec<LinkUpdate> = links
+            .iter()
+            .filter_map(|(s, _, u)| {
+                let index = source.links.iter().position(|l| l.start == *s)?;
+                Some(LinkUpdate { index, ..*u })
+            })
+            .collect();
+        let text = splice(&source, &updates, &options).map_err(|errors| {
+            for e in errors {
+                let link = &source.links[e.index];
+                errln!(
+                    "error: {}:{}: link `{}`: {}",
+                    path.display(),
+                    link.line,
+                    link.name,
+                    e.message
+                );
+            }
+            errln!("error: nothing written to {}", path.display());
+            ExitStatus::Error
+        })?;
+        let bytes = source.encoding.encode(&text).map_err(|e| {
+            errln!("error: {}: {e}", path.display());
+            ExitStatus::Error
+        })?;
+        if let Err(e) = write::write_output(path, &bytes) {
+            errln!("error: {e}");
+            return Err(ExitStatus::Error);
+        }
+    }
+    errln!(
+        "urdf-inertia: {}: wrote {written} of {} computed link(s) into {files} xacro source file(s)",
+        robot.path.display(),
+        report.links.len()
+    );
     Ok(())
 }
 
@@ -463,8 +659,8 @@ fn compare_all<'a>(robot: &Robot, report: &'a FillReport) -> Vec<Row<'a>> {
 }
 
 /// Problems of the existing `<inertial>` elements themselves (no computation needed); their count.
-fn check_existing(robot: &Robot, config: &Config, all_links: bool) -> usize {
-    let path = robot.path.display();
+fn check_existing(input: &Input, config: &Config, all_links: bool) -> usize {
+    let robot = &input.robot;
     let mut problems = 0;
     for link in robot
         .links
@@ -474,9 +670,8 @@ fn check_existing(robot: &Robot, config: &Config, all_links: bool) -> usize {
         let Some(span) = &link.inertial else {
             if link.has_collision_geometry() {
                 outln!(
-                    "{path}:{}: link `{}`: has collision geometry but no <inertial>",
-                    link.line,
-                    link.name
+                    "{}: has collision geometry but no <inertial>",
+                    input.link_at(link.line, &link.name)
                 );
                 problems += 1;
             }
@@ -487,11 +682,17 @@ fn check_existing(robot: &Robot, config: &Config, all_links: bool) -> usize {
         for p in existing_problems(link) {
             if !link.has_collision_geometry() && !all_links && duplicates.as_ref() != Some(&p) {
                 if config.verbose {
-                    let note = Diagnostic::new(Code::UrdfFrameInertial, format!("{path}:{}: link `{}` (no collision geometry, so fill cannot compute it): {p}", span.line, link.name));
+                    let note = Diagnostic::new(
+                        Code::UrdfFrameInertial,
+                        format!(
+                            "{} (no collision geometry, so fill cannot compute it): {p}",
+                            input.link_at(span.line, &link.name)
+                        ),
+                    );
                     errln!("{}: {}", note.severity.as_str(), note.message);
                 }
             } else {
-                outln!("{path}:{}: link `{}`: {p}", span.line, link.name);
+                outln!("{}: {p}", input.link_at(span.line, &link.name));
                 problems += 1;
             }
         }
@@ -501,7 +702,8 @@ fn check_existing(robot: &Robot, config: &Config, all_links: bool) -> usize {
 
 /// Without densities nothing is computed, but a collision that cannot be is still an error; their
 /// count.
-fn check_collisions(robot: &Robot, src: &Sources) -> usize {
+fn check_collisions(input: &Input, src: &Sources) -> usize {
+    let robot = &input.robot;
     let mut errors = 0;
     for link in robot
         .links
@@ -511,10 +713,8 @@ fn check_collisions(robot: &Robot, src: &Sources) -> usize {
         for c in &link.collisions {
             if let Geometry::Invalid { line, message } = &c.geometry {
                 errln!(
-                    "error: {}:{}: link `{}`: collision {} (line {line}): {message}",
-                    robot.path.display(),
-                    link.line,
-                    link.name,
+                    "error: {}: collision {} (line {line}): {message}",
+                    input.link_at(link.line, &link.name),
                     c.index
                 );
                 errors += 1;
@@ -526,7 +726,8 @@ fn check_collisions(robot: &Robot, src: &Sources) -> usize {
 
 /// Existing against computed, beyond the tolerance (invalid values are reported by
 /// `check_existing`); their count.
-fn check_against_computed(robot: &Robot, rows: &[Row], tolerance: f64) -> usize {
+fn check_against_computed(input: &Input, rows: &[Row], tolerance: f64) -> usize {
+    let robot = &input.robot;
     let mut problems = 0;
     for r in rows {
         let (Some(e), Some(c)) = (&r.existing, &r.comparison) else {
@@ -546,9 +747,8 @@ fn check_against_computed(robot: &Robot, rows: &[Row], tolerance: f64) -> usize 
             .as_ref()
             .map_or(r.link.line, |s| s.line);
         outln!(
-            "{}:{line}: link `{}`: {}{causes} (tolerance {tolerance})",
-            robot.path.display(),
-            r.link.name,
+            "{}: {}{causes} (tolerance {tolerance})",
+            input.link_at(line, &r.link.name),
             off.join("; ")
         );
         problems += 1;

@@ -4,6 +4,7 @@
 //! Data flows one way, each stage a module:
 //! URDF scan ([`urdf`]) → resolve and load geometry ([`mesh`]) → mass core ([`mass`]) →
 //! per-link composition ([`fill`]) → splice `<inertial>` into the original bytes ([`urdf::write`]).
+//! xacro sources are expanded first ([`xacro`]), with a map back to their files and lines.
 #![forbid(unsafe_code)]
 
 pub mod density;
@@ -15,6 +16,7 @@ pub mod mesh;
 pub mod overlap;
 pub mod text;
 pub mod urdf;
+pub mod xacro;
 
 /// A small deterministic generator for the unit tests (xorshift64; the same sequence on every run).
 #[cfg(test)]

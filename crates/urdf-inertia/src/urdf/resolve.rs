@@ -146,6 +146,26 @@ impl PackageResolver {
         }
     }
 
+    /// The directory of package `pkg` as xacro's `$(find pkg)` gives it, searched the way mesh
+    /// `package://` URIs are (explicit paths, `ROS_PACKAGE_PATH`, `AMENT_PREFIX_PATH`, walking up
+    /// from the directory of `from_file`).
+    pub fn package_dir(&self, pkg: &str, from_file: &Path) -> Result<PathBuf, NotFound> {
+        let base = from_file
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
+        let mut searched = Vec::new();
+        let found = self
+            .package_dirs(pkg, &base, &mut searched)
+            .into_iter()
+            .find(|d| d.is_dir());
+        found.ok_or_else(|| NotFound {
+            uri: format!("$(find {pkg})"),
+            searched,
+            hint: format!("pass --package-path {pkg}=DIR (DIR is the package's directory), or set ROS_PACKAGE_PATH"),
+        })
+    }
+
     /// Candidate directories for package `pkg`, in search order (recording what was looked at).
     fn package_dirs(&self, pkg: &str, base: &Path, searched: &mut Vec<PathBuf>) -> Vec<PathBuf> {
         let mut out = Vec::new();

@@ -1,0 +1,46 @@
+//! `xacro`: a xacro file expanded to URDF on stdout, as the `xacro` tool prints it; expansion
+//! errors as `FILE:LINE: …` on stderr with exit 2.
+
+use super::args::XacroArgs;
+use super::ExitStatus;
+use urdf_inertia::urdf::resolve::PackageResolver;
+use urdf_inertia::xacro;
+
+pub fn run(a: &XacroArgs) -> ExitStatus {
+    let parsed = (|| -> Result<_, String> {
+        let args = a
+            .args
+            .iter()
+            .map(|s| xacro::parse_arg(s))
+            .collect::<Result<Vec<_>, String>>()?;
+        let pkgs = a
+            .package_path
+            .iter()
+            .map(|p| PackageResolver::parse_package_arg(p))
+            .collect::<Result<Vec<_>, String>>()?;
+        Ok((args, pkgs))
+    })();
+    let (args, pkgs) = match parsed {
+        Ok(p) => p,
+        Err(e) => {
+            errln!("error: {e}");
+            return ExitStatus::Error;
+        }
+    };
+    let resolver = PackageResolver::new(&pkgs);
+    let opts = xacro::Options::from_process(args, &resolver);
+    match xacro::expand_file(&a.file, &opts) {
+        Ok(e) => {
+            for w in &e.warnings {
+                errln!("warning: {w}");
+            }
+            // A failure is reported there and turns the exit status to 2 (`output::stdout_failed`).
+            let _ = super::output::write_stdout(e.text.as_bytes());
+            ExitStatus::Success
+        }
+        Err(e) => {
+            errln!("error: {e}");
+            ExitStatus::Error
+        }
+    }
+}
