@@ -959,7 +959,9 @@ fn sample_part(parts: &[PlacedPart], nb: &[Vec<usize>], i: usize, n: usize) -> P
             }
         }
     }
-    out.shared = sum * cell_volume;
+    // A part shares at most its own volume: on a coarse grid, a sample can stand for more.
+    // (The true share lies in [0, volume], so this only brings the estimate closer to it.)
+    out.shared = (sum * cell_volume).min(p.volume);
     out.found = out.most > 1;
     out.uncertain = (uncertain as f64 + 3.0 * SHRINK * (n * n * n) as f64) * cell_volume;
     out
