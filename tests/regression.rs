@@ -881,7 +881,10 @@ fn overlap_of_2000_spheres_completes() {
 fn overlap_of_1000_crowded_convex_pieces_keeps_to_the_work_cap() {
     let tmp = tempfile::tempdir().unwrap();
     let (v, f) = common::icosphere(3);
-    let v: Vec<[f64; 3]> = v.iter().map(|p| [0.7 * p[0], 0.6 * p[1], 0.55 * p[2]]).collect();
+    let v: Vec<[f64; 3]> = v
+        .iter()
+        .map(|p| [0.7 * p[0], 0.6 * p[1], 0.55 * p[2]])
+        .collect();
     std::fs::write(
         tmp.path().join("piece.stl"),
         urdf_inertia::mesh::stl::write_binary(b"piece", &v, &f),
@@ -893,7 +896,10 @@ fn overlap_of_1000_crowded_convex_pieces_keeps_to_the_work_cap() {
             let t = [0, 1, 2].map(|_| rng.range(0.0, 2.0));
             let r = [0, 1, 2].map(|_| rng.range(-1.0, 1.0));
             (
-                format!("{} {} {}\" rpy=\"{} {} {}", t[0], t[1], t[2], r[0], r[1], r[2]),
+                format!(
+                    "{} {} {}\" rpy=\"{} {} {}",
+                    t[0], t[1], t[2], r[0], r[1], r[2]
+                ),
                 "<mesh filename=\"piece.stl\"/>".to_string(),
             )
         })
@@ -1477,8 +1483,9 @@ impl Row {
             .and_then(|k| k.parse::<u64>().ok())
             .map(|k| k * 1024);
         let seconds = field("Elapsed (wall clock) time (h:mm:ss or m:ss):").and_then(|t| {
-            t.split(':')
-                .try_fold(0.0, |s, part| part.parse::<f64>().ok().map(|x| 60.0 * s + x))
+            t.split(':').try_fold(0.0, |s, part| {
+                part.parse::<f64>().ok().map(|x| 60.0 * s + x)
+            })
         });
         Row {
             what: what.trim_start_matches("large: ").to_string(),
@@ -1698,7 +1705,10 @@ fn large_inputs(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)
     // A convex decomposition: 320-triangle hulls on a unit lattice (a cube of side ⌈N^⅓⌉), each turned
     // its own way and overlapping its neighbours, as benches/overlap.rs places them.
     let (pv, pf) = common::icosphere(3);
-    let pv: Vec<[f64; 3]> = pv.iter().map(|p| [0.7 * p[0], 0.6 * p[1], 0.55 * p[2]]).collect();
+    let pv: Vec<[f64; 3]> = pv
+        .iter()
+        .map(|p| [0.7 * p[0], 0.6 * p[1], 0.55 * p[2]])
+        .collect();
     std::fs::write(
         d.join("piece.stl"),
         urdf_inertia::mesh::stl::write_binary(b"piece", &pv, &pf),

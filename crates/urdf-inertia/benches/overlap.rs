@@ -33,8 +33,10 @@ pub fn pieces(n: usize, cluster: bool) -> Vec<PlacedPart> {
         .map(|i| {
             let axes = [0, 1, 2].map(|_| rng.range(0.55, 0.75));
             let rpy = [0, 1, 2].map(|_| rng.range(-1.0, 1.0));
-            let vertices: Vec<[f64; 3]> =
-                v.iter().map(|p| [0, 1, 2].map(|k| p[k] * axes[k])).collect();
+            let vertices: Vec<[f64; 3]> = v
+                .iter()
+                .map(|p| [0, 1, 2].map(|k| p[k] * axes[k]))
+                .collect();
             let raw = RawMesh {
                 vertices,
                 faces: Polygons::from_triangles(&f),

@@ -100,10 +100,7 @@ struct SurfaceCells {
 }
 
 impl SurfaceCells {
-    fn new<'a>(
-        triangles: impl Iterator<Item = &'a [[f64; 3]; 3]>,
-        region: &Aabb,
-    ) -> Option<Self> {
+    fn new<'a>(triangles: impl Iterator<Item = &'a [[f64; 3]; 3]>, region: &Aabb) -> Option<Self> {
         let g = SURFACE_GRID;
         let lo = region.0;
         let cell = [0, 1, 2].map(|k| ((region.1[k] - lo[k]) / g as f64).max(f64::MIN_POSITIVE));
@@ -627,9 +624,8 @@ impl PlacedPart {
         // The box's bounding box in the part's frame, grown by far more than the rounding of `q`
         // (a few ulps of its coordinates), so that the verdict holds for the box as it is exactly.
         let size = (0..3).fold(0.0f64, |m, k| m.max(q[k].abs()).max(h[k]));
-        let e = [0, 1, 2].map(|k| {
-            (0..3).map(|m| rt[k][m].abs() * h[m]).sum::<f64>() + 1e-12 * size
-        });
+        let e =
+            [0, 1, 2].map(|k| (0..3).map(|m| rt[k][m].abs() * h[m]).sum::<f64>() + 1e-12 * size);
         let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         // `d` ± `r` against `limit`: the distance `d` of the centre from a centre set, moved by at most
         // the box's radius `r`, either way.
@@ -696,7 +692,6 @@ impl PlacedPart {
         self.locator = Some(Arc::new(locator));
         Some(bound.unwrap_or(usize::MAX / 4))
     }
-
 }
 
 /// The winding number of a closed, outward surface around `q`: 1 inside, 0 outside.
@@ -1376,7 +1371,10 @@ mod tests {
                     other => panic!("expected an estimate, got {other:?}"),
                 };
                 let error = (e.excess - exact).abs();
-                assert!(error <= e.bound, "{as_mesh} {budget}: {error} > {e:?} ({exact})");
+                assert!(
+                    error <= e.bound,
+                    "{as_mesh} {budget}: {error} > {e:?} ({exact})"
+                );
                 assert_eq!(e.capped, e.grid < GRID);
                 bounds.push((e.bound, e.capped, e.grid));
             }
@@ -1426,7 +1424,11 @@ mod tests {
         let e = estimated(&mut parts);
         assert!(e.capped && e.grid < GRID, "{e:?}");
         let error = (e.excess - exact).abs();
-        assert!(error <= e.bound, "{error} > {} ({e:?}, exact {exact})", e.bound);
+        assert!(
+            error <= e.bound,
+            "{error} > {} ({e:?}, exact {exact})",
+            e.bound
+        );
         assert_eq!(e.most, 8);
     }
 

@@ -19,9 +19,9 @@
 
 use super::weld::VertexTable;
 use super::{parse_f64, short_decimal, MeshError, MeshErrorKind, RawMesh};
-use std::io::Read as _;
 use crate::mass::Polygons;
 use std::fmt::Write as _;
+use std::io::Read as _;
 use std::path::Path;
 
 /// Parses STL bytes (binary or ASCII). Corners with bit-identical coordinates share one vertex, in
@@ -388,7 +388,9 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
             b"vertex" => {
                 out.dependent |= !out.outer;
                 if !in_loop {
-                    out.error = fail(MeshErrorKind::Syntax("`vertex` outside `outer loop`".into()));
+                    out.error = fail(MeshErrorKind::Syntax(
+                        "`vertex` outside `outer loop`".into(),
+                    ));
                     break;
                 }
                 match words.vertex() {
@@ -467,9 +469,8 @@ impl AsciiWords<'_> {
                 .position(|b| !b.is_ascii_whitespace())
                 .unwrap_or(self.rest.len());
             self.rest = &self.rest[skip..];
-            let fast = short_decimal(self.rest).filter(|&(_, n)| {
-                self.rest.get(n).is_none_or(|b| b.is_ascii_whitespace())
-            });
+            let fast = short_decimal(self.rest)
+                .filter(|&(_, n)| self.rest.get(n).is_none_or(|b| b.is_ascii_whitespace()));
             *c = match fast {
                 Some((x, n)) => {
                     self.rest = &self.rest[n..];
@@ -648,9 +649,7 @@ fn facet_chunks(text: &[u8], size: usize) -> Vec<&[u8]> {
                 .iter()
                 .position(|&b| !matches!(b, b' ' | b'\t' | b'\r' | b'\x0c'))
                 .map_or(&line[line.len()..], |w| &line[w..]);
-            if word.starts_with(b"facet")
-                && word.get(5).is_none_or(|b| b.is_ascii_whitespace())
-            {
+            if word.starts_with(b"facet") && word.get(5).is_none_or(|b| b.is_ascii_whitespace()) {
                 cut = Some(next);
                 break;
             }
@@ -866,7 +865,10 @@ mod tests {
             s += &format!("{ind}facet{g}normal{g}0{g}0{g}1{eol}{ind}{ind}outer{g}loop{eol}");
             for &i in face {
                 let p = v[i as usize].map(style.number);
-                s += &format!("{ind}{ind}{ind}vertex{g}{}{g}{}{g}{}{eol}", p[0], p[1], p[2]);
+                s += &format!(
+                    "{ind}{ind}{ind}vertex{g}{}{g}{}{g}{}{eol}",
+                    p[0], p[1], p[2]
+                );
             }
             s += &format!("{ind}{ind}endloop{eol}{ind}endfacet{eol}");
         }
@@ -933,7 +935,11 @@ mod tests {
                 );
             }
             (Err(a), Err(b)) => assert_eq!(format!("{a:?}"), format!("{b:?}"), "{what}"),
-            (a, b) => panic!("{what}: {:?} against {:?}", a.as_ref().err(), b.as_ref().err()),
+            (a, b) => panic!(
+                "{what}: {:?} against {:?}",
+                a.as_ref().err(),
+                b.as_ref().err()
+            ),
         }
     }
 
@@ -946,10 +952,18 @@ mod tests {
         for (piece, chunk) in [(7, 1), (64, 40), (300, 100), (1 << 20, 1000)] {
             let mut tiny = Ascii::new(path, chunk);
             tiny.feed(bytes);
-            same(&reference, &tiny.finish(), &format!("{what}, chunks of {chunk}"));
+            same(
+                &reference,
+                &tiny.finish(),
+                &format!("{what}, chunks of {chunk}"),
+            );
             let head = bytes[..bytes.len().min(5)].to_vec();
             let streamed = ascii_stream(head, &bytes[bytes.len().min(5)..], path, piece, chunk);
-            same(&reference, &streamed, &format!("{what}, pieces of {piece}, chunks of {chunk}"));
+            same(
+                &reference,
+                &streamed,
+                &format!("{what}, pieces of {piece}, chunks of {chunk}"),
+            );
         }
         if looks_ascii(bytes) && is_text(&bytes[..bytes.len().min(4096)]) {
             let read = read_split(bytes, bytes.len() as u64, path, CHUNK, None);
