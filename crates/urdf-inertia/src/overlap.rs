@@ -616,9 +616,10 @@ impl PlacedPart {
         }
     }
 
-    /// Whether the part's surface may meet the box of centre `x` and half sides `h` (link frame):
-    /// `false` only when every point of the box is surely inside the solid, or surely outside it.
-    fn may_cross(&self, x: [f64; 3], h: [f64; 3]) -> bool {
+    /// Where the box of centre `x` and half sides `h` (link frame) lies: `Some(true)` when every
+    /// point of it is surely inside the solid, `Some(false)` when surely outside, `None` when the
+    /// part's surface may cross it. A verdict is what [`Self::contains`] says of `x`.
+    fn classify(&self, x: [f64; 3], h: [f64; 3]) -> Option<bool> {
         let rt = transpose(&self.rotation);
         let q = mat_vec(&rt, [0, 1, 2].map(|k| x[k] - self.translation[k]));
         // The box's bounding box in the part's frame, grown by far more than the rounding of `q`
@@ -629,31 +630,42 @@ impl PlacedPart {
         let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         // `d` ± `r` against `limit`: the distance `d` of the centre from a centre set, moved by at most
         // the box's radius `r`, either way.
-        let straddles = |d: f64, r: f64, limit: f64| !(d + r < limit || d - r > limit);
-        match &self.shape {
-            PartShape::Box(hb) => {
-                let inside = (0..3).all(|k| q[k].abs() + e[k] < hb[k]);
-                let outside = (0..3).any(|k| q[k].abs() - e[k] > hb[k]);
-                !(inside || outside)
+        let verdict = |inside: bool, outside: bool| {
+            if inside {
+                Some(true)
+            } else if outside {
+                Some(false)
+            } else {
+                None
             }
-            PartShape::Sphere(r) => straddles(norm(q), norm(e), *r),
+        };
+        let around = |d: f64, r: f64, limit: f64| verdict(d + r < limit, d - r > limit);
+        match &self.shape {
+            PartShape::Box(hb) => verdict(
+                (0..3).all(|k| q[k].abs() + e[k] < hb[k]),
+                (0..3).any(|k| q[k].abs() - e[k] > hb[k]),
+            ),
+            PartShape::Sphere(r) => around(norm(q), norm(e), *r),
             PartShape::Cylinder(r, hl) => {
                 let (rho, re) = (q[0].hypot(q[1]), e[0].hypot(e[1]));
-                let inside = rho + re < *r && q[2].abs() + e[2] < *hl;
-                let outside = rho - re > *r || q[2].abs() - e[2] > *hl;
-                !(inside || outside)
+                verdict(
+                    rho + re < *r && q[2].abs() + e[2] < *hl,
+                    rho - re > *r || q[2].abs() - e[2] > *hl,
+                )
             }
             PartShape::Capsule(r, hl) => {
                 let z = q[2].clamp(-hl, *hl);
-                straddles(norm([q[0], q[1], q[2] - z]), norm(e), *r)
+                around(norm([q[0], q[1], q[2] - z]), norm(e), *r)
             }
-            PartShape::Mesh(_) => match self.locator.as_ref().and_then(|l| l.surface.as_ref()) {
-                Some(s) => s.may_meet(&(
+            PartShape::Mesh(_) => {
+                let locator = self.locator.as_ref()?;
+                let surface = locator.surface.as_ref()?;
+                let b = (
                     [0, 1, 2].map(|k| q[k] - e[k]),
                     [0, 1, 2].map(|k| q[k] + e[k]),
-                )),
-                None => true,
-            },
+                );
+                (!surface.may_meet(&b)).then(|| locator.contains(q))
+            }
         }
     }
 
@@ -908,7 +920,6 @@ fn sample_part(parts: &[PlacedPart], nb: &[Vec<usize>], i: usize, n: usize) -> P
     let mut sum = 0.0;
     let mut uncertain = 0usize;
     let mut row: Vec<(usize, u32, u32)> = Vec::with_capacity(masks.len());
-    let mut near: Vec<usize> = Vec::with_capacity(masks.len());
     for a in 0..n {
         for b in 0..n {
             row.clear();
@@ -928,27 +939,36 @@ fn sample_part(parts: &[PlacedPart], nb: &[Vec<usize>], i: usize, n: usize) -> P
                 let c = cs.trailing_zeros() as usize;
                 cs &= cs - 1;
                 let x = [axes[0][a], axes[1][b], axes[2][c]];
-                let crossed = p.may_cross(x, core);
-                let inside = p.contains(x);
                 // A core the part's surface misses is all outside the part or all inside it; outside,
                 // the part covers none of it, whatever the neighbours do.
-                if !crossed && !inside {
+                let own = p.classify(x, core);
+                if own == Some(false) {
                     continue;
                 }
-                if crossed
-                    || row
-                        .iter()
-                        .any(|r| r.2 >> c & 1 == 1 && parts[r.0].may_cross(x, core))
-                {
+                let inside = own.unwrap_or_else(|| p.contains(x));
+                // Each neighbour whose box the cell meets: whether its surface may cross the core,
+                // and (where the centre is in its box) whether it covers the centre, which its
+                // verdict on the core already says when there is one.
+                let mut crossed = own.is_none();
+                let mut k = 1;
+                let mut in_a_box = false;
+                for r in row.iter().filter(|r| r.2 >> c & 1 == 1) {
+                    let v = parts[r.0].classify(x, core);
+                    crossed |= v.is_none();
+                    if r.1 >> c & 1 == 1 {
+                        in_a_box = true;
+                        if inside && v.unwrap_or_else(|| parts[r.0].contains(x)) {
+                            k += 1;
+                        }
+                    }
+                }
+                if crossed {
                     uncertain += 1;
                 }
                 // A centre in no neighbour's box is covered once at most.
-                if !inside || row.iter().all(|r| r.1 >> c & 1 == 0) {
+                if !inside || !in_a_box {
                     continue;
                 }
-                near.clear();
-                near.extend(row.iter().filter(|r| r.1 >> c & 1 == 1).map(|r| r.0));
-                let k = 1 + near.iter().filter(|&&j| parts[j].contains(x)).count();
                 out.most = out.most.max(k);
                 sum += 1.0 - 1.0 / k as f64;
             }
