@@ -875,6 +875,7 @@ struct PartSample {
 /// Samples part `i` on an `n`³ grid over its [`region`]. A cell that no surface of the part or of a
 /// neighbour whose box it meets crosses has one covering count throughout, which its centre's
 /// sample gets exactly; every other cell's sample is off by less than the cell's volume.
+#[allow(clippy::too_many_lines)] // one pass over the cells: masks, sample and verdict together
 fn sample_part(parts: &[PlacedPart], nb: &[Vec<usize>], i: usize, n: usize) -> PartSample {
     let p = &parts[i];
     let (lo, hi) = region(parts, nb, i);
@@ -1436,7 +1437,7 @@ mod tests {
     fn a_thousand_overlapping_boxes_stay_within_the_cap_and_the_bound() {
         let mut parts: Vec<PlacedPart> = (0..1000)
             .map(|i| {
-                let t = [i % 10, i / 10 % 10, i / 100].map(|c| c as f64);
+                let t = [i % 10, i / 10 % 10, i / 100].map(f64::from);
                 placed(PartShape::Box([0.75; 3]), t, [0.75; 3], 3.375)
             })
             .collect();

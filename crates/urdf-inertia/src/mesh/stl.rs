@@ -348,6 +348,7 @@ struct AsciiChunk {
 }
 
 /// Parses whole lines of ASCII STL starting in `start`, numbering new vertices from `base`.
+#[allow(clippy::too_many_lines)] // one match over the line kinds, each with its error
 fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
     let mut out = AsciiChunk {
         vertices: Vec::new(),
@@ -862,15 +863,19 @@ mod tests {
         } = style;
         let mut s = format!("{}{eol}", style.solid);
         for face in f {
-            s += &format!("{ind}facet{g}normal{g}0{g}0{g}1{eol}{ind}{ind}outer{g}loop{eol}");
+            let _ = write!(
+                s,
+                "{ind}facet{g}normal{g}0{g}0{g}1{eol}{ind}{ind}outer{g}loop{eol}"
+            );
             for &i in face {
                 let p = v[i as usize].map(style.number);
-                s += &format!(
+                let _ = write!(
+                    s,
                     "{ind}{ind}{ind}vertex{g}{}{g}{}{g}{}{eol}",
                     p[0], p[1], p[2]
                 );
             }
-            s += &format!("{ind}{ind}endloop{eol}{ind}endfacet{eol}");
+            let _ = write!(s, "{ind}{ind}endloop{eol}{ind}endfacet{eol}");
         }
         s += style.end;
         s.into_bytes()
