@@ -874,6 +874,53 @@ fn overlap_of_2000_spheres_completes() {
     assert!(err.contains("is counted twice"), "{err}");
 }
 
+/// Issue 25: 1000 overlapping convex pieces in one link (a decomposition crowded into a 2 m cube, every
+/// piece overlapping most others) took 5 s, because a minimum grid overrode the work cap. The cap now
+/// holds, and the warning says that the grid is coarser and gives the wider bound. The excess it reports
+/// is positive and below the pieces' summed volume.
+#[test]
+fn overlap_of_1000_crowded_convex_pieces_keeps_to_the_work_cap() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (v, f) = common::icosphere(3);
+    let v: Vec<[f64; 3]> = v
+        .iter()
+        .map(|p| [0.7 * p[0], 0.6 * p[1], 0.55 * p[2]])
+        .collect();
+    std::fs::write(
+        tmp.path().join("piece.stl"),
+        urdf_inertia::mesh::stl::write_binary(b"piece", &v, &f),
+    )
+    .unwrap();
+    let mut rng = common::Rng(25);
+    let shapes: Vec<(String, String)> = (0..1000)
+        .map(|_| {
+            let t = [0, 1, 2].map(|_| rng.range(0.0, 2.0));
+            let r = [0, 1, 2].map(|_| rng.range(-1.0, 1.0));
+            (
+                format!(
+                    "{} {} {}\" rpy=\"{} {} {}",
+                    t[0], t[1], t[2], r[0], r[1], r[2]
+                ),
+                "<mesh filename=\"piece.stl\"/>".to_string(),
+            )
+        })
+        .collect();
+    let path = tmp.path().join("r.urdf");
+    std::fs::write(&path, one_link(&shapes)).unwrap();
+    let out = run(&["fill", s(&path), "--density", "1000"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("and 995 others overlap: about "), "{err}");
+    assert!(
+        err.contains("(coarser than 24³: the work cap for this many overlapping parts; the bound widens with the grid), within ±"),
+        "{err}"
+    );
+    let at = err.find("overlap: about ").unwrap() + "overlap: about ".len();
+    let excess: f64 = err[at..].split(' ').next().unwrap().parse().unwrap();
+    let sphere = 4.0 / 3.0 * std::f64::consts::PI * 0.7 * 0.6 * 0.55;
+    assert!(excess > 0.0 && excess < 1000.0 * sphere, "{excess}");
+}
+
 /// Peak resident memory of this process (VmHWM), bytes.
 fn peak_rss() -> u64 {
     let status = std::fs::read_to_string("/proc/self/status").expect("/proc/self/status");
@@ -1396,7 +1443,7 @@ fn timed(d: &Path) -> Command {
         .unwrap_or_else(|| env!("CARGO_BIN_EXE_urdf-inertia").into());
     if Path::new("/usr/bin/time").exists() {
         let mut c = Command::new("/usr/bin/time");
-        c.args(["-f", "%M %e", "-o"]).arg(d.join(".time")).arg(exe);
+        c.args(["-v", "-o"]).arg(d.join(".time")).arg(exe);
         c
     } else {
         Command::new(exe)
@@ -1426,14 +1473,21 @@ impl Row {
             .unwrap_or(0);
         let time = std::fs::read_to_string(d.join(".time")).unwrap_or_default();
         let _ = std::fs::remove_file(d.join(".time"));
-        // GNU time prints "Command exited with non-zero status N" first when the status is not 0.
-        let last = time.lines().last().unwrap_or("");
-        let mut f = last.split_whitespace();
-        let peak = f
-            .next()
+        // `/usr/bin/time -v`, what a user runs: "Maximum resident set size (kbytes): N" and
+        // "Elapsed (wall clock) time (h:mm:ss or m:ss): M:SS.ss".
+        let field = |name: &str| {
+            time.lines()
+                .find_map(|l| l.trim().strip_prefix(name))
+                .map(str::trim)
+        };
+        let peak = field("Maximum resident set size (kbytes):")
             .and_then(|k| k.parse::<u64>().ok())
             .map(|k| k * 1024);
-        let seconds = f.next().and_then(|t| t.parse::<f64>().ok());
+        let seconds = field("Elapsed (wall clock) time (h:mm:ss or m:ss):").and_then(|t| {
+            t.split(':').try_fold(0.0, |s, part| {
+                part.parse::<f64>().ok().map(|x| 60.0 * s + x)
+            })
+        });
         Row {
             what: what.trim_start_matches("large: ").to_string(),
             out,
@@ -1649,6 +1703,35 @@ fn large_inputs(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)
             ("0.3 0 0".into(), "<box size=\"0.2 0.2 0.2\"/>".into()),
         ],
     );
+    // A convex decomposition: 320-triangle hulls on a unit lattice (a cube of side ⌈N^⅓⌉), each turned
+    // its own way and overlapping its neighbours, as benches/overlap.rs places them.
+    let (pv, pf) = common::icosphere(3);
+    let pv: Vec<[f64; 3]> = pv
+        .iter()
+        .map(|p| [0.7 * p[0], 0.6 * p[1], 0.55 * p[2]])
+        .collect();
+    std::fs::write(
+        d.join("piece.stl"),
+        urdf_inertia::mesh::stl::write_binary(b"piece", &pv, &pf),
+    )
+    .unwrap();
+    for n in [10usize, 100, 1000] {
+        let side = (1..).find(|s: &usize| s * s * s >= n).unwrap_or(1);
+        link(
+            &format!("pieces{n}.urdf"),
+            &format!("{n} overlapping convex pieces (320-triangle meshes) in one link"),
+            (0..n)
+                .map(|i| {
+                    let (x, y, z) = (i % side, i / side % side, i / (side * side));
+                    let rpy = [0.37 * i as f64, 0.61 * i as f64, 0.23 * i as f64];
+                    (
+                        format!("{x} {y} {z}\" rpy=\"{} {} {}", rpy[0], rpy[1], rpy[2]),
+                        "<mesh filename=\"piece.stl\"/>".into(),
+                    )
+                })
+                .collect(),
+        );
+    }
 }
 
 #[test]
@@ -1838,7 +1921,7 @@ fn write_reliability_table() {
     ));
     std::fs::set_permissions(d.join("rodir"), std::fs::Permissions::from_mode(0o755)).unwrap();
 
-    let mut md = String::from("# Reliability: hostile input, what urdf-inertia does, exit code, memory and time\n\nGenerated by `cargo test --release --test regression -- --ignored write_reliability_table` (every input is made by the test in a temp dir; file names are relative to it), on purpose: CI does not run it. Exit codes: 0 ok, 1 `check` found problems, 2 error. Each row has a regression test in `tests/regression.rs`. SIGINT/SIGTERM during a write removes the temporary file and exits 130 (`temp_file_has_the_targets_mode_and_is_removed_on_sigterm`). Peak memory (maximum resident set) and wall time are GNU time's (`/usr/bin/time -f '%M %e'`) for the whole process, on the machine that generated this file (2 cores shared with other work); input size is the largest file named on the command line (for `fill`, the URDF, not its meshes); the program itself takes a few MB. Every reader is also fuzzed, with the figures of the last run in [fuzz/README.md](../fuzz/README.md).\n\n| hostile input | input size | what the tool does (first error line, or first line of stderr) | exit | peak memory | time |\n| --- | --- | --- | --- | --- | --- |\n");
+    let mut md = String::from("# Reliability: hostile input, what urdf-inertia does, exit code, memory and time\n\nGenerated by `cargo test --release --test regression -- --ignored write_reliability_table` (every input is made by the test in a temp dir; file names are relative to it), on purpose: CI does not run it. Exit codes: 0 ok, 1 `check` found problems, 2 error. Each row has a regression test in `tests/regression.rs`. SIGINT/SIGTERM during a write removes the temporary file and exits 130 (`temp_file_has_the_targets_mode_and_is_removed_on_sigterm`). Peak memory (maximum resident set) and wall time are GNU time's (`/usr/bin/time -v`, what a user runs: its \"Maximum resident set size\" and \"Elapsed (wall clock) time\") for the whole process, on the default thread count, on the machine that generated this file (2 cores shared with other work); input size is the largest file named on the command line (for `fill`, the URDF, not its meshes); the program itself takes a few MB. Every reader is also fuzzed, with the figures of the last run in [fuzz/README.md](../fuzz/README.md).\n\n| hostile input | input size | what the tool does (first error line, or first line of stderr) | exit | peak memory | time |\n| --- | --- | --- | --- | --- | --- |\n");
     for row in rows.iter().filter(|r| !r.large) {
         md.push_str(&row.markdown(d));
     }

@@ -910,10 +910,19 @@ fn overlap_estimate(parts: &mut [Part]) -> (Option<(f64, String, usize)>, Option
     } else {
         format!("is counted more than once (up to {} times)", e.most)
     };
+    let capped = if e.capped {
+        format!(
+            " (coarser than {g}³: the work cap for this many overlapping parts; the bound widens with the grid)",
+            g = overlap::GRID
+        )
+    } else {
+        String::new()
+    };
     let message = format!(
-        "parts {which} overlap: about {} m³ ({:.1}% of the link's volume) {how}; the parts' volumes less their union's, estimated on a {n}³ grid per part",
+        "parts {which} overlap: about {} m³ ({:.1}% of the link's volume) {how}; the parts' volumes less their union's, estimated on a {n}³ grid per part{capped}, within ±{} m³",
         crate::text::significant(v, 4),
-        100.0 * v / total
+        100.0 * v / total,
+        crate::text::significant(e.bound, 2),
     );
     (Some((v, which, n)), Some(message))
 }
