@@ -74,6 +74,9 @@ pub fn main() -> i32 {
         Command::Diff(d) => robot_cmd::diff(&d),
         Command::Check(c) => robot_cmd::check(&c),
     };
+    if let Some(note) = urdf_inertia::threads::note() {
+        errln!("warning: {note}");
+    }
     if output::stdout_failed() {
         return ExitStatus::Error as i32;
     }

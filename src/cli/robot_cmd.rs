@@ -292,6 +292,7 @@ fn run_one(config: &Config, path: &Path, cache: &mut MeshCache) -> Outcome {
 
 /// Reads, decodes and scans a URDF, printing the scan's warnings (and notes, if `verbose`) to stderr.
 fn read_robot(path: &Path, verbose: bool) -> Result<Robot, String> {
+    write::remember_before_reading(path);
     let bytes = urdf_inertia::input::read_file(path)
         .map_err(|e| format!("{}: cannot read the URDF: {e}", path.display()))?;
     let robot = scan_bytes(bytes, path).map_err(|e| e.to_string())?;
@@ -309,7 +310,11 @@ fn print_diagnostics(diagnostics: &[Diagnostic], verbose: bool) {
 fn print_failures(robot: &Robot, report: &FillReport) {
     let path = robot.path.display();
     for f in &report.failures {
-        errln!("error: {path}:{}: link `{}`: {f}", f.line, f.link);
+        errln!(
+            "error: {path}:{}: link `{}`: {f}",
+            f.line,
+            urdf_inertia::text::escape_control(&f.link)
+        );
     }
     for e in &report.robot_errors {
         errln!("error: {path}: {e}");
@@ -341,7 +346,12 @@ fn write_robot(
         return Err(ExitStatus::Error);
     }
     let target = file.unwrap_or(Path::new("-"));
-    if let Err(e) = write::write_output(target, &text) {
+    let written = if w.in_place {
+        write::write_in_place(target, &text)
+    } else {
+        write::write_output(target, &text)
+    };
+    if let Err(e) = written {
         // A failing stdout was reported where it failed.
         if file.is_some() {
             errln!("error: {e}");
@@ -409,7 +419,7 @@ fn spliced(robot: &Robot, report: &FillReport, w: &WriteConfig) -> Result<Vec<u8
                 "error: {}:{}: link `{}`: {}",
                 robot.path.display(),
                 link.line,
-                link.name,
+                urdf_inertia::text::escape_control(&link.name),
                 e.message
             );
         }
@@ -473,7 +483,7 @@ fn check_existing(robot: &Robot, config: &Config, all_links: bool) -> usize {
                 outln!(
                     "{path}:{}: link `{}`: has collision geometry but no <inertial>",
                     link.line,
-                    link.name
+                    urdf_inertia::text::escape_control(&link.name)
                 );
                 problems += 1;
             }
@@ -488,7 +498,11 @@ fn check_existing(robot: &Robot, config: &Config, all_links: bool) -> usize {
                     errln!("{}: {}", note.severity.as_str(), note.message);
                 }
             } else {
-                outln!("{path}:{}: link `{}`: {p}", span.line, link.name);
+                outln!(
+                    "{path}:{}: link `{}`: {p}",
+                    span.line,
+                    urdf_inertia::text::escape_control(&link.name)
+                );
                 problems += 1;
             }
         }
@@ -511,7 +525,7 @@ fn check_collisions(robot: &Robot, src: &Sources) -> usize {
                     "error: {}:{}: link `{}`: collision {} (line {line}): {message}",
                     robot.path.display(),
                     link.line,
-                    link.name,
+                    urdf_inertia::text::escape_control(&link.name),
                     c.index
                 );
                 errors += 1;
@@ -545,7 +559,7 @@ fn check_against_computed(robot: &Robot, rows: &[Row], tolerance: f64) -> usize 
         outln!(
             "{}:{line}: link `{}`: {}{causes} (tolerance {tolerance})",
             robot.path.display(),
-            r.link.name,
+            urdf_inertia::text::escape_control(&r.link.name),
             off.join("; ")
         );
         problems += 1;

@@ -329,14 +329,40 @@ fn check_positive(x: f64, what: &str) -> Result<(), String> {
     }
 }
 
+/// The longest glob accepted, in bytes: link and mesh names are short, and `globset` panics while
+/// compiling a pattern of some hundred kilobytes (its regex grows past the compiler's size limit).
+pub const MAX_GLOB_LEN: usize = 4096;
+
 /// A glob pattern, compiled with the `globset` crate: `*` and `?` (which also match `/`), `[abc]`,
-/// `[!a-z]`, `{a,b}` and `**`. Used by `--only`, `--skip` and the density map's keys.
+/// `[!a-z]`, `{a,b}` and `**`. Used by `--only`, `--skip` and the density map's keys. Patterns
+/// longer than [`MAX_GLOB_LEN`] are refused, and a panic left in the crate becomes this error too.
 pub fn glob(pattern: &str) -> Result<globset::GlobMatcher, String> {
-    globset::GlobBuilder::new(pattern)
-        .backslash_escape(true)
-        .build()
-        .map(|g| g.compile_matcher())
-        .map_err(|e| format!("`{pattern}` is not a valid glob: {}", e.kind()))
+    if pattern.len() > MAX_GLOB_LEN {
+        let head: String = pattern.chars().take(40).collect();
+        return Err(format!(
+            "`{}…` ({} bytes) is longer than the {MAX_GLOB_LEN} bytes a glob may have",
+            crate::text::escape_control(&head),
+            pattern.len()
+        ));
+    }
+    let compiled = std::panic::catch_unwind(|| {
+        globset::GlobBuilder::new(pattern)
+            .backslash_escape(true)
+            .build()
+            .map(|g| g.compile_matcher())
+    });
+    match compiled {
+        Ok(Ok(g)) => Ok(g),
+        Ok(Err(e)) => Err(format!(
+            "`{}` is not a valid glob: {}",
+            crate::text::escape_control(pattern),
+            e.kind()
+        )),
+        Err(_) => Err(format!(
+            "`{}` cannot be compiled as a glob; simplify it",
+            crate::text::escape_control(pattern)
+        )),
+    }
 }
 
 /// Whether `name` matches the glob `pattern` (an invalid pattern matches nothing; patterns from the

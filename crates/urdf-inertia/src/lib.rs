@@ -14,6 +14,7 @@ pub mod mass;
 pub mod mesh;
 pub mod overlap;
 pub mod text;
+pub mod threads;
 pub mod urdf;
 
 /// A small deterministic generator for the unit tests (xorshift64; the same sequence on every run).

@@ -103,6 +103,9 @@ pub struct InertialSpan {
     pub value: Inertial,
     /// A problem reading its numbers, if any (the link is then treated as having an invalid inertial).
     pub problem: Option<String>,
+    /// The line of its (first) `<mass>`, if it has one: `--keep-mass` names it when the value is no
+    /// usable mass.
+    pub mass_line: Option<usize>,
 }
 
 /// A `<link>` with everything the tool needs.
@@ -527,6 +530,7 @@ impl<'t> Scanner<'t> {
                     line: tag.line,
                     value: Inertial::default(),
                     problem: None,
+                    mass_line: None,
                 };
                 let i = InertialInProgress {
                     span,
@@ -612,6 +616,9 @@ impl<'t> Scanner<'t> {
         }
         i.seen.insert(child.to_string(), line);
         let span = &mut i.span;
+        if child == "mass" {
+            span.mass_line = Some(line);
+        }
         let r = match child {
             "origin" => pose(a).map(|p| span.value.origin = p),
             "mass" => num(a, "value").map(|m| span.value.mass = Some(m)),
@@ -826,9 +833,12 @@ fn num(a: &HashMap<String, String>, key: &str) -> Result<f64, String> {
     let s = a
         .get(key)
         .ok_or_else(|| format!("missing attribute `{key}`"))?;
-    s.trim()
-        .parse::<f64>()
-        .map_err(|_| format!("{key}=\"{s}\" is not a number"))
+    s.trim().parse::<f64>().map_err(|_| {
+        format!(
+            "{key}=\"{}\" is not a number",
+            crate::text::escape_control(s)
+        )
+    })
 }
 
 /// A primitive's size: finite and not negative (zero is valid URDF).
