@@ -2500,3 +2500,101 @@ fn mesh_overflow_and_underflow_are_named() {
         assert!(!err.contains("NaN"), "{file}: {err}");
     }
 }
+
+/// Two `<robot>` roots: urdfdom reads the first; both were once filled. The second is left as it
+/// is, with a warning on its line.
+#[test]
+fn second_robot_root_is_left_alone() {
+    let second = "<robot name=\"s\">\n  <link name=\"b\">\n    <collision><geometry><box size=\"1 1 1\"/></geometry></collision>\n  </link>\n</robot>\n";
+    let text = format!("{}{second}", one_box());
+    let (_tmp, urdf) = urdf_in_tmp(&text);
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-o", "-"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let filled = String::from_utf8(out.stdout.clone()).unwrap();
+    assert_eq!(filled.matches("<inertial>").count(), 1, "{filled}");
+    assert!(filled.ends_with(second), "{filled}");
+    assert!(
+        stderr(&out).contains(":6: a second root element <robot> is ignored"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+/// A URDF whose lines end with CR alone once got LF lines inserted and every message on line 1: it
+/// keeps CR line ends, and messages name their lines.
+#[test]
+fn cr_only_urdf_keeps_its_line_ends_and_lines() {
+    let text = boxes(&[("a", "1 2 3", "0 0 0"), ("b", "1 -2 3", "0 0 0")]).replace('\n', "\r");
+    let (_tmp, urdf) = urdf_in_tmp(&text);
+    let out = run(&[
+        "fill",
+        s(&urdf),
+        "--density",
+        "1000",
+        "--keep-going",
+        "-o",
+        "-",
+    ]);
+    let filled = String::from_utf8(out.stdout.clone()).unwrap();
+    assert!(filled.contains("<inertial>"), "{}", stderr(&out));
+    assert!(!filled.contains('\n'), "{filled:?}");
+    // Link `b` is on line 5 and its collision (a negative size) on line 6.
+    assert!(
+        stderr(&out).contains("r.urdf:5: link `b`: collision 1 (line 6)"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+/// UTF-32 and UTF-16 without a byte-order mark or a declaration were once "malformed attributes";
+/// UTF-16 is read (and written back as UTF-16), UTF-32 is named.
+#[test]
+fn utf16_without_a_mark_is_read_and_utf32_is_named() {
+    let text = one_box();
+    let utf16le: Vec<u8> = text.encode_utf16().flat_map(u16::to_le_bytes).collect();
+    let utf16be: Vec<u8> = text.encode_utf16().flat_map(u16::to_be_bytes).collect();
+    for (name, bytes, le) in [("le", utf16le, true), ("be", utf16be, false)] {
+        let tmp = tempfile::tempdir().unwrap();
+        let urdf = tmp.path().join("r.urdf");
+        std::fs::write(&urdf, &bytes).unwrap();
+        let out = run(&["fill", s(&urdf), "--density", "1000", "-o", "-"]);
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        let units: Vec<u16> = out
+            .stdout
+            .chunks_exact(2)
+            .map(|c| {
+                if le {
+                    u16::from_le_bytes([c[0], c[1]])
+                } else {
+                    u16::from_be_bytes([c[0], c[1]])
+                }
+            })
+            .collect();
+        let back = String::from_utf16(&units).unwrap();
+        assert!(back.contains("<inertial>"), "{name}: {back}");
+    }
+    for (name, bytes) in [
+        (
+            "LE",
+            text.chars()
+                .flat_map(|c| (c as u32).to_le_bytes())
+                .collect::<Vec<u8>>(),
+        ),
+        (
+            "BE",
+            text.chars()
+                .flat_map(|c| (c as u32).to_be_bytes())
+                .collect(),
+        ),
+    ] {
+        let (_tmp, urdf) = urdf_in_tmp("");
+        std::fs::write(&urdf, &bytes).unwrap();
+        let out = run(&["check", s(&urdf)]);
+        assert_eq!(out.status.code(), Some(2), "{name}");
+        assert!(
+            stderr(&out).contains("the file is UTF-32"),
+            "{name}: {}",
+            stderr(&out)
+        );
+    }
+}

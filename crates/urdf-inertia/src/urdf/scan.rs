@@ -402,6 +402,17 @@ impl<'t> Scanner<'t> {
                 _ => continue,
             };
             let name = String::from_utf8_lossy(e.name().as_ref()).into_owned();
+            if self.stack.is_empty() && self.robot_name.is_some() {
+                // A second root: urdfdom reads the first root element only, so the rest is left
+                // alone (filling it too would give the file inertials no consumer reads).
+                let message = format!("a second root element <{name}> is ignored, with everything after it (urdfdom reads the first <robot> only); keep one <robot> per file");
+                self.notes.push(warning(
+                    lines.at(pos),
+                    &None,
+                    crate::text::escape_control(&message).into_owned(),
+                ));
+                break;
+            }
             let a = attrs(&e).map_err(|(at, m)| self.err(pos + 1 + at, m))?;
             let tag = Tag {
                 a: &a,
@@ -677,8 +688,22 @@ impl<'t> Scanner<'t> {
 
 /// Scans URDF text. `path` is used in messages and for resolving relative mesh paths.
 pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
-    let (name, links, notes) = Scanner::new(&text, path).run()?;
-    let newline = if text.contains("\r\n") { "\r\n" } else { "\n" };
+    // Lines ended by CR alone (classic Mac OS): scanned as XML reads them (end-of-line handling turns
+    // each CR into LF, XML 1.0 section 2.11), byte for byte the same length, so every span stays
+    // right, every message gets its own line, and the writer ends inserted lines with CR.
+    let cr_only = !text.contains('\n') && text.contains('\r');
+    let (name, links, notes) = if cr_only {
+        Scanner::new(&text.replace('\r', "\n"), path).run()?
+    } else {
+        Scanner::new(&text, path).run()?
+    };
+    let newline = if text.contains("\r\n") {
+        "\r\n"
+    } else if cr_only {
+        "\r"
+    } else {
+        "\n"
+    };
     Ok(Robot {
         path: path.to_path_buf(),
         name,
