@@ -2043,6 +2043,13 @@ fn gltf_buffer_uris_are_relative_references_or_refused() {
     let b = gltf_gen::box_builder([1.0, 2.0, 3.0], [0.0, 0.0, 0.0], serde_json::json!({}));
     std::fs::write(tmp.path().join("up one.bin"), &b.bin).unwrap();
     let absolute = tmp.path().join("up one.bin");
+    // The input guard covers buffers too: a FIFO (which would hang) and a symlink to /dev/zero.
+    assert!(Command::new("mkfifo")
+        .arg(sub.join("fifo.bin"))
+        .status()
+        .unwrap()
+        .success());
+    std::os::unix::fs::symlink("/dev/zero", sub.join("zero.bin")).unwrap();
     for (uri, ok) in [
         ("../up%20one.bin".to_string(), true),
         ("..%2Fup%20one.bin".to_string(), true),
@@ -2053,6 +2060,8 @@ fn gltf_buffer_uris_are_relative_references_or_refused() {
             false,
         ),
         ("http://example.com/up.bin".to_string(), false),
+        ("fifo.bin".to_string(), false),
+        ("zero.bin".to_string(), false),
     ] {
         let file = sub.join("box.gltf");
         std::fs::write(&file, b.gltf_external(&uri)).unwrap();
@@ -2061,10 +2070,12 @@ fn gltf_buffer_uris_are_relative_references_or_refused() {
             assert_eq!((code, volume), (Some(0), Some(6.0)), "{uri}: {err}");
         } else {
             assert_eq!(code, Some(2), "{uri}: {err}");
-            assert!(
-                err.contains("is absolute; only relative references"),
-                "{uri}: {err}"
-            );
+            let why = if uri.starts_with("fifo") || uri.starts_with("zero") {
+                "is not a regular file"
+            } else {
+                "is absolute; only relative references"
+            };
+            assert!(err.contains(why), "{uri}: {err}");
         }
     }
 }
