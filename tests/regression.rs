@@ -1059,6 +1059,164 @@ fn fill_on_threads(
     })
 }
 
+/// The reliability table's rows for the second hardening campaign (each also a regression test).
+fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)) {
+    let a = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let write = |name: &str, bytes: &[u8]| std::fs::write(d.join(name), bytes).unwrap();
+    let geometry = format!(
+        "<library_geometries>{}</library_geometries>\n",
+        dae_box(Some("g"), 1.0, 0.0)
+    );
+    for (i, value) in ["0,001", "1 mm", "1e308"].iter().enumerate() {
+        let name = format!("u{i}.dae");
+        write(
+            &name,
+            dae(&format!(
+                "<asset><unit meter=\"{value}\"/></asset>\n{geometry}"
+            ))
+            .as_bytes(),
+        );
+        add(
+            &format!("COLLADA `<unit meter=\"{value}\">`"),
+            a(&["mesh", &name]),
+            None,
+        );
+    }
+    std::fs::create_dir_all(d.join("pkg/urdf")).unwrap();
+    assert!(Command::new("mkfifo")
+        .arg(d.join("pkg/package.xml"))
+        .status()
+        .unwrap()
+        .success());
+    write("pkg/urdf/r.urdf", b"<robot name=\"r\">\n  <link name=\"a\">\n    <collision><geometry><mesh filename=\"package://pkg/a.stl\"/></geometry></collision>\n  </link>\n</robot>\n");
+    add(
+        "`package.xml` is a FIFO",
+        a(&["fill", "pkg/urdf/r.urdf", "--density", "1000"]),
+        None,
+    );
+    // glTF: ten levels of shared nodes over a 20,000-vertex mesh.
+    let mut b = gltf_gen::GltfBuilder::new();
+    let points: Vec<[f32; 3]> = (0..20_000)
+        .map(|i| [i as f32, (i % 7) as f32, (i % 13) as f32])
+        .collect();
+    let tris: Vec<u32> = (0..19_998).flat_map(|i| [i, i + 1, i + 2]).collect();
+    let pa = b.positions(&points);
+    let ia = b.indices(&tris, gltf_gen::U32);
+    let mesh = b.mesh(&[(pa, Some(ia), gltf_gen::TRIANGLES)]);
+    let mut child = b.node(serde_json::json!({ "mesh": mesh }));
+    for _ in 0..10 {
+        child = b.node(serde_json::json!({ "children": [child, child] }));
+    }
+    let sc = b.add_scene(&[child]);
+    b.scene = Some(sc);
+    write("fan.glb", &b.glb());
+    add(
+        "glTF nodes shared by two parents, 10 levels over 20k vertices",
+        a(&["mesh", "fan.glb"]),
+        None,
+    );
+    let bx = gltf_gen::box_builder([1.0, 2.0, 3.0], [0.0, 0.0, 0.0], serde_json::json!({}));
+    let mut bin = bx.bin.clone();
+    bin.resize(5 << 20, 0);
+    write("five.bin", &bin);
+    let mut doc: serde_json::Value = serde_json::from_str(&bx.gltf_external("five.bin")).unwrap();
+    doc["buffers"] = serde_json::Value::Array(vec![doc["buffers"][0].clone(); 2000]);
+    write("many.gltf", &serde_json::to_vec(&doc).unwrap());
+    add(
+        "glTF: 2,000 buffers naming one 5 MB file",
+        a(&["mesh", "many.gltf"]),
+        None,
+    );
+    write(
+        "abs.gltf",
+        bx.gltf_external(s(&d.join("five.bin"))).as_bytes(),
+    );
+    add(
+        "glTF buffer with an absolute path",
+        a(&["mesh", "abs.gltf"]),
+        None,
+    );
+    write("grid.stl", &integer_grid_of_cubes(20));
+    add(
+        "binary STL of 8,000 cubes at integer coordinates",
+        a(&["mesh", "grid.stl"]),
+        None,
+    );
+    write(
+        "key.toml",
+        format!(
+            "default = 1000\n[links]\n\"{}\" = 2000\n",
+            "a*".repeat(200_000)
+        )
+        .as_bytes(),
+    );
+    add(
+        "a 400 KB density-map key",
+        a(&["fill", "r.urdf", "--density-map", "key.toml"]),
+        None,
+    );
+    write("km.urdf", b"<robot name=\"r\">\n  <link name=\"arm\">\n    <inertial><mass value=\"1,5\"/></inertial>\n    <collision><geometry><box size=\"1 1 1\"/></geometry></collision>\n  </link>\n</robot>\n");
+    add(
+        "`--keep-mass` on `<mass value=\"1,5\">`",
+        a(&["fill", "km.urdf", "--density", "1000", "--keep-mass"]),
+        None,
+    );
+    let tet = |x: &str| {
+        format!("v 0 0 0\nv {x} 0 0\nv 0 {x} 0\nv 0 0 {x}\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
+    };
+    write("huge.obj", tet("1e150").as_bytes());
+    write("subnormal.obj", tet("1e-310").as_bytes());
+    write("unit.obj", tet("1").as_bytes());
+    add(
+        "an OBJ with 1e150 coordinates",
+        a(&["mesh", "huge.obj"]),
+        None,
+    );
+    add(
+        "an OBJ at `--scale 1e150`",
+        a(&["mesh", "unit.obj", "--scale", "1e150", "1e150", "1e150"]),
+        None,
+    );
+    add(
+        "an OBJ with 1e-310 coordinates",
+        a(&["mesh", "subnormal.obj"]),
+        None,
+    );
+    write("ctl.urdf", b"<robot name=\"r\">\n  <link name=\"a&#10;::error::forged&#27;[2J\">\n    <collision><geometry><mesh filename=\"missing.stl\"/></geometry></collision>\n  </link>\n</robot>\n");
+    add(
+        "a link name holding `&#10;::error::` and `&#27;`",
+        a(&["fill", "ctl.urdf", "--density", "1000"]),
+        None,
+    );
+    let long = format!("{}.urdf", "n".repeat(245));
+    write(&long, one_box().as_bytes());
+    add(
+        "`fill -i` on a 250-byte file name",
+        a(&["fill", &long, "--density", "1000", "-i"]),
+        None,
+    );
+    write(
+        "two.urdf",
+        format!(
+            "{}{}",
+            one_box(),
+            one_box().replace("name=\"r\"", "name=\"s\"")
+        )
+        .as_bytes(),
+    );
+    add(
+        "two `<robot>` roots",
+        a(&["fill", "two.urdf", "--density", "1000", "-o", "/dev/null"]),
+        None,
+    );
+    let utf32: Vec<u8> = one_box()
+        .chars()
+        .flat_map(|c| (c as u32).to_le_bytes())
+        .collect();
+    write("u32.urdf", &utf32);
+    add("a UTF-32 URDF", a(&["check", "u32.urdf"]), None);
+}
+
 // ---------------------------------------------------------------------------------------------------
 // Fuzzing: what fuzz/fuzz_targets do with one input, without the instrumentation, so that seeds and a
 // corpus grown by `bash fuzz/run.sh` can be replayed by any build.
@@ -1812,6 +1970,7 @@ fn write_reliability_table() {
         write(&name, text);
         add(what, a(&["mesh", &name]), None);
     }
+    second_campaign_rows(d, &mut add);
     let full = || Some(dev_full());
     add(
         "`fill >/dev/full`",
@@ -1837,7 +1996,7 @@ fn write_reliability_table() {
     ));
     std::fs::set_permissions(d.join("rodir"), std::fs::Permissions::from_mode(0o755)).unwrap();
 
-    let mut md = String::from("# Reliability: hostile input, what urdf-inertia does, exit code, memory and time\n\nGenerated by `cargo test --release --test regression -- --ignored write_reliability_table` (every input is made by the test in a temp dir; file names are relative to it), on purpose: CI does not run it. Exit codes: 0 ok, 1 `check` found problems, 2 error. Each row has a regression test in `tests/regression.rs`. SIGINT/SIGTERM during a write removes the temporary file and exits 130 (`temp_file_has_the_targets_mode_and_is_removed_on_sigterm`). Peak memory (maximum resident set) and wall time are GNU time's (`/usr/bin/time -f '%M %e'`) for the whole process, on the machine that generated this file (2 cores shared with other work); input size is the largest file named on the command line (for `fill`, the URDF, not its meshes); the program itself takes a few MB. Every reader is also fuzzed, with the figures of the last run in [fuzz/README.md](../fuzz/README.md).\n\n| hostile input | input size | what the tool does (first error line, or first line of stderr) | exit | peak memory | time |\n| --- | --- | --- | --- | --- | --- |\n");
+    let mut md = String::from("# Reliability: hostile input, what urdf-inertia does, exit code, memory and time\n\nGenerated by `cargo test --release --test regression -- --ignored write_reliability_table` (every input is made by the test in a temp dir; file names are relative to it), on purpose: CI does not run it. Exit codes: 0 ok, 1 `check` found problems, 2 error. Each row has a regression test in `tests/regression.rs`. Every catchable signal whose default action ends the process (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU) during a write removes the temporary file and exits 130 (`temp_file_has_the_targets_mode_and_is_removed_on_sigterm`, `every_ending_signal_removes_the_temp_file`); SIGXFSZ is caught, so a file-size limit is a write error (`file_size_limit_is_a_write_error`); an edit made while `fill -i` runs is kept and the run fails (`edit_during_fill_in_place_is_kept`). Only SIGKILL (or a crash) can leave a temporary file. Peak memory (maximum resident set) and wall time are GNU time's (`/usr/bin/time -f '%M %e'`) for the whole process, on the machine that generated this file (2 cores shared with other work); input size is the largest file named on the command line (for `fill`, the URDF, not its meshes); the program itself takes a few MB. Every reader is also fuzzed, with the figures of the last run in [fuzz/README.md](../fuzz/README.md).\n\n| hostile input | input size | what the tool does (first error line, or first line of stderr) | exit | peak memory | time |\n| --- | --- | --- | --- | --- | --- |\n");
     for row in rows.iter().filter(|r| !r.large) {
         md.push_str(&row.markdown(d));
     }
