@@ -1107,6 +1107,166 @@ fn fill_on_threads(
     })
 }
 
+/// The reliability table's rows for the second hardening campaign (each also a regression test).
+// A list of table rows, one input each: splitting it would only scatter the list.
+#[allow(clippy::too_many_lines)]
+fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)) {
+    let a = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let write = |name: &str, bytes: &[u8]| std::fs::write(d.join(name), bytes).unwrap();
+    let geometry = format!(
+        "<library_geometries>{}</library_geometries>\n",
+        dae_box(Some("g"), 1.0, 0.0)
+    );
+    for (i, value) in ["0,001", "1 mm", "1e308"].iter().enumerate() {
+        let name = format!("u{i}.dae");
+        write(
+            &name,
+            dae(&format!(
+                "<asset><unit meter=\"{value}\"/></asset>\n{geometry}"
+            ))
+            .as_bytes(),
+        );
+        add(
+            &format!("COLLADA `<unit meter=\"{value}\">`"),
+            a(&["mesh", &name]),
+            None,
+        );
+    }
+    std::fs::create_dir_all(d.join("pkg/urdf")).unwrap();
+    assert!(Command::new("mkfifo")
+        .arg(d.join("pkg/package.xml"))
+        .status()
+        .unwrap()
+        .success());
+    write("pkg/urdf/r.urdf", b"<robot name=\"r\">\n  <link name=\"a\">\n    <collision><geometry><mesh filename=\"package://pkg/a.stl\"/></geometry></collision>\n  </link>\n</robot>\n");
+    add(
+        "`package.xml` is a FIFO",
+        a(&["fill", "pkg/urdf/r.urdf", "--density", "1000"]),
+        None,
+    );
+    // glTF: ten levels of shared nodes over a 20,000-vertex mesh.
+    let mut b = gltf_gen::GltfBuilder::new();
+    let points: Vec<[f32; 3]> = (0..20_000)
+        .map(|i| [i as f32, (i % 7) as f32, (i % 13) as f32])
+        .collect();
+    let tris: Vec<u32> = (0..19_998).flat_map(|i| [i, i + 1, i + 2]).collect();
+    let pa = b.positions(&points);
+    let ia = b.indices(&tris, gltf_gen::U32);
+    let mesh = b.mesh(&[(pa, Some(ia), gltf_gen::TRIANGLES)]);
+    let mut child = b.node(serde_json::json!({ "mesh": mesh }));
+    for _ in 0..10 {
+        child = b.node(serde_json::json!({ "children": [child, child] }));
+    }
+    let sc = b.add_scene(&[child]);
+    b.scene = Some(sc);
+    write("fan.glb", &b.glb());
+    add(
+        "glTF nodes shared by two parents, 10 levels over 20k vertices",
+        a(&["mesh", "fan.glb"]),
+        None,
+    );
+    let bx = gltf_gen::box_builder([1.0, 2.0, 3.0], [0.0, 0.0, 0.0], serde_json::json!({}));
+    let mut bin = bx.bin.clone();
+    bin.resize(5 << 20, 0);
+    write("five.bin", &bin);
+    let mut doc: serde_json::Value = serde_json::from_str(&bx.gltf_external("five.bin")).unwrap();
+    doc["buffers"] = serde_json::Value::Array(vec![doc["buffers"][0].clone(); 2000]);
+    write("many.gltf", &serde_json::to_vec(&doc).unwrap());
+    add(
+        "glTF: 2,000 buffers naming one 5 MB file",
+        a(&["mesh", "many.gltf"]),
+        None,
+    );
+    write(
+        "abs.gltf",
+        bx.gltf_external(s(&d.join("five.bin"))).as_bytes(),
+    );
+    add(
+        "glTF buffer with an absolute path",
+        a(&["mesh", "abs.gltf"]),
+        None,
+    );
+    write("grid.stl", &integer_grid_of_cubes(20));
+    add(
+        "binary STL of 8,000 cubes at integer coordinates",
+        a(&["mesh", "grid.stl"]),
+        None,
+    );
+    write(
+        "key.toml",
+        format!(
+            "default = 1000\n[links]\n\"{}\" = 2000\n",
+            "a*".repeat(200_000)
+        )
+        .as_bytes(),
+    );
+    add(
+        "a 400 KB density-map key",
+        a(&["fill", "r.urdf", "--density-map", "key.toml"]),
+        None,
+    );
+    write("km.urdf", b"<robot name=\"r\">\n  <link name=\"arm\">\n    <inertial><mass value=\"1,5\"/></inertial>\n    <collision><geometry><box size=\"1 1 1\"/></geometry></collision>\n  </link>\n</robot>\n");
+    add(
+        "`--keep-mass` on `<mass value=\"1,5\">`",
+        a(&["fill", "km.urdf", "--density", "1000", "--keep-mass"]),
+        None,
+    );
+    let tet = |x: &str| {
+        format!("v 0 0 0\nv {x} 0 0\nv 0 {x} 0\nv 0 0 {x}\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
+    };
+    write("huge.obj", tet("1e150").as_bytes());
+    write("subnormal.obj", tet("1e-310").as_bytes());
+    write("unit.obj", tet("1").as_bytes());
+    add(
+        "an OBJ with 1e150 coordinates",
+        a(&["mesh", "huge.obj"]),
+        None,
+    );
+    add(
+        "an OBJ at `--scale 1e150`",
+        a(&["mesh", "unit.obj", "--scale", "1e150", "1e150", "1e150"]),
+        None,
+    );
+    add(
+        "an OBJ with 1e-310 coordinates",
+        a(&["mesh", "subnormal.obj"]),
+        None,
+    );
+    write("ctl.urdf", b"<robot name=\"r\">\n  <link name=\"a&#10;::error::forged&#27;[2J\">\n    <collision><geometry><mesh filename=\"missing.stl\"/></geometry></collision>\n  </link>\n</robot>\n");
+    add(
+        "a link name holding `&#10;::error::` and `&#27;`",
+        a(&["fill", "ctl.urdf", "--density", "1000"]),
+        None,
+    );
+    let long = format!("{}.urdf", "n".repeat(245));
+    write(&long, one_box().as_bytes());
+    add(
+        "`fill -i` on a 250-byte file name",
+        a(&["fill", &long, "--density", "1000", "-i"]),
+        None,
+    );
+    write(
+        "two.urdf",
+        format!(
+            "{}{}",
+            one_box(),
+            one_box().replace("name=\"r\"", "name=\"s\"")
+        )
+        .as_bytes(),
+    );
+    add(
+        "two `<robot>` roots",
+        a(&["fill", "two.urdf", "--density", "1000", "-o", "/dev/null"]),
+        None,
+    );
+    let utf32: Vec<u8> = one_box()
+        .chars()
+        .flat_map(|c| (c as u32).to_le_bytes())
+        .collect();
+    write("u32.urdf", &utf32);
+    add("a UTF-32 URDF", a(&["check", "u32.urdf"]), None);
+}
+
 // ---------------------------------------------------------------------------------------------------
 // Fuzzing: what fuzz/fuzz_targets do with one input, without the instrumentation, so that seeds and a
 // corpus grown by `bash fuzz/run.sh` can be replayed by any build.
@@ -1896,6 +2056,7 @@ fn write_reliability_table() {
         write(&name, text);
         add(what, a(&["mesh", &name]), None);
     }
+    second_campaign_rows(d, &mut add);
     let full = || Some(dev_full());
     add(
         "`fill >/dev/full`",
@@ -1922,6 +2083,8 @@ fn write_reliability_table() {
     std::fs::set_permissions(d.join("rodir"), std::fs::Permissions::from_mode(0o755)).unwrap();
 
     let mut md = String::from("# Reliability: hostile input, what urdf-inertia does, exit code, memory and time\n\nGenerated by `cargo test --release --test regression -- --ignored write_reliability_table` (every input is made by the test in a temp dir; file names are relative to it), on purpose: CI does not run it. Exit codes: 0 ok, 1 `check` found problems, 2 error. Each row has a regression test in `tests/regression.rs`. SIGINT/SIGTERM during a write removes the temporary file and exits 130 (`temp_file_has_the_targets_mode_and_is_removed_on_sigterm`). Peak memory (maximum resident set) and wall time are GNU time's (`/usr/bin/time -v`, what a user runs: its \"Maximum resident set size\" and \"Elapsed (wall clock) time\") for the whole process, on the default thread count, on the machine that generated this file (2 cores shared with other work); input size is the largest file named on the command line (for `fill`, the URDF, not its meshes); the program itself takes a few MB. Every reader is also fuzzed, with the figures of the last run in [fuzz/README.md](../fuzz/README.md).\n\n| hostile input | input size | what the tool does (first error line, or first line of stderr) | exit | peak memory | time |\n| --- | --- | --- | --- | --- | --- |\n");
+
+    let mut md = String::from("# Reliability: hostile input, what urdf-inertia does, exit code, memory and time\n\nGenerated by `cargo test --release --test regression -- --ignored write_reliability_table` (every input is made by the test in a temp dir; file names are relative to it), on purpose: CI does not run it. Exit codes: 0 ok, 1 `check` found problems, 2 error. Each row has a regression test in `tests/regression.rs`. Every catchable signal whose default action ends the process (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU) during a write removes the temporary file and exits 130 (`temp_file_has_the_targets_mode_and_is_removed_on_sigterm`, `every_ending_signal_removes_the_temp_file`); SIGXFSZ is caught, so a file-size limit is a write error (`file_size_limit_is_a_write_error`); an edit made while `fill -i` runs is kept and the run fails (`edit_during_fill_in_place_is_kept`). Only SIGKILL (or a crash) can leave a temporary file. Peak memory (maximum resident set) and wall time are GNU time's (`/usr/bin/time -f '%M %e'`) for the whole process, on the machine that generated this file (2 cores shared with other work); input size is the largest file named on the command line (for `fill`, the URDF, not its meshes); the program itself takes a few MB. Every reader is also fuzzed, with the figures of the last run in [fuzz/README.md](../fuzz/README.md).\n\n| hostile input | input size | what the tool does (first error line, or first line of stderr) | exit | peak memory | time |\n| --- | --- | --- | --- | --- | --- |\n");
     for row in rows.iter().filter(|r| !r.large) {
         md.push_str(&row.markdown(d));
     }
@@ -1977,4 +2140,756 @@ fn density_globs_compiled_once_agree_with_a_plain_scan() {
     let e = DensityMap::parse(&long, Path::new("d.toml")).unwrap_err();
     assert_eq!(e.line, Some(3), "{e}");
     assert!(e.message.contains("longer than the 4096"), "{e}");
+
+// ---------------------------------------------------------------------------------------------------
+// Second campaign: no silent unit slip, every read guarded, budgets, sanitised messages, careful writes.
+
+/// A COLLADA `<unit meter>` that is not a positive finite decimal is an error naming the file, the
+/// line and the value; it was once read as 1 m (a millimetre file 10⁹ times too heavy, exit 0).
+#[test]
+fn collada_unit_that_is_no_positive_number_is_an_error() {
+    let geometry = format!(
+        "<library_geometries>{}</library_geometries>\n",
+        dae_box(Some("g"), 1.0, 0.0)
+    );
+    for value in [
+        "0,001", "1 mm", "abc", "0", "-1", "inf", "NaN", "1e-400", "",
+    ] {
+        let text = dae(&format!(
+            "<asset><unit meter=\"{value}\" name=\"x\"/></asset>\n{geometry}"
+        ));
+        assert_fails_with(
+            "unit.dae",
+            &text,
+            &format!("unit.dae:3: <unit meter=\"{value}\"> is not a positive number of metres"),
+        );
+    }
+    for (value, what) in [("1e308", "overflows"), ("1e-310", "underflows")] {
+        let text = dae(&format!(
+            "<asset><unit meter=\"{value}\"/></asset>\n{geometry}"
+        ));
+        assert_fails_with(
+            "unit.dae",
+            &text,
+            &format!("unit.dae:3: with <unit meter=\"{value}\">, the mesh's coordinates, volume or inertia {what} a 64-bit float"),
+        );
+    }
+    // A well-formed millimetre unit scales: the 1-unit box is 1e-9 m³ (exact: 0.001³ rounds to it).
+    let text = dae(&format!(
+        "<asset><unit meter=\" 0.001 \"/></asset>\n{geometry}"
+    ));
+    let outs = dae_through_every_command("unit.dae", &text);
+    assert!(outs[0].status.success(), "{}", stderr(&outs[0]));
+    let json: serde_json::Value = serde_json::from_slice(&outs[0].stdout).unwrap();
+    let volume = json["volume"].as_f64().unwrap();
+    assert!((volume - 1e-9).abs() <= 1e-24, "{json}");
+}
+
+/// Runs the binary, killing it (and failing the test) if it has not ended after `seconds`: a guard
+/// against the hangs some of these inputs once caused, not a timing assertion.
+fn run_or_kill(cmd: &mut Command, seconds: u64) -> Output {
+    let mut child = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn urdf-inertia");
+    for _ in 0..seconds * 10 {
+        if child.try_wait().expect("try_wait").is_some() {
+            return child.wait_with_output().expect("output");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    panic!("urdf-inertia still running after {seconds} s: {cmd:?}");
+}
+
+/// A `package.xml` found while looking for a package goes through the input guard: a FIFO once hung
+/// the run, and a symlink to `/dev/zero` read zeros until memory ran out. Each is an error naming it.
+#[test]
+fn package_xml_that_is_no_regular_file_is_an_error() {
+    for (kind, what) in [("fifo", "a FIFO"), ("zero", "a character device")] {
+        let tmp = tempfile::tempdir().unwrap();
+        let pkg = tmp.path().join("my_robot");
+        std::fs::create_dir_all(pkg.join("urdf")).unwrap();
+        std::fs::create_dir_all(pkg.join("meshes")).unwrap();
+        let xml = pkg.join("package.xml");
+        if kind == "fifo" {
+            assert!(Command::new("mkfifo").arg(&xml).status().unwrap().success());
+        } else {
+            std::os::unix::fs::symlink("/dev/zero", &xml).unwrap();
+        }
+        let urdf = pkg.join("urdf").join("r.urdf");
+        std::fs::write(&urdf, "<robot name=\"r\">\n  <link name=\"a\">\n    <collision><geometry><mesh filename=\"package://my_robot/meshes/a.stl\"/></geometry></collision>\n  </link>\n</robot>\n").unwrap();
+        for cmd in ["fill", "check"] {
+            let out = run_or_kill(bin().args([cmd, s(&urdf), "--density", "1000"]), 60);
+            assert_eq!(out.status.code(), Some(2), "{kind} {cmd}: {}", stderr(&out));
+            assert!(
+                stderr(&out).contains(&format!(
+                    "{} is not a regular file ({what}); remove or fix it",
+                    xml.display()
+                )),
+                "{kind} {cmd}: {}",
+                stderr(&out)
+            );
+        }
+    }
+}
+
+/// `mesh FILE --format json` (with `extra` arguments): the exit code, the volume when it succeeded,
+/// and stderr.
+fn mesh_volume(file: &Path, extra: &[&str]) -> (Option<i32>, Option<f64>, String) {
+    let mut args = vec!["mesh", s(file), "--format", "json"];
+    args.extend_from_slice(extra);
+    let out = run_or_kill(bin().args(&args), 300);
+    let volume = serde_json::from_slice::<serde_json::Value>(&out.stdout)
+        .ok()
+        .and_then(|v| v["volume"].as_f64());
+    (out.status.code(), volume, stderr(&out))
+}
+
+/// glTF nodes shared by several parents multiply their mesh: ten levels of two children each over a
+/// 20,000-vertex mesh ask for 20 M vertices from a few hundred kilobytes, which once grew to about
+/// 1.9 GB and aborted. The expansion budget COLLADA has stops it with an error.
+#[test]
+fn gltf_instance_fan_out_has_a_budget() {
+    use serde_json::json;
+    let mut b = gltf_gen::GltfBuilder::new();
+    let points: Vec<[f32; 3]> = (0..20_000)
+        .map(|i| [i as f32, (i % 7) as f32, (i % 13) as f32])
+        .collect();
+    let tris: Vec<u32> = (0..19_998).flat_map(|i| [i, i + 1, i + 2]).collect();
+    let pa = b.positions(&points);
+    let ia = b.indices(&tris, gltf_gen::U32);
+    let mesh = b.mesh(&[(pa, Some(ia), gltf_gen::TRIANGLES)]);
+    let mut child = b.node(json!({ "mesh": mesh }));
+    for _ in 0..10 {
+        child = b.node(json!({ "children": [child, child] }));
+    }
+    let sc = b.add_scene(&[child]);
+    b.scene = Some(sc);
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("fan.glb");
+    std::fs::write(&file, b.glb()).unwrap();
+    assert!(std::fs::metadata(&file).unwrap().len() < 600_000);
+    let (code, _, err) = mesh_volume(&file, &[]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("fan.glb: the scene instances more than 16777216 vertices"),
+        "{err}"
+    );
+}
+
+/// A glTF whose buffers all name one file reads it once (2,000 buffers naming one 5 MB file once
+/// read 10 GB); distinct buffer files count together against the one-file size limit.
+#[test]
+fn gltf_buffers_are_read_once_and_within_the_size_limit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let b = gltf_gen::box_builder([1.0, 2.0, 3.0], [0.0, 0.0, 0.0], serde_json::json!({}));
+    let mut bin = b.bin.clone();
+    bin.resize(600, 0);
+    std::fs::write(tmp.path().join("a.bin"), &bin).unwrap();
+    std::fs::write(tmp.path().join("b.bin"), &bin).unwrap();
+    let mut doc: serde_json::Value = serde_json::from_str(&b.gltf_external("a.bin")).unwrap();
+    let buffer = doc["buffers"][0].clone();
+    doc["buffers"] = serde_json::Value::Array(vec![buffer.clone(); 2000]);
+    let many = tmp.path().join("many.gltf");
+    std::fs::write(&many, serde_json::to_vec(&doc).unwrap()).unwrap();
+    // 2,000 buffers of one 600-byte file: within a limit of 100 KB, as the file is read once.
+    let (code, volume, err) = mesh_volume(&many, &["--max-file-size", "100K"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(volume, Some(6.0));
+    // Two distinct 600-byte files against a limit of 1,000 bytes.
+    let mut other = buffer;
+    other["uri"] = "b.bin".into();
+    doc["buffers"] = serde_json::json!([doc["buffers"][0].clone(), other]);
+    let two = tmp.path().join("two.gltf");
+    std::fs::write(&two, serde_json::to_vec(&doc).unwrap()).unwrap();
+    assert!(std::fs::metadata(&two).unwrap().len() < 1000);
+    let (code, _, err) = mesh_volume(&two, &["--max-file-size", "1000"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains(
+            "buffer 1: the file's buffers together are larger than the limit of 1000 bytes"
+        ),
+        "{err}"
+    );
+}
+
+/// glTF buffer URIs: absolute paths and other schemes are refused as the message says; `../` and
+/// percent-encoded relative references are read (resolved against the glTF's directory), so the
+/// message and what is read agree.
+#[test]
+fn gltf_buffer_uris_are_relative_references_or_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sub = tmp.path().join("meshes");
+    std::fs::create_dir(&sub).unwrap();
+    let b = gltf_gen::box_builder([1.0, 2.0, 3.0], [0.0, 0.0, 0.0], serde_json::json!({}));
+    std::fs::write(tmp.path().join("up one.bin"), &b.bin).unwrap();
+    let absolute = tmp.path().join("up one.bin");
+    // The input guard covers buffers too: a FIFO (which would hang) and a symlink to /dev/zero.
+    assert!(Command::new("mkfifo")
+        .arg(sub.join("fifo.bin"))
+        .status()
+        .unwrap()
+        .success());
+    std::os::unix::fs::symlink("/dev/zero", sub.join("zero.bin")).unwrap();
+    for (uri, ok) in [
+        ("../up%20one.bin".to_string(), true),
+        ("..%2Fup%20one.bin".to_string(), true),
+        (s(&absolute).to_string(), false),
+        (s(&absolute).replace(' ', "%20"), false),
+        (
+            format!("file://{}", s(&absolute).replace(' ', "%20")),
+            false,
+        ),
+        ("http://example.com/up.bin".to_string(), false),
+        ("fifo.bin".to_string(), false),
+        ("zero.bin".to_string(), false),
+    ] {
+        let file = sub.join("box.gltf");
+        std::fs::write(&file, b.gltf_external(&uri)).unwrap();
+        let (code, volume, err) = mesh_volume(&file, &[]);
+        if ok {
+            assert_eq!((code, volume), (Some(0), Some(6.0)), "{uri}: {err}");
+        } else {
+            assert_eq!(code, Some(2), "{uri}: {err}");
+            let why = if uri.starts_with("fifo") || uri.starts_with("zero") {
+                "is not a regular file"
+            } else {
+                "is absolute; only relative references"
+            };
+            assert!(err.contains(why), "{uri}: {err}");
+        }
+    }
+}
+
+/// `--keep-mass` on a `<mass>` it cannot keep (`1,5`, `nan`, `-0`, `0`, `-2`) is an error naming
+/// the link and the line; it was once replaced by the density's mass without a word. A link without
+/// any `<mass>` still takes the density.
+#[test]
+fn keep_mass_with_an_unusable_mass_is_an_error() {
+    for value in ["1,5", "nan", "-0", "0", "-2", "inf", "abc"] {
+        let text = format!("<robot name=\"r\">\n  <link name=\"arm\">\n    <inertial>\n      <mass value=\"{value}\"/>\n    </inertial>\n    <collision><geometry><box size=\"1 1 1\"/></geometry></collision>\n  </link>\n  <link name=\"b\">\n    <collision><geometry><box size=\"1 1 1\"/></geometry></collision>\n  </link>\n</robot>\n");
+        let (_tmp, urdf) = urdf_in_tmp(&text);
+        for cmd in ["fill", "check"] {
+            let out = run(&[cmd, s(&urdf), "--density", "1000", "--keep-mass"]);
+            assert_eq!(
+                out.status.code(),
+                Some(2),
+                "{value} {cmd}: {}",
+                stderr(&out)
+            );
+            let err = stderr(&out);
+            assert!(err.contains("link `arm`"), "{value} {cmd}: {err}");
+            assert!(
+                err.contains("--keep-mass: <mass> on line 4:")
+                    && err.contains("is not a positive number of kilograms"),
+                "{value} {cmd}: {err}"
+            );
+        }
+        assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text, "{value}");
+    }
+}
+
+/// A held `fill -i` (see the test hook in src/cli/write.rs): the child and its temporary file.
+fn held_fill_in_place(urdf: &Path) -> (std::process::Child, PathBuf) {
+    let mut child = bin()
+        .args(["fill", s(urdf), "--density", "1000", "-i"])
+        .env("URDF_INERTIA_TEST_HOLD_TEMP", "1")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    let mut lines = BufReader::new(child.stderr.take().expect("stderr")).lines();
+    let temp = loop {
+        let line = lines
+            .next()
+            .expect("the binary announces its temp file")
+            .expect("line");
+        if let Some(p) = line.strip_prefix("holding temporary file ") {
+            break PathBuf::from(p);
+        }
+    };
+    // The rest of stderr is drained so that the child never blocks on it.
+    std::thread::spawn(move || lines.for_each(drop));
+    (child, temp)
+}
+
+/// Every catchable signal whose default action ends the process removes the temporary file and
+/// leaves the URDF as it was (exit 130); SIGQUIT, SIGUSR1, SIGALRM and SIGXCPU once left it behind.
+#[test]
+fn every_ending_signal_removes_the_temp_file() {
+    for signal in [
+        "QUIT", "USR1", "USR2", "ALRM", "VTALRM", "PROF", "XCPU", "INT", "HUP",
+    ] {
+        let text = one_box();
+        let (_tmp, urdf) = urdf_in_tmp(&text);
+        let (mut child, temp) = held_fill_in_place(&urdf);
+        assert!(temp.exists(), "{signal}");
+        let st = Command::new("kill")
+            .args([&format!("-{signal}"), &child.id().to_string()])
+            .status()
+            .expect("kill");
+        assert!(st.success());
+        let status = child.wait().expect("wait");
+        assert_eq!(status.code(), Some(130), "SIG{signal}");
+        assert!(!temp.exists(), "SIG{signal}: temp file left behind");
+        assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text, "SIG{signal}");
+    }
+}
+
+/// A file-size limit (`ulimit -f`) below the output is an EFBIG write error (SIGXFSZ is caught, so
+/// the process is not killed leaving a partial temporary file): exit 2, the URDF as it was, no
+/// temporary file.
+#[test]
+fn file_size_limit_is_a_write_error() {
+    let names: Vec<String> = (0..8).map(|i| format!("link_{i}")).collect();
+    let links: Vec<(&str, &str, &str)> = names
+        .iter()
+        .map(|n| (n.as_str(), "1 2 3", "0 0 0"))
+        .collect();
+    let text = boxes(&links);
+    let (tmp, urdf) = urdf_in_tmp(&text);
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -f 2 && exec \"{}\" fill \"{}\" --density 1000 -i",
+            env!("CARGO_BIN_EXE_urdf-inertia"),
+            s(&urdf)
+        ))
+        .output()
+        .unwrap();
+    // The filled file is over 1 KiB (2 blocks of 512 bytes for POSIX sh's ulimit -f).
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("cannot write the temporary file: File too large"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
+    let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().flatten().collect();
+    assert_eq!(left.len(), 1, "{left:?}");
+}
+
+/// An edit made to the URDF while `fill -i` works is kept and the run fails saying so; it was once
+/// overwritten with exit 0.
+#[test]
+fn edit_during_fill_in_place_is_kept() {
+    let text = one_box();
+    let (_tmp, urdf) = urdf_in_tmp(&text);
+    let (mut child, temp) = held_fill_in_place(&urdf);
+    let edited = text.replace("<robot name=\"r\">", "<robot name=\"r\"><!-- edited -->");
+    std::fs::write(&urdf, &edited).unwrap();
+    child
+        .stdin
+        .take()
+        .expect("stdin")
+        .write_all(b"\n")
+        .expect("release");
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(2));
+    assert!(!temp.exists());
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), edited);
+    // Without an edit the same run writes.
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(std::fs::read_to_string(&urdf)
+        .unwrap()
+        .contains("<inertial>"));
+}
+
+/// A run whose output is the file's bytes already writes nothing (same inode, same modification
+/// time); a 250-byte file name (the temporary name once exceeded NAME_MAX) fills in place.
+#[test]
+fn unchanged_output_is_not_written_and_long_names_fill_in_place() {
+    let tmp = tempfile::tempdir().unwrap();
+    let urdf = tmp.path().join(format!("{}.urdf", "n".repeat(245)));
+    assert_eq!(urdf.file_name().unwrap().len(), 250);
+    std::fs::write(&urdf, one_box()).unwrap();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let filled = std::fs::read_to_string(&urdf).unwrap();
+    assert!(filled.contains("<inertial>"));
+    let before = std::fs::metadata(&urdf).unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let after = std::fs::metadata(&urdf).unwrap();
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), filled);
+    assert_eq!(after.ino(), before.ino());
+    assert_eq!(
+        (after.mtime(), after.mtime_nsec()),
+        (before.mtime(), before.mtime_nsec())
+    );
+}
+
+/// `-i /dev/stdin` once rewrote a read-only, hard-linked file through the descriptor; `-i` takes a
+/// regular file named by its path only.
+#[test]
+fn fill_in_place_on_stdin_is_refused() {
+    let text = one_box();
+    let (tmp, urdf) = urdf_in_tmp(&text);
+    std::fs::hard_link(&urdf, tmp.path().join("other.urdf")).unwrap();
+    std::fs::set_permissions(&urdf, std::fs::Permissions::from_mode(0o444)).unwrap();
+    for name in ["/dev/stdin", "/proc/self/fd/0"] {
+        let out = bin()
+            .args(["fill", name, "--density", "1000", "-i"])
+            .stdin(std::fs::File::open(&urdf).unwrap())
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{name}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains("-i rewrites a regular file named by its path"),
+            "{name}: {}",
+            stderr(&out)
+        );
+        assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
+    }
+}
+
+/// `fill -i` keeps the file's extended attributes (POSIX ACLs are some): they are copied to the
+/// temporary file before the rename. Checked with a `user.` attribute where the temp dir's file
+/// system takes one.
+#[test]
+fn fill_in_place_keeps_extended_attributes() {
+    let (_tmp, urdf) = urdf_in_tmp(&one_box());
+    if xattr::set(&urdf, "user.urdf_inertia_test", b"kept").is_err() {
+        eprintln!("the temp dir's file system takes no user xattrs: not checked here");
+        return;
+    }
+    let ino = std::fs::metadata(&urdf).unwrap().ino();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(std::fs::read_to_string(&urdf)
+        .unwrap()
+        .contains("<inertial>"));
+    assert_ne!(
+        std::fs::metadata(&urdf).unwrap().ino(),
+        ino,
+        "replaced through a temp file"
+    );
+    assert_eq!(
+        xattr::get(&urdf, "user.urdf_inertia_test")
+            .unwrap()
+            .as_deref(),
+        Some(&b"kept"[..])
+    );
+}
+
+/// Control characters from input are shown escaped in every text message: a link name holding
+/// `&#10;::error …::` once wrote a fake CI annotation line into the log, and `&#27;` escape
+/// sequences rewrote the terminal.
+#[test]
+fn control_characters_from_input_are_escaped_in_messages() {
+    let text = "<robot name=\"r\">\n  <link name=\"arm&#10;::error file=x::forged&#27;[2J&#13;\">\n    <collision><geometry><mesh filename=\"missing&#10;::warning::m.stl\"/></geometry></collision>\n  </link>\n  <link name=\"b&#27;]0;title&#7;\">\n    <inertial><mass value=\"1&#10;::error::\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial>\n    <collision><geometry><box size=\"1 1 1\"/></geometry></collision>\n  </link>\n</robot>\n";
+    let (_tmp, urdf) = urdf_in_tmp(text);
+    for args in [
+        vec!["fill", s(&urdf), "--density", "1000"],
+        vec![
+            "fill",
+            s(&urdf),
+            "--density",
+            "1000",
+            "--keep-going",
+            "-o",
+            "-",
+        ],
+        vec!["check", s(&urdf), "--density", "1000"],
+        vec!["check", s(&urdf)],
+        vec!["diff", s(&urdf), "--density", "1000"],
+        vec!["fill", s(&urdf), "--density", "1000", "--keep-mass"],
+    ] {
+        let out = run(&args);
+        let err = stderr(&out);
+        let shown = format!("{err}{}", String::from_utf8_lossy(&out.stdout));
+        let messages = if args.contains(&"-o") {
+            err.clone()
+        } else {
+            shown
+        };
+        for line in messages.lines() {
+            assert!(
+                !line.starts_with("::error") && !line.starts_with("::warning"),
+                "{args:?}: forged annotation line {line:?} in\n{messages}"
+            );
+        }
+        assert!(
+            !messages
+                .bytes()
+                .any(|b| b == 0x1b || b == 0x07 || b == b'\r'),
+            "{args:?}: raw control character in {messages:?}"
+        );
+        assert!(
+            messages.contains("arm\\n::error file=x::forged\\x1b[2J\\r"),
+            "{args:?}: {messages}"
+        );
+    }
+}
+
+/// A density-map key of 400 KB once panicked in globset (exit 101); it is an error on its line now.
+#[test]
+fn huge_density_map_key_is_an_error() {
+    let (tmp, urdf) = urdf_in_tmp(&one_box());
+    let map = tmp.path().join("d.toml");
+    std::fs::write(
+        &map,
+        format!(
+            "default = 1000\n[links]\n\"{}\" = 2000\n",
+            "a*".repeat(200_000)
+        ),
+    )
+    .unwrap();
+    let out = run(&["fill", s(&urdf), "--density-map", s(&map)]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("d.toml:3"), "{err}");
+    assert!(
+        err.contains("(400000 bytes) is longer than the 4096 bytes a glob may have"),
+        "{err}"
+    );
+    assert!(
+        err.len() < 2000,
+        "the key is not echoed whole: {} bytes",
+        err.len()
+    );
+}
+
+/// A thread pool that cannot start (here: no stack can be mapped for a new thread) once panicked
+/// (exit 101); the work runs on the calling thread with a warning. `RAYON_NUM_THREADS` far beyond the
+/// cores is capped at four a core (at least 8), with a warning.
+#[test]
+fn thread_pool_failures_fall_back_to_one_thread() {
+    let tmp = tempfile::tempdir().unwrap();
+    let urdf = robot_of_every_kind_of_mesh(tmp.path());
+    let filled = |threads: &str| {
+        bin()
+            .args([
+                "fill",
+                s(&urdf),
+                "--density",
+                "1000",
+                "--keep-going",
+                "-o",
+                "-",
+            ])
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .unwrap()
+    };
+    let reference = filled("1");
+    assert_eq!(reference.status.code(), Some(2), "{}", stderr(&reference));
+    assert!(!reference.stdout.is_empty());
+    let out = bin()
+        .args([
+            "fill",
+            s(&urdf),
+            "--density",
+            "1000",
+            "--keep-going",
+            "-o",
+            "-",
+        ])
+        .env("RUST_MIN_STACK", (1u64 << 50).to_string())
+        .output()
+        .unwrap();
+    assert!(
+        stderr(&out).contains("warning: cannot start")
+            && stderr(&out).contains("working on one thread"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(out.stdout, reference.stdout, "same URDF as on one thread");
+    let out = filled("5000");
+    assert!(
+        stderr(&out).contains("RAYON_NUM_THREADS=5000 is more threads than"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(out.stdout, reference.stdout, "same URDF as on one thread");
+}
+
+/// Binary STL of `n`³ disjoint unit cubes at even integer coordinates (whole numbers: as f64 their
+/// low 40 and more bits are zero), 12 outward triangles each.
+fn integer_grid_of_cubes(n: u32) -> Vec<u8> {
+    let (corners, tris) = common::box_mesh([1.0, 1.0, 1.0]);
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                let base = vertices.len() as u32;
+                let at = [i, j, k].map(|c| f64::from(2 * c) + 0.5);
+                vertices.extend(
+                    corners
+                        .iter()
+                        .map(|p| [p[0] + at[0], p[1] + at[1], p[2] + at[2]]),
+                );
+                triangles.extend(tris.iter().map(|t| t.map(|v| v + base)));
+            }
+        }
+    }
+    urdf_inertia::mesh::stl::write_binary(b"integer grid", &vertices, &triangles)
+}
+
+/// Whole-number coordinates once made the weld quadratic (its hash kept their zero low bits: a
+/// 4 M-triangle integer grid took 12.1 s against 0.59 s with other spacing). 8,000 cubes (64,000
+/// distinct integer vertices) load and weld into 8,000 closed cubes of exact total volume; the unit
+/// test `integer_and_millimetre_grids_hash_apart` bounds the table's probes.
+#[test]
+fn integer_grid_coordinates_weld() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("grid.stl");
+    std::fs::write(&file, integer_grid_of_cubes(20)).unwrap();
+    let (code, volume, err) = mesh_volume(&file, &[]);
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(volume, Some(8000.0), "{err}");
+}
+
+/// A mesh beyond f64 (1e150 coordinates, `--scale 1e150`, subnormal 1e-310 coordinates) was
+/// "flat or degenerate" with `NaN m³`; it overflows or underflows a 64-bit float now, as primitives
+/// of those sizes do.
+#[test]
+fn mesh_overflow_and_underflow_are_named() {
+    let tmp = tempfile::tempdir().unwrap();
+    let tet = |x: &str| {
+        format!("v 0 0 0\nv {x} 0 0\nv 0 {x} 0\nv 0 0 {x}\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
+    };
+    std::fs::write(tmp.path().join("huge.obj"), tet("1e150")).unwrap();
+    std::fs::write(tmp.path().join("unit.obj"), tet("1")).unwrap();
+    std::fs::write(tmp.path().join("subnormal.obj"), tet("1e-310")).unwrap();
+    for (file, scale, what) in [
+        ("huge.obj", None, "overflows"),
+        ("unit.obj", Some("1e150"), "overflows"),
+        ("subnormal.obj", None, "underflows"),
+    ] {
+        let mut args = vec!["mesh", file];
+        if let Some(s) = scale {
+            args.extend(["--scale", s, s, s]);
+        }
+        let out = bin().args(&args).current_dir(tmp.path()).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{file}: {}", stderr(&out));
+        let err = stderr(&out);
+        assert!(
+            err.contains("a 64-bit float") && err.contains(what),
+            "{file}: {err}"
+        );
+        assert!(
+            !err.contains("NaN") && !err.contains("flat or degenerate"),
+            "{file}: {err}"
+        );
+        // In a URDF, the link fails with the same words.
+        let scale_attr = scale
+            .map(|s| format!(" scale=\"{s} {s} {s}\""))
+            .unwrap_or_default();
+        let urdf = tmp.path().join("r.urdf");
+        std::fs::write(&urdf, format!("<robot name=\"r\">\n  <link name=\"x\">\n    <collision><geometry><mesh filename=\"{file}\"{scale_attr}/></geometry></collision>\n  </link>\n</robot>\n")).unwrap();
+        let out = run(&["fill", s(&urdf), "--density", "1000"]);
+        assert_eq!(out.status.code(), Some(2), "{file}");
+        let err = stderr(&out);
+        assert!(
+            err.contains("link `x`") && err.contains(what),
+            "{file}: {err}"
+        );
+        assert!(!err.contains("NaN"), "{file}: {err}");
+    }
+}
+
+/// Two `<robot>` roots: urdfdom reads the first; both were once filled. The second is left as it
+/// is, with a warning on its line.
+#[test]
+fn second_robot_root_is_left_alone() {
+    let second = "<robot name=\"s\">\n  <link name=\"b\">\n    <collision><geometry><box size=\"1 1 1\"/></geometry></collision>\n  </link>\n</robot>\n";
+    let text = format!("{}{second}", one_box());
+    let (_tmp, urdf) = urdf_in_tmp(&text);
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-o", "-"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let filled = String::from_utf8(out.stdout.clone()).unwrap();
+    assert_eq!(filled.matches("<inertial>").count(), 1, "{filled}");
+    assert!(filled.ends_with(second), "{filled}");
+    assert!(
+        stderr(&out).contains(":6: a second root element <robot> is ignored"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+/// A URDF whose lines end with CR alone once got LF lines inserted and every message on line 1: it
+/// keeps CR line ends, and messages name their lines.
+#[test]
+fn cr_only_urdf_keeps_its_line_ends_and_lines() {
+    let text = boxes(&[("a", "1 2 3", "0 0 0"), ("b", "1 -2 3", "0 0 0")]).replace('\n', "\r");
+    let (_tmp, urdf) = urdf_in_tmp(&text);
+    let out = run(&[
+        "fill",
+        s(&urdf),
+        "--density",
+        "1000",
+        "--keep-going",
+        "-o",
+        "-",
+    ]);
+    let filled = String::from_utf8(out.stdout.clone()).unwrap();
+    assert!(filled.contains("<inertial>"), "{}", stderr(&out));
+    assert!(!filled.contains('\n'), "{filled:?}");
+    // Link `b` is on line 5 and its collision (a negative size) on line 6.
+    assert!(
+        stderr(&out).contains("r.urdf:5: link `b`: collision 1 (line 6)"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+/// UTF-32 and UTF-16 without a byte-order mark or a declaration were once "malformed attributes";
+/// UTF-16 is read (and written back as UTF-16), UTF-32 is named.
+#[test]
+fn utf16_without_a_mark_is_read_and_utf32_is_named() {
+    let text = one_box();
+    let utf16le: Vec<u8> = text.encode_utf16().flat_map(u16::to_le_bytes).collect();
+    let utf16be: Vec<u8> = text.encode_utf16().flat_map(u16::to_be_bytes).collect();
+    for (name, bytes, le) in [("le", utf16le, true), ("be", utf16be, false)] {
+        let tmp = tempfile::tempdir().unwrap();
+        let urdf = tmp.path().join("r.urdf");
+        std::fs::write(&urdf, &bytes).unwrap();
+        let out = run(&["fill", s(&urdf), "--density", "1000", "-o", "-"]);
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        let units: Vec<u16> = out
+            .stdout
+            .chunks_exact(2)
+            .map(|c| {
+                if le {
+                    u16::from_le_bytes([c[0], c[1]])
+                } else {
+                    u16::from_be_bytes([c[0], c[1]])
+                }
+            })
+            .collect();
+        let back = String::from_utf16(&units).unwrap();
+        assert!(back.contains("<inertial>"), "{name}: {back}");
+    }
+    for (name, bytes) in [
+        (
+            "LE",
+            text.chars()
+                .flat_map(|c| (c as u32).to_le_bytes())
+                .collect::<Vec<u8>>(),
+        ),
+        (
+            "BE",
+            text.chars()
+                .flat_map(|c| (c as u32).to_be_bytes())
+                .collect(),
+        ),
+    ] {
+        let (_tmp, urdf) = urdf_in_tmp("");
+        std::fs::write(&urdf, &bytes).unwrap();
+        let out = run(&["check", s(&urdf)]);
+        assert_eq!(out.status.code(), Some(2), "{name}");
+        assert!(
+            stderr(&out).contains("the file is UTF-32"),
+            "{name}: {}",
+            stderr(&out)
+        );
+    }
 }

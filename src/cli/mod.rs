@@ -77,6 +77,9 @@ pub fn main() -> i32 {
         Command::Check(c) => robot_cmd::check(&c),
         Command::Xacro(x) => xacro_cmd::run(&x),
     };
+    if let Some(note) = urdf_inertia::threads::note() {
+        errln!("warning: {note}");
+    }
     if output::stdout_failed() {
         return ExitStatus::Error as i32;
     }

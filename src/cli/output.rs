@@ -47,20 +47,31 @@ pub fn write_stderr(bytes: &[u8]) {
     let _ = err.write_all(bytes).and_then(|()| err.flush());
 }
 
-/// One line on stdout (see [`write_stdout`]; the error is already reported and remembered).
-pub fn out_line(line: &str) {
+/// `line` with every control character but its line breaks escaped (`\x1b`, `\r`, `\t`, ...), and a
+/// line break: text from input files (a link name holding ESC) never reaches the terminal raw. Line
+/// breaks inside names are escaped where the names are put into messages
+/// ([`urdf_inertia::text::escape_control`]); the ones left here are the messages' own.
+fn sanitised_line(line: &str) -> String {
     let mut s = String::with_capacity(line.len() + 1);
-    s.push_str(line);
+    for (i, piece) in line.split('\n').enumerate() {
+        if i > 0 {
+            s.push('\n');
+        }
+        s.push_str(&urdf_inertia::text::escape_control(piece));
+    }
     s.push('\n');
-    let _ = write_stdout(s.as_bytes());
+    s
 }
 
-/// One line on stderr.
+/// One line on stdout (see [`write_stdout`]; the error is already reported and remembered), control
+/// characters escaped (see [`sanitised_line`]).
+pub fn out_line(line: &str) {
+    let _ = write_stdout(sanitised_line(line).as_bytes());
+}
+
+/// One line on stderr, control characters escaped (see [`sanitised_line`]).
 pub fn err_line(line: &str) {
-    let mut s = String::with_capacity(line.len() + 1);
-    s.push_str(line);
-    s.push('\n');
-    write_stderr(s.as_bytes());
+    write_stderr(sanitised_line(line).as_bytes());
 }
 
 /// From now on stdout carries only a summary of work already done (the URDF went to a file): failing to

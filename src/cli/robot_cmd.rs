@@ -319,6 +319,7 @@ impl Input {
     /// `FILE:LINE: link `name`` for an element on `line` of the scanned text; for a xacro source
     /// the file and line where it was written, and the macro calls that produced it.
     fn link_at(&self, line: usize, name: &str) -> String {
+        let name = urdf_inertia::text::escape_control(name);
         match self.xacro.as_ref().and_then(|x| Some((x, x.origin(line)?))) {
             Some((x, o)) => format!("{}: link `{name}`{}", x.at(o), x.calls_text(o)),
             None => format!("{}:{line}: link `{name}`", self.robot.path.display()),
@@ -349,6 +350,7 @@ fn read_input(path: &Path, src: &Sources, verbose: bool) -> Result<Input, String
         urdf_inertia::input::read_rest(std::io::stdin().lock(), Vec::new())
             .map_err(|e| format!("stdin: cannot read the URDF: {e}"))?
     } else {
+        write::remember_before_reading(path);
         urdf_inertia::input::read_file(path)
             .map_err(|e| format!("{}: cannot read the URDF: {e}", path.display()))?
     };
@@ -453,7 +455,12 @@ fn write_robot(
             let text = spliced(robot, report, w)?;
             check_failed()?;
             let target = file.unwrap_or(Path::new("-"));
-            if let Err(e) = write::write_output(target, &text) {
+            let written = if w.in_place {
+                write::write_in_place(target, &text)
+            } else {
+                write::write_output(target, &text)
+            };
+            if let Err(e) = written {
                 // A failing stdout was reported where it failed.
                 if file.is_some() {
                     errln!("error: {e}");
@@ -608,7 +615,7 @@ fn spliced(robot: &Robot, report: &FillReport, w: &WriteConfig) -> Result<Vec<u8
                 "error: {}:{}: link `{}`: {}",
                 robot.path.display(),
                 link.line,
-                link.name,
+                urdf_inertia::text::escape_control(&link.name),
                 e.message
             );
         }

@@ -27,7 +27,10 @@ fn by_severity<'a>(ds: impl Iterator<Item = &'a Diagnostic>, warning: bool) -> V
 fn part_lines(l: &LinkReport, p: &PartReport, verbose: bool, out: &mut Vec<String>) {
     let head = format!(
         "link `{}`, collision {}, {}: {}",
-        l.name, p.collision, p.what, p.provenance
+        urdf_inertia::text::escape_control(&l.name),
+        p.collision,
+        p.what,
+        p.provenance
     );
     let warnings: Vec<&Diagnostic> = p.warnings().collect();
     for w in &warnings {
@@ -53,7 +56,7 @@ fn link_lines(l: &LinkReport, verbose: bool) -> Vec<String> {
         out.push(format!(
             "  {}: link `{}`: {}",
             d.severity.as_str(),
-            l.name,
+            urdf_inertia::text::escape_control(&l.name),
             d.message
         ));
     }
@@ -120,7 +123,7 @@ fn worst_error(report: &FillReport) {
         errln!(
             "  worst error estimate: {} (relative bound on volume and inertia; link `{}`, collision {}: {})",
             p.error.describe(),
-            l.name,
+            urdf_inertia::text::escape_control(&l.name),
             p.collision,
             p.provenance
         );

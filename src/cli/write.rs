@@ -1,9 +1,18 @@
 //! Writing the filled URDF (`-o FILE`, `-o -`, `-i`): the write policy documented in the README.
 //!
 //! * A regular file (or a symlink to one, followed to its target, dangling ones included) is replaced
-//!   atomically: a temporary file `.NAME.urdf-inertia.PID.N.tmp` in the target's directory, created with
-//!   the target's mode (never wider), given the target's owner and group where the process may, synced,
-//!   then renamed over the target. It is removed on error, SIGINT, SIGTERM and SIGHUP (exit 130).
+//!   atomically: a temporary file `.NAME.urdf-inertia.PID.N.tmp` in the target's directory (NAME cut
+//!   to its first 64 bytes, so that a name near NAME_MAX still has room), created with the target's
+//!   mode (never wider), given the target's owner and group where the process may, and its extended
+//!   attributes (POSIX ACLs among them) where the file system and the process allow, synced, then
+//!   renamed over the target. It is removed on error and on every catchable signal that would end
+//!   the process (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF,
+//!   SIGXCPU: exit 130); SIGXFSZ is caught and ignored, so a file-size limit is an EFBIG write error.
+//! * A target whose bytes are already the output is not written at all (same inode, same times).
+//! * `-i`: the URDF's size, modification time and inode are noted before it is read, and checked
+//!   again just before the rename: an edit made meanwhile is kept, and the run fails saying so.
+//!   `-i` on something that is not a regular file named by its path (`/dev/stdin`, `/proc/self/fd/0`)
+//!   is refused.
 //! * Anything else that exists (a character device such as `/dev/null`, a FIFO, `/dev/stdout` and other
 //!   `/proc` or `/dev/fd` links) is opened for writing and written directly: never replaced, never
 //!   truncated unless it turns out to be a regular file.
@@ -13,13 +22,25 @@
 //!   without any write bit, a directory as target.
 
 use super::output;
-use signal_hook::consts::signal::{SIGHUP, SIGINT, SIGTERM};
+use signal_hook::consts::signal::{
+    SIGALRM, SIGHUP, SIGINT, SIGPROF, SIGQUIT, SIGTERM, SIGUSR1, SIGUSR2, SIGVTALRM, SIGXCPU,
+    SIGXFSZ,
+};
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, Write};
 use std::os::unix::fs::{MetadataExt, OpenOptionsExt, PermissionsExt};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Arc, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// Catchable signals whose default action ends the process: each removes a live temporary file.
+/// (SIGPIPE is ignored by the Rust runtime: a closed pipe is an EPIPE error where it is written.)
+const ENDING_SIGNALS: [i32; 10] = [
+    SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU,
+];
+
+/// The longest part of the target's name kept in the temporary file's name, in bytes.
+const TEMP_NAME_PART: usize = 64;
 
 static TEMP_COUNTER: AtomicUsize = AtomicUsize::new(0);
 
@@ -48,15 +69,17 @@ struct Signals {
 
 static SIGNALS: OnceLock<Signals> = OnceLock::new();
 
-/// Installs the SIGINT/SIGTERM/SIGHUP handling that removes a live temporary file, then exits 130.
+/// Installs the handling of [`ENDING_SIGNALS`] that removes a live temporary file, then exits 130,
+/// and catches SIGXFSZ so that exceeding a file-size limit is a write error, not a killed process.
 pub fn remove_temp_files_on_signal() {
     SIGNALS.get_or_init(|| {
         let s = Signals {
             exit_at_once: Arc::new(AtomicBool::new(true)),
             caught: Arc::new(AtomicBool::new(false)),
         };
-        for signal in [SIGINT, SIGTERM, SIGHUP] {
-            // These three can always be caught; were one refused, it would keep its default action
+        let _ = signal_hook::flag::register(SIGXFSZ, Arc::new(AtomicBool::new(false)));
+        for signal in ENDING_SIGNALS {
+            // These can always be caught; were one refused, it would keep its default action
             // (ending the process), which leaves a temporary file but never a damaged target.
             let _ = signal_hook::flag::register(signal, Arc::clone(&s.caught));
             let _ = signal_hook::flag::register_conditional_shutdown(
@@ -136,15 +159,89 @@ fn resolve(path: &Path) -> Result<Resolved, String> {
     ))
 }
 
+/// What identifies a file's content without reading it: device, inode, size and modification time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Stamp {
+    dev: u64,
+    ino: u64,
+    size: u64,
+    mtime: (i64, i64),
+}
+
+impl Stamp {
+    fn of(meta: &fs::Metadata) -> Stamp {
+        Stamp {
+            dev: meta.dev(),
+            ino: meta.ino(),
+            size: meta.size(),
+            mtime: (meta.mtime(), meta.mtime_nsec()),
+        }
+    }
+}
+
+/// The stamps of the URDFs read, by the path they were read by (for `-i`'s changed-since-read check).
+static READ_STAMPS: Mutex<Vec<(PathBuf, Stamp)>> = Mutex::new(Vec::new());
+
+/// Notes the state of `path` before it is read, for [`write_in_place`].
+pub fn remember_before_reading(path: &Path) {
+    if let Ok(meta) = fs::metadata(path) {
+        READ_STAMPS
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .push((path.to_path_buf(), Stamp::of(&meta)));
+    }
+}
+
+fn stamp_when_read(path: &Path) -> Option<Stamp> {
+    READ_STAMPS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+        .iter()
+        .rev()
+        .find(|(p, _)| p == path)
+        .map(|(_, s)| *s)
+}
+
+/// Writes `text` over the URDF it was computed from (`-i`): only a regular file named by its path,
+/// and only if it has not changed since it was read (see the module docs).
+pub fn write_in_place(path: &Path, text: &[u8]) -> Result<(), String> {
+    match resolve(path)? {
+        Resolved::Regular(..) => {}
+        _ => {
+            return Err(format!(
+                "{}: -i rewrites a regular file named by its path, and this is not one (stdin, a device or a descriptor link); write with -o FILE instead",
+                path.display()
+            ))
+        }
+    }
+    write_checked(path, text, stamp_when_read(path))
+}
+
 /// Writes `text` to `path` (`-` is stdout) following the module's write policy.
 pub fn write_output(path: &Path, text: &[u8]) -> Result<(), String> {
+    write_checked(path, text, None)
+}
+
+/// Whether the regular file `meta` describes at `p` holds exactly `text` (read only when the sizes
+/// agree).
+fn holds(p: &Path, meta: &fs::Metadata, text: &[u8]) -> bool {
+    meta.len() == text.len() as u64 && fs::read(p).is_ok_and(|bytes| bytes == text)
+}
+
+fn write_checked(path: &Path, text: &[u8], expected: Option<Stamp>) -> Result<(), String> {
     if path.as_os_str() == "-" {
         return output::write_stdout(text).map_err(|e| format!("cannot write to stdout: {e}"));
     }
     match resolve(path)? {
         Resolved::Direct(p) => write_direct(&p, text),
-        Resolved::New(p) => replace_through_temp(&p, None, text),
+        Resolved::New(p) => replace_through_temp(&p, None, text, None),
         Resolved::Regular(p, meta) => {
+            if expected.is_some_and(|s| s != Stamp::of(&meta)) {
+                return Err(changed(&p));
+            }
+            if holds(&p, &meta, text) {
+                return Ok(());
+            }
             let mode = meta.permissions().mode() & 0o7777;
             if mode & 0o222 == 0 {
                 return Err(format!(
@@ -164,9 +261,16 @@ pub fn write_output(path: &Path, text: &[u8]) -> Result<(), String> {
                 .write(true)
                 .open(&p)
                 .map_err(|e| format!("{}: cannot write: {e}", p.display()))?;
-            replace_through_temp(&p, Some(&meta), text)
+            replace_through_temp(&p, Some(&meta), text, expected)
         }
     }
+}
+
+fn changed(p: &Path) -> String {
+    format!(
+        "{}: the file changed while urdf-inertia worked on it; nothing written (the change is kept): run again",
+        p.display()
+    )
 }
 
 fn write_direct(p: &Path, text: &[u8]) -> Result<(), String> {
@@ -180,19 +284,28 @@ fn write_direct(p: &Path, text: &[u8]) -> Result<(), String> {
 }
 
 /// Writes `text` to a temporary file beside `target` and renames it over `target`. `original` is the
-/// target's metadata when it exists (mode, owner and group to keep).
+/// target's metadata when it exists (mode, owner, group and extended attributes to keep); with
+/// `expected`, the target must still have that stamp just before the rename.
 fn replace_through_temp(
     target: &Path,
     original: Option<&fs::Metadata>,
     text: &[u8],
+    expected: Option<Stamp>,
 ) -> Result<(), String> {
     let dir = target
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let name = target
+    let mut name = target
         .file_name()
         .map_or_else(|| "urdf".into(), |n| n.to_string_lossy().into_owned());
+    if name.len() > TEMP_NAME_PART {
+        let mut end = TEMP_NAME_PART;
+        while !name.is_char_boundary(end) {
+            end -= 1;
+        }
+        name.truncate(end);
+    }
     let tmp = dir.join(format!(
         ".{name}.urdf-inertia.{}.{}.tmp",
         std::process::id(),
@@ -227,9 +340,17 @@ fn replace_through_temp(
         .map_err(|e| dir_error(&e))
         .and_then(|mut file| {
             let result = fill_temp(&mut file, &tmp, original, mode, text).and_then(|()| {
+                if original.is_some() {
+                    copy_xattrs(target, &tmp);
+                }
                 exit_if_signalled(&tmp);
                 hold_for_test(&tmp);
                 exit_if_signalled(&tmp);
+                if let Some(expected) = expected {
+                    if fs::metadata(target).map(|m| Stamp::of(&m)).ok() != Some(expected) {
+                        return Err(changed(target));
+                    }
+                }
                 fs::rename(&tmp, target).map_err(|e| {
                     format!(
                         "{}: cannot replace it with the temporary file {}: {e}",
@@ -273,6 +394,21 @@ fn fill_temp(
     }
     file.write_all(text).map_err(fail)?;
     file.sync_all().map_err(fail)
+}
+
+/// Copies the target's extended attributes (POSIX ACLs are `system.posix_acl_*` attributes) to the
+/// temporary file, each one the process may set: an attribute the file system or the process's
+/// privileges refuse (`security.*` without root, a file system without xattrs) is left out, as `cp -a`
+/// does.
+fn copy_xattrs(target: &Path, tmp: &Path) {
+    let Ok(names) = xattr::list(target) else {
+        return;
+    };
+    for name in names {
+        if let Ok(Some(value)) = xattr::get(target, &name) {
+            let _ = xattr::set(tmp, &name, &value);
+        }
+    }
 }
 
 fn hold_for_test(tmp: &Path) {

@@ -450,15 +450,23 @@ impl Glob {
 /// Parses a pattern without compiling its matcher (a glob set compiles its patterns together).
 fn parse_glob(pattern: &str) -> Result<globset::Glob, String> {
     if pattern.len() > MAX_GLOB_LEN {
+        let head: String = pattern.chars().take(40).collect();
         return Err(format!(
-            "a pattern of {} bytes is longer than the {MAX_GLOB_LEN} accepted",
+            "`{}…` ({} bytes) is longer than the {MAX_GLOB_LEN} bytes a glob may have",
+            crate::text::escape_control(&head),
             pattern.len()
         ));
     }
     globset::GlobBuilder::new(pattern)
         .backslash_escape(true)
         .build()
-        .map_err(|e| format!("`{pattern}` is not a valid glob: {}", e.kind()))
+        .map_err(|e| {
+            format!(
+                "`{}` is not a valid glob: {}",
+                crate::text::escape_control(pattern),
+                e.kind()
+            )
+        })
 }
 
 impl PartialEq for Glob {

@@ -214,14 +214,14 @@ impl Diagnostic {
         let mut s = format!("{}: ", self.severity.as_str());
         if let Some(l) = &self.location {
             if let Some(f) = &l.file {
-                s.push_str(&f.display().to_string());
+                s.push_str(&crate::text::escape_control(&f.display().to_string()));
                 if let Some(line) = l.line {
                     let _ = write!(s, ":{line}");
                 }
                 s.push_str(": ");
             }
             if let Some(link) = &l.link {
-                let _ = write!(s, "link `{link}`: ");
+                let _ = write!(s, "link `{}`: ", crate::text::escape_control(link));
             }
         }
         s.push_str(&self.message);
@@ -330,11 +330,13 @@ pub enum LinkErrorKind {
     },
     /// Values beyond f64 (overflow or underflow), with the reasons.
     Unrepresentable(String),
+    /// `--keep-mass` on a `<mass>` (at `line`) that is no positive finite number: `value` as read.
+    KeptMassInvalid { line: usize, value: String },
 }
 
 impl LinkErrorKind {
     /// A short stable name for JSON: `invalid-geometry`, `mesh-not-found`, `mesh`, `mass-target`,
-    /// `unrepresentable`.
+    /// `unrepresentable`, `invalid-kept-mass`.
     pub fn name(&self) -> &'static str {
         match self {
             LinkErrorKind::InvalidGeometry { .. } => "invalid-geometry",
@@ -342,6 +344,7 @@ impl LinkErrorKind {
             LinkErrorKind::Mesh(_) => "mesh",
             LinkErrorKind::MassTarget { .. } => "mass-target",
             LinkErrorKind::Unrepresentable(_) => "unrepresentable",
+            LinkErrorKind::KeptMassInvalid { .. } => "invalid-kept-mass",
         }
     }
 }
@@ -362,8 +365,9 @@ impl fmt::Display for LinkError {
             } => {
                 let list: Vec<String> = searched
                     .iter()
-                    .map(|p| format!("    {}", p.display()))
+                    .map(|p| format!("    {}", crate::text::escape_control(&p.display().to_string())))
                     .collect();
+                let uri = crate::text::escape_control(uri);
                 let list = if list.is_empty() {
                     "    (nothing)".to_string()
                 } else {
@@ -384,6 +388,10 @@ impl fmt::Display for LinkError {
                 "{source} gives the link {mass} kg, but its parts with their own [meshes] rule already weigh {own_mass} kg"
             ),
             LinkErrorKind::Unrepresentable(m) => f.write_str(m),
+            LinkErrorKind::KeptMassInvalid { line, value } => write!(
+                f,
+                "--keep-mass: <mass> on line {line}: {value} is not a positive number of kilograms; fix the value (a decimal with a point) or drop --keep-mass for this link"
+            ),
         }
     }
 }
@@ -420,7 +428,7 @@ impl fmt::Display for RobotError {
             RobotError::MissingDensity { links } => {
                 let list: Vec<String> = links
                     .iter()
-                    .map(|(n, l)| format!("`{n}` (line {l})"))
+                    .map(|(n, l)| format!("`{}` (line {l})", crate::text::escape_control(n)))
                     .collect();
                 write!(
                     f,

@@ -670,23 +670,40 @@ struct Densities {
     diagnostics: Vec<Diagnostic>,
 }
 
-/// The link's rule: its kept mass (`--keep-mass`), a `[links]` rule, or the default.
-fn link_rule(link: &Link, map: &DensityMap, opts: &FillOptions) -> Option<Rule> {
-    let kept = if opts.keep_mass {
-        link.inertial
-            .as_ref()
-            .and_then(|s| s.value.mass)
-            .filter(|m| *m > 0.0 && m.is_finite())
-    } else {
-        None
+/// The link's rule: its kept mass (`--keep-mass`), a `[links]` rule, or the default. A `<mass>`
+/// that `--keep-mass` cannot keep (`1,5`, `nan`, `-0`, `0`) is an error naming its line: replacing
+/// it with the density's mass would drop the number the user asked to keep without a word.
+fn link_rule(link: &Link, map: &DensityMap, opts: &FillOptions) -> Result<Option<Rule>, LinkError> {
+    let kept = match link.inertial.as_ref().filter(|_| opts.keep_mass) {
+        Some(span) => match (span.mass_line, span.value.mass) {
+            (Some(_), Some(m)) if m > 0.0 && m.is_finite() => Some(m),
+            (Some(line), value) => {
+                let value = match value {
+                    Some(m) => format!("value=\"{m}\""),
+                    None => span
+                        .problem
+                        .as_deref()
+                        .and_then(|p| p.split_once("<mass>: "))
+                        .map_or_else(|| "its value".into(), |(_, m)| m.to_string()),
+                };
+                return Err(LinkError {
+                    link: link.name.clone(),
+                    line: link.line,
+                    collision: None,
+                    kind: Box::new(LinkErrorKind::KeptMassInvalid { line, value }),
+                });
+            }
+            (None, _) => None,
+        },
+        None => None,
     };
-    match kept {
+    Ok(match kept {
         Some(m) => Some(("existing <mass> (--keep-mass)".into(), Spec::Mass(m))),
         None => map
             .link_rule(&link.name)
             .map(|(k, s)| (format!("[links] \"{k}\""), s))
             .or_else(|| map.default.map(|d| ("default".into(), Spec::Density(d)))),
-    }
+    })
 }
 
 /// Densities for a link's parts; `Ok(None)` when a part needs the link's rule and there is none.
@@ -705,7 +722,7 @@ fn densities(
                 .map(|(k, s)| (format!("[meshes] \"{k}\""), s))
         })
         .collect();
-    let link_spec = link_rule(link, map, opts);
+    let link_spec = link_rule(link, map, opts)?;
     if link_spec.is_none() && own.iter().any(Option::is_none) {
         return Ok(None);
     }
@@ -881,7 +898,7 @@ fn reject_unrepresentable(report: &mut FillReport) {
 /// when the estimate was skipped.
 fn overlap_estimate(parts: &mut [Part]) -> (Option<(f64, String, usize)>, Option<String>) {
     let mut placed: Vec<PlacedPart> = parts.iter().map(|p| p.placed.clone()).collect();
-    let e = match overlap::estimate(&mut placed) {
+    let e = match crate::threads::install(|| overlap::estimate(&mut placed)) {
         Overlap::None => return (None, None),
         Overlap::Skipped(why) => {
             return (

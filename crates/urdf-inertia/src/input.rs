@@ -1,6 +1,11 @@
-//! Reading input files (URDF, meshes, density maps) with two guards: only regular files are read (a
-//! FIFO would hang, `/dev/zero` or `/dev/urandom` never end), and no more than a size limit, 1 GiB by
-//! default, set with `--max-file-size` or the `URDF_INERTIA_MAX_FILE_SIZE` environment variable.
+//! Reading input files with two guards: only regular files are read (a FIFO would hang, `/dev/zero`
+//! or `/dev/urandom` never end), and no more than a size limit, 1 GiB by default, set with
+//! `--max-file-size` or the `URDF_INERTIA_MAX_FILE_SIZE` environment variable (the CLI reads both).
+//!
+//! This is the one way the library reads a file: URDFs, meshes, glTF buffers, density maps and
+//! `package.xml` all go through [`read_file`] or [`open_file`] (a test in tests/regression.rs puts a
+//! FIFO and a `/dev/zero` symlink at each); a new reader (xacro includes, YAML) uses them too. The
+//! `_within` forms take the limit as an argument, for callers that carry their own.
 
 use std::fs::{self, File};
 use std::io::Read;
@@ -70,14 +75,24 @@ fn kind(ft: fs::FileType) -> &'static str {
 /// The whole content of a regular file no larger than [`max_file_size`]. The error says why, without
 /// the path (callers name the file and what it is).
 pub fn read_file(path: &Path) -> Result<Vec<u8>, String> {
-    let (file, len) = open_file(path)?;
-    read_rest(file, Vec::with_capacity(len as usize))
+    read_file_within(path, max_file_size())
+}
+
+/// [`read_file`] with the size limit `limit` instead of the process-wide one.
+pub fn read_file_within(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
+    let (file, len) = open_file_within(path, limit)?;
+    read_rest_within(file, Vec::with_capacity(len as usize), limit)
 }
 
 /// A regular file no larger than [`max_file_size`], opened for reading, and its length: for readers
 /// that stream a big file instead of holding all of it (then they must read no more than the
 /// length, and treat a shorter file as truncated).
 pub fn open_file(path: &Path) -> Result<(File, u64), String> {
+    open_file_within(path, max_file_size())
+}
+
+/// [`open_file`] with the size limit `limit` instead of the process-wide one.
+pub fn open_file_within(path: &Path, limit: u64) -> Result<(File, u64), String> {
     let regular = |meta: &fs::Metadata| {
         if meta.is_file() {
             Ok(())
@@ -93,30 +108,37 @@ pub fn open_file(path: &Path) -> Result<(File, u64), String> {
     let file = File::open(path).map_err(|e| e.to_string())?;
     let meta = file.metadata().map_err(|e| e.to_string())?;
     regular(&meta)?;
-    if meta.len() > max_file_size() {
-        return Err(too_large());
+    if meta.len() > limit {
+        return Err(too_large(limit));
     }
     Ok((file, meta.len()))
 }
 
 /// Appends the rest of `file` to `bytes`, up to [`max_file_size`] in all (a file can grow after its
 /// size was checked).
-pub fn read_rest(file: impl Read, mut bytes: Vec<u8>) -> Result<Vec<u8>, String> {
-    let limit = max_file_size();
+pub fn read_rest(file: impl Read, bytes: Vec<u8>) -> Result<Vec<u8>, String> {
+    read_rest_within(file, bytes, max_file_size())
+}
+
+/// [`read_rest`] with the size limit `limit` instead of the process-wide one.
+pub fn read_rest_within(
+    file: impl Read,
+    mut bytes: Vec<u8>,
+    limit: u64,
+) -> Result<Vec<u8>, String> {
     let room = limit.saturating_sub(bytes.len() as u64);
     file.take(room.saturating_add(1))
         .read_to_end(&mut bytes)
         .map_err(|e| e.to_string())?;
     if bytes.len() as u64 > limit {
-        return Err(too_large());
+        return Err(too_large(limit));
     }
     Ok(bytes)
 }
 
-fn too_large() -> String {
+fn too_large(limit: u64) -> String {
     format!(
-        "is larger than the limit of {} bytes (raise it with --max-file-size or {MAX_FILE_SIZE_ENV})",
-        max_file_size()
+        "is larger than the limit of {limit} bytes (raise it with --max-file-size or {MAX_FILE_SIZE_ENV})"
     )
 }
 
@@ -132,6 +154,17 @@ mod tests {
         assert_eq!(parse_size("3m"), Ok(3 << 20));
         assert!(parse_size("x").is_err());
         assert!(parse_size("99999999999999999999G").is_err());
+    }
+
+    #[test]
+    fn a_limit_passed_in_is_the_limit() {
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let p = tmp.path().join("f");
+        std::fs::write(&p, [7u8; 100]).expect("write");
+        assert_eq!(read_file_within(&p, 100).map(|b| b.len()), Ok(100));
+        assert!(read_file_within(&p, 99)
+            .unwrap_err()
+            .contains("larger than the limit of 99 bytes"));
     }
 
     #[test]

@@ -15,6 +15,7 @@ pub mod mass;
 pub mod mesh;
 pub mod overlap;
 pub mod text;
+pub mod threads;
 pub mod urdf;
 pub mod xacro;
 

@@ -106,6 +106,32 @@ impl std::str::FromStr for Digits {
     }
 }
 
+/// `s` with its control characters written as escapes (`\n`, `\r`, `\t`, `\x1b`, `\u{85}`), for every
+/// text message that shows something an input file or a user controls: a link name holding a newline
+/// could otherwise forge a CI annotation line, and an ESC rewrite the terminal. Borrowed unchanged when
+/// there is nothing to escape (the usual case).
+pub fn escape_control(s: &str) -> std::borrow::Cow<'_, str> {
+    if !s.chars().any(char::is_control) {
+        return s.into();
+    }
+    let mut out = String::with_capacity(s.len() + 8);
+    for c in s.chars() {
+        match c {
+            '\n' => out.push_str("\\n"),
+            '\r' => out.push_str("\\r"),
+            '\t' => out.push_str("\\t"),
+            c if (c as u32) < 0x80 && c.is_control() => {
+                let _ = std::fmt::Write::write_fmt(&mut out, format_args!("\\x{:02x}", c as u32));
+            }
+            c if c.is_control() => {
+                let _ = std::fmt::Write::write_fmt(&mut out, format_args!("\\u{{{:x}}}", c as u32));
+            }
+            c => out.push(c),
+        }
+    }
+    out.into()
+}
+
 /// The shortest text that reads back as the same f64: plain notation for ordinary magnitudes,
 /// scientific for very small or large ones; `-0` is written `0`.
 pub fn shortest(x: f64) -> String {
@@ -322,6 +348,15 @@ mod tests {
         assert_eq!("full".parse(), Ok(Digits::Full));
         assert_eq!("6".parse(), Ok(Digits::Fixed(6)));
         assert!("2".parse::<Digits>().is_err());
+    }
+
+    #[test]
+    fn control_characters_are_escaped() {
+        assert_eq!(escape_control("forearm"), "forearm");
+        assert_eq!(
+            escape_control("a\n::error::x\u{1b}[2J\t\r\u{7f}\u{85}é"),
+            "a\\n::error::x\\x1b[2J\\t\\r\\x7f\\u{85}é"
+        );
     }
 
     #[test]

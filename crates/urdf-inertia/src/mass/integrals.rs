@@ -847,13 +847,15 @@ pub fn volume_integrals(
         // Fixed chunks, whatever the number of threads, each summed with compensation and combined
         // in chunk order as double-doubles: the same bits for any thread count.
         use rayon::prelude::*;
-        let chunks: Vec<([f64; 10], [f64; 10])> = (0..n.div_ceil(CHUNK))
-            .into_par_iter()
-            .map(|c| {
-                let range = c * CHUNK..((c + 1) * CHUNK).min(n);
-                fan_sums(vertices, range.map(|i| faces.face(i)), reference, options)
-            })
-            .collect();
+        let chunks: Vec<([f64; 10], [f64; 10])> = crate::threads::install(|| {
+            (0..n.div_ceil(CHUNK))
+                .into_par_iter()
+                .map(|c| {
+                    let range = c * CHUNK..((c + 1) * CHUNK).min(n);
+                    fan_sums(vertices, range.map(|i| faces.face(i)), reference, options)
+                })
+                .collect()
+        });
         let mut hi = [0.0; 10];
         let mut lo = [0.0; 10];
         for (h, l) in chunks {

@@ -91,26 +91,28 @@ impl MeshCache {
             // Each thread takes the next file (largest first) while there is one; a healed file
             // queues the tasks it completes, which a thread runs once no file is left to take.
             let next = AtomicUsize::new(0);
-            rayon::scope(|s| {
-                for _ in 0..rayon::current_num_threads().min(work.len()) {
-                    s.spawn(|s| loop {
-                        let w = next.fetch_add(1, Ordering::Relaxed);
-                        if w >= work.len() {
-                            break;
-                        }
-                        load(w);
-                        for &t in &releases[w] {
-                            if pending[t].fetch_sub(1, Ordering::AcqRel) == 1 {
-                                s.spawn(move |_| run(t));
+            crate::threads::install(|| {
+                rayon::scope(|s| {
+                    for _ in 0..rayon::current_num_threads().min(work.len()) {
+                        s.spawn(|s| loop {
+                            let w = next.fetch_add(1, Ordering::Relaxed);
+                            if w >= work.len() {
+                                break;
                             }
-                        }
-                    });
-                }
-                for (t, w) in waits.iter().enumerate() {
-                    if w.is_empty() {
-                        s.spawn(move |_| run(t));
+                            load(w);
+                            for &t in &releases[w] {
+                                if pending[t].fetch_sub(1, Ordering::AcqRel) == 1 {
+                                    s.spawn(move |_| run(t));
+                                }
+                            }
+                        });
                     }
-                }
+                    for (t, w) in waits.iter().enumerate() {
+                        if w.is_empty() {
+                            s.spawn(move |_| run(t));
+                        }
+                    }
+                })
             });
         }
         let loaded: Vec<LoadedFile> = done.into_iter().filter_map(OnceLock::into_inner).collect();

@@ -13,7 +13,10 @@
 //!   not supported and reported); `<lines>` and `<linestrips>` carry no surface and are skipped.
 
 use super::affine::{self, compose, Affine, IDENTITY};
-use super::{parse_f64_bytes, short_decimal, MeshError, MeshErrorKind, RawMesh};
+use super::{
+    beyond_expansion_budget, parse_f64_bytes, short_decimal, MeshError, MeshErrorKind, RawMesh,
+    MAX_INSTANCED_CORNERS, MAX_INSTANCED_VERTICES, MAX_NODE_VISITS,
+};
 use crate::mass::{Mat3, Polygons};
 use crate::text::line_of;
 use quick_xml::events::Event;
@@ -88,12 +91,6 @@ impl El {
 /// Deepest element nesting accepted. The tree is dropped recursively (and real files nest a few dozen
 /// levels), so a bound keeps a hostile file from overflowing a worker thread's stack.
 const MAX_DEPTH: usize = 512;
-
-/// Budget for what the scene graph may instance (`<instance_node>` can double a mesh per level, so a few
-/// kilobytes could ask for 2^40 copies): vertices, polygon corners and node visits.
-const MAX_INSTANCED_VERTICES: usize = 1 << 24;
-const MAX_INSTANCED_CORNERS: usize = 1 << 26;
-const MAX_NODE_VISITS: usize = 1 << 20;
 
 fn local(name: &[u8]) -> String {
     let s = String::from_utf8_lossy(name);
@@ -750,12 +747,8 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
                 MeshErrorKind::Syntax("no <COLLADA> root element".into()),
             )
         })?;
-    let unit = root
-        .child("asset")
-        .and_then(|a| a.child("unit"))
-        .and_then(|u| u.attr("meter"))
-        .and_then(|m| m.trim().parse::<f64>().ok())
-        .unwrap_or(1.0);
+    let unit_el = root.child("asset").and_then(|a| a.child("unit"));
+    let unit = unit_of(unit_el, path)?;
 
     let mut all: Vec<&El> = Vec::new();
     root.walk(&mut all);
@@ -770,6 +763,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         unit,
         geom_cache: HashMap::new(),
         corners: 0,
+        unit_loss: None,
         out: RawMesh {
             faces: Polygons::new(),
             ..Default::default()
@@ -797,7 +791,23 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
                 .push("no visual scene: every geometry counted once, untransformed".into());
         }
     }
-    let Instancer { mut out, notes, .. } = inst;
+    let Instancer {
+        mut out,
+        notes,
+        unit_loss: inst_unit_loss,
+        ..
+    } = inst;
+    let inst_unit_loss = inst_unit_loss.or_else(|| unit_extent_loss(&out.vertices, unit));
+    if let (Some(what), Some(u)) = (inst_unit_loss, unit_el) {
+        return Err(MeshError::new(
+            path,
+            Some(u.line),
+            MeshErrorKind::Syntax(format!(
+                "with <unit meter=\"{}\">, the mesh's coordinates, volume or inertia {what} a 64-bit float; fix the unit or the mesh's coordinates",
+                crate::text::escape_control(u.attr("meter").unwrap_or_default())
+            )),
+        ));
+    }
     // Reader messages that say something was left out are warnings; the rest are notes.
     for n in notes {
         match n.strip_prefix("warning: ") {
@@ -806,6 +816,58 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         }
     }
     Ok(out)
+}
+
+/// Metres per unit: `<unit meter="s">`'s value, 1 without the element or the attribute. Anything but
+/// a positive finite decimal (`0,001`, `1 mm`, `0`, `-1`, `inf`) is an error: read as 1 m, a millimetre
+/// file would weigh 10⁹ times too much without a word.
+fn unit_of(unit: Option<&El>, path: &Path) -> Result<f64, MeshError> {
+    let Some((el, text)) = unit.and_then(|u| u.attr("meter").map(|m| (u, m))) else {
+        return Ok(1.0);
+    };
+    match text.trim().parse::<f64>() {
+        Ok(m) if m.is_finite() && m > 0.0 => Ok(m),
+        _ => Err(MeshError::new(
+            path,
+            Some(el.line),
+            MeshErrorKind::Syntax(format!(
+                "<unit meter=\"{}\"> is not a positive number of metres (write a decimal with a point, e.g. meter=\"0.001\" for millimetres)",
+                crate::text::escape_control(text)
+            )),
+        )),
+    }
+}
+
+/// What multiplying an authored coordinate by the unit did to it, when it lost it: `<unit
+/// meter="1e308">` overflows, `meter="1e-310"` underflows, and either would otherwise be reported as
+/// a flat mesh of NaN or zero volume.
+fn unit_range_loss(authored: f64, scaled: f64) -> Option<&'static str> {
+    if authored.is_finite() && !scaled.is_finite() {
+        Some("overflows")
+    } else if authored.is_normal() && !scaled.is_normal() {
+        Some("underflows")
+    } else {
+        None
+    }
+}
+
+/// Whether the unit made the mesh's size overflow or underflow what its inertia (the fifth power of
+/// the size) can hold, when the authored size could: `<unit meter="1e308">` on a 1-unit box.
+fn unit_extent_loss(vertices: &[[f64; 3]], unit: f64) -> Option<&'static str> {
+    if unit == 1.0 || vertices.is_empty() {
+        return None;
+    }
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for v in vertices {
+        for k in 0..3 {
+            lo[k] = lo[k].min(v[k]);
+            hi[k] = hi[k].max(v[k]);
+        }
+    }
+    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    let authored = size / unit;
+    unit_range_loss(authored.powi(5), size.powi(5))
 }
 
 /// Places geometries into one mesh, each read once however often the scene instances it, within the
@@ -819,6 +881,8 @@ struct Instancer<'a> {
     geom_cache: HashMap<*const El, (Vec<[f64; 3]>, Polygons)>,
     /// Polygon corners instanced so far.
     corners: usize,
+    /// Set when the unit made a coordinate overflow or underflow (see [`unit_range_loss`]).
+    unit_loss: Option<&'static str>,
     out: RawMesh,
     /// Reader messages; those starting `warning: ` become warnings.
     notes: Vec<String>,
@@ -835,9 +899,10 @@ impl Instancer<'_> {
             }
         };
         self.corners = self.corners.saturating_add(f.indices.len());
-        if self.out.vertices.len().saturating_add(v.len()) > MAX_INSTANCED_VERTICES
-            || self.corners > MAX_INSTANCED_CORNERS
-        {
+        if beyond_expansion_budget(
+            self.out.vertices.len().saturating_add(v.len()),
+            self.corners,
+        ) {
             return Err(MeshError::new(
                 self.path,
                 Some(geom.line),
@@ -849,6 +914,7 @@ impl Instancer<'_> {
         let base = self.out.vertices.len() as u32;
         self.out.vertices.reserve(v.len());
         let a = &xf.0;
+        let check_unit = self.unit != 1.0;
         for p in v {
             // `mass::mat_vec`'s sums in its order, written out: its `[0, 1, 2].map` is a call here
             // (`core::array::try_map` in profiles), 7 of the 37 M instructions placing go1's trunk.dae.
@@ -857,11 +923,20 @@ impl Instancer<'_> {
                 a[1][0] * p[0] + a[1][1] * p[1] + a[1][2] * p[2],
                 a[2][0] * p[0] + a[2][1] * p[1] + a[2][2] * p[2],
             ];
-            self.out.vertices.push([
-                (q[0] + xf.1[0]) * self.unit,
-                (q[1] + xf.1[1]) * self.unit,
-                (q[2] + xf.1[2]) * self.unit,
-            ]);
+            let authored = [q[0] + xf.1[0], q[1] + xf.1[1], q[2] + xf.1[2]];
+            let placed = [
+                authored[0] * self.unit,
+                authored[1] * self.unit,
+                authored[2] * self.unit,
+            ];
+            if check_unit {
+                for i in 0..3 {
+                    self.unit_loss = self
+                        .unit_loss
+                        .or_else(|| unit_range_loss(authored[i], placed[i]));
+                }
+            }
+            self.out.vertices.push(placed);
         }
         // A mirroring node transform reverses the faces' orientation.
         let mirrored = affine::mirrors(xf);

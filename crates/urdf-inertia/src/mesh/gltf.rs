@@ -11,7 +11,12 @@
 //! * triangles, triangle strips and triangle fans, indexed or not; points and lines carry no surface and
 //!   are skipped with a note; a node with a negative determinant mirrors its triangles, whose winding is
 //!   reversed to stay outward;
-//! * buffers from the GLB `BIN` chunk, base64 `data:` URIs, or files relative to the .gltf file;
+//! * buffers from the GLB `BIN` chunk, base64 `data:` URIs, or relative URI references resolved against
+//!   the .gltf file's directory (percent-decoded, `../` allowed as RFC 3986 resolves it); absolute paths
+//!   and other schemes are refused. Each distinct URI is read once however many buffers name it, and
+//!   the buffers' bytes together count against the one-file size limit (`--max-file-size`);
+//! * what the scene instances is bounded by the expansion budget COLLADA has too (vertices, triangle
+//!   corners, node visits);
 //! * positions are f32 by the format and convert exactly to f64.
 //!
 //! Refused with an error naming them: Draco (`KHR_draco_mesh_compression`) and meshopt
@@ -20,12 +25,17 @@
 //! crate reads an accessor, and the crate call is also guarded against panics, so no input panics.
 
 use super::affine::{self, compose, Affine, IDENTITY};
-use super::{MeshError, MeshErrorKind, RawMesh};
+use super::{
+    beyond_expansion_budget, MeshError, MeshErrorKind, RawMesh, MAX_INSTANCED_CORNERS,
+    MAX_INSTANCED_VERTICES, MAX_NODE_VISITS,
+};
 use crate::mass::Polygons;
 use base64::Engine as _;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
+use std::collections::HashMap;
 use std::path::Path;
+use std::rc::Rc;
 
 /// Required extensions that only touch materials, textures or lights: geometry reads the same.
 const GEOMETRY_NEUTRAL_PREFIXES: &[&str] = &[
@@ -37,8 +47,6 @@ const GEOMETRY_NEUTRAL_PREFIXES: &[&str] = &[
 
 /// A node tree deeper than this is malformed (glTF node hierarchies are trees).
 const MAX_DEPTH: usize = 256;
-/// Node visits allowed in one traversal (a node shared by many parents could otherwise explode).
-const MAX_VISITS: usize = 1_000_000;
 
 fn syntax(path: &Path, msg: String) -> MeshError {
     MeshError::new(path, None, MeshErrorKind::Syntax(msg))
@@ -132,28 +140,54 @@ fn node_transform(node: &gltf::Node<'_>, path: &Path) -> Result<Affine, MeshErro
     Ok(xf)
 }
 
-/// Buffer contents, by buffer index.
+/// A buffer's bytes, shared by every buffer that names the same source.
+type Buffer = Rc<Vec<u8>>;
+
+/// Buffer contents, by buffer index: each distinct source (the BIN chunk, a URI) read once, and all
+/// of them together within the one-file size limit (2,000 buffers naming one 5 MB file once read
+/// 10 GB).
 fn load_buffers(
     doc: &gltf::Document,
-    blob: Option<&[u8]>,
+    blob: Option<Vec<u8>>,
     path: &Path,
     meshopt_used: bool,
-) -> Result<Vec<Vec<u8>>, MeshError> {
+) -> Result<Vec<Buffer>, MeshError> {
     let mut out = Vec::new();
+    let blob = blob.map(Rc::new);
+    let mut by_uri: HashMap<&str, Buffer> = HashMap::new();
+    let mut total = blob.as_ref().map_or(0, |b| b.len() as u64);
     for buffer in doc.buffers() {
         let data = match buffer.source() {
-            gltf::buffer::Source::Bin => blob
-                .ok_or_else(|| {
-                    syntax(
-                        path,
-                        format!(
-                            "buffer {} refers to the GLB BIN chunk, but the file has none",
-                            buffer.index()
-                        ),
-                    )
-                })?
-                .to_vec(),
-            gltf::buffer::Source::Uri(uri) => read_uri(uri, path, buffer.index())?,
+            gltf::buffer::Source::Bin => Rc::clone(blob.as_ref().ok_or_else(|| {
+                syntax(
+                    path,
+                    format!(
+                        "buffer {} refers to the GLB BIN chunk, but the file has none",
+                        buffer.index()
+                    ),
+                )
+            })?),
+            gltf::buffer::Source::Uri(uri) => match by_uri.get(uri) {
+                Some(data) => Rc::clone(data),
+                None => {
+                    let data = Rc::new(read_uri(uri, path, buffer.index())?);
+                    total = total.saturating_add(data.len() as u64);
+                    if total > crate::input::max_file_size() {
+                        return Err(MeshError::new(
+                            path,
+                            None,
+                            MeshErrorKind::Io(format!(
+                                "buffer {}: the file's buffers together are larger than the limit of {} bytes (raise it with --max-file-size or {})",
+                                buffer.index(),
+                                crate::input::max_file_size(),
+                                crate::input::MAX_FILE_SIZE_ENV
+                            )),
+                        ));
+                    }
+                    by_uri.insert(uri, Rc::clone(&data));
+                    data
+                }
+            },
         };
         if data.len() < buffer.length() {
             let what = format!(
@@ -196,18 +230,28 @@ fn read_uri(uri: &str, path: &Path, index: usize) -> Result<Vec<u8>, MeshError> 
                 )
             });
     }
-    if uri.contains("://") {
-        return Err(syntax(
-            path,
-            format!("buffer {index}: URI `{uri}` is not a file next to the glTF; only relative paths and data URIs are read"),
-        ));
-    }
     let decoded = urlencoding::decode(uri).map_err(|_| {
         syntax(
             path,
             format!("buffer {index}: URI `{uri}` is not valid percent-encoded UTF-8"),
         )
     })?;
+    // A scheme (`file:`, `http:`) or an absolute path, also once percent-decoded: glTF buffers are
+    // relative references or data URIs.
+    let has_scheme = |u: &str| {
+        u.split_once(':').is_some_and(|(scheme, _)| {
+            !scheme.is_empty()
+                && scheme
+                    .bytes()
+                    .all(|b| b.is_ascii_alphanumeric() || b"+-.".contains(&b))
+        })
+    };
+    if has_scheme(uri) || uri.starts_with('/') || Path::new(decoded.as_ref()).is_absolute() {
+        return Err(syntax(
+            path,
+            format!("buffer {index}: URI `{}` is absolute; only relative references (resolved against the glTF's directory) and data URIs are read", crate::text::escape_control(uri)),
+        ));
+    }
     let file = path
         .parent()
         .unwrap_or(Path::new("."))
@@ -226,7 +270,7 @@ fn read_uri(uri: &str, path: &Path, index: usize) -> Result<Vec<u8>, MeshError> 
 /// covers inside its buffer view and buffer.
 fn check_accessor(
     acc: &gltf::Accessor<'_>,
-    buffers: &[Vec<u8>],
+    buffers: &[Buffer],
     path: &Path,
     what: &str,
     draco_used: bool,
@@ -264,7 +308,7 @@ fn check_accessor(
         .checked_mul(stride)
         .and_then(|n| n.checked_add(elem))
         .and_then(|n| n.checked_add(acc.offset()));
-    let buffer = buffers.get(view.buffer().index()).map_or(0, Vec::len);
+    let buffer = buffers.get(view.buffer().index()).map_or(0, |b| b.len());
     let view_end = view.offset().checked_add(view.length());
     match (need, view_end) {
         (Some(need), Some(view_end)) if count == 0 || (need <= view.length() && view_end <= buffer) => Ok(()),
@@ -284,7 +328,7 @@ fn check_accessor(
 fn add_primitive(
     prim: &gltf::Primitive<'_>,
     xf: &Affine,
-    buffers: &[Vec<u8>],
+    buffers: &[Buffer],
     path: &Path,
     draco_used: bool,
     out: &mut RawMesh,
@@ -307,7 +351,16 @@ fn add_primitive(
     if pos.count() == 0 {
         return Ok(());
     }
-    let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    if beyond_expansion_budget(
+        out.vertices.len().saturating_add(pos.count()),
+        out.faces
+            .indices
+            .len()
+            .saturating_add(corners_at_most(prim, &pos)),
+    ) {
+        return Err(over_budget(path));
+    }
+    let reader = prim.reader(|b| buffers.get(b.index()).map(|b| b.as_slice()));
     let cannot =
         |what: &str, index: usize| syntax(path, format!("{what} accessor {index} cannot be read"));
     let positions = reader
@@ -398,7 +451,7 @@ fn check_indices(indices: &[u32], n: usize, path: &Path) -> Result<(), MeshError
 fn check_primitive_accessors(
     prim: &gltf::Primitive<'_>,
     pos: &gltf::Accessor<'_>,
-    buffers: &[Vec<u8>],
+    buffers: &[Buffer],
     path: &Path,
     draco_used: bool,
 ) -> Result<(), MeshError> {
@@ -535,7 +588,7 @@ fn parse_checked(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     // Material-only required extensions are accepted above; the crate's validation would refuse them.
     root.extensions_required.clear();
     let doc = gltf::Document::from_json(root).map_err(|e| syntax(path, format!("{e}")))?;
-    let buffers = load_buffers(&doc, blob.as_deref(), path, meshopt_used)?;
+    let buffers = load_buffers(&doc, blob, path, meshopt_used)?;
 
     let mut out = RawMesh {
         faces: Polygons::new(),
@@ -615,24 +668,69 @@ fn check_json(root: &gltf::json::Root, path: &Path) -> Result<(bool, bool), Mesh
     Ok((draco_used, meshopt_used))
 }
 
+/// What the scene would instance, counted from the accessors' declared counts before anything is
+/// placed, against the expansion budget: a file asking for too much fails at once, before it has
+/// taken the budget's memory. (The placing checks again as it goes; this pass only fails early.)
+fn check_scene_budget(scene: &gltf::Scene<'_>, path: &Path) -> Result<(), MeshError> {
+    let (mut vertices, mut corners, mut visits) = (0usize, 0usize, 0usize);
+    let mut stack: Vec<(gltf::Node<'_>, usize)> = scene.nodes().map(|n| (n, 0)).collect();
+    while let Some((node, depth)) = stack.pop() {
+        visits += 1;
+        if depth > MAX_DEPTH || visits > MAX_NODE_VISITS {
+            // Reported by the placing pass, with its message.
+            return Ok(());
+        }
+        for prim in node.mesh().iter().flat_map(gltf::Mesh::primitives) {
+            if let Some(pos) = prim.get(&gltf::Semantic::Positions) {
+                vertices = vertices.saturating_add(pos.count());
+                corners = corners.saturating_add(corners_at_most(&prim, &pos));
+            }
+        }
+        if beyond_expansion_budget(vertices, corners) {
+            return Err(over_budget(path));
+        }
+        stack.extend(node.children().map(|c| (c, depth + 1)));
+    }
+    Ok(())
+}
+
+/// The triangle corners a primitive can make: one per index of TRIANGLES, three per index of a strip
+/// or fan (each index adds at most one triangle).
+fn corners_at_most(prim: &gltf::Primitive<'_>, pos: &gltf::Accessor<'_>) -> usize {
+    let indices = prim.indices().map_or(pos.count(), |a| a.count());
+    match prim.mode() {
+        Mode::Triangles => indices,
+        Mode::TriangleStrip | Mode::TriangleFan => indices.saturating_mul(3),
+        _ => 0,
+    }
+}
+
+fn over_budget(path: &Path) -> MeshError {
+    syntax(
+        path,
+        format!("the scene instances more than {MAX_INSTANCED_VERTICES} vertices or {MAX_INSTANCED_CORNERS} triangle corners (nodes shared by several parents multiply their mesh); simplify the collision mesh"),
+    )
+}
+
 /// Every primitive of the meshes a scene's node hierarchy reaches, in the world frame (depth and
 /// visits are bounded: a cycle is an error, not a hang).
 fn add_scene(
     scene: &gltf::Scene<'_>,
-    buffers: &[Vec<u8>],
+    buffers: &[Buffer],
     path: &Path,
     draco_used: bool,
     out: &mut RawMesh,
 ) -> Result<(), MeshError> {
+    check_scene_budget(scene, path)?;
     let mut visits = 0usize;
     let mut stack: Vec<(gltf::Node<'_>, Affine, usize)> =
         scene.nodes().map(|n| (n, IDENTITY, 0)).collect();
     while let Some((node, parent, depth)) = stack.pop() {
         visits += 1;
-        if depth > MAX_DEPTH || visits > MAX_VISITS {
+        if depth > MAX_DEPTH || visits > MAX_NODE_VISITS {
             return Err(syntax(
                 path,
-                format!("the node hierarchy is deeper than {MAX_DEPTH} or reaches more than {MAX_VISITS} nodes (a cycle?)"),
+                format!("the node hierarchy is deeper than {MAX_DEPTH} or reaches more than {MAX_NODE_VISITS} nodes (a cycle?)"),
             ));
         }
         let xf = compose(&parent, &node_transform(&node, path)?);

@@ -20,6 +20,21 @@ use std::borrow::Cow;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+/// The expansion budget shared by the readers whose scene graphs instance geometry (COLLADA's
+/// `<instance_node>`, glTF nodes shared by several parents): a few kilobytes can ask for 2^40 copies
+/// of a mesh, so what one file may place is bounded. Vertices (24 bytes each) and polygon corners
+/// (4 bytes each) bound the mesh at about 650 MB, node visits bound the traversal.
+pub(crate) const MAX_INSTANCED_VERTICES: usize = 1 << 24;
+/// See [`MAX_INSTANCED_VERTICES`].
+pub(crate) const MAX_INSTANCED_CORNERS: usize = 1 << 26;
+/// See [`MAX_INSTANCED_VERTICES`].
+pub(crate) const MAX_NODE_VISITS: usize = 1 << 20;
+
+/// Whether a mesh of `vertices` and `corners` in all is beyond the expansion budget.
+pub(crate) fn beyond_expansion_budget(vertices: usize, corners: usize) -> bool {
+    vertices > MAX_INSTANCED_VERTICES || corners > MAX_INSTANCED_CORNERS
+}
+
 /// Vertices and faces as read from a file, before any health check.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct RawMesh {
@@ -99,11 +114,14 @@ pub enum MeshErrorKind {
     Internal(String),
     /// A feature of the format urdf-inertia does not read (a glTF compression extension, ...), named.
     Unsupported(String),
+    /// A mesh too large or too small for f64 (its volume and inertia overflow or underflow).
+    OutOfRange(String),
 }
 
 impl fmt::Display for MeshError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.path.display())?;
+        let path = self.path.display().to_string();
+        write!(f, "{}", crate::text::escape_control(&path))?;
         if let Some(line) = self.line {
             write!(f, ":{line}")?;
         }
@@ -136,7 +154,7 @@ impl fmt::Display for MeshError {
                 f,
                 "internal error while processing the mesh (a bug in urdf-inertia; please report it with the file): {msg}"
             ),
-            MeshErrorKind::Unsupported(msg) => write!(f, "{msg}"),
+            MeshErrorKind::Unsupported(msg) | MeshErrorKind::OutOfRange(msg) => write!(f, "{msg}"),
         }
     }
 }
@@ -305,7 +323,10 @@ fn solid_from(
     catching_panics(path, || {
         if scale == [1.0; 3] {
             // A unit scale (the common case) uses the mesh as read.
-            return health::heal(raw, path, options, weld::Precision::of);
+            // The extent is taken before healing takes the mesh: one pass over the vertices.
+            let size = flat_or_out_of_range(&raw, scale)();
+            return health::heal(raw, path, options, weld::Precision::of)
+                .map_err(|e| out_of_range(e, || size, scale));
         }
         let scaled = apply_scale(&raw, scale, path)?;
         // The precision of the file's own numbers, before the scale multiplies them; the largest
@@ -313,7 +334,57 @@ fn solid_from(
         health::heal(Cow::Owned(scaled), path, options, |_| {
             weld::Precision::of(&raw.vertices)
         })
+        .map_err(|e| out_of_range(e, flat_or_out_of_range(&raw, scale), scale))
     })
+}
+
+/// The mesh's largest extent along an axis once scaled, computed only when healing reports no
+/// volume (see [`out_of_range`]): a closure, so the common case pays nothing.
+fn flat_or_out_of_range(raw: &RawMesh, scale: [f64; 3]) -> impl Fn() -> f64 + '_ {
+    move || {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for v in &raw.vertices {
+            for k in 0..3 {
+                lo[k] = lo[k].min(v[k]);
+                hi[k] = hi[k].max(v[k]);
+            }
+        }
+        (0..3)
+            .map(|k| (hi[k] - lo[k]) * scale[k].abs())
+            .fold(0.0, f64::max)
+    }
+}
+
+/// A "no volume" error of a mesh whose size is beyond f64 becomes what it is: inertia grows as the
+/// fifth power of the size, so an extent above about 1e61 m (1e150 coordinates, `--scale 1e150`)
+/// overflows and one below about 1e-61 m (subnormal coordinates, 1e-310) underflows, as primitives of
+/// those sizes are reported. Flat meshes of ordinary size keep their error.
+fn out_of_range(e: MeshError, extent: impl Fn() -> f64, scale: [f64; 3]) -> MeshError {
+    if !matches!(e.kind, MeshErrorKind::ZeroVolume { .. }) {
+        return e;
+    }
+    let size = extent();
+    let fifth = size.powi(5);
+    let what = if !fifth.is_finite() {
+        "overflow"
+    } else if size > 0.0 && fifth < f64::MIN_POSITIVE {
+        "underflow"
+    } else {
+        return e;
+    };
+    let scaled = if scale == [1.0; 3] {
+        String::new()
+    } else {
+        format!(" at scale \"{} {} {}\"", scale[0], scale[1], scale[2])
+    };
+    MeshError {
+        kind: MeshErrorKind::OutOfRange(format!(
+            "the mesh spans {} m{scaled}: its volume or inertia {what}s a 64-bit float (check the units and the scale: metres)",
+            crate::text::significant(size, 4)
+        )),
+        ..e
+    }
 }
 
 /// Parses a float the way all three formats write them, NaN and infinities included (they are caught

@@ -234,8 +234,9 @@ impl Binary {
     fn feed(&mut self, records: &[u8]) {
         use rayon::prelude::*;
         for piece in records.chunks(50 * self.chunk * PIECE) {
-            let welded: Vec<(Vec<[f64; 3]>, Vec<u32>)> =
-                piece.par_chunks(50 * self.chunk).map(weld_chunk).collect();
+            let welded: Vec<(Vec<[f64; 3]>, Vec<u32>)> = crate::threads::install(|| {
+                piece.par_chunks(50 * self.chunk).map(weld_chunk).collect()
+            });
             for (vertices, indices) in welded {
                 let base = self.vertices.len() as u32;
                 self.vertices.extend(vertices);

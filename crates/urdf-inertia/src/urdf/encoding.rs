@@ -130,6 +130,13 @@ fn declared_encoding(bytes: &[u8]) -> Option<&[u8]> {
 
 /// Decodes a URDF file's bytes to UTF-8 text.
 pub fn decode(bytes: Vec<u8>) -> Result<(String, SourceEncoding), DecodeError> {
+    if let Some(form) = utf32_form(&bytes) {
+        return Err(DecodeError::at(
+            &bytes,
+            0,
+            format!("the file is UTF-32 ({form}), which urdf-inertia does not read; save it as UTF-8 (e.g. `iconv -f UTF-32 -t UTF-8`)"),
+        ));
+    }
     if let Some((big_endian, bom)) = utf16_form(&bytes) {
         return decode_utf16(&bytes, big_endian, bom);
     }
@@ -139,14 +146,30 @@ pub fn decode(bytes: Vec<u8>) -> Result<(String, SourceEncoding), DecodeError> {
     }
 }
 
-/// `(big_endian, bom)` if the bytes are UTF-16: a byte-order mark, or `<?` as 16-bit units (XML 1.0
-/// appendix F).
+/// The UTF-32 form of the bytes, if they are UTF-32: a byte-order mark, or a markup start or
+/// whitespace as one 32-bit unit (XML 1.0 appendix F). Checked before UTF-16: `FF FE 00 00` is the
+/// UTF-32LE mark.
+fn utf32_form(bytes: &[u8]) -> Option<&'static str> {
+    let markup = |b: u8| b == b'<' || b.is_ascii_whitespace();
+    match bytes.get(..4)? {
+        [0, 0, 0xfe, 0xff] => Some("big-endian, with a byte-order mark"),
+        [0xff, 0xfe, 0, 0] => Some("little-endian, with a byte-order mark"),
+        &[0, 0, 0, b] if markup(b) => Some("big-endian"),
+        &[b, 0, 0, 0] if markup(b) => Some("little-endian"),
+        _ => None,
+    }
+}
+
+/// `(big_endian, bom)` if the bytes are UTF-16: a byte-order mark, or markup (`<`, whitespace)
+/// followed by another ASCII character as 16-bit units (XML 1.0 appendix F; a file without an XML
+/// declaration starts `<robot`).
 fn utf16_form(bytes: &[u8]) -> Option<(bool, bool)> {
+    let markup = |b: u8| b == b'<' || b.is_ascii_whitespace();
     match bytes.get(..4) {
         Some([0xff, 0xfe, ..]) => Some((false, true)),
         Some([0xfe, 0xff, ..]) => Some((true, true)),
-        Some([b'<', 0, b'?', 0]) => Some((false, false)),
-        Some([0, b'<', 0, b'?']) => Some((true, false)),
+        Some(&[a, 0, b, 0]) if markup(a) && b != 0 && b.is_ascii() => Some((false, false)),
+        Some(&[0, a, 0, b]) if markup(a) && b != 0 && b.is_ascii() => Some((true, false)),
         _ => None,
     }
 }

@@ -18,13 +18,17 @@ pub struct PackageResolver {
     cache: Found,
 }
 
+/// What walking up from a directory found for a package: its directory, none, or an unreadable
+/// `package.xml` on the way.
+type WalkResult = Result<Option<PathBuf>, String>;
+
 /// The package directories found by walking up, per (package, directory): shared by the threads that
 /// compute links (a lock, as a lookup is rare next to their work).
 #[derive(Debug, Default)]
-struct Found(std::sync::Mutex<HashMap<(String, PathBuf), Option<PathBuf>>>);
+struct Found(std::sync::Mutex<HashMap<(String, PathBuf), WalkResult>>);
 
 impl Found {
-    fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<(String, PathBuf), Option<PathBuf>>> {
+    fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<(String, PathBuf), WalkResult>> {
         self.0
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner)
@@ -83,7 +87,14 @@ impl PackageResolver {
             let rest = rest.trim_start_matches('/');
             let (pkg, inner) = rest.split_once('/').unwrap_or((rest, ""));
             let mut searched = Vec::new();
-            for dir in self.package_dirs(pkg, &base, &mut searched) {
+            let dirs = self
+                .package_dirs(pkg, &base, &mut searched)
+                .map_err(|hint| NotFound {
+                    uri: uri.to_string(),
+                    searched: searched.clone(),
+                    hint,
+                })?;
+            for dir in dirs {
                 let p = dir.join(inner);
                 if p.is_file() {
                     return Ok(p);
@@ -155,10 +166,14 @@ impl PackageResolver {
             .map(Path::to_path_buf)
             .unwrap_or_default();
         let mut searched = Vec::new();
-        let found = self
+        let dirs = self
             .package_dirs(pkg, &base, &mut searched)
-            .into_iter()
-            .find(|d| d.is_dir());
+            .map_err(|e| NotFound {
+                uri: format!("$(find {pkg})"),
+                searched: Vec::new(),
+                hint: e,
+            })?;
+        let found = dirs.into_iter().find(|d| d.is_dir());
         found.ok_or_else(|| NotFound {
             uri: format!("$(find {pkg})"),
             searched,
@@ -166,14 +181,20 @@ impl PackageResolver {
         })
     }
 
-    /// Candidate directories for package `pkg`, in search order (recording what was looked at).
-    fn package_dirs(&self, pkg: &str, base: &Path, searched: &mut Vec<PathBuf>) -> Vec<PathBuf> {
+    /// Candidate directories for package `pkg`, in search order (recording what was looked at); an
+    /// unreadable `package.xml` on the way is an error.
+    fn package_dirs(
+        &self,
+        pkg: &str,
+        base: &Path,
+        searched: &mut Vec<PathBuf>,
+    ) -> Result<Vec<PathBuf>, String> {
         let mut out = Vec::new();
         if let Some(d) = self.explicit.get(pkg) {
             out.push(d.clone());
         }
         for root in &self.ros_package_path {
-            if is_package(root, pkg) {
+            if is_package(root, pkg)? {
                 out.push(root.clone());
             } else {
                 let cand = root.join(pkg);
@@ -202,11 +223,11 @@ impl PackageResolver {
                 f
             }
         };
-        match found {
+        match found? {
             Some(d) => out.push(d),
             None => searched.push(base.join(format!("..(each parent)/{pkg}"))),
         }
-        out
+        Ok(out)
     }
 }
 
@@ -236,19 +257,28 @@ pub fn percent_decode(s: &str) -> String {
 }
 
 /// Whether `dir` is package `pkg`: its `package.xml` names it, or the directory has the package's name.
-fn is_package(dir: &Path, pkg: &str) -> bool {
+/// A `package.xml` that is there but cannot be read through the input guard (a FIFO, a symlink to
+/// `/dev/zero`, a file over the size limit) is an error naming it, not a hang or a read without end.
+fn is_package(dir: &Path, pkg: &str) -> Result<bool, String> {
     let xml = dir.join("package.xml");
-    if let Ok(text) = std::fs::read_to_string(&xml) {
+    if xml.exists() {
+        let bytes = crate::input::read_file(&xml).map_err(|e| {
+            format!(
+                "{} {e}; remove or fix it (urdf-inertia reads it to find package `{pkg}`)",
+                xml.display()
+            )
+        })?;
+        let text = String::from_utf8_lossy(&bytes);
         if let (Some(a), Some(b)) = (text.find("<name>"), text.find("</name>")) {
             if a < b && text[a + 6..b].trim() == pkg {
-                return true;
+                return Ok(true);
             }
         }
     }
-    dir.file_name().and_then(|n| n.to_str()) == Some(pkg)
+    Ok(dir.file_name().and_then(|n| n.to_str()) == Some(pkg))
 }
 
-fn walk_up(base: &Path, pkg: &str) -> Option<PathBuf> {
+fn walk_up(base: &Path, pkg: &str) -> Result<Option<PathBuf>, String> {
     // `robot.urdf` given relative to the working directory: its folder is "", which is ".".
     let base = if base.as_os_str().is_empty() {
         Path::new(".")
@@ -258,16 +288,16 @@ fn walk_up(base: &Path, pkg: &str) -> Option<PathBuf> {
     let start = std::fs::canonicalize(base).unwrap_or_else(|_| base.to_path_buf());
     let mut dir = Some(start.as_path());
     while let Some(d) = dir {
-        if is_package(d, pkg) {
-            return Some(d.to_path_buf());
+        if is_package(d, pkg)? {
+            return Ok(Some(d.to_path_buf()));
         }
         let child = d.join(pkg);
         if child.is_dir() {
-            return Some(child);
+            return Ok(Some(child));
         }
         dir = d.parent();
     }
-    None
+    Ok(None)
 }
 
 #[cfg(test)]

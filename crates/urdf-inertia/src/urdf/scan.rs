@@ -103,6 +103,9 @@ pub struct InertialSpan {
     pub value: Inertial,
     /// A problem reading its numbers, if any (the link is then treated as having an invalid inertial).
     pub problem: Option<String>,
+    /// The line of its (first) `<mass>`, if it has one: `--keep-mass` names it when the value is no
+    /// usable mass.
+    pub mass_line: Option<usize>,
 }
 
 /// A `<link>` with everything the tool needs.
@@ -399,6 +402,17 @@ impl<'t> Scanner<'t> {
                 _ => continue,
             };
             let name = String::from_utf8_lossy(e.name().as_ref()).into_owned();
+            if self.stack.is_empty() && self.robot_name.is_some() {
+                // A second root: urdfdom reads the first root element only, so the rest is left
+                // alone (filling it too would give the file inertials no consumer reads).
+                let message = format!("a second root element <{name}> is ignored, with everything after it (urdfdom reads the first <robot> only); keep one <robot> per file");
+                self.notes.push(warning(
+                    lines.at(pos),
+                    &None,
+                    crate::text::escape_control(&message).into_owned(),
+                ));
+                break;
+            }
             let a = attrs(&e).map_err(|(at, m)| self.err(pos + 1 + at, m))?;
             let tag = Tag {
                 a: &a,
@@ -527,6 +541,7 @@ impl<'t> Scanner<'t> {
                     line: tag.line,
                     value: Inertial::default(),
                     problem: None,
+                    mass_line: None,
                 };
                 let i = InertialInProgress {
                     span,
@@ -612,6 +627,9 @@ impl<'t> Scanner<'t> {
         }
         i.seen.insert(child.to_string(), line);
         let span = &mut i.span;
+        if child == "mass" {
+            span.mass_line = Some(line);
+        }
         let r = match child {
             "origin" => pose(a).map(|p| span.value.origin = p),
             "mass" => num(a, "value").map(|m| span.value.mass = Some(m)),
@@ -670,8 +688,22 @@ impl<'t> Scanner<'t> {
 
 /// Scans URDF text. `path` is used in messages and for resolving relative mesh paths.
 pub fn scan(text: String, path: &Path) -> Result<Robot, UrdfError> {
-    let (name, links, notes) = Scanner::new(&text, path).run()?;
-    let newline = if text.contains("\r\n") { "\r\n" } else { "\n" };
+    // Lines ended by CR alone (classic Mac OS): scanned as XML reads them (end-of-line handling turns
+    // each CR into LF, XML 1.0 section 2.11), byte for byte the same length, so every span stays
+    // right, every message gets its own line, and the writer ends inserted lines with CR.
+    let cr_only = !text.contains('\n') && text.contains('\r');
+    let (name, links, notes) = if cr_only {
+        Scanner::new(&text.replace('\r', "\n"), path).run()?
+    } else {
+        Scanner::new(&text, path).run()?
+    };
+    let newline = if text.contains("\r\n") {
+        "\r\n"
+    } else if cr_only {
+        "\r"
+    } else {
+        "\n"
+    };
     Ok(Robot {
         path: path.to_path_buf(),
         name,
@@ -826,9 +858,12 @@ fn num(a: &HashMap<String, String>, key: &str) -> Result<f64, String> {
     let s = a
         .get(key)
         .ok_or_else(|| format!("missing attribute `{key}`"))?;
-    s.trim()
-        .parse::<f64>()
-        .map_err(|_| format!("{key}=\"{s}\" is not a number"))
+    s.trim().parse::<f64>().map_err(|_| {
+        format!(
+            "{key}=\"{}\" is not a number",
+            crate::text::escape_control(s)
+        )
+    })
 }
 
 /// A primitive's size: finite and not negative (zero is valid URDF).
