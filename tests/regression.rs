@@ -2140,6 +2140,7 @@ fn density_globs_compiled_once_agree_with_a_plain_scan() {
     let e = DensityMap::parse(&long, Path::new("d.toml")).unwrap_err();
     assert_eq!(e.line, Some(3), "{e}");
     assert!(e.message.contains("longer than the 4096"), "{e}");
+}
 
 // ---------------------------------------------------------------------------------------------------
 // Second campaign: no silent unit slip, every read guarded, budgets, sanitised messages, careful writes.
