@@ -2892,3 +2892,81 @@ fn utf16_without_a_mark_is_read_and_utf32_is_named() {
         );
     }
 }
+
+/// An ASCII STL written with upper-case keywords (`SOLID`, `FACET NORMAL`, `VERTEX`), as some
+/// exporters do, was once read as binary records: garbage faces, or an error about the triangle count.
+/// A 1 × 2 × 3 box must have the box's volume and inertia, whatever the keywords' case.
+#[test]
+fn upper_case_ascii_stl_is_read_as_ascii() {
+    let (a, b, c) = (1.0_f64, 2.0_f64, 3.0_f64);
+    let v = |i: u32| {
+        [
+            f64::from(i & 1) * a,
+            f64::from((i >> 1) & 1) * b,
+            f64::from((i >> 2) & 1) * c,
+        ]
+    };
+    // Outward triangles of the box whose corner i has coordinates (bit0·a, bit1·b, bit2·c).
+    let faces: [[u32; 3]; 12] = [
+        [0, 2, 1],
+        [1, 2, 3],
+        [4, 5, 6],
+        [5, 7, 6],
+        [0, 1, 4],
+        [1, 5, 4],
+        [2, 6, 3],
+        [3, 6, 7],
+        [0, 4, 2],
+        [2, 4, 6],
+        [1, 3, 5],
+        [3, 7, 5],
+    ];
+    let tmp = tempfile::tempdir().unwrap();
+    for (name, case) in [("lower", false), ("upper", true), ("mixed", true)] {
+        let k = |w: &str| {
+            if !case {
+                w.to_string()
+            } else if name == "mixed" {
+                let mut c = w.chars();
+                c.next().map_or(String::new(), |f| {
+                    f.to_ascii_uppercase().to_string() + c.as_str()
+                })
+            } else {
+                w.to_ascii_uppercase()
+            }
+        };
+        let mut text = format!("{} BOX\n", k("solid"));
+        for f in faces {
+            text += &format!(
+                "  {} {} 0 0 0\n    {} {}\n",
+                k("facet"),
+                k("normal"),
+                k("outer"),
+                k("loop")
+            );
+            for i in f {
+                let p = v(i);
+                text += &format!("      {} {:E} {:E} {:E}\n", k("vertex"), p[0], p[1], p[2]);
+            }
+            text += &format!("    {}\n  {}\n", k("endloop"), k("endfacet"));
+        }
+        text += &format!("{} BOX\n", k("endsolid"));
+        let path = tmp.path().join(format!("{name}.stl"));
+        std::fs::write(&path, &text).unwrap();
+        let out = run(&["mesh", s(&path), "--density", "1", "--format", "json"]);
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let mass = json["mass"].as_f64().unwrap();
+        assert!(
+            (mass - a * b * c).abs() < 1e-12,
+            "{name}: mass {mass}: {json}"
+        );
+        // The box's moment about its centre around x: m (b² + c²) / 12.
+        let ixx = json["inertia"][0][0].as_f64().unwrap();
+        let want = a * b * c * (b * b + c * c) / 12.0;
+        assert!(
+            (ixx - want).abs() < 1e-12 * want,
+            "{name}: ixx {ixx} against {want}"
+        );
+    }
+}

@@ -77,13 +77,49 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     ))
 }
 
-/// Whether the first word is `solid` (the ASCII keyword; also the start of many binary headers).
+/// Whether the first word is `solid` in any case (the ASCII keyword; also the start of many binary
+/// headers). Some exporters write every keyword in upper case (`SOLID`, `FACET NORMAL`, `VERTEX`).
 fn looks_ascii(bytes: &[u8]) -> bool {
     let start = bytes
         .iter()
         .position(|b| !b.is_ascii_whitespace())
         .unwrap_or(bytes.len());
-    bytes[start..].starts_with(b"solid")
+    bytes[start..]
+        .get(..5)
+        .is_some_and(|w| w.eq_ignore_ascii_case(b"solid"))
+}
+
+/// The words an ASCII STL line can begin with. Keywords are matched without regard to case: the
+/// format's grammar gives them in lower case, but exporters writing `SOLID`/`VERTEX` exist and every
+/// peer reader (assimp, trimesh, numpy-stl) accepts them.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Keyword {
+    Vertex,
+    Outer,
+    EndLoop,
+    /// `solid`, `facet`, `endfacet`, `endsolid`: structure this reader does not need.
+    Ignored,
+    Other,
+}
+
+impl Keyword {
+    fn of(word: &[u8]) -> Keyword {
+        // The common case first, exactly: one comparison per vertex line.
+        if word == b"vertex" || word.eq_ignore_ascii_case(b"vertex") {
+            Keyword::Vertex
+        } else if word.eq_ignore_ascii_case(b"outer") {
+            Keyword::Outer
+        } else if word.eq_ignore_ascii_case(b"endloop") {
+            Keyword::EndLoop
+        } else if [b"facet" as &[u8], b"endfacet", b"solid", b"endsolid"]
+            .iter()
+            .any(|k| word.eq_ignore_ascii_case(k))
+        {
+            Keyword::Ignored
+        } else {
+            Keyword::Other
+        }
+    }
 }
 
 fn is_text(bytes: &[u8]) -> bool {
@@ -386,8 +422,8 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
         let Some(word) = words.next() else { continue };
         let lineno = out.lines;
         let fail = |kind| Some((lineno, kind));
-        match word {
-            b"vertex" => {
+        match Keyword::of(word) {
+            Keyword::Vertex => {
                 out.dependent |= !out.outer;
                 if !in_loop {
                     out.error = fail(MeshErrorKind::Syntax(
@@ -403,12 +439,12 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
                     }
                 }
             }
-            b"outer" => {
+            Keyword::Outer => {
                 out.outer = true;
                 in_loop = true;
                 current.clear();
             }
-            b"endloop" => {
+            Keyword::EndLoop => {
                 out.dependent |= !out.outer;
                 in_loop = false;
                 if current.len() < 3 {
@@ -421,11 +457,11 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
                 out.indices.extend_from_slice(&current);
                 out.sizes.push(current.len() as u32);
             }
-            b"solid" | b"facet" | b"endfacet" | b"endsolid" => {}
-            other => {
+            Keyword::Ignored => {}
+            Keyword::Other => {
                 out.error = fail(MeshErrorKind::Syntax(format!(
                     "unexpected `{}` in ASCII STL",
-                    String::from_utf8_lossy(other)
+                    String::from_utf8_lossy(word)
                 )));
                 break;
             }
@@ -651,7 +687,11 @@ fn facet_chunks(text: &[u8], size: usize) -> Vec<&[u8]> {
                 .iter()
                 .position(|&b| !matches!(b, b' ' | b'\t' | b'\r' | b'\x0c'))
                 .map_or(&line[line.len()..], |w| &line[w..]);
-            if word.starts_with(b"facet") && word.get(5).is_none_or(|b| b.is_ascii_whitespace()) {
+            if word
+                .get(..5)
+                .is_some_and(|w| w.eq_ignore_ascii_case(b"facet"))
+                && word.get(5).is_none_or(|b| b.is_ascii_whitespace())
+            {
                 cut = Some(next);
                 break;
             }
@@ -692,8 +732,8 @@ fn ascii_reference(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         let lineno = lineno + 1;
         let mut words = line.split_ascii_whitespace();
         let Some(word) = words.next() else { continue };
-        match word {
-            "vertex" => {
+        match Keyword::of(word.as_bytes()) {
+            Keyword::Vertex => {
                 if !in_loop {
                     return Err(MeshError::new(
                         path,
@@ -704,11 +744,11 @@ fn ascii_reference(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
                 let p = ascii_vertex(words, lineno, path)?;
                 current.push(vertices.insert(p));
             }
-            "outer" => {
+            Keyword::Outer => {
                 in_loop = true;
                 current.clear();
             }
-            "endloop" => {
+            Keyword::EndLoop => {
                 in_loop = false;
                 if current.len() < 3 {
                     return Err(MeshError::new(
@@ -719,12 +759,12 @@ fn ascii_reference(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
                 }
                 faces.push(&current);
             }
-            "solid" | "facet" | "endfacet" | "endsolid" => {}
-            other => {
+            Keyword::Ignored => {}
+            Keyword::Other => {
                 return Err(MeshError::new(
                     path,
                     Some(lineno),
-                    MeshErrorKind::Syntax(format!("unexpected `{other}` in ASCII STL")),
+                    MeshErrorKind::Syntax(format!("unexpected `{word}` in ASCII STL")),
                 ));
             }
         }
