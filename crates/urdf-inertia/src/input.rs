@@ -55,11 +55,20 @@ pub fn parse_size(s: &str) -> Result<u64, String> {
         .ok_or_else(|| format!("`{s}` is not a size (bytes, or a number with K, M or G)"))
 }
 
+/// What a file that is not a regular file is, for the message.
 fn kind(ft: fs::FileType) -> &'static str {
-    use std::os::unix::fs::FileTypeExt;
     if ft.is_dir() {
         "a directory"
-    } else if ft.is_fifo() {
+    } else {
+        special_kind(ft)
+    }
+}
+
+// FIFOs, devices and sockets are Unix file types; elsewhere the library names them generically.
+#[cfg(unix)]
+fn special_kind(ft: fs::FileType) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    if ft.is_fifo() {
         "a FIFO"
     } else if ft.is_char_device() {
         "a character device"
@@ -70,6 +79,11 @@ fn kind(ft: fs::FileType) -> &'static str {
     } else {
         "not a file"
     }
+}
+
+#[cfg(not(unix))]
+fn special_kind(_: fs::FileType) -> &'static str {
+    "not a file"
 }
 
 /// The whole content of a regular file no larger than [`max_file_size`]. The error says why, without
