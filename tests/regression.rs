@@ -2946,7 +2946,8 @@ fn upper_case_ascii_stl_is_read_as_ascii() {
         };
         let mut text = format!("{} BOX\n", k("solid"));
         for f in faces {
-            text += &format!(
+            let _ = write!(
+                text,
                 "  {} {} 0 0 0\n    {} {}\n",
                 k("facet"),
                 k("normal"),
@@ -2955,11 +2956,18 @@ fn upper_case_ascii_stl_is_read_as_ascii() {
             );
             for i in f {
                 let p = v(i);
-                text += &format!("      {} {:E} {:E} {:E}\n", k("vertex"), p[0], p[1], p[2]);
+                let _ = writeln!(
+                    text,
+                    "      {} {:E} {:E} {:E}",
+                    k("vertex"),
+                    p[0],
+                    p[1],
+                    p[2]
+                );
             }
-            text += &format!("    {}\n  {}\n", k("endloop"), k("endfacet"));
+            let _ = write!(text, "    {}\n  {}\n", k("endloop"), k("endfacet"));
         }
-        text += &format!("{} BOX\n", k("endsolid"));
+        let _ = writeln!(text, "{} BOX", k("endsolid"));
         let path = tmp.path().join(format!("{name}.stl"));
         std::fs::write(&path, &text).unwrap();
         let out = run(&["mesh", s(&path), "--density", "1", "--format", "json"]);
@@ -2978,4 +2986,52 @@ fn upper_case_ascii_stl_is_read_as_ascii() {
             "{name}: ixx {ixx} against {want}"
         );
     }
+}
+
+/// Running out of memory once aborted the process (exit 134) with no file named, and the later files
+/// of a multi-file `fill -i` were never processed. A mesh whose reading would exceed `--max-memory`
+/// fails its link with an error naming the mesh and the budget; the other URDF is still filled.
+#[test]
+fn a_mesh_over_the_memory_budget_fails_its_link_and_the_run_goes_on() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    // A 1 MB binary STL: 20,000 copies of one triangle (the size is what matters here).
+    let n: u32 = 20_000;
+    let mut stl = vec![0u8; 80];
+    stl.extend_from_slice(&n.to_le_bytes());
+    for _ in 0..n {
+        stl.extend_from_slice(&[0u8; 12]);
+        for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+            for c in p {
+                stl.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        stl.extend_from_slice(&[0u8; 2]);
+    }
+    std::fs::write(d.join("big.stl"), &stl).unwrap();
+    let heavy = "<robot name=\"r\">\n  <link name=\"heavy\">\n    <collision><geometry><mesh filename=\"big.stl\"/></geometry></collision>\n  </link>\n</robot>\n";
+    std::fs::write(d.join("a.urdf"), heavy).unwrap();
+    std::fs::write(d.join("b.urdf"), one_box()).unwrap();
+    let out = run(&[
+        "fill",
+        "-i",
+        s(&d.join("a.urdf")),
+        s(&d.join("b.urdf")),
+        "--density",
+        "1000",
+        "--max-memory",
+        "512K",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("big.stl"), "{err}");
+    assert!(err.contains("memory budget (--max-memory)"), "{err}");
+    // a.urdf is left as it was; b.urdf is filled.
+    assert_eq!(std::fs::read_to_string(d.join("a.urdf")).unwrap(), heavy);
+    assert!(std::fs::read_to_string(d.join("b.urdf"))
+        .unwrap()
+        .contains("<inertial>"));
+    let out = run(&["check", s(&d.join("b.urdf")), "--max-memory", "lots"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--max-memory"), "{}", stderr(&out));
 }

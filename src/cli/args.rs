@@ -79,6 +79,10 @@ pub struct SourceArgs {
     /// URDF_INERTIA_MAX_FILE_SIZE environment variable.
     #[arg(long, value_name = "SIZE")]
     pub max_file_size: Option<String>,
+    /// Memory the meshes may take: bytes or K/M/G; default the machine's available memory
+    /// (MemAvailable in /proc/meminfo). A mesh that would need more fails its links, named.
+    #[arg(long, value_name = "SIZE")]
+    pub max_memory: Option<String>,
 }
 
 #[derive(Debug, Clone, ClapArgs)]

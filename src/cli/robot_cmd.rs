@@ -26,6 +26,22 @@ struct Sources {
     /// `--arg NAME:=VALUE` for xacro inputs.
     xacro_args: Vec<(String, String)>,
     options: FillOptions,
+    /// `--max-memory`, or the machine's available memory.
+    memory_budget: u64,
+}
+
+/// `--max-memory`, or by default the memory the kernel reports available (Linux: MemAvailable in
+/// /proc/meminfo); no budget where neither is known.
+fn memory_budget(s: &SourceArgs) -> Result<u64, String> {
+    if let Some(v) = &s.max_memory {
+        return urdf_inertia::input::parse_size(v).map_err(|e| format!("--max-memory: {e}"));
+    }
+    let meminfo = std::fs::read_to_string("/proc/meminfo").unwrap_or_default();
+    Ok(meminfo
+        .lines()
+        .find_map(|l| l.strip_prefix("MemAvailable:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+        .map_or(u64::MAX, |kib| kib.saturating_mul(1024)))
 }
 
 fn density_map(s: &SourceArgs) -> Result<Option<DensityMap>, String> {
@@ -71,6 +87,7 @@ fn sources(s: &SourceArgs) -> Result<Sources, String> {
             missing_only: false,
             keep_mass: s.keep_mass,
         },
+        memory_budget: memory_budget(s)?,
     })
 }
 
@@ -255,7 +272,7 @@ fn run_command(config: Result<Config, String>) -> ExitStatus {
 
 /// The pipeline: every URDF read, computed (with densities), compared, then handed to the mode.
 fn run(config: &Config) -> Outcome {
-    let mut cache = MeshCache::default();
+    let mut cache = MeshCache::with_memory_budget(config.src.memory_budget);
     let mut outcome = Outcome::default();
     for path in &config.files {
         outcome += run_one(config, path, &mut cache);

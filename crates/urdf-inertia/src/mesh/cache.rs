@@ -12,15 +12,145 @@ use std::time::{Duration, Instant};
 /// healed: the cache keeps the solids (a read error as the error of each scale asked for), and of the
 /// files only which were read (a file asked for again with a new scale, by a later call sharing the
 /// cache, is read again).
-#[derive(Debug, Default)]
+///
+/// Between calls it holds at most [`HELD_AT_MOST`] of solids (and half the memory budget), dropping
+/// those used least recently (a later call that needs one reads it again). With a memory budget
+/// ([`MeshCache::with_memory_budget`]) a file whose reading would need more than what is left of it
+/// fails with an error naming it instead of exhausting the machine.
+#[derive(Debug)]
 pub struct MeshCache {
     read: HashSet<PathBuf>,
     solids: SolidMap,
+    /// When each held solid was last asked for (the call's number) and the bytes it holds.
+    usage: HashMap<SolidKey, (u64, u64)>,
+    calls: u64,
+    memory_budget: u64,
     pub load_time: Duration,
     pub integrate_time: Duration,
 }
 
+impl Default for MeshCache {
+    fn default() -> Self {
+        Self::with_memory_budget(u64::MAX)
+    }
+}
+
+/// Most bytes of solids held between calls: a check over many URDFs keeps the meshes that recent
+/// files used, not every mesh of the run. 256 MiB holds the healed meshes of all 69 URDFs of
+/// example-robot-data (1.46 M faces) several times over, so robots that share meshes read them once.
+const HELD_AT_MOST: u64 = 256 << 20;
+
+/// Peak memory of reading, welding and healing a mesh file, as a multiple of its size, per format:
+/// the largest ratio measured for each format on a 1 M-face torus (docs/reliability.md, "Large
+/// inputs"), rounded up. Instancing in COLLADA and glTF can multiply a file beyond this; their
+/// expansion budget bounds that separately.
+fn peak_per_byte(path: &Path) -> f64 {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("stl") | Some("obj") => 2.5,
+        Some("dae") => 3.0,
+        Some("glb") | Some("gltf") => 7.5,
+        _ => 3.0,
+    }
+}
+
+/// The estimated peak memory of reading and healing `path`, `size` bytes long.
+fn peak_of(path: &Path, size: u64) -> u64 {
+    (size as f64 * peak_per_byte(path)) as u64
+}
+
+/// Bytes of memory a healed solid holds.
+fn solid_bytes(solid: &Result<Arc<Solid>, MeshError>) -> u64 {
+    solid.as_ref().map_or(256, |s| {
+        (s.vertices.capacity() * 24
+            + (s.faces.indices.capacity() + s.faces.starts.capacity()) * 4
+            + 512) as u64
+    })
+}
+
+/// `bytes` for people: KiB, MiB or GiB with one decimal.
+fn human(bytes: u64) -> String {
+    let b = bytes as f64;
+    if b >= f64::from(1u32 << 30) {
+        format!("{:.1} GiB", b / f64::from(1u32 << 30))
+    } else if b >= f64::from(1u32 << 20) {
+        format!("{:.1} MiB", b / f64::from(1u32 << 20))
+    } else {
+        format!("{:.1} KiB", b / 1024.0)
+    }
+}
+
 impl MeshCache {
+    /// An empty cache whose work stays within `bytes` of memory: a mesh file whose reading and
+    /// healing would need more (its size times the format's measured peak ratio) fails with an
+    /// error naming it, and solids held between calls are dropped, least recently used first,
+    /// beyond half of it. `u64::MAX` (the default) sets no budget (the cache still holds no more
+    /// than [`HELD_AT_MOST`] between calls).
+    pub fn with_memory_budget(bytes: u64) -> Self {
+        Self {
+            read: HashSet::new(),
+            solids: SolidMap::new(),
+            usage: HashMap::new(),
+            calls: 0,
+            memory_budget: bytes,
+            load_time: Duration::ZERO,
+            integrate_time: Duration::ZERO,
+        }
+    }
+
+    /// Bytes the held solids take.
+    pub fn held_bytes(&self) -> u64 {
+        self.usage.values().map(|&(_, b)| b).sum()
+    }
+
+    /// Counts a new call, marks the solids `needs` names as used by it, and drops old ones.
+    fn start_call(&mut self, needs: &[Vec<(PathBuf, [f64; 3])>]) {
+        self.calls += 1;
+        let wanted: HashSet<SolidKey> = needs
+            .iter()
+            .flatten()
+            .map(|(p, s)| (p.clone(), s.map(f64::to_bits)))
+            .collect();
+        for key in &wanted {
+            if let Some(u) = self.usage.get_mut(key) {
+                u.0 = self.calls;
+            }
+        }
+        self.evict(&wanted);
+    }
+
+    /// Drops the least recently used solids, other than those `keep` names, until what is held
+    /// fits in [`HELD_AT_MOST`] and half the budget.
+    fn evict(&mut self, keep: &HashSet<SolidKey>) {
+        let cap = (self.memory_budget / 2).min(HELD_AT_MOST);
+        let mut held = self.held_bytes();
+        if held <= cap {
+            return;
+        }
+        let mut old: Vec<(u64, SolidKey, u64)> = self
+            .usage
+            .iter()
+            .filter(|(k, _)| !keep.contains(*k))
+            .map(|(k, &(used, bytes))| (used, k.clone(), bytes))
+            .collect();
+        old.sort_by(|a, b| a.0.cmp(&b.0).then_with(|| a.1.cmp(&b.1)));
+        for (_, key, bytes) in old {
+            if held <= cap {
+                break;
+            }
+            self.solids.remove(&key);
+            self.usage.remove(&key);
+            held -= bytes;
+            // A file with no scale left is read again when asked for.
+            if !self.solids.keys().any(|(p, _)| *p == key.0) {
+                self.read.remove(&key.0);
+            }
+        }
+    }
+
     /// Reads and heals every (file, scale) that `needs` names and the cache lacks, in parallel (each
     /// file once, then each of its scales), and runs `task(i, solids)` for each `needs[i]` on the same
     /// threads as soon as the files it names are healed: a robot's links start while its largest
@@ -35,31 +165,24 @@ impl MeshCache {
     ) -> Vec<R> {
         use std::sync::atomic::{AtomicUsize, Ordering};
         use std::sync::{Mutex, OnceLock};
+        self.start_call(needs);
         let work = self.missing(needs.iter().flatten());
+        // The budget left beside what is held, and each file's estimated peak. When the files
+        // together may not fit, they are read one after another on this thread, never two at once
+        // (a wait for room inside rayon's pool could deadlock: a waiting worker may hold a part of
+        // the very read it waits for); a file that alone does not fit is refused.
+        let room = self.memory_budget.saturating_sub(self.held_bytes());
+        let peaks: Vec<u64> = work
+            .iter()
+            .map(|(size, path, _)| peak_of(path, *size))
+            .collect();
+        let one_at_a_time = self.memory_budget != u64::MAX && peaks.iter().sum::<u64>() > room;
         let index: HashMap<&PathBuf, usize> = work
             .iter()
             .enumerate()
             .map(|(w, (_, p, _))| (*p, w))
             .collect();
-        // The files each task waits for, and the tasks each file may release.
-        let waits: Vec<Vec<usize>> = needs
-            .iter()
-            .map(|n| {
-                let mut w: Vec<usize> = n
-                    .iter()
-                    .filter_map(|(p, _)| index.get(p).copied())
-                    .collect();
-                w.sort_unstable();
-                w.dedup();
-                w
-            })
-            .collect();
-        let mut releases = vec![Vec::new(); work.len()];
-        for (t, w) in waits.iter().enumerate() {
-            for &w in w {
-                releases[w].push(t);
-            }
-        }
+        let (waits, releases) = schedule(needs, &index, work.len());
         let pending: Vec<AtomicUsize> = waits.iter().map(|w| AtomicUsize::new(w.len())).collect();
         let done: Vec<OnceLock<LoadedFile>> = work.iter().map(|_| OnceLock::new()).collect();
         let results: Mutex<Vec<Option<R>>> = Mutex::new(needs.iter().map(|_| None).collect());
@@ -70,8 +193,13 @@ impl MeshCache {
             options,
         };
         let load = |w: usize| {
-            let (_, path, scales) = &work[w];
-            let _ = done[w].set(load_file(path, scales, options));
+            let (size, path, scales) = &work[w];
+            let loaded = if self.memory_budget != u64::MAX && peaks[w] > room {
+                refused(path, scales, peaks[w], *size, room)
+            } else {
+                load_file(path, scales, options)
+            };
+            let _ = done[w].set(loaded);
         };
         let run = |t: usize| {
             let r = task(t, &solids);
@@ -84,7 +212,7 @@ impl MeshCache {
         // worker while this thread waits. On URDFs whose collision geometry has no mesh (ur3, a1)
         // that was 0.35–0.65 ms of a 2–2.8 ms task-clock and 22 page faults per process (perf stat
         // -r 50, 2 cores); pre-commit and the benchmarks run one process per URDF.
-        if work.len() <= 1 && needs.len() <= 1 {
+        if one_at_a_time || (work.len() <= 1 && needs.len() <= 1) {
             (0..work.len()).for_each(load);
             (0..needs.len()).for_each(run);
         } else {
@@ -160,8 +288,10 @@ impl MeshCache {
             self.load_time += load;
             self.integrate_time += integrate;
             for (scale, solid) in solids {
-                self.solids
-                    .insert((path.clone(), scale.map(f64::to_bits)), solid);
+                let key = (path.clone(), scale.map(f64::to_bits));
+                self.usage
+                    .insert(key.clone(), (self.calls, solid_bytes(&solid)));
+                self.solids.insert(key, solid);
             }
             self.read.insert(path);
         }
@@ -199,8 +329,52 @@ fn heal_scales(
     solids
 }
 
+/// The files (indices into the work) each task waits for, and the tasks each file may release.
+fn schedule(
+    needs: &[Vec<(PathBuf, [f64; 3])>],
+    index: &HashMap<&PathBuf, usize>,
+    files: usize,
+) -> (Vec<Vec<usize>>, Vec<Vec<usize>>) {
+    let waits: Vec<Vec<usize>> = needs
+        .iter()
+        .map(|n| {
+            let mut w: Vec<usize> = n
+                .iter()
+                .filter_map(|(p, _)| index.get(p).copied())
+                .collect();
+            w.sort_unstable();
+            w.dedup();
+            w
+        })
+        .collect();
+    let mut releases = vec![Vec::new(); files];
+    for (t, w) in waits.iter().enumerate() {
+        for &w in w {
+            releases[w].push(t);
+        }
+    }
+    (waits, releases)
+}
+
+/// A file and the bits of a scale.
+type SolidKey = (PathBuf, [u64; 3]);
+
 /// Each (file, scale bits) healed, or why not.
-type SolidMap = HashMap<(PathBuf, [u64; 3]), Result<Arc<Solid>, MeshError>>;
+type SolidMap = HashMap<SolidKey, Result<Arc<Solid>, MeshError>>;
+
+/// A file refused by the memory budget: the same error at every scale asked for.
+fn refused(path: &Path, scales: &[[f64; 3]], peak: u64, size: u64, room: u64) -> LoadedFile {
+    let why = format!(
+        "reading and healing it needs about {} of memory ({} file), more than the {} left of the \
+         memory budget (--max-memory)",
+        human(peak),
+        human(size),
+        human(room)
+    );
+    let e = MeshError::new(path, None, super::MeshErrorKind::Io(why));
+    let solids = scales.iter().map(|&s| (s, Err(e.clone()))).collect();
+    (path.to_path_buf(), solids, Duration::ZERO, Duration::ZERO)
+}
 
 type SolidsByScale = Vec<([f64; 3], Result<Arc<Solid>, MeshError>)>;
 
@@ -241,4 +415,110 @@ fn load_file(path: &Path, scales: &[[f64; 3]], options: HealthOptions) -> Loaded
     let solids = heal_scales(raw, scales, path, options);
     // The raw mesh has ended, before the next file of this thread is read.
     (path.to_path_buf(), solids, t1 - t0, t1.elapsed())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A binary STL of a closed box `size` across, made of `split`² squares a side (two triangles
+    /// each), so that its size in bytes can be chosen.
+    fn box_stl(path: &Path, size: f64, split: u32) {
+        let mut tris: Vec<[[f64; 3]; 3]> = Vec::new();
+        let step = size / f64::from(split);
+        for axis in 0..3 {
+            for side in [0.0, size] {
+                for i in 0..split {
+                    for j in 0..split {
+                        let (u0, v0) = (f64::from(i) * step, f64::from(j) * step);
+                        let p = |u: f64, v: f64| {
+                            let mut q = [0.0; 3];
+                            q[axis] = side;
+                            q[(axis + 1) % 3] = u;
+                            q[(axis + 2) % 3] = v;
+                            q
+                        };
+                        let (a, b, c, d) = (
+                            p(u0, v0),
+                            p(u0 + step, v0),
+                            p(u0 + step, v0 + step),
+                            p(u0, v0 + step),
+                        );
+                        // Outward: counter-clockwise seen from outside on the far side.
+                        if side > 0.0 {
+                            tris.push([a, b, c]);
+                            tris.push([a, c, d]);
+                        } else {
+                            tris.push([a, c, b]);
+                            tris.push([a, d, c]);
+                        }
+                    }
+                }
+            }
+        }
+        let mut bytes = vec![0u8; 80];
+        bytes.extend_from_slice(&(tris.len() as u32).to_le_bytes());
+        for t in &tris {
+            bytes.extend_from_slice(&[0u8; 12]);
+            for p in t {
+                for c in p {
+                    bytes.extend_from_slice(&(*c as f32).to_le_bytes());
+                }
+            }
+            bytes.extend_from_slice(&[0u8; 2]);
+        }
+        std::fs::write(path, bytes).unwrap();
+    }
+
+    fn volume(cache: &mut MeshCache, path: &Path) -> Result<f64, MeshError> {
+        let needs = vec![vec![(path.to_path_buf(), [1.0; 3])]];
+        let mut out = cache.load_and_run(&needs, HealthOptions::default(), |_, solids| {
+            solids.get(&needs[0][0].0, [1.0; 3]).map(|s| s.unit.mass)
+        });
+        out.remove(0)
+    }
+
+    /// Solids no call asks for again are dropped beyond half the budget, least recently used first,
+    /// and read again (with the same result) when asked for; a file that alone needs more than the
+    /// budget fails with an error that names the budget, and the cache goes on with the next.
+    #[test]
+    fn the_memory_budget_bounds_what_is_held_and_refuses_what_cannot_fit() {
+        let tmp = tempfile::tempdir().unwrap();
+        let files: Vec<PathBuf> = (0..6)
+            .map(|i| {
+                let p = tmp.path().join(format!("b{i}.stl"));
+                box_stl(&p, 1.0 + f64::from(i), 20);
+                p
+            })
+            .collect();
+        let file_size = std::fs::metadata(&files[0]).unwrap().len();
+        // Room to read one file at a time, not to keep all six.
+        let budget = 2 * peak_of(&files[0], file_size);
+        let mut cache = MeshCache::with_memory_budget(budget);
+        let mut unbounded = MeshCache::default();
+        for (i, f) in files.iter().enumerate() {
+            let side = 1.0 + i as f64;
+            let v = volume(&mut cache, f).unwrap();
+            assert!((v - side.powi(3)).abs() < 1e-12 * side.powi(3), "{v}");
+            assert_eq!(v.to_bits(), volume(&mut unbounded, f).unwrap().to_bits());
+            assert!(
+                cache.held_bytes()
+                    <= budget / 2 + cache.usage[&(f.clone(), [1.0f64; 3].map(f64::to_bits))].1
+            );
+        }
+        // Every solid stays in the unbounded cache; the bounded one dropped some.
+        assert_eq!(unbounded.usage.len(), 6);
+        assert!(cache.usage.len() < 6, "{}", cache.usage.len());
+        // The first file was dropped, and reading it again gives the same numbers.
+        let again = volume(&mut cache, &files[0]).unwrap();
+        assert!((again - 1.0).abs() < 1e-12);
+        // A file bigger than the whole budget is refused, by name of the budget.
+        let big = tmp.path().join("big.stl");
+        box_stl(&big, 1.0, 120);
+        let e = volume(&mut cache, &big).unwrap_err().to_string();
+        assert!(e.contains("memory budget (--max-memory)"), "{e}");
+        assert!(e.contains("big.stl"), "{e}");
+        // The cache goes on: a small file after it is read.
+        assert!((volume(&mut cache, &files[1]).unwrap() - 8.0).abs() < 1e-11);
+    }
 }
