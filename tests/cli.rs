@@ -1301,6 +1301,11 @@ fn check_baseline_fails_only_on_new_problems() {
         "demo_arm.urdf:5: link `base_link`: has collision geometry but no <inertial> [UI601]"
     ));
     assert!(stderr_of(&out).contains("--write-baseline") && stderr_of(&out).contains("--skip"));
+    // --quiet keeps the problems and their count, not the advice.
+    let out = check(&["-q"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 6);
+    assert!(!stderr_of(&out).contains("help:"), "{}", stderr_of(&out));
     // Record: exit 0, one sorted line per problem (5 links without <inertial>, 1 invalid).
     let out = check(&["--write-baseline", "known.txt"]);
     assert_eq!(out.status.code(), Some(0), "{}", stderr_of(&out));
@@ -1346,9 +1351,28 @@ fn check_baseline_fails_only_on_new_problems() {
         "{}",
         stderr_of(&out)
     );
+    // Fixing a recorded problem is said, and passes.
+    let out = check(&[
+        "--baseline",
+        "known.txt",
+        "--skip",
+        "extra",
+        "--skip",
+        "base_link",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr_of(&out));
+    assert!(
+        stderr_of(&out).contains("1 problem(s) of the baseline known.txt are gone"),
+        "{}",
+        stderr_of(&out)
+    );
     // From the configuration file as well.
     std::fs::write(root.join("urdf-inertia.toml"), "baseline = \"known.txt\"\n").unwrap();
     let out = check(&[]);
     assert_eq!(out.status.code(), Some(1));
     assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 1);
+    // --baseline FILE --update records the new problem too: then nothing fails.
+    let out = check(&["--baseline", "known.txt", "--update"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr_of(&out));
+    assert_eq!(check(&[]).status.code(), Some(0));
 }

@@ -195,6 +195,9 @@ pub struct CheckArgs {
     /// new problems.
     #[arg(long, value_name = "FILE", conflicts_with = "baseline")]
     pub write_baseline: Option<PathBuf>,
+    /// With --baseline FILE: record today's problems in it (as --write-baseline FILE).
+    #[arg(long, requires = "baseline")]
+    pub update: bool,
 }
 
 #[derive(Debug, Clone, ClapArgs)]

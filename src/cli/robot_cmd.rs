@@ -226,6 +226,7 @@ impl Config {
         let src = sources(&a.source, &settings)?;
         let baseline = match (&a.write_baseline, &a.baseline, &settings.baseline) {
             (Some(w), _, _) => Some(BaselineUse::Write(w.clone())),
+            (None, Some(b), _) if a.update => Some(BaselineUse::Write(b.clone())),
             (None, Some(b), _) | (None, None, Some(b)) => {
                 Some(BaselineUse::Read(Baseline::read(b)?))
             }
@@ -368,7 +369,7 @@ fn report_problems(config: &Config, problems: &[Problem], errors: usize) -> usiz
         let fixed = b.unmatched(problems);
         if fixed > 0 && !config.policy.quiet {
             errln!(
-                "note: {fixed} problem(s) of the baseline {} are gone: `--write-baseline {}` records the shorter list",
+                "urdf-inertia check: {fixed} problem(s) of the baseline {} are gone: `--write-baseline {}` records the shorter list",
                 b.path.display(),
                 b.path.display()
             );
@@ -376,7 +377,7 @@ fn report_problems(config: &Config, problems: &[Problem], errors: usize) -> usiz
     }
     if errors == 0 && !new.is_empty() {
         errln!("urdf-inertia check: {} problem(s) found; `urdf-inertia fill -i FILE --density-map …` computes correct values", new.len());
-        if config.baseline.is_none() {
+        if config.baseline.is_none() && !config.policy.quiet {
             errln!(
                 "help: problems that were there before your change? record them once with `urdf-inertia check FILES --write-baseline urdf-inertia.baseline` (commit it; `baseline = \"urdf-inertia.baseline\"` in urdf-inertia.toml) and later runs fail only on new ones; or leave a link alone with --skip NAME"
             );
