@@ -1222,6 +1222,9 @@ fn quiet_ignore_and_warn_as_error() {
     assert_eq!(out.status.code(), Some(1), "{}", stderr_of(&out));
     assert!(stderr_of(&out).contains("error[UI101]"));
     assert_eq!(check(&["--no-config"], &sub).status.code(), Some(0));
+    // From elsewhere (no configuration there), it is found from the input file's directory.
+    let elsewhere = tempfile::tempdir().unwrap();
+    assert_eq!(check(&[], elsewhere.path()).status.code(), Some(1));
     // A mistyped key names the file and the keys.
     std::fs::write(
         tmp.path().join("urdf-inertia.toml"),
@@ -1301,6 +1304,14 @@ fn check_baseline_fails_only_on_new_problems() {
         "demo_arm.urdf:5: link `base_link`: has collision geometry but no <inertial> [UI601]"
     ));
     assert!(stderr_of(&out).contains("--write-baseline") && stderr_of(&out).contains("--skip"));
+    // --ignore selects problems too: only the invalid upper arm is left.
+    let out = check(&["--ignore", "UI601"]);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert_eq!(stdout.lines().count(), 1, "{stdout}");
+    assert!(
+        stdout.contains("link `upper_arm_link`: ") && stdout.ends_with("[UI602]\n"),
+        "{stdout}"
+    );
     // --quiet keeps the problems and their count, not the advice.
     let out = check(&["-q"]);
     assert_eq!(out.status.code(), Some(1));
