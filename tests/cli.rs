@@ -409,7 +409,7 @@ fn check_exit_codes() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         stdout.contains(
-            "demo_arm.urdf:5: link `base_link`: has collision geometry but no <inertial>"
+            "demo_arm.urdf:5: link `base_link`: has collision geometry but no <inertial> [UI601]"
         ),
         "{stdout}"
     );
@@ -458,7 +458,7 @@ fn diff_names_unit_slips() {
         "json",
     ]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
-    assert_eq!(v[0]["mass_ratio"].as_f64(), Some(1000.0));
+    assert_eq!(v["links"][0]["mass_ratio"].as_f64(), Some(1000.0));
 }
 
 #[test]
@@ -786,32 +786,7 @@ fn keep_mass_and_total_mass() {
 fn json_summary_names_repairs() {
     let tmp = tempfile::tempdir().unwrap();
     // An inside-out box mesh: the summary must say it was flipped.
-    let v: Vec<[f64; 3]> = (0..8)
-        .map(|i| {
-            [
-                f64::from(i & 1),
-                f64::from((i >> 1) & 1),
-                f64::from((i >> 2) & 1),
-            ]
-        })
-        .collect();
-    let quads = [
-        [0u32, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let tris: Vec<[u32; 3]> = quads
-        .iter()
-        .flat_map(|q| [[q[0], q[2], q[1]], [q[0], q[3], q[2]]])
-        .collect();
-    std::fs::write(
-        tmp.path().join("inside.stl"),
-        urdf_inertia::mesh::stl::write_binary(b"in", &v, &tris),
-    )
-    .unwrap();
+    inside_out_cube(&tmp.path().join("inside.stl"));
     let urdf = tmp.path().join("r.urdf");
     std::fs::write(&urdf, "<robot name=\"r\">\n  <link name=\"box\">\n    <collision><geometry><mesh filename=\"inside.stl\"/></geometry></collision>\n  </link>\n</robot>\n").unwrap();
     let out = run(&[
@@ -844,13 +819,30 @@ fn json_summary_names_repairs() {
             && stderr.contains("inside.stl: closed mesh wound inward (an error under --strict)"),
         "{stderr}"
     );
-    // The text summary names the repair too.
+    // The text summary names the repair too, with its code: a note by default, since turning the
+    // box outside in is exact (its bound is round-off, below --note-below's 1e-9), a warning with
+    // --note-below 0.
     let out = run(&["fill", urdf.to_str().unwrap(), "--density", "1000"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("UI101"), "{stderr}");
+    let out = run(&["fill", urdf.to_str().unwrap(), "--density", "1000", "-v"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains(
-            "warning: link `box`, collision 1, inside.stl: inverted: all 12 faces wound inward"
-        ),
+        stderr.contains("note[UI101]: inside.stl: inverted: all 12 faces wound inward")
+            && stderr.contains("(link `box`, collision 1)"),
+        "{stderr}"
+    );
+    let out = run(&[
+        "fill",
+        urdf.to_str().unwrap(),
+        "--density",
+        "1000",
+        "--note-below",
+        "0",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("warning[UI101]: inside.stl: inverted: all 12 faces wound inward"),
         "{stderr}"
     );
 }
@@ -865,7 +857,19 @@ fn millimetre_meshes_without_scale_are_flagged() {
     let out = run(&["fill", urdf.to_str().unwrap(), "--density", "1000"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
-    assert!(stderr.contains("link `shoulder_link`, collision 1, package://demo_arm_description/meshes/shoulder.STL: exact: the mesh is 229.8 m across: if it was exported in millimetres, give it scale=\"0.001 0.001 0.001\""), "{stderr}");
+    assert!(stderr.contains("warning[UI106]: package://demo_arm_description/meshes/shoulder.STL: exact: the mesh is 229.8 m across: if it was exported in millimetres, give it scale=\"0.001 0.001 0.001\" (link `shoulder_link`, collision 1)"), "{stderr}");
+    // diff and check show it too (they compute the same meshes).
+    let (_, map) = demo();
+    for command in ["diff", "check"] {
+        let out = run(&[
+            command,
+            urdf.to_str().unwrap(),
+            "--density-map",
+            map.to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains("warning[UI106]: package://demo_arm_description/meshes/shoulder.STL: exact: the mesh is 229.8 m across"), "{command}: {stderr}");
+    }
 }
 
 #[test]
@@ -1043,6 +1047,344 @@ fn overlapping_parts_are_reported_with_the_doubly_counted_volume() {
     std::fs::write(&path, text).unwrap();
     let out = run(&["fill", path.to_str().unwrap(), "--density", "1000"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("link `cubes`: parts 1 and 2 overlap: about 0.5 m³ (25.0% of the link's volume) is counted twice"), "{stderr}");
+    assert!(stderr.contains("warning[UI401]: link `cubes`: parts 1 and 2 overlap: about 0.5 m³ (25.0% of the link's volume) is counted twice"), "{stderr}");
+    // The summary's worst error estimate is the overlap, not the primitives' round-off: 0.5 m³ of
+    // the parts' 2 m³. The total mass: 2 m³ of cubes and a 4/3·π m³ ball with a 0.008 m³ box.
+    assert!(stderr.contains("worst error estimate: 25.0% of link `cubes`'s volume, counted more than once where its parts 1 and 2 overlap (UI401)"), "{stderr}");
+    let total = 1000.0 * (2.0 + 4.0 / 3.0 * PI + 0.008);
+    let line = stderr
+        .lines()
+        .find(|l| l.contains("total mass: "))
+        .expect("total mass line");
+    let got: f64 = line
+        .split_whitespace()
+        .nth(2)
+        .expect("value")
+        .parse()
+        .expect("number");
+    assert!(
+        (got - total).abs() <= 1e-5 * total,
+        "{line} against {total}"
+    );
     assert!(!stderr.contains("link `ball`: parts"), "{stderr}");
+}
+
+/// An inside-out unit cube (every face wound inward) as a binary STL at `path`: turned outside out
+/// exactly, so its repair (UI101) has a round-off bound.
+fn inside_out_cube(path: &Path) {
+    let v: Vec<[f64; 3]> = (0..8)
+        .map(|i| {
+            [
+                f64::from(i & 1),
+                f64::from((i >> 1) & 1),
+                f64::from((i >> 2) & 1),
+            ]
+        })
+        .collect();
+    let quads = [
+        [0u32, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let tris: Vec<[u32; 3]> = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[2], q[1]], [q[0], q[3], q[2]]])
+        .collect();
+    std::fs::write(
+        path,
+        urdf_inertia::mesh::stl::write_binary(b"in", &v, &tris),
+    )
+    .unwrap();
+}
+
+/// A robot of four links sharing one inside-out cube mesh, in `dir` (a `.git` there makes it a
+/// repository root for the configuration file's search).
+fn shared_mesh_robot(dir: &Path) -> PathBuf {
+    std::fs::create_dir_all(dir.join(".git")).unwrap();
+    inside_out_cube(&dir.join("cube.stl"));
+    let links: String = ["a", "b", "c", "d"]
+        .iter()
+        .map(|l| format!("  <link name=\"{l}\">\n    <collision><geometry><mesh filename=\"cube.stl\"/></geometry></collision>\n  </link>\n"))
+        .collect();
+    let text = format!("<robot name=\"r\">\n{links}</robot>\n");
+    let urdf = dir.join("r.urdf");
+    std::fs::write(&urdf, text).unwrap();
+    urdf
+}
+
+fn stderr_of(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+// A mesh shared by four links is reported once by fill, diff and check (the first hour: diff and
+// check printed no mesh warning, fill printed one per link).
+#[test]
+fn mesh_warnings_once_per_file_in_fill_diff_and_check() {
+    let tmp = tempfile::tempdir().unwrap();
+    let urdf = shared_mesh_robot(tmp.path());
+    let u = urdf.to_str().unwrap();
+    let once = "warning[UI101]: cube.stl: inverted: all 12 faces wound inward (negative volume); flipped (4 links: `a` collision 1, `b` collision 1, `c` collision 1, `d` collision 1)";
+    for command in ["fill", "diff", "check"] {
+        let out = run(&[command, u, "--density", "1000", "--note-below", "0"]);
+        let stderr = stderr_of(&out);
+        assert_eq!(stderr.matches("[UI101]").count(), 1, "{command}: {stderr}");
+        assert!(stderr.contains(once), "{command}: {stderr}");
+    }
+    // JSON: one entry naming the four links.
+    let out = run(&[
+        "diff",
+        u,
+        "--density",
+        "1000",
+        "--note-below",
+        "0",
+        "--format",
+        "json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    let d = v["mesh_diagnostics"].as_array().expect("array");
+    assert_eq!(d.len(), 1, "{d:?}");
+    assert_eq!(d[0]["code"], "UI101");
+    assert_eq!(d[0]["severity"], "warning");
+    assert_eq!(d[0]["links"].as_array().map(Vec::len), Some(4));
+    // Four unit cubes of 1000 kg/m³.
+    assert_eq!(v["total_mass"].as_f64(), Some(4000.0));
+    // By default the exact repair is a note: printed with -v only.
+    let out = run(&["diff", u, "--density", "1000"]);
+    assert!(!stderr_of(&out).contains("UI101"), "{}", stderr_of(&out));
+    let out = run(&["diff", u, "--density", "1000", "-v"]);
+    assert!(stderr_of(&out).contains("note[UI101]: cube.stl"));
+}
+
+#[test]
+fn quiet_ignore_and_warn_as_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    let urdf = shared_mesh_robot(tmp.path());
+    let u = urdf.to_str().unwrap();
+    let out_file = tmp.path().join("out.urdf");
+    let o = out_file.to_str().unwrap();
+    let fill = |extra: &[&str]| {
+        let mut args = vec!["fill", u, "--density", "1000", "--note-below", "0", "-o", o];
+        args.extend(extra);
+        run(&args)
+    };
+    // --quiet: no warnings, no summary.
+    let out = fill(&["-q"]);
+    assert_eq!(out.status.code(), Some(0));
+    assert_eq!(stderr_of(&out), "");
+    // --ignore: that code is gone, the summary stays.
+    let out = fill(&["--ignore", "UI102,UI101"]);
+    assert!(!stderr_of(&out).contains("UI101"), "{}", stderr_of(&out));
+    assert!(
+        stderr_of(&out).contains("total mass: 4000 kg"),
+        "{}",
+        stderr_of(&out)
+    );
+    // --warn-as-error: fill writes nothing and exits 2.
+    std::fs::remove_file(&out_file).unwrap();
+    let out = fill(&["--warn-as-error", "UI101"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr_of(&out));
+    assert!(stderr_of(&out).contains("error[UI101]: cube.stl: inverted"));
+    assert!(stderr_of(&out).contains("nothing written"));
+    assert!(!out_file.exists());
+    // check on the filled robot: clean, unless the warning is an error.
+    fill(&[]);
+    let check = |extra: &[&str], dir: &Path| {
+        let mut args = vec!["check", o, "--density", "1000", "--note-below", "0"];
+        args.extend(extra);
+        bin().args(&args).current_dir(dir).output().unwrap()
+    };
+    assert_eq!(check(&[], tmp.path()).status.code(), Some(0));
+    assert_eq!(
+        check(&["--warn-as-error", "UI101"], tmp.path())
+            .status
+            .code(),
+        Some(1)
+    );
+    // Unknown codes and errors are refused.
+    let out = check(&["--ignore", "UI999"], tmp.path());
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr_of(&out).contains("unknown code `UI999`"));
+    let out = check(&["--ignore", "UI702"], tmp.path());
+    assert_eq!(out.status.code(), Some(2));
+    // The same in urdf-inertia.toml, found from a subdirectory up to the repository root.
+    std::fs::write(
+        tmp.path().join("urdf-inertia.toml"),
+        "warn-as-error = [\"UI101\"]\n",
+    )
+    .unwrap();
+    let sub = tmp.path().join("sub/dir");
+    std::fs::create_dir_all(&sub).unwrap();
+    let out = check(&[], &sub);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr_of(&out));
+    assert!(stderr_of(&out).contains("error[UI101]"));
+    assert_eq!(check(&["--no-config"], &sub).status.code(), Some(0));
+    // From elsewhere (no configuration there), it is found from the input file's directory.
+    let elsewhere = tempfile::tempdir().unwrap();
+    assert_eq!(check(&[], elsewhere.path()).status.code(), Some(1));
+    // A mistyped key names the file and the keys.
+    std::fs::write(
+        tmp.path().join("urdf-inertia.toml"),
+        "ignroe = [\"UI101\"]\n",
+    )
+    .unwrap();
+    let out = check(&[], &sub);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr_of(&out).contains("urdf-inertia.toml")
+            && stderr_of(&out).contains("ignore, warn-as-error, note-below"),
+        "{}",
+        stderr_of(&out)
+    );
+}
+
+#[test]
+fn colours_on_request_only_and_never_in_json() {
+    let (urdf, map) = demo();
+    let args = [
+        "diff",
+        urdf.to_str().unwrap(),
+        "--density-map",
+        map.to_str().unwrap(),
+        "-v",
+    ];
+    // Through a pipe: plain text with the codes.
+    let out = run(&args);
+    assert!(
+        stderr_of(&out).contains("note[UI105]: ../meshes/upper_arm.obj: exact: 2 objects/groups")
+    );
+    assert!(!stderr_of(&out).contains('\x1b'));
+    let forced = bin()
+        .args(args)
+        .env("CLICOLOR_FORCE", "1")
+        .env_remove("NO_COLOR")
+        .output()
+        .unwrap();
+    assert!(
+        stderr_of(&forced).contains("\x1b[1;32mnote[UI105]\x1b[0m: ../meshes/upper_arm.obj"),
+        "{}",
+        stderr_of(&forced)
+    );
+    assert!(!String::from_utf8_lossy(&forced.stdout).contains('\x1b'));
+    let no_color = bin()
+        .args(args)
+        .env("CLICOLOR_FORCE", "1")
+        .env("NO_COLOR", "1")
+        .output()
+        .unwrap();
+    assert!(!stderr_of(&no_color).contains('\x1b'));
+    let mut json = args.to_vec();
+    json.extend(["--format", "json"]);
+    let out = bin()
+        .args(&json)
+        .env("CLICOLOR_FORCE", "1")
+        .output()
+        .unwrap();
+    assert!(!String::from_utf8_lossy(&out.stdout).contains('\x1b'));
+    serde_json::from_slice::<serde_json::Value>(&out.stdout).expect("json");
+}
+
+// Adopting the check on a repository with known problems: record them, then only new ones fail.
+#[test]
+#[allow(clippy::too_many_lines)] // one adoption scenario checked step by step
+fn check_baseline_fails_only_on_new_problems() {
+    let (tmp, urdf, _) = demo_copy();
+    let root = tmp.path().join("demo_arm_description");
+    let check = |extra: &[&str]| {
+        let mut args = vec!["check", "urdf/demo_arm.urdf"];
+        args.extend(extra);
+        bin().args(&args).current_dir(&root).output().unwrap()
+    };
+    // Without a baseline the first failure says how to adopt the check.
+    let out = check(&[]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stdout).contains(
+        "demo_arm.urdf:5: link `base_link`: has collision geometry but no <inertial> [UI601]"
+    ));
+    assert!(stderr_of(&out).contains("--write-baseline") && stderr_of(&out).contains("--skip"));
+    // --ignore selects problems too: only the invalid upper arm is left.
+    let out = check(&["--ignore", "UI601"]);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert_eq!(stdout.lines().count(), 1, "{stdout}");
+    assert!(
+        stdout.contains("link `upper_arm_link`: ") && stdout.ends_with("[UI602]\n"),
+        "{stdout}"
+    );
+    // --quiet keeps the problems and their count, not the advice.
+    let out = check(&["-q"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 6);
+    assert!(!stderr_of(&out).contains("help:"), "{}", stderr_of(&out));
+    // Record: exit 0, one sorted line per problem (5 links without <inertial>, 1 invalid).
+    let out = check(&["--write-baseline", "known.txt"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr_of(&out));
+    let text = std::fs::read_to_string(root.join("known.txt")).unwrap();
+    let lines: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(lines.len(), 6, "{text}");
+    let mut sorted = lines.clone();
+    sorted.sort_unstable();
+    assert_eq!(lines, sorted);
+    assert!(
+        lines.contains(
+            &"urdf/demo_arm.urdf\tbase_link\tUI601\thas collision geometry but no <inertial>"
+        ),
+        "{text}"
+    );
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("urdf/demo_arm.urdf\tupper_arm_link\tUI602\t")),
+        "{text}"
+    );
+    // Old problems pass.
+    let out = check(&["--baseline", "known.txt"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr_of(&out));
+    assert_eq!(String::from_utf8_lossy(&out.stdout), "");
+    // A new one fails, and is the only one printed.
+    let text = std::fs::read_to_string(&urdf).unwrap().replace(
+        "</robot>",
+        "  <link name=\"extra\">\n    <collision><geometry><box size=\"1 1 1\"/></geometry></collision>\n  </link>\n</robot>",
+    );
+    std::fs::write(&urdf, text).unwrap();
+    let out = check(&["--baseline", "known.txt"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(stdout.lines().count(), 1, "{stdout}");
+    assert!(
+        stdout.contains("link `extra`: has collision geometry but no <inertial> [UI601]"),
+        "{stdout}"
+    );
+    assert!(
+        stderr_of(&out)
+            .contains("6 problem(s) recorded in the baseline known.txt (not failing), 1 new"),
+        "{}",
+        stderr_of(&out)
+    );
+    // Fixing a recorded problem is said, and passes.
+    let out = check(&[
+        "--baseline",
+        "known.txt",
+        "--skip",
+        "extra",
+        "--skip",
+        "base_link",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr_of(&out));
+    assert!(
+        stderr_of(&out).contains("1 problem(s) of the baseline known.txt are gone"),
+        "{}",
+        stderr_of(&out)
+    );
+    // From the configuration file as well.
+    std::fs::write(root.join("urdf-inertia.toml"), "baseline = \"known.txt\"\n").unwrap();
+    let out = check(&[]);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 1);
+    // --baseline FILE --update records the new problem too: then nothing fails.
+    let out = check(&["--baseline", "known.txt", "--update"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr_of(&out));
+    assert_eq!(check(&[]).status.code(), Some(0));
 }

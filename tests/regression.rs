@@ -1583,7 +1583,7 @@ fn what_it_says(out: &Output, tmp: &Path) -> String {
     let stdout = String::from_utf8_lossy(&out.stdout);
     let first = err
         .lines()
-        .find(|l| l.starts_with("error:"))
+        .find(|l| l.starts_with("error:") || l.starts_with("error["))
         .or_else(|| err.lines().next())
         .or_else(|| stdout.lines().find(|l| l.contains("volume")))
         .map_or("(nothing)", str::trim);
@@ -2703,7 +2703,7 @@ fn thread_pool_failures_fall_back_to_one_thread() {
         .output()
         .unwrap();
     assert!(
-        stderr(&out).contains("warning: cannot start")
+        stderr(&out).contains("warning[UI503]: cannot start")
             && stderr(&out).contains("working on one thread"),
         "{}",
         stderr(&out)

@@ -133,7 +133,7 @@ fn duplicate_inertials_are_replaced_by_one_and_flagged() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(
-        stderr.contains("warning: ") && stderr.contains("dup.urdf:12: link `a`: a second <inertial> is ignored (urdfdom reads the first, on line 5)"),
+        stderr.contains("warning[UI201]: ") && stderr.contains("dup.urdf:12: link `a`: a second <inertial> is ignored (urdfdom reads the first, on line 5)"),
         "{stderr}"
     );
     let text = std::fs::read_to_string(&filled).expect("filled");
@@ -268,7 +268,7 @@ fn zero_size_primitives_contribute_nothing() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(
-        stderr.contains("note: ")
+        stderr.contains("note[UI203]: ")
             && stderr.contains(
                 "zero.urdf:2: link `contact_point`: its collision geometry has no volume"
             ),
@@ -326,7 +326,7 @@ fn repeated_collision_parts_use_the_first() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     for expect in [
-        "warning: ",
+        "warning[UI201]: ",
         "rep.urdf:5: link `a`: collision 1: a second <origin> is ignored (urdfdom reads the first, on line 4)",
         "rep.urdf:8: link `a`: collision 1: <origin> inside <geometry> is ignored (as urdfdom does): an origin belongs in <collision>",
         "rep.urdf:9: link `a`: collision 1: a second shape <sphere> in <geometry> is ignored (urdfdom reads only the first, <box> on line 7)",

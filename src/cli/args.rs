@@ -83,6 +83,35 @@ pub struct SourceArgs {
     /// (MemAvailable in /proc/meminfo). A mesh that would need more fails its links, named.
     #[arg(long, value_name = "SIZE")]
     pub max_memory: Option<String>,
+    #[command(flatten)]
+    pub diagnostics: DiagnosticArgs,
+}
+
+/// Which diagnostics are printed, and how (also in `urdf-inertia.toml`).
+#[derive(Debug, Clone, ClapArgs)]
+pub struct DiagnosticArgs {
+    /// Print only errors and problems (no warnings, notes or summary).
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// Silence these codes (`UI102`, or a comma list; repeatable): warnings, notes, or check's
+    /// problems (UI6xx).
+    #[arg(long, value_name = "CODE")]
+    pub ignore: Vec<String>,
+    /// Make these warnings errors (`UI101`, or a comma list; repeatable): `fill` writes nothing
+    /// and exits 2, `diff` and `check` exit 1.
+    #[arg(long, value_name = "CODE")]
+    pub warn_as_error: Vec<String>,
+    /// Repair warnings (UI101, UI102) whose relative error bound is below this are notes
+    /// (default 1e-9; 0 keeps them all warnings).
+    #[arg(long, value_name = "BOUND")]
+    pub note_below: Option<f64>,
+    /// Read settings from this file instead of the `urdf-inertia.toml` found by walking up from
+    /// the current directory to the repository root.
+    #[arg(long, value_name = "FILE", conflicts_with = "no_config")]
+    pub config: Option<PathBuf>,
+    /// Read no configuration file.
+    #[arg(long)]
+    pub no_config: bool,
 }
 
 #[derive(Debug, Clone, ClapArgs)]
@@ -161,6 +190,18 @@ pub struct CheckArgs {
     /// part); warnings are printed always, and JSON carries both.
     #[arg(short, long)]
     pub verbose: bool,
+    /// Fail only on problems not recorded in this file (written by --write-baseline; also
+    /// `baseline = "FILE"` in urdf-inertia.toml).
+    #[arg(long, value_name = "FILE")]
+    pub baseline: Option<PathBuf>,
+    /// Record today's problems in FILE (one line each: file, link, code, message; sorted) and
+    /// exit 0: the repository adopts the check, and later runs with --baseline FILE fail only on
+    /// new problems.
+    #[arg(long, value_name = "FILE", conflicts_with = "baseline")]
+    pub write_baseline: Option<PathBuf>,
+    /// With --baseline FILE: record today's problems in it (as --write-baseline FILE).
+    #[arg(long, requires = "baseline")]
+    pub update: bool,
 }
 
 #[derive(Debug, Clone, ClapArgs)]

@@ -215,10 +215,7 @@ fn print_text(
         solid.error.describe()
     );
     outln!("  time              {:.3} ms", elapsed.as_secs_f64() * 1e3);
-    for w in &solid.warnings {
-        outln!("  warning: {w}");
-    }
-    for n in &solid.notes {
-        outln!("  note: {n}");
+    for d in urdf_inertia::diagnostic::mesh_health(solid) {
+        outln!("  {}: {}", d.head(), d.message);
     }
 }

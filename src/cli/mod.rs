@@ -12,9 +12,11 @@ macro_rules! errln {
 }
 
 mod args;
+mod baseline;
 mod compare;
 mod mesh_cmd;
 pub mod output;
+mod policy;
 mod robot_cmd;
 mod summary;
 pub mod write;
@@ -78,7 +80,10 @@ pub fn main() -> i32 {
         Command::Xacro(x) => xacro_cmd::run(&x),
     };
     if let Some(note) = urdf_inertia::threads::note() {
-        errln!("warning: {note}");
+        errln!(
+            "warning[{}]: {note}",
+            urdf_inertia::diagnostic::Code::RunThreads
+        );
     }
     if output::stdout_failed() {
         return ExitStatus::Error as i32;

@@ -7,9 +7,15 @@
 //!   [`stdout_failed`] makes the command exit 2 — unless what failed was only the summary printed after
 //!   the URDF was already written to a file ([`stdout_is_summary`]);
 //! * stderr errors are ignored: there is nowhere left to report them.
+//!
+//! Colour: the `error[…]`, `warning[…]`, `note[…]` and `help` heads of stderr lines are coloured when
+//! stderr is a terminal (as anstream decides: `NO_COLOR` wins, then `CLICOLOR_FORCE`, then
+//! `CLICOLOR=0`, then a terminal whose `TERM` is not `dumb`). stdout (the URDF, tables, JSON) is
+//! never coloured.
 
-use std::io::{self, Write};
+use std::io::{self, IsTerminal, Write};
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
+use std::sync::OnceLock;
 
 const OK: u8 = 0;
 const BROKEN_PIPE: u8 = 1;
@@ -69,9 +75,61 @@ pub fn out_line(line: &str) {
     let _ = write_stdout(sanitised_line(line).as_bytes());
 }
 
-/// One line on stderr, control characters escaped (see [`sanitised_line`]).
+/// One line on stderr, control characters escaped (see [`sanitised_line`]), its head coloured on a
+/// terminal (see [`coloured`]).
 pub fn err_line(line: &str) {
-    write_stderr(sanitised_line(line).as_bytes());
+    let line = sanitised_line(line);
+    if stderr_colour() {
+        write_stderr(coloured(&line).as_bytes());
+    } else {
+        write_stderr(line.as_bytes());
+    }
+}
+
+/// Whether stderr gets colours: anstream's rules (`NO_COLOR`, `CLICOLOR_FORCE`, `CLICOLOR`, a
+/// terminal, `TERM=dumb`), decided once.
+fn stderr_colour() -> bool {
+    static CHOICE: OnceLock<bool> = OnceLock::new();
+    *CHOICE.get_or_init(|| {
+        let set = |k: &str| std::env::var_os(k).is_some_and(|v| !v.is_empty());
+        let value = |k: &str| std::env::var(k).ok();
+        if set("NO_COLOR") {
+            return false;
+        }
+        if set("CLICOLOR_FORCE") && value("CLICOLOR_FORCE").as_deref() != Some("0") {
+            return true;
+        }
+        if value("CLICOLOR").as_deref() == Some("0") {
+            return false;
+        }
+        io::stderr().is_terminal() && value("TERM").as_deref() != Some("dumb")
+    })
+}
+
+/// `line` (already sanitised: it holds no ESC of its own) with its head coloured as compilers do:
+/// `error[…]` bold red, `warning[…]` bold yellow, `note[…]` bold green, `help` bold cyan; the
+/// indentation before it is kept.
+fn coloured(line: &str) -> String {
+    let body = line.trim_start_matches(' ');
+    let indent = &line[..line.len() - body.len()];
+    for (word, colour) in [("error", 31), ("warning", 33), ("note", 32), ("help", 36)] {
+        let Some(rest) = body.strip_prefix(word) else {
+            continue;
+        };
+        let code_len = if rest.starts_with('[') {
+            rest.find(']').map_or(0, |i| i + 1)
+        } else {
+            0
+        };
+        if rest[code_len..].starts_with(':') {
+            let head = &body[..word.len() + code_len];
+            return format!(
+                "{indent}\x1b[1;{colour}m{head}\x1b[0m{}",
+                &body[word.len() + code_len..]
+            );
+        }
+    }
+    line.to_string()
 }
 
 /// From now on stdout carries only a summary of work already done (the URDF went to a file): failing to
@@ -83,4 +141,20 @@ pub fn stdout_is_summary() {
 /// Whether writing to stdout failed (other than a closed pipe) where it matters for the exit status.
 pub fn stdout_failed() -> bool {
     STDOUT.load(Ordering::Relaxed) == FAILED && !SUMMARY_ONLY.load(Ordering::Relaxed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::coloured;
+
+    #[test]
+    fn only_the_head_is_coloured() {
+        assert_eq!(
+            coloured("  warning[UI101]: a: b\n"),
+            "  \x1b[1;33mwarning[UI101]\x1b[0m: a: b\n"
+        );
+        assert_eq!(coloured("error: x\n"), "\x1b[1;31merror\x1b[0m: x\n");
+        assert_eq!(coloured("warnings: x\n"), "warnings: x\n");
+        assert_eq!(coloured("urdf-inertia: x\n"), "urdf-inertia: x\n");
+    }
 }

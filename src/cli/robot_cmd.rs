@@ -3,13 +3,15 @@
 //! printed or written, and [`Outcome::status`] decides the exit status in one place.
 
 use super::args::{CheckArgs, DiffArgs, FillArgs, Format, SourceArgs};
+use super::baseline::{Baseline, Problem};
 use super::compare::{compare, Comparison};
+use super::policy::{Policy, Settings};
 use super::summary;
 use super::{write, ExitStatus};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use urdf_inertia::density::{DensityMap, Glob};
-use urdf_inertia::diagnostic::{Code, Diagnostic, Location};
+use urdf_inertia::diagnostic::{Code, Diagnostic, Location, Severity};
 use urdf_inertia::fill::{self, existing_problems, existing_props, FillOptions, FillReport};
 use urdf_inertia::fill::{LinkReport, MeshCache};
 use urdf_inertia::mass::MassProperties;
@@ -44,9 +46,19 @@ fn memory_budget(s: &SourceArgs) -> Result<u64, String> {
         .map_or(u64::MAX, |kib| kib.saturating_mul(1024)))
 }
 
-fn density_map(s: &SourceArgs) -> Result<Option<DensityMap>, String> {
+fn density_map(s: &SourceArgs, settings: &Settings) -> Result<Option<DensityMap>, String> {
     Ok(match (&s.density_map, s.density) {
         (Some(p), _) => Some(DensityMap::load(p).map_err(|e| e.to_string())?),
+        (None, None) if settings.density_map.is_some() => {
+            let p = settings.density_map.as_deref().unwrap_or(Path::new(""));
+            Some(DensityMap::load(p).map_err(|e| {
+                let file = settings
+                    .file
+                    .as_ref()
+                    .map_or(String::new(), |f| format!("{}: density-map: ", f.display()));
+                format!("{file}{e}")
+            })?)
+        }
         (None, Some(d)) => {
             if !(d > 0.0 && d.is_finite()) {
                 return Err(format!("--density {d} must be a positive number (kg/m³)"));
@@ -58,8 +70,8 @@ fn density_map(s: &SourceArgs) -> Result<Option<DensityMap>, String> {
     })
 }
 
-fn sources(s: &SourceArgs) -> Result<Sources, String> {
-    let map = density_map(s)?;
+fn sources(s: &SourceArgs, settings: &Settings) -> Result<Sources, String> {
+    let map = density_map(s, settings)?;
     let globs = |patterns: &[String]| {
         patterns
             .iter()
@@ -69,6 +81,7 @@ fn sources(s: &SourceArgs) -> Result<Sources, String> {
     let pkgs = s
         .package_path
         .iter()
+        .chain(&settings.package_path)
         .map(|p| PackageResolver::parse_package_arg(p))
         .collect::<Result<Vec<_>, String>>()?;
     let xacro_args = s
@@ -92,8 +105,12 @@ fn sources(s: &SourceArgs) -> Result<Sources, String> {
 }
 
 /// Sources that must include densities (`fill`, `diff`).
-fn sources_with_densities(s: &SourceArgs, command: &str) -> Result<Sources, String> {
-    let src = sources(s)?;
+fn sources_with_densities(
+    s: &SourceArgs,
+    settings: &Settings,
+    command: &str,
+) -> Result<Sources, String> {
+    let src = sources(s, settings)?;
     if src.map.is_none() {
         return Err(format!("{command} needs densities: pass --density RHO (kg/m³), --density-map FILE, or --keep-mass"));
     }
@@ -133,13 +150,24 @@ pub enum Mode {
     Diff { format: Format },
 }
 
+/// What `check` does with a baseline file.
+pub enum BaselineUse {
+    /// `--baseline FILE`: problems recorded there do not fail the run.
+    Read(Baseline),
+    /// `--write-baseline FILE`: today's problems are recorded there.
+    Write(PathBuf),
+}
+
 /// A validated command.
 pub struct Config {
     mode: Mode,
     files: Vec<PathBuf>,
     src: Sources,
     tolerance: f64,
-    verbose: bool,
+    policy: Policy,
+    /// The configuration file in effect, if any.
+    config_file: Option<PathBuf>,
+    baseline: Option<BaselineUse>,
 }
 
 impl Config {
@@ -165,7 +193,12 @@ impl Config {
                 "-i writes files in place: stdin (`-`) has none; use -o OUT or stdout".into(),
             );
         }
-        let mut src = sources_with_densities(&a.source, "fill")?;
+        let (policy, settings) = Policy::new(
+            &a.source.diagnostics,
+            a.verbose,
+            a.urdf.first().map(PathBuf::as_path),
+        )?;
+        let mut src = sources_with_densities(&a.source, &settings, "fill")?;
         src.options.missing_only = a.missing_only;
         let write = WriteConfig {
             target: a.output.clone().filter(|p| p.as_os_str() != "-"),
@@ -181,23 +214,41 @@ impl Config {
             files: a.urdf.clone(),
             src,
             tolerance: 0.05,
-            verbose: a.verbose,
+            policy,
+            config_file: settings.file,
+            baseline: None,
         })
     }
 
     fn diff(a: &DiffArgs) -> Result<Config, String> {
         let tolerance = validated_tolerance(a.tolerance)?;
+        let (policy, settings) = Policy::new(&a.source.diagnostics, a.verbose, Some(&a.urdf))?;
         Ok(Config {
             mode: Mode::Diff { format: a.format },
             files: vec![a.urdf.clone()],
-            src: sources_with_densities(&a.source, "diff")?,
+            src: sources_with_densities(&a.source, &settings, "diff")?,
             tolerance,
-            verbose: a.verbose,
+            policy,
+            config_file: settings.file,
+            baseline: None,
         })
     }
 
     fn check(a: &CheckArgs) -> Result<Config, String> {
-        let src = sources(&a.source)?;
+        let (policy, settings) = Policy::new(
+            &a.source.diagnostics,
+            a.verbose,
+            a.urdf.first().map(PathBuf::as_path),
+        )?;
+        let src = sources(&a.source, &settings)?;
+        let baseline = match (&a.write_baseline, &a.baseline, &settings.baseline) {
+            (Some(w), _, _) => Some(BaselineUse::Write(w.clone())),
+            (None, Some(b), _) if a.update => Some(BaselineUse::Write(b.clone())),
+            (None, Some(b), _) | (None, None, Some(b)) => {
+                Some(BaselineUse::Read(Baseline::read(b)?))
+            }
+            (None, None, None) => None,
+        };
         Ok(Config {
             mode: Mode::Check {
                 all_links: a.all_links,
@@ -205,7 +256,9 @@ impl Config {
             files: a.urdf.clone(),
             src,
             tolerance: validated_tolerance(a.tolerance)?,
-            verbose: a.verbose,
+            policy,
+            config_file: settings.file,
+            baseline,
         })
     }
 }
@@ -274,18 +327,90 @@ fn run_command(config: Result<Config, String>) -> ExitStatus {
 fn run(config: &Config) -> Outcome {
     let mut cache = MeshCache::with_memory_budget(config.src.memory_budget);
     let mut outcome = Outcome::default();
-    for path in &config.files {
-        outcome += run_one(config, path, &mut cache);
+    if let Some(f) = &config.config_file {
+        let d = Diagnostic::new(
+            Code::RunConfig,
+            format!("settings read from {}", f.display()),
+        );
+        if config.policy.shows(&d) {
+            errln!("{}", d.render());
+        }
     }
-    if matches!(config.mode, Mode::Check { .. }) && outcome.errors == 0 && outcome.problems > 0 {
-        errln!("urdf-inertia check: {} problem(s) found; `urdf-inertia fill -i FILE --density-map …` computes correct values", outcome.problems);
+    let mut problems = Vec::new();
+    for path in &config.files {
+        outcome += run_one(config, path, &mut cache, &mut problems);
+    }
+    if matches!(config.mode, Mode::Check { .. }) {
+        outcome.problems += report_problems(config, &problems, outcome.errors);
     }
     outcome
 }
 
-fn run_one(config: &Config, path: &Path, cache: &mut MeshCache) -> Outcome {
+/// `check`'s problems against the baseline (if any): the new ones printed on stdout and counted,
+/// the known ones counted, a baseline to write written; then the closing line on stderr.
+fn report_problems(config: &Config, problems: &[Problem], errors: usize) -> usize {
+    let (new, known): (Vec<&Problem>, Vec<&Problem>) = match &config.baseline {
+        Some(BaselineUse::Read(b)) => problems.iter().partition(|p| !b.contains(p)),
+        _ => (problems.iter().collect(), Vec::new()),
+    };
+    if let Some(BaselineUse::Write(path)) = &config.baseline {
+        return match Baseline::write(path, problems) {
+            Ok(()) => {
+                errln!(
+                    "urdf-inertia check: recorded {} problem(s) in {}; `urdf-inertia check --baseline {}` now fails only on new ones",
+                    problems.len(),
+                    path.display(),
+                    path.display()
+                );
+                0
+            }
+            Err(e) => {
+                errln!("error: {e}");
+                // Not a problem of the robot, but the run failed all the same.
+                1
+            }
+        };
+    }
+    for p in &new {
+        outln!("{}", p.line());
+    }
+    if let Some(BaselineUse::Read(b)) = &config.baseline {
+        if !known.is_empty() || !new.is_empty() {
+            errln!(
+                "urdf-inertia check: {} problem(s) recorded in the baseline {} (not failing), {} new",
+                known.len(),
+                b.path.display(),
+                new.len()
+            );
+        }
+        let fixed = b.unmatched(problems);
+        if fixed > 0 && !config.policy.quiet {
+            errln!(
+                "urdf-inertia check: {fixed} problem(s) of the baseline {} are gone: `--write-baseline {}` records the shorter list",
+                b.path.display(),
+                b.path.display()
+            );
+        }
+    }
+    if errors == 0 && !new.is_empty() {
+        errln!("urdf-inertia check: {} problem(s) found; `urdf-inertia fill -i FILE --density-map …` computes correct values", new.len());
+        if config.baseline.is_none() && !config.policy.quiet {
+            errln!(
+                "help: problems that were there before your change? record them once with `urdf-inertia check FILES --write-baseline urdf-inertia.baseline` (commit it; `baseline = \"urdf-inertia.baseline\"` in urdf-inertia.toml) and later runs fail only on new ones; or leave a link alone with --skip NAME"
+            );
+        }
+    }
+    new.len()
+}
+
+fn run_one(
+    config: &Config,
+    path: &Path,
+    cache: &mut MeshCache,
+    problems: &mut Vec<Problem>,
+) -> Outcome {
     let start = Instant::now();
-    let input = match read_input(path, &config.src, config.verbose) {
+    let input = match read_input(path, &config.src, &config.policy) {
         Ok(r) => r,
         Err(e) => {
             errln!("error: {e}");
@@ -295,34 +420,62 @@ fn run_one(config: &Config, path: &Path, cache: &mut MeshCache) -> Outcome {
     let robot = &input.robot;
     let mut outcome = Outcome::default();
     if let Mode::Check { all_links } = config.mode {
-        outcome.problems += check_existing(&input, config, all_links);
+        check_existing(&input, config, all_links, problems);
     }
+    let promoted_notes = promoted(&robot.notes);
     let Some(map) = &config.src.map else {
         // Only `check` runs without densities: nothing is computed, but a collision that cannot be
         // is still an error.
         outcome.errors += check_collisions(&input, &config.src);
+        outcome.problems += promoted_notes;
         return outcome;
     };
     let src = &config.src;
-    let report = fill::compute_with(robot, map, &src.resolver, &src.options, cache);
+    let mut report = fill::compute_with(robot, map, &src.resolver, &src.options, cache);
+    config.policy.apply_report(&mut report);
     print_failures(&input, &report);
     outcome.errors += report.error_count();
+    let promoted = promoted_notes + promoted_in(&report);
     let rows = compare_all(robot, &report);
     match &config.mode {
         Mode::Write(w) => {
-            if write_robot(&input, &report, w, config.verbose, start).is_err() {
+            if write_robot(&input, &report, w, &config.policy, start, promoted).is_err() {
                 outcome.errors += 1;
             }
         }
         Mode::Diff { format } => {
-            summary::diff(&rows, *format, config.tolerance);
+            summary::computed_diagnostics(&report, &config.policy);
+            summary::diff(&rows, *format, config.tolerance, robot, &report);
             outcome.problems += rows.iter().filter(|r| r.differs(config.tolerance)).count();
+            outcome.problems += promoted;
         }
         Mode::Check { .. } => {
-            outcome.problems += check_against_computed(&input, &rows, config.tolerance);
+            summary::computed_diagnostics(&report, &config.policy);
+            check_against_computed(&input, &rows, config, problems);
+            outcome.problems += promoted;
         }
     }
     outcome
+}
+
+/// How many diagnostics `--warn-as-error` made errors.
+fn promoted(ds: &[Diagnostic]) -> usize {
+    ds.iter().filter(|d| d.severity == Severity::Error).count()
+}
+
+/// The same over a computed robot's parts and links.
+fn promoted_in(report: &FillReport) -> usize {
+    report
+        .links
+        .iter()
+        .map(|l| {
+            promoted(&l.diagnostics)
+                + l.parts
+                    .iter()
+                    .map(|p| promoted(&p.diagnostics))
+                    .sum::<usize>()
+        })
+        .sum()
 }
 
 /// A robot as read: the scanned URDF and, for a xacro source, its expansion (whose source map
@@ -361,7 +514,7 @@ impl Input {
 
 /// Reads, decodes and scans a URDF (a file, or stdin for `-`), expanding a xacro source first,
 /// and prints the scan's warnings (and notes, if `verbose`) to stderr.
-fn read_input(path: &Path, src: &Sources, verbose: bool) -> Result<Input, String> {
+fn read_input(path: &Path, src: &Sources, policy: &Policy) -> Result<Input, String> {
     let stdin = path.as_os_str() == "-";
     let bytes = if stdin {
         urdf_inertia::input::read_rest(std::io::stdin().lock(), Vec::new())
@@ -372,20 +525,26 @@ fn read_input(path: &Path, src: &Sources, verbose: bool) -> Result<Input, String
             .map_err(|e| format!("{}: cannot read the URDF: {e}", path.display()))?
     };
     if stdin {
-        let robot = scan_bytes(bytes, Path::new("<stdin>")).map_err(|e| e.to_string())?;
-        print_diagnostics(&robot.notes, verbose);
+        let mut robot = scan_bytes(bytes, Path::new("<stdin>")).map_err(|e| e.to_string())?;
+        policy.apply_all(&mut robot.notes);
+        print_diagnostics(&robot.notes, policy);
         return Ok(Input { robot, xacro: None });
     }
     if !xacro::is_xacro(path, &bytes) {
-        let robot = scan_bytes(bytes, path).map_err(|e| e.to_string())?;
-        print_diagnostics(&robot.notes, verbose);
+        let mut robot = scan_bytes(bytes, path).map_err(|e| e.to_string())?;
+        policy.apply_all(&mut robot.notes);
+        print_diagnostics(&robot.notes, policy);
         return Ok(Input { robot, xacro: None });
     }
     let opts = xacro::Options::from_process(src.xacro_args.clone(), &src.resolver);
     let x = xacro::expand_file(path, &opts).map_err(|e| e.to_string())?;
-    for w in &x.warnings {
-        errln!("warning: {w}");
-    }
+    let mut warnings: Vec<Diagnostic> = x
+        .warnings
+        .iter()
+        .map(|w| Diagnostic::new(Code::XacroWarning, w.to_string()))
+        .collect();
+    policy.apply_all(&mut warnings);
+    print_diagnostics(&warnings, policy);
     let robot =
         scan_bytes(x.text.clone().into_bytes(), path).map_err(|e| match x.origin(e.line) {
             Some(o) => format!(
@@ -402,26 +561,40 @@ fn read_input(path: &Path, src: &Sources, verbose: bool) -> Result<Input, String
                 e.message
             ),
         })?;
-    if robot.links.is_empty() && verbose {
+    if robot.links.is_empty() {
         // A file of macros (what pre-commit passes along with the top-level files): nothing to
         // check on its own; its links are checked through the files that include it.
-        errln!(
-            "note: {}: expands to no links (a file of macros?): its links are checked through the top-level xacro files that include it",
-            path.display()
-        );
+        let note = Diagnostic::new(
+            Code::XacroNoLinks,
+            "expands to no links (a file of macros?): its links are checked through the top-level xacro files that include it",
+        )
+        .at(Location {
+            file: Some(path.to_path_buf()),
+            ..Location::default()
+        });
+        print_diagnostics(&policy.apply(&note).into_iter().collect::<Vec<_>>(), policy);
     }
-    let input = Input {
+    let mut input = Input {
         robot,
         xacro: Some(x),
     };
-    let notes: Vec<Diagnostic> = input.robot.notes.iter().map(|d| input.located(d)).collect();
-    print_diagnostics(&notes, verbose);
+    let mut notes: Vec<Diagnostic> = input.robot.notes.iter().map(|d| input.located(d)).collect();
+    policy.apply_all(&mut notes);
+    print_diagnostics(&notes, policy);
+    input.robot.notes = notes;
     Ok(input)
 }
 
-/// Warnings always, notes with `--verbose`.
-fn print_diagnostics(diagnostics: &[Diagnostic], verbose: bool) {
-    for d in diagnostics.iter().filter(|d| verbose || d.is_warning()) {
+/// One diagnostic without a location of its own (its message names it), as the policy shows it.
+fn print_one(policy: &Policy, d: &Diagnostic) {
+    if let Some(d) = policy.apply(d).filter(|d| policy.shows(d)) {
+        errln!("{}: {}", d.head(), d.message);
+    }
+}
+
+/// What the policy shows: errors always, warnings unless `--quiet`, notes with `--verbose`.
+fn print_diagnostics(diagnostics: &[Diagnostic], policy: &Policy) {
+    for d in diagnostics.iter().filter(|d| policy.shows(d)) {
         errln!("{}", d.render());
     }
 }
@@ -429,10 +602,14 @@ fn print_diagnostics(diagnostics: &[Diagnostic], verbose: bool) {
 fn print_failures(input: &Input, report: &FillReport) {
     let path = input.robot.path.display();
     for f in &report.failures {
-        errln!("error: {}: {f}", input.link_at(f.line, &f.link));
+        errln!(
+            "error[{}]: {}: {f}",
+            f.kind.code(),
+            input.link_at(f.line, &f.link)
+        );
     }
     for e in &report.robot_errors {
-        errln!("error: {path}: {e}");
+        errln!("error[{}]: {path}: {e}", e.code());
     }
 }
 
@@ -442,11 +619,25 @@ fn write_robot(
     input: &Input,
     report: &FillReport,
     w: &WriteConfig,
-    verbose: bool,
+    policy: &Policy,
     start: Instant,
+    promoted: usize,
 ) -> Result<(), ExitStatus> {
     let robot = &input.robot;
     let t_write = Instant::now();
+    if promoted > 0 {
+        let run = run_diagnostics(robot, report);
+        let times = summary::Times {
+            seconds: start.elapsed().as_secs_f64(),
+            write: 0.0,
+        };
+        summary::fill_text(robot, report, &run, policy, times, w.several);
+        errln!(
+            "error: {}: {promoted} warning(s) made errors by --warn-as-error (or warn-as-error in urdf-inertia.toml): nothing written",
+            robot.path.display()
+        );
+        return Err(ExitStatus::Error);
+    }
     let file = if w.in_place {
         Some(robot.path.as_path())
     } else {
@@ -466,7 +657,7 @@ fn write_robot(
     match (&input.xacro, w.in_place) {
         (Some(x), true) => {
             check_failed()?;
-            write_into_sources(input, x, report, w)?;
+            write_into_sources(input, x, report, w, policy)?;
         }
         _ => {
             let text = spliced(robot, report, w)?;
@@ -493,11 +684,12 @@ fn write_robot(
         seconds: start.elapsed().as_secs_f64(),
         write: t_write.elapsed().as_secs_f64(),
     };
-    let run = run_diagnostics(robot, report);
+    let mut run = run_diagnostics(robot, report);
+    policy.apply_all(&mut run);
     if w.json && file.is_some() {
         summary::fill_json(robot, report, &run, w.digits, times.seconds);
     } else {
-        summary::fill_text(robot, report, &run, verbose, times, w.several);
+        summary::fill_text(robot, report, &run, policy, times, w.several);
     }
     Ok(())
 }
@@ -511,6 +703,7 @@ fn write_into_sources(
     x: &Expansion,
     report: &FillReport,
     w: &WriteConfig,
+    policy: &Policy,
 ) -> Result<(), ExitStatus> {
     let robot = &input.robot;
     let options = WriteOptions {
@@ -530,11 +723,17 @@ fn write_into_sources(
                 .entry(o.file)
                 .or_default()
                 .push((o.start, o.end, l.update())),
-            Err(why) => errln!(
-                "warning: {}: not written into the xacro source: {why}; `urdf-inertia fill {} -o filled.urdf` writes the filled expansion",
-                input.link_at(link.line, &link.name),
-                robot.path.display()
-            ),
+            Err(why) => {
+                let d = Diagnostic::new(
+                    Code::OutputNotInSource,
+                    format!(
+                        "{}: not written into the xacro source: {why}; `urdf-inertia fill {} -o filled.urdf` writes the filled expansion",
+                        input.link_at(link.line, &link.name),
+                        robot.path.display()
+                    ),
+                );
+                print_one(policy, &d);
+            }
         }
     }
     let written: usize = per_file.values().map(Vec::len).sum();
@@ -560,10 +759,11 @@ fn write_into_sources(
             for e in errors {
                 let link = &source.links[e.index];
                 errln!(
-                    "error: {}:{}: link `{}`: {}",
+                    "error[{}]: {}:{}: link `{}`: {}",
+                    Code::ErrorWrite,
                     path.display(),
                     link.line,
-                    link.name,
+                    urdf_inertia::text::escape_control(&link.name),
                     e.message
                 );
             }
@@ -629,7 +829,8 @@ fn spliced(robot: &Robot, report: &FillReport, w: &WriteConfig) -> Result<Vec<u8
         for e in errors {
             let link = &robot.links[e.index];
             errln!(
-                "error: {}:{}: link `{}`: {}",
+                "error[{}]: {}:{}: link `{}`: {}",
+                Code::ErrorWrite,
                 robot.path.display(),
                 link.line,
                 urdf_inertia::text::escape_control(&link.name),
@@ -682,10 +883,21 @@ fn compare_all<'a>(robot: &Robot, report: &'a FillReport) -> Vec<Row<'a>> {
         .collect()
 }
 
-/// Problems of the existing `<inertial>` elements themselves (no computation needed); their count.
-fn check_existing(input: &Input, config: &Config, all_links: bool) -> usize {
+/// Problems of the existing `<inertial>` elements themselves (no computation needed), added to
+/// `problems`.
+fn check_existing(input: &Input, config: &Config, all_links: bool, problems: &mut Vec<Problem>) {
     let robot = &input.robot;
-    let mut problems = 0;
+    let mut problem = |code: Code, line: usize, link: &str, message: String| {
+        if config.policy.reports(code) {
+            problems.push(Problem {
+                file: robot.path.clone(),
+                link: link.to_string(),
+                code,
+                message,
+                at: input.link_at(line, link),
+            });
+        }
+    };
     for link in robot
         .links
         .iter()
@@ -693,11 +905,12 @@ fn check_existing(input: &Input, config: &Config, all_links: bool) -> usize {
     {
         let Some(span) = &link.inertial else {
             if link.has_collision_geometry() {
-                outln!(
-                    "{}: has collision geometry but no <inertial>",
-                    input.link_at(link.line, &link.name)
+                problem(
+                    Code::CheckMissingInertial,
+                    link.line,
+                    &link.name,
+                    "has collision geometry but no <inertial>".to_string(),
                 );
-                problems += 1;
             }
             continue;
         };
@@ -705,23 +918,19 @@ fn check_existing(input: &Input, config: &Config, all_links: bool) -> usize {
         let duplicates = fill::duplicate_inertials(link);
         for p in existing_problems(link) {
             if !link.has_collision_geometry() && !all_links && duplicates.as_ref() != Some(&p) {
-                if config.verbose {
-                    let note = Diagnostic::new(
-                        Code::UrdfFrameInertial,
-                        format!(
-                            "{} (no collision geometry, so fill cannot compute it): {p}",
-                            input.link_at(span.line, &link.name)
-                        ),
-                    );
-                    errln!("{}: {}", note.severity.as_str(), note.message);
-                }
+                let note = Diagnostic::new(
+                    Code::UrdfFrameInertial,
+                    format!(
+                        "{} (no collision geometry, so fill cannot compute it): {p}",
+                        input.link_at(span.line, &link.name)
+                    ),
+                );
+                print_one(&config.policy, &note);
             } else {
-                outln!("{}: {p}", input.link_at(span.line, &link.name));
-                problems += 1;
+                problem(Code::CheckInvalidInertial, span.line, &link.name, p);
             }
         }
     }
-    problems
 }
 
 /// Without densities nothing is computed, but a collision that cannot be is still an error; their
@@ -737,7 +946,8 @@ fn check_collisions(input: &Input, src: &Sources) -> usize {
         for c in &link.collisions {
             if let Geometry::Invalid { line, message } = &c.geometry {
                 errln!(
-                    "error: {}: collision {} (line {line}): {message}",
+                    "error[{}]: {}: collision {} (line {line}): {message}",
+                    Code::ErrorInvalidGeometry,
                     input.link_at(link.line, &link.name),
                     c.index
                 );
@@ -749,10 +959,18 @@ fn check_collisions(input: &Input, src: &Sources) -> usize {
 }
 
 /// Existing against computed, beyond the tolerance (invalid values are reported by
-/// `check_existing`); their count.
-fn check_against_computed(input: &Input, rows: &[Row], tolerance: f64) -> usize {
+/// `check_existing`), added to `problems`.
+fn check_against_computed(
+    input: &Input,
+    rows: &[Row],
+    config: &Config,
+    problems: &mut Vec<Problem>,
+) {
     let robot = &input.robot;
-    let mut problems = 0;
+    let tolerance = config.tolerance;
+    if !config.policy.reports(Code::CheckDiffers) {
+        return;
+    }
     for r in rows {
         let (Some(e), Some(c)) = (&r.existing, &r.comparison) else {
             continue;
@@ -770,12 +988,12 @@ fn check_against_computed(input: &Input, rows: &[Row], tolerance: f64) -> usize 
             .inertial
             .as_ref()
             .map_or(r.link.line, |s| s.line);
-        outln!(
-            "{}: {}{causes} (tolerance {tolerance})",
-            input.link_at(line, &r.link.name),
-            off.join("; ")
-        );
-        problems += 1;
+        problems.push(Problem {
+            file: robot.path.clone(),
+            link: r.link.name.clone(),
+            code: Code::CheckDiffers,
+            message: format!("{}{causes} (tolerance {tolerance})", off.join("; ")),
+            at: input.link_at(line, &r.link.name),
+        });
     }
-    problems
 }

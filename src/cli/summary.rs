@@ -3,10 +3,11 @@
 //! JSON as `{"severity", "code", "message", …}` objects.
 
 use super::args::Format;
+use super::policy::Policy;
 use super::robot_cmd::Row;
 use serde_json::json;
-use urdf_inertia::diagnostic::Diagnostic;
-use urdf_inertia::fill::{FillReport, LinkReport, PartReport};
+use urdf_inertia::diagnostic::{Diagnostic, Provenance, Severity};
+use urdf_inertia::fill::{existing_props, FillReport, LinkReport, PartReport};
 use urdf_inertia::mass::MassProperties;
 use urdf_inertia::text::{self, shortest, significant, Digits};
 use urdf_inertia::urdf::write::{tidy, tidy_moments};
@@ -20,47 +21,226 @@ pub struct Times {
 }
 
 fn by_severity<'a>(ds: impl Iterator<Item = &'a Diagnostic>, warning: bool) -> Vec<&'a Diagnostic> {
-    ds.filter(|d| d.is_warning() == warning).collect()
+    ds.filter(|d| (d.severity != Severity::Note) == warning)
+        .collect()
 }
 
-/// A part's lines of the text summary: each warning, or the repair alone; notes with `verbose`.
-fn part_lines(l: &LinkReport, p: &PartReport, verbose: bool, out: &mut Vec<String>) {
-    let head = format!(
-        "link `{}`, collision {}, {}: {}",
-        urdf_inertia::text::escape_control(&l.name),
-        p.collision,
-        p.what,
-        p.provenance
-    );
-    let warnings: Vec<&Diagnostic> = p.warnings().collect();
-    for w in &warnings {
-        out.push(format!("  warning: {head}: {}", w.message));
+/// One diagnostic of a mesh file and every (link, collision) that uses the mesh: a mesh shared by
+/// four links is reported once.
+#[derive(Debug)]
+pub struct MeshGroup<'a> {
+    /// The URI as the first user wrote it.
+    pub what: &'a str,
+    pub file: Option<&'a std::path::Path>,
+    pub provenance: &'a Provenance,
+    pub diagnostic: &'a Diagnostic,
+    pub users: Vec<(&'a str, usize)>,
+}
+
+/// The diagnostics of the parts, grouped by mesh file (and scale, through the message), in the
+/// order they first occur.
+pub fn mesh_groups(report: &FillReport) -> Vec<MeshGroup<'_>> {
+    let mut groups: Vec<MeshGroup<'_>> = Vec::new();
+    for l in &report.links {
+        for p in &l.parts {
+            for d in &p.diagnostics {
+                let same = |g: &MeshGroup<'_>| {
+                    g.file == p.file.as_deref()
+                        && (p.file.is_some() || g.what == p.what)
+                        && g.provenance == &p.provenance
+                        && g.diagnostic.code == d.code
+                        && g.diagnostic.severity == d.severity
+                        && g.diagnostic.message == d.message
+                };
+                match groups.iter_mut().find(|g| same(g)) {
+                    Some(g) => g.users.push((&l.name, p.collision)),
+                    None => groups.push(MeshGroup {
+                        what: &p.what,
+                        file: p.file.as_deref(),
+                        provenance: &p.provenance,
+                        diagnostic: d,
+                        users: vec![(&l.name, p.collision)],
+                    }),
+                }
+            }
+        }
     }
-    if warnings.is_empty() && p.provenance.is_repaired() {
-        out.push(format!("  warning: {head}"));
-    }
-    if verbose {
-        for n in p.notes() {
-            out.push(format!("  note: {head}: {}", n.message));
+    groups
+}
+
+/// `link `a`, collision 1`, or `3 links: `a` collision 1, `b` collision 2, `c` collision 1`.
+fn users_text(users: &[(&str, usize)]) -> String {
+    const SHOWN: usize = 8;
+    let name = |(l, c): &(&str, usize)| format!("`{}` collision {c}", text::escape_control(l));
+    match users {
+        [(l, c)] => format!("link `{}`, collision {c}", text::escape_control(l)),
+        _ => {
+            let mut names: Vec<String> = users.iter().take(SHOWN).map(name).collect();
+            if users.len() > SHOWN {
+                names.push(format!("and {} more", users.len() - SHOWN));
+            }
+            format!("{} links: {}", users.len(), names.join(", "))
         }
     }
 }
 
-/// The diagnostics of the text summary, link by link.
-fn link_lines(l: &LinkReport, verbose: bool) -> Vec<String> {
-    let mut out = Vec::new();
-    for p in &l.parts {
-        part_lines(l, p, verbose, &mut out);
+/// The lines of the mesh diagnostics the policy shows, each mesh once with the links using it:
+/// `warning[UI101]: MESH: RUNG: MESSAGE (link `a`, collision 1)`.
+pub fn mesh_lines(report: &FillReport, policy: &Policy) -> Vec<String> {
+    mesh_groups(report)
+        .into_iter()
+        .filter(|g| policy.shows(g.diagnostic))
+        .map(|g| {
+            format!(
+                "{}: {}: {}: {} ({})",
+                g.diagnostic.head(),
+                text::escape_control(g.what),
+                g.provenance,
+                g.diagnostic.message,
+                users_text(&g.users)
+            )
+        })
+        .collect()
+}
+
+/// The lines of the links' own diagnostics (overlaps, overridden rules) the policy shows.
+pub fn link_lines(report: &FillReport, policy: &Policy) -> Vec<String> {
+    report
+        .links
+        .iter()
+        .flat_map(|l| l.diagnostics.iter().map(move |d| (l, d)))
+        .filter(|(_, d)| policy.shows(d))
+        .map(|(l, d)| {
+            format!(
+                "{}: link `{}`: {}",
+                d.head(),
+                text::escape_control(&l.name),
+                d.message
+            )
+        })
+        .collect()
+}
+
+/// The diagnostics of a computed robot on stderr (what `diff` and `check` show of the meshes they
+/// computed).
+pub fn computed_diagnostics(report: &FillReport, policy: &Policy) {
+    for line in mesh_lines(report, policy)
+        .into_iter()
+        .chain(link_lines(report, policy))
+    {
+        errln!("{line}");
     }
-    for d in l.diagnostics.iter().filter(|d| verbose || d.is_warning()) {
-        out.push(format!(
-            "  {}: link `{}`: {}",
-            d.severity.as_str(),
-            urdf_inertia::text::escape_control(&l.name),
-            d.message
-        ));
+}
+
+/// The mesh diagnostics as JSON, each mesh once with the links that use it.
+fn mesh_json(report: &FillReport) -> Vec<serde_json::Value> {
+    mesh_groups(report)
+        .into_iter()
+        .map(|g| {
+            json!({
+                "mesh": g.what,
+                "file": g.file.map(|f| f.display().to_string()),
+                "provenance": g.provenance,
+                "severity": g.diagnostic.severity,
+                "code": g.diagnostic.code,
+                "message": g.diagnostic.message,
+                "links": g.users.iter().map(|(l, c)| json!({"link": l, "collision": c})).collect::<Vec<_>>(),
+            })
+        })
+        .collect()
+}
+
+/// The robot's mass after the run: the computed links, and the others' existing `<mass>`; (total,
+/// computed, as they are, how many links as they are carry a mass).
+pub fn total_mass(robot: &Robot, report: &FillReport) -> (f64, f64, f64, usize) {
+    let computed = report.links.iter().fold(0.0, |a, l| a + l.computed.mass);
+    let done: std::collections::HashSet<usize> = report.links.iter().map(|l| l.index).collect();
+    let kept: Vec<f64> = robot
+        .links
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !done.contains(i))
+        .filter_map(|(_, l)| existing_props(&l.inertial.as_ref()?.value).map(|p| p.mass))
+        .collect();
+    // Folded from +0: an empty f64 sum is -0.
+    let kept_sum = kept.iter().fold(0.0, |a, m| a + m);
+    let err = report
+        .links
+        .iter()
+        .map(LinkReport::error_estimate)
+        .fold(0.0, f64::max);
+    let tidy = |x: f64| text::within(x, text::rounding_tolerance(err) * x);
+    (
+        tidy(computed + kept_sum),
+        tidy(computed),
+        tidy(kept_sum),
+        kept.len(),
+    )
+}
+
+/// The worst relative error of the run: a part's bound, or the volume overlapping parts count more
+/// than once relative to their link's volume, whichever is larger; (value, what it is).
+pub fn worst_error(report: &FillReport) -> Option<(f64, String)> {
+    let part = report
+        .links
+        .iter()
+        .flat_map(|l| l.parts.iter().map(move |p| (p.error_estimate, l, p)))
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(e, l, p)| {
+            (
+                e,
+                format!(
+                    "{} (relative bound on volume and inertia; link `{}`, collision {}: {})",
+                    p.error.describe(),
+                    text::escape_control(&l.name),
+                    p.collision,
+                    p.provenance
+                ),
+            )
+        });
+    let overlap = report
+        .links
+        .iter()
+        .filter_map(|l| {
+            let (v, which, _) = l.overlap.as_ref()?;
+            let volume: f64 = l.parts.iter().map(|p| p.volume).sum();
+            (volume > 0.0).then(|| (v / volume, l, which))
+        })
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    match (part, overlap) {
+        (Some(p), Some((o, l, which))) if o > p.0 => Some((
+            o,
+            format!(
+                "{:.1}% of link `{}`'s volume, counted more than once where its parts {which} overlap (UI401); the largest bound of a part alone: {}",
+                100.0 * o,
+                text::escape_control(&l.name),
+                p.1
+            ),
+        )),
+        (p, _) => p,
     }
-    out
+}
+
+/// The summary's closing lines: the robot's total mass and the worst error estimate.
+fn closing_lines(robot: &Robot, report: &FillReport) {
+    let (total, computed, kept, n) = total_mass(robot, report);
+    let kept_text = if n > 0 {
+        format!(
+            "; {n} link(s) left as they are: {} kg",
+            text::significant(kept, 6)
+        )
+    } else {
+        String::new()
+    };
+    errln!(
+        "  total mass: {} kg ({} link(s) computed: {} kg{kept_text})",
+        text::significant(total, 6),
+        report.links.len(),
+        text::significant(computed, 6)
+    );
+    if let Some((_, what)) = worst_error(report) {
+        errln!("  worst error estimate: {what}");
+    }
 }
 
 /// The text summary of `fill` on stderr; `name_file` when several URDFs were filled.
@@ -68,7 +248,7 @@ pub fn fill_text(
     robot: &Robot,
     report: &FillReport,
     run: &[Diagnostic],
-    verbose: bool,
+    policy: &Policy,
     t: Times,
     name_file: bool,
 ) {
@@ -78,55 +258,38 @@ pub fn fill_text(
     } else {
         String::new()
     };
-    errln!(
-        "urdf-inertia: {file}robot `{}`: filled {} link(s) ({} parts, {} mesh files, {} faces) in {:.3} s (CPU time over all cores: mesh loading {:.3} s, healing and integration {:.3} s; writing {:.3} s)",
-        robot.name,
-        report.links.len(),
-        parts,
-        report.mesh_files,
-        report.faces,
-        t.seconds,
-        report.timing.load.as_secs_f64(),
-        report.timing.integrate.as_secs_f64(),
-        t.write
-    );
-    for d in run {
-        // The run's own diagnostics keep their historical wording (`not written` needs no prefix).
-        if d.code == urdf_inertia::diagnostic::Code::OutputNotWritten {
-            errln!("  {}", d.message);
-        } else {
-            errln!("  {}: {}", d.severity.as_str(), d.message);
-        }
+    if !policy.quiet {
+        errln!(
+            "urdf-inertia: {file}robot `{}`: filled {} link(s) ({} parts, {} mesh files, {} faces) in {:.3} s (CPU time over all cores: mesh loading {:.3} s, healing and integration {:.3} s; writing {:.3} s)",
+            robot.name,
+            report.links.len(),
+            parts,
+            report.mesh_files,
+            report.faces,
+            t.seconds,
+            report.timing.load.as_secs_f64(),
+            report.timing.integrate.as_secs_f64(),
+            t.write
+        );
     }
-    if report.without_geometry + report.not_selected > 0 {
+    for d in run.iter().filter(|d| policy.shows(d)) {
+        errln!("  {}: {}", d.head(), d.message);
+    }
+    if report.without_geometry + report.not_selected > 0 && !policy.quiet {
         errln!(
             "  left as they are: {} link(s) without collision geometry, {} not selected",
             report.without_geometry,
             report.not_selected
         );
     }
-    for l in &report.links {
-        for line in link_lines(l, verbose) {
-            errln!("{line}");
-        }
+    for line in mesh_lines(report, policy)
+        .into_iter()
+        .chain(link_lines(report, policy))
+    {
+        errln!("  {line}");
     }
-    worst_error(report);
-}
-
-fn worst_error(report: &FillReport) {
-    let worst = report
-        .links
-        .iter()
-        .flat_map(|l| l.parts.iter().map(move |p| (p.error_estimate, l, p)))
-        .max_by(|a, b| a.0.total_cmp(&b.0));
-    if let Some((_, l, p)) = worst {
-        errln!(
-            "  worst error estimate: {} (relative bound on volume and inertia; link `{}`, collision {}: {})",
-            p.error.describe(),
-            urdf_inertia::text::escape_control(&l.name),
-            p.collision,
-            p.provenance
-        );
+    if !policy.quiet {
+        closing_lines(robot, report);
     }
 }
 
@@ -174,13 +337,13 @@ fn errors_json(report: &FillReport) -> Vec<serde_json::Value> {
             "line": f.line,
             "collision": f.collision.map(|c| c.index),
             "kind": f.kind.name(),
+            "code": f.kind.code(),
             "message": f.to_string(),
         })
     });
-    let robot = report
-        .robot_errors
-        .iter()
-        .map(|e| json!({"link": null, "kind": e.name(), "message": e.to_string()}));
+    let robot = report.robot_errors.iter().map(
+        |e| json!({"link": null, "kind": e.name(), "code": e.code(), "message": e.to_string()}),
+    );
     links.chain(robot).collect()
 }
 
@@ -194,6 +357,7 @@ pub fn fill_json(
 ) {
     let mut notes: Vec<&Diagnostic> = robot.notes.iter().collect();
     notes.extend(run);
+    let (total, computed, kept, _) = total_mass(robot, report);
     let v = json!({
         "urdf": robot.path.display().to_string(),
         "robot": robot.name,
@@ -204,6 +368,11 @@ pub fn fill_json(
         "faces": report.faces,
         "errors": errors_json(report),
         "notes": notes,
+        "mesh_diagnostics": mesh_json(report),
+        "total_mass": total,
+        "total_mass_computed": computed,
+        "total_mass_as_they_are": kept,
+        "worst_error_estimate": worst_error(report).map(|w| w.0),
         "seconds": seconds,
         "seconds_load": report.timing.load.as_secs_f64(),
         "seconds_integrate": report.timing.integrate.as_secs_f64(),
@@ -239,7 +408,13 @@ fn row_notes(r: &Row) -> Vec<String> {
     )
 }
 
-fn diff_json(rows: &[Row], tolerance: f64) -> serde_json::Value {
+/// The diff as JSON: `{"links": [rows], "mesh_diagnostics": [each mesh once], "total_mass"}`.
+fn diff_json(
+    rows: &[Row],
+    tolerance: f64,
+    robot: &Robot,
+    report: &FillReport,
+) -> serde_json::Value {
     let v: Vec<serde_json::Value> = rows
         .iter()
         .map(|r| {
@@ -257,10 +432,22 @@ fn diff_json(rows: &[Row], tolerance: f64) -> serde_json::Value {
                 "differs": r.differs(tolerance),
                 "notes": row_notes(r),
                 "provenance": l.parts.iter().map(|p| p.provenance.clone()).collect::<Vec<_>>(),
+                "warnings": by_severity(l.diagnostics.iter(), true),
+                "link_notes": by_severity(l.diagnostics.iter(), false),
             })
         })
         .collect();
-    serde_json::Value::Array(v)
+    let (total, computed, kept, _) = total_mass(robot, report);
+    json!({
+        "urdf": robot.path.display().to_string(),
+        "robot": robot.name,
+        "links": v,
+        "mesh_diagnostics": mesh_json(report),
+        "total_mass": total,
+        "total_mass_computed": computed,
+        "total_mass_as_they_are": kept,
+        "worst_error_estimate": worst_error(report).map(|w| w.0),
+    })
 }
 
 fn diff_row(r: &Row) {
@@ -312,11 +499,12 @@ fn diff_row(r: &Row) {
 }
 
 /// The diff: a table, or JSON.
-pub fn diff(rows: &[Row], format: Format, tolerance: f64) {
+pub fn diff(rows: &[Row], format: Format, tolerance: f64, robot: &Robot, report: &FillReport) {
     match format {
         Format::Json => outln!(
             "{}",
-            serde_json::to_string_pretty(&diff_json(rows, tolerance)).unwrap_or_default()
+            serde_json::to_string_pretty(&diff_json(rows, tolerance, robot, report))
+                .unwrap_or_default()
         ),
         Format::Text => {
             outln!(

@@ -32,7 +32,10 @@ pub fn run(a: &XacroArgs) -> ExitStatus {
     match xacro::expand_file(&a.file, &opts) {
         Ok(e) => {
             for w in &e.warnings {
-                errln!("warning: {w}");
+                errln!(
+                    "warning[{}]: {w}",
+                    urdf_inertia::diagnostic::Code::XacroWarning
+                );
             }
             // A failure is reported there and turns the exit status to 2 (`output::stdout_failed`).
             let _ = super::output::write_stdout(e.text.as_bytes());

@@ -4,8 +4,9 @@
 //! A warning asks the user to look (a repaired mesh, overlapping parts, an element urdfdom ignores); a
 //! note needs no action (a mesh welded within tolerance, a zero-size part). Codes are stable: tools
 //! and people match them, never the message text. They are grouped by hundreds: mesh health (1xx),
-//! URDF reading (2xx), density (3xx), overlap (4xx), output (5xx). README's "Diagnostics" table lists
-//! them.
+//! URDF reading (2xx), density (3xx), overlap (4xx), output and run (5xx), problems `check` finds in
+//! existing `<inertial>` elements (6xx), errors that fail a link or a robot (7xx). README's
+//! "Diagnostics" table lists them.
 
 use crate::mesh::health::{HealthKind, Rung, Solid};
 use crate::mesh::MeshError;
@@ -21,6 +22,8 @@ pub enum Severity {
     Note,
     /// The user should look; always printed.
     Warning,
+    /// A problem or an error: the run fails (a warning becomes one with `--warn-as-error`).
+    Error,
 }
 
 impl Severity {
@@ -29,6 +32,7 @@ impl Severity {
         match self {
             Severity::Note => "note",
             Severity::Warning => "warning",
+            Severity::Error => "error",
         }
     }
 }
@@ -78,11 +82,46 @@ pub enum Code {
     PartsOverlap,
     /// UI501: links that failed were left as they were (`--keep-going`).
     OutputNotWritten,
+    /// UI208: a warning of the xacro expansion (an unknown builtin, a deprecated form).
+    XacroWarning,
+    /// UI209: a xacro file that expands to no links (a file of macros).
+    XacroNoLinks,
+    /// UI502: a computed link not written into its xacro source (it comes from a macro).
+    OutputNotInSource,
+    /// UI503: the thread setting was capped or ignored.
+    RunThreads,
+    /// UI504: the settings of a configuration file (`urdf-inertia.toml`) are in effect.
+    RunConfig,
+    /// UI601: a link with collision geometry and no `<inertial>` (`check`).
+    CheckMissingInertial,
+    /// UI602: an invalid `<inertial>` (non-finite, mass <= 0, not positive definite, triangle
+    /// inequality, several of them).
+    CheckInvalidInertial,
+    /// UI603: an existing `<inertial>` off the computed one by more than the tolerance.
+    CheckDiffers,
+    /// UI701: a collision that cannot be read (unknown shape, bad vector, negative size).
+    ErrorInvalidGeometry,
+    /// UI702: a mesh URI that resolves to no file.
+    ErrorMeshNotFound,
+    /// UI703: a mesh that cannot become a solid (unreadable, empty, `--strict` repair).
+    ErrorMesh,
+    /// UI704: a mass target below what the parts with their own rules weigh.
+    ErrorMassTarget,
+    /// UI705: values beyond f64.
+    ErrorUnrepresentable,
+    /// UI706: `--keep-mass` on a `<mass>` that is no positive number.
+    ErrorKeptMass,
+    /// UI707: links with collision geometry and no density from anywhere.
+    ErrorMissingDensity,
+    /// UI708: the density map's `total_mass` cannot be met.
+    ErrorTotalMass,
+    /// UI709: a link's values cannot be written validly (`--digits N` rounding broke the tensor).
+    ErrorWrite,
 }
 
 impl Code {
     /// Every code, in table order.
-    pub const ALL: [Code; 17] = [
+    pub const ALL: [Code; 34] = [
         Code::MeshRepaired,
         Code::MeshFacesDropped,
         Code::MeshWelded,
@@ -97,9 +136,26 @@ impl Code {
         Code::UrdfXacroNamespace,
         Code::UrdfNoRobotName,
         Code::UrdfFrameInertial,
+        Code::XacroWarning,
+        Code::XacroNoLinks,
         Code::DensityRuleOverridden,
         Code::PartsOverlap,
         Code::OutputNotWritten,
+        Code::OutputNotInSource,
+        Code::RunThreads,
+        Code::RunConfig,
+        Code::CheckMissingInertial,
+        Code::CheckInvalidInertial,
+        Code::CheckDiffers,
+        Code::ErrorInvalidGeometry,
+        Code::ErrorMeshNotFound,
+        Code::ErrorMesh,
+        Code::ErrorMassTarget,
+        Code::ErrorUnrepresentable,
+        Code::ErrorKeptMass,
+        Code::ErrorMissingDensity,
+        Code::ErrorTotalMass,
+        Code::ErrorWrite,
     ];
 
     /// The stable code, `UI101` …
@@ -122,7 +178,38 @@ impl Code {
             Code::DensityRuleOverridden => "UI301",
             Code::PartsOverlap => "UI401",
             Code::OutputNotWritten => "UI501",
+            Code::XacroWarning => "UI208",
+            Code::XacroNoLinks => "UI209",
+            Code::OutputNotInSource => "UI502",
+            Code::RunThreads => "UI503",
+            Code::RunConfig => "UI504",
+            Code::CheckMissingInertial => "UI601",
+            Code::CheckInvalidInertial => "UI602",
+            Code::CheckDiffers => "UI603",
+            Code::ErrorInvalidGeometry => "UI701",
+            Code::ErrorMeshNotFound => "UI702",
+            Code::ErrorMesh => "UI703",
+            Code::ErrorMassTarget => "UI704",
+            Code::ErrorUnrepresentable => "UI705",
+            Code::ErrorKeptMass => "UI706",
+            Code::ErrorMissingDensity => "UI707",
+            Code::ErrorTotalMass => "UI708",
+            Code::ErrorWrite => "UI709",
         }
+    }
+
+    /// The code named `s` (`UI101` or `ui101`), if there is one.
+    pub fn parse(s: &str) -> Option<Code> {
+        Code::ALL
+            .into_iter()
+            .find(|c| c.as_str().eq_ignore_ascii_case(s.trim()))
+    }
+
+    /// Whether a run can go on past it: warnings and notes, which `--ignore` may silence and
+    /// `--warn-as-error` promote, and `check`'s problems (6xx), which `--ignore` may silence; not
+    /// the errors (7xx).
+    pub fn is_error(self) -> bool {
+        self.as_str().starts_with("UI7")
     }
 
     /// The code's severity.
@@ -133,7 +220,21 @@ impl Code {
             | Code::MeshFacesCancelled
             | Code::UrdfZeroVolume
             | Code::UrdfXacroNamespace
-            | Code::UrdfFrameInertial => Severity::Note,
+            | Code::UrdfFrameInertial
+            | Code::XacroNoLinks
+            | Code::RunConfig => Severity::Note,
+            Code::CheckMissingInertial
+            | Code::CheckInvalidInertial
+            | Code::CheckDiffers
+            | Code::ErrorInvalidGeometry
+            | Code::ErrorMeshNotFound
+            | Code::ErrorMesh
+            | Code::ErrorMassTarget
+            | Code::ErrorUnrepresentable
+            | Code::ErrorKeptMass
+            | Code::ErrorMissingDensity
+            | Code::ErrorTotalMass
+            | Code::ErrorWrite => Severity::Error,
             _ => Severity::Warning,
         }
     }
@@ -209,9 +310,14 @@ impl Diagnostic {
         self.location.as_ref().and_then(|l| l.link.as_deref())
     }
 
-    /// `warning: PATH:LINE: link `NAME`: MESSAGE` (the parts the location has).
+    /// The prefix compilers print: `warning[UI101]`, `note[UI103]`, `error[UI702]`.
+    pub fn head(&self) -> String {
+        format!("{}[{}]", self.severity.as_str(), self.code)
+    }
+
+    /// `warning[UI101]: PATH:LINE: link `NAME`: MESSAGE` (the parts the location has).
     pub fn render(&self) -> String {
-        let mut s = format!("{}: ", self.severity.as_str());
+        let mut s = format!("{}: ", self.head());
         if let Some(l) = &self.location {
             if let Some(f) = &l.file {
                 s.push_str(&crate::text::escape_control(&f.display().to_string()));
@@ -347,6 +453,18 @@ impl LinkErrorKind {
             LinkErrorKind::KeptMassInvalid { .. } => "invalid-kept-mass",
         }
     }
+
+    /// The stable code (`UI701` …).
+    pub fn code(&self) -> Code {
+        match self {
+            LinkErrorKind::InvalidGeometry { .. } => Code::ErrorInvalidGeometry,
+            LinkErrorKind::MeshNotFound { .. } => Code::ErrorMeshNotFound,
+            LinkErrorKind::Mesh(_) => Code::ErrorMesh,
+            LinkErrorKind::MassTarget { .. } => Code::ErrorMassTarget,
+            LinkErrorKind::Unrepresentable(_) => Code::ErrorUnrepresentable,
+            LinkErrorKind::KeptMassInvalid { .. } => Code::ErrorKeptMass,
+        }
+    }
 }
 
 impl fmt::Display for LinkError {
@@ -420,6 +538,14 @@ impl RobotError {
             RobotError::TotalMass { .. } => "total-mass",
         }
     }
+
+    /// The stable code (`UI707`, `UI708`).
+    pub fn code(&self) -> Code {
+        match self {
+            RobotError::MissingDensity { .. } => Code::ErrorMissingDensity,
+            RobotError::TotalMass { .. } => Code::ErrorTotalMass,
+        }
+    }
 }
 
 impl fmt::Display for RobotError {
@@ -462,7 +588,27 @@ mod tests {
             let s = c.as_str();
             assert!(seen.insert(s), "{s} twice");
             assert!(s.starts_with("UI") && s.len() == 5, "{s}");
+            assert_eq!(Code::parse(&s.to_lowercase()), Some(c));
+            assert_eq!(
+                c.is_error(),
+                c.severity() == Severity::Error && !s.starts_with("UI6")
+            );
         }
+        assert_eq!(Code::parse("UI999"), None);
+    }
+
+    #[test]
+    fn rendered_with_the_code_as_compilers_print_it() {
+        let d = Diagnostic::new(Code::MeshRepaired, "re-oriented").at(Location {
+            file: Some("r.urdf".into()),
+            line: Some(3),
+            link: Some("arm".into()),
+            collision: None,
+        });
+        assert_eq!(
+            d.render(),
+            "warning[UI101]: r.urdf:3: link `arm`: re-oriented"
+        );
     }
 
     #[test]
