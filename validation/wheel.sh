@@ -77,6 +77,13 @@ case "$got" in
   *) fail "urdf-inertia --version says '$got', expected $version" ;;
 esac
 
+# The two manifests are valid and define the same hooks but for the language.
+isolated pre-commit validate-manifest .pre-commit-hooks.yaml packaging/pre-commit-mirror/.pre-commit-hooks.yaml
+hooks_of() { sed -n '/^- id:/,$p' "$1" | sed -e 's/^  language: .*$/  language: LANG/'; }
+if ! diff -u <(hooks_of .pre-commit-hooks.yaml) <(hooks_of packaging/pre-commit-mirror/.pre-commit-hooks.yaml); then
+  fail ".pre-commit-hooks.yaml and packaging/pre-commit-mirror/.pre-commit-hooks.yaml differ beyond the language"
+fi
+
 # 3. The mirror template as a repository of its own, as pre-commit clones it.
 mirror="$work/mirror"
 cp -R packaging/pre-commit-mirror "$mirror"
@@ -95,6 +102,7 @@ EOF
 cat >"$repo/urdf/robot.urdf.xacro" <<'EOF'
 <?xml version="1.0"?>
 <robot name="two_arms" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:arg name="with_right_arm" default="true"/>
   <xacro:include filename="arm_macro.xacro"/>
   <link name="base_link">
     <inertial>
@@ -106,7 +114,9 @@ cat >"$repo/urdf/robot.urdf.xacro" <<'EOF'
     </collision>
   </link>
   <xacro:arm prefix="left_" parent="base_link"/>
-  <xacro:arm prefix="right_" parent="base_link"/>
+  <xacro:if value="$(arg with_right_arm)">
+    <xacro:arm prefix="right_" parent="base_link"/>
+  </xacro:if>
 </robot>
 EOF
 cat >"$repo/urdf/arm_macro.xacro" <<'EOF'
@@ -116,7 +126,7 @@ cat >"$repo/urdf/arm_macro.xacro" <<'EOF'
     <link name="${prefix}upper_arm">
       <inertial>
         <mass value="-1.5"/>
-        <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.001"/>
+        <inertia ixx="0.00655" ixy="0" ixz="0" iyy="0.00655" iyz="0" izz="0.000382"/>
       </inertial>
       <collision>
         <geometry><cylinder radius="0.03" length="0.3"/></geometry>
@@ -182,7 +192,7 @@ expect_in_log "mass -1.5 is not positive"
 expect_in_log "link \`wheel\`"
 expect_in_log "files were modified by this hook"
 echo "== check hook: fails on the negative mass in the macro file and on the wheel without <inertial>:"
-grep -F -e "arm_macro.xacro:$macro_line" -e "wheel" "$work/hooks.log" | sed 's/^/   /'
+grep -E "^urdf/(arm_macro.xacro:$macro_line|cart.urdf:[0-9]+: link \`wheel\`)" "$work/hooks.log" | sed 's/^/   /'
 "$venv/bin/python" - "$repo/urdf/cart.urdf" <<'EOF'
 import math, sys
 import xml.etree.ElementTree as ET
@@ -203,11 +213,52 @@ print(f"== fill hook: wrote the wheel's <inertial> (mass {got_m} kg, the cylinde
 EOF
 isolated git -C "$repo" diff --stat | sed 's/^/   /'
 
-# The fix (a valid inertial; the check hook judges validity without a density source), staged with the
-# filled URDF: the whole repository, so this run is the one a clean commit gets.
-sed -i 's/<mass value="-1.5"\/>/<mass value="0.85"\/>/' "$repo/urdf/arm_macro.xacro"
+# The fix (the solid cylinder's mass, 1000 * pi * 0.03^2 * 0.3 = 0.848 kg), staged with the filled URDF:
+# the whole repository, so this run is the one a clean commit gets.
+sed -i 's/<mass value="-1.5"\/>/<mass value="0.848"\/>/' "$repo/urdf/arm_macro.xacro"
 isolated git -C "$repo" add -A
 hooks 0
 isolated git -C "$repo" commit --quiet -m "two arms and a cart"
 echo "== both hooks pass on the fixed files (fill's second run: nothing to write); committed"
+
+# 5. The README's configuration for a xacro repository: a local hook with language: python and the wheel
+# as additional dependency; check runs on the top-level files with their --arg and the density map
+# whatever robot file changed (pass_filenames: false), so a commit that touches only the macro file is
+# checked too.
+cat >"$repo/.pre-commit-config.yaml" <<EOF
+repos:
+  - repo: local
+    hooks:
+      - id: urdf-inertia-check
+        name: urdf-inertia check
+        entry: urdf-inertia check
+        language: python
+        additional_dependencies: [urdf-inertia==$version]
+        files: \.(urdf|xacro)$|^densities\.toml$
+        pass_filenames: false
+        args: [urdf/robot.urdf.xacro, urdf/cart.urdf, --arg, "with_right_arm:=false", --density-map, densities.toml]
+EOF
+run_config() {
+  local expected="$1" status=0
+  shift
+  (cd "$repo" && isolated pre-commit run "$@") >"$work/hooks.log" 2>&1 || status=$?
+  if [ "$status" != "$expected" ]; then
+    cat "$work/hooks.log"
+    fail "pre-commit run $*: exit $status, expected $expected"
+  fi
+}
+isolated git -C "$repo" add -A
+run_config 0 --all-files
+isolated git -C "$repo" commit --quiet -m "pre-commit configuration"
+sed -i 's/<mass value="0.848"\/>/<mass value="-0.848"\/>/' "$repo/urdf/arm_macro.xacro"
+isolated git -C "$repo" add urdf/arm_macro.xacro
+run_config 1
+expect_in_log "arm_macro.xacro:$macro_line: link \`left_upper_arm\`"
+if grep -qF right_upper_arm "$work/hooks.log"; then
+  cat "$work/hooks.log"
+  fail "--arg with_right_arm:=false was not applied"
+fi
+echo "== the README's xacro configuration (local, language: python, --arg, --density-map): passes on the"
+echo "   clean commit, fails when only the macro file changes:"
+grep -F "arm_macro.xacro:$macro_line" "$work/hooks.log" | sed 's/^/   /'
 echo "wheel.sh: passed in $((SECONDS - start)) s"
