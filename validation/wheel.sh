@@ -191,6 +191,7 @@ expect_in_log "arm_macro.xacro:$macro_line: link \`left_upper_arm\`"
 expect_in_log "mass -1.5 is not positive"
 expect_in_log "link \`wheel\`"
 expect_in_log "files were modified by this hook"
+cp "$work/hooks.log" "$work/hooks-first.log"
 echo "== check hook: fails on the negative mass in the macro file and on the wheel without <inertial>:"
 grep -E "^urdf/(arm_macro.xacro:$macro_line|cart.urdf:[0-9]+: link \`wheel\`)" "$work/hooks.log" | sed 's/^/   /'
 "$venv/bin/python" - "$repo/urdf/cart.urdf" <<'EOF'
