@@ -37,7 +37,7 @@ else
   python3 -m venv "$work/build-venv"
   "$work/build-venv/bin/python" -m pip install --quiet --disable-pip-version-check \
     -r validation/wheel-build-requirements.txt
-  if ! "$work/build-venv/bin/maturin" build --release --out "$wheels" >"$work/maturin.log" 2>&1; then
+  if ! "$work/build-venv/bin/maturin" build --release --locked --out "$wheels" >"$work/maturin.log" 2>&1; then
     cat "$work/maturin.log"
     fail "maturin build failed"
   fi
@@ -69,6 +69,7 @@ isolated() {
 if isolated sh -c 'command -v cargo || command -v rustc'; then
   fail "cargo or rustc is on the isolated PATH"
 fi
+isolated sh -c 'command -v git' >/dev/null || fail "pre-commit needs git in /usr/bin or /bin"
 [ "$(isolated sh -c 'command -v urdf-inertia')" = "$venv/bin/urdf-inertia" ] ||
   fail "the wheel did not put urdf-inertia on the venv's PATH"
 got="$(isolated urdf-inertia --version)"
