@@ -180,6 +180,11 @@ fn fill_in_place_writes_literal_links_into_their_files() {
         stderr.contains("warning[UI502]: arms/arm_macro.xacro:4: link `left_shoulder_link` (macro arm called at robots/robot.urdf.xacro:11): not written into the xacro source: it is written in the body of macro arm; `urdf-inertia fill robots/robot.urdf.xacro -o filled.urdf` writes the filled expansion"),
         "{stderr}"
     );
+    // The summary counts what was written: the macro's link was computed, not filled.
+    assert!(
+        stderr.contains("computed 3 link(s), 2 written") && !stderr.contains("filled 3 link(s)"),
+        "{stderr}"
+    );
     // The top file and the included file got their links' inertials, nothing else changed.
     let top = std::fs::read_to_string(dir.join("robots/robot.urdf.xacro")).expect("read");
     let arm = std::fs::read_to_string(dir.join("arms/arm_macro.xacro")).expect("read");
@@ -351,5 +356,22 @@ fn fill_to_a_file_writes_the_filled_expansion() {
     assert_eq!(
         std::fs::read_to_string(dir.join("robots/robot.urdf.xacro")).expect("read"),
         TOP
+    );
+}
+
+/// A file of macros alone expands to a nameless robot without links: pre-commit hands it to the fill
+/// hook on every commit that touches it, which once warned each time that `<robot>` had no name.
+#[test]
+fn a_macro_file_alone_gets_no_robot_name_warning() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let only_macros = "<robot xmlns:xacro=\"http://www.ros.org/wiki/xacro\">\n  <xacro:macro name=\"m\" params=\"p\">\n    <link name=\"${p}\"><collision><geometry><box size=\"1 1 1\"/></geometry></collision></link>\n  </xacro:macro>\n</robot>\n";
+    std::fs::write(tmp.path().join("m.xacro"), only_macros).expect("write");
+    let out = run_in(tmp.path(), &["fill", "-i", "m.xacro", "--density", "1000"]);
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("UI206"), "{stderr}");
+    assert_eq!(
+        std::fs::read_to_string(tmp.path().join("m.xacro")).expect("read"),
+        only_macros
     );
 }

@@ -630,6 +630,7 @@ fn write_robot(
         let times = summary::Times {
             seconds: start.elapsed().as_secs_f64(),
             write: 0.0,
+            written: Some(0),
         };
         summary::fill_text(robot, report, &run, policy, times, w.several);
         errln!(
@@ -654,10 +655,12 @@ fn write_robot(
         }
         Ok(())
     };
+    let mut written = None;
     match (&input.xacro, w.in_place) {
         (Some(x), true) => {
             check_failed()?;
-            write_into_sources(input, x, report, w, policy)?;
+            let k = write_into_sources(input, x, report, w, policy)?;
+            written = (k < report.links.len()).then_some(k);
         }
         _ => {
             let text = spliced(robot, report, w)?;
@@ -683,6 +686,7 @@ fn write_robot(
     let times = summary::Times {
         seconds: start.elapsed().as_secs_f64(),
         write: t_write.elapsed().as_secs_f64(),
+        written,
     };
     let mut run = run_diagnostics(robot, report);
     policy.apply_all(&mut run);
@@ -704,7 +708,7 @@ fn write_into_sources(
     report: &FillReport,
     w: &WriteConfig,
     policy: &Policy,
-) -> Result<(), ExitStatus> {
+) -> Result<usize, ExitStatus> {
     let robot = &input.robot;
     let options = WriteOptions {
         digits: w.digits,
@@ -784,7 +788,7 @@ fn write_into_sources(
         robot.path.display(),
         report.links.len()
     );
-    Ok(())
+    Ok(written)
 }
 
 /// Warnings about the run as a whole: a robot without a name, links left as they were.
@@ -794,7 +798,9 @@ fn run_diagnostics(robot: &Robot, report: &FillReport) -> Vec<Diagnostic> {
         ..Location::default()
     };
     let mut out = Vec::new();
-    if robot.name.is_empty() {
+    // A file of xacro macros expands to a nameless robot with no links: pre-commit passes every
+    // such file to the hooks, where the name warning would be noise on each run.
+    if robot.name.is_empty() && !robot.links.is_empty() {
         out.push(
             Diagnostic::new(
                 Code::UrdfNoRobotName,

@@ -18,6 +18,9 @@ use urdf_inertia::urdf::Robot;
 pub struct Times {
     pub seconds: f64,
     pub write: f64,
+    /// How many of the computed links were written, when not all were (a xacro source's macro links,
+    /// or nothing at all): the summary then says "computed", not "filled".
+    pub written: Option<usize>,
 }
 
 fn by_severity<'a>(ds: impl Iterator<Item = &'a Diagnostic>, warning: bool) -> Vec<&'a Diagnostic> {
@@ -260,9 +263,15 @@ pub fn fill_text(
     };
     if !policy.quiet {
         errln!(
-            "urdf-inertia: {file}robot `{}`: filled {} link(s) ({} parts, {} mesh files, {} faces) in {:.3} s (CPU time over all cores: mesh loading {:.3} s, healing and integration {:.3} s; writing {:.3} s)",
+            "urdf-inertia: {file}robot `{}`: {} ({} parts, {} mesh files, {} faces) in {:.3} s (CPU time over all cores: mesh loading {:.3} s, healing and integration {:.3} s; writing {:.3} s)",
             robot.name,
-            report.links.len(),
+            match t.written {
+                None => format!("filled {} link(s)", report.links.len()),
+                Some(k) => format!(
+                    "computed {} link(s), {k} written",
+                    report.links.len()
+                ),
+            },
             parts,
             report.mesh_files,
             report.faces,
