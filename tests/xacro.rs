@@ -475,7 +475,10 @@ fn xacro_fuzz_seeds_replay() {
     let tmp = tempfile::tempdir().expect("tempdir");
     for (name, text) in XACRO_SEEDS {
         let on_disk = std::fs::read_to_string(seeds.join("xacro").join(name)).expect("seed");
-        assert_eq!(on_disk, text, "fuzz/seeds/xacro/{name} is stale: regenerate");
+        assert_eq!(
+            on_disk, text,
+            "fuzz/seeds/xacro/{name} is stale: regenerate"
+        );
         xacro_check::xacro(text.as_bytes(), tmp.path());
     }
     for (name, text) in YAML_SEEDS {
@@ -483,4 +486,27 @@ fn xacro_fuzz_seeds_replay() {
         assert_eq!(on_disk, text, "fuzz/seeds/yaml/{name} is stale: regenerate");
         xacro_check::yaml(text.as_bytes(), tmp.path());
     }
+}
+
+/// A corpus grown by `bash fuzz/run.sh SECONDS xacro yaml` (fuzz/corpus, not committed), replayed
+/// without instrumentation.
+#[test]
+#[ignore = "replays fuzz/corpus/xacro and fuzz/corpus/yaml after a fuzzing run"]
+fn xacro_fuzz_corpus_replay() {
+    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus");
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let mut n = 0;
+    for (target, one) in [
+        ("xacro", xacro_check::xacro as fn(&[u8], &Path)),
+        ("yaml", xacro_check::yaml),
+    ] {
+        let Ok(dir) = std::fs::read_dir(corpus.join(target)) else {
+            continue;
+        };
+        for entry in dir.flatten() {
+            one(&std::fs::read(entry.path()).expect("read"), tmp.path());
+            n += 1;
+        }
+    }
+    eprintln!("{n} inputs replayed");
 }

@@ -2,6 +2,7 @@
 #![no_main]
 
 #[path = "xacro_check.rs"]
+#[allow(dead_code)] // the other target's half
 mod xacro_check;
 
 use libfuzzer_sys::fuzz_target;
@@ -11,7 +12,8 @@ use std::sync::OnceLock;
 fn dir() -> &'static PathBuf {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
-        let d = std::env::temp_dir().join(format!("urdf-inertia-fuzz-xacro-{}", std::process::id()));
+        let d =
+            std::env::temp_dir().join(format!("urdf-inertia-fuzz-xacro-{}", std::process::id()));
         std::fs::create_dir_all(&d).expect("a temp directory");
         d
     })

@@ -2,6 +2,7 @@
 #![no_main]
 
 #[path = "xacro_check.rs"]
+#[allow(dead_code)] // the other target's half
 mod xacro_check;
 
 use libfuzzer_sys::fuzz_target;
