@@ -17,7 +17,7 @@ cd "$(dirname "$0")"
 secs=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(stl stl_stream obj collada gltf urdf density)
+[ ${#targets[@]} -eq 0 ] && targets=(stl stl_stream obj collada gltf urdf density xacro yaml)
 triple=$(rustc -vV | sed -n 's/^host: //p')
 export RUSTFLAGS="-C passes=sancov-module -C llvm-args=-sanitizer-coverage-level=4 \
 -C llvm-args=-sanitizer-coverage-inline-8bit-counters -C llvm-args=-sanitizer-coverage-pc-table \

@@ -1,6 +1,10 @@
 //! The real binary on xacro sources made by this project: `xacro`, `check`, `diff` and `fill` with
 //! messages at source lines, write-back into the sources, expansion errors, stdin.
 
+// The xacro and yaml fuzz targets' code itself, so that their seeds replay through it.
+#[path = "../fuzz/fuzz_targets/xacro_check.rs"]
+mod xacro_check;
+
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 
@@ -374,4 +378,161 @@ fn a_macro_file_alone_gets_no_robot_name_warning() {
         std::fs::read_to_string(tmp.path().join("m.xacro")).expect("read"),
         only_macros
     );
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Fuzzing seeds for the `xacro` and `yaml` targets (fuzz/seeds/xacro, fuzz/seeds/yaml): regenerate with
+//   cargo test --release --test xacro -- --ignored write_xacro_fuzz_seeds
+
+/// Small xacro sources, each using a different part of the language.
+const XACRO_SEEDS: [(&str, &str); 6] = [
+    ("arm_macro.xacro", ARM_MACRO),
+    (
+        "properties.xacro",
+        "<robot name=\"p\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">
+  <xacro:property name=\"r\" value=\"${0.05 * 2}\"/>
+  <xacro:property name=\"later\" value=\"${r + 1}\"/>
+  <xacro:property name=\"block\"><origin xyz=\"0 0 ${r}\" rpy=\"0 0 ${pi/2}\"/></xacro:property>
+  <xacro:arg name=\"side\" default=\"left\"/>
+  <link name=\"$(arg side)_${'%s_%d' % ('l', 3)}\">
+    <collision><xacro:insert_block name=\"block\"/><geometry><sphere radius=\"${later}\"/></geometry></collision>
+  </link>
+  <xacro:if value=\"${r > 0.01 and not False}\"><link name=\"yes\"/></xacro:if>
+  <xacro:unless value=\"true\"><link name=\"no\"/></xacro:unless>
+</robot>
+",
+    ),
+    (
+        "blocks.xacro",
+        "<robot name=\"b\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">
+  <xacro:macro name=\"part\" params=\"name *geom **extra m:=1.5 scale:=^|2\">
+    <link name=\"${name}\">
+      <inertial><mass value=\"${m}\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial>
+      <collision><geometry><xacro:insert_block name=\"geom\"/></geometry></collision>
+      <xacro:insert_block name=\"extra\"/>
+    </link>
+  </xacro:macro>
+  <xacro:part name=\"a\"><box size=\"1 2 3\"/><extra><visual/></extra></xacro:part>
+  <xacro:part name=\"b\" m=\"${max(1, 2)}\"><cylinder radius=\"0.1\" length=\"0.2\"/><extra/></xacro:part>
+</robot>
+",
+    ),
+    (
+        "elements.xacro",
+        "<robot name=\"e\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">
+  <xacro:property name=\"d\" value=\"${dict(a=1, b=[1, 2, 3])}\"/>
+  <xacro:element xacro:name=\"link\" name=\"${'x' if d['a'] == 1 else 'y'}\">
+    <xacro:attribute name=\"type\" value=\"${str(len(d['b']))}\"/>
+  </xacro:element>
+  <link name=\"$${not_expanded}\"/>
+  <link name=\"${str(radians(180))}_${int(round(degrees(pi)))}_${-2 if 1 in [1, 2] else 0}_${float('1e3')}\"/>
+  <link name=\"$(eval 1 + 2)\"/>
+</robot>
+",
+    ),
+    (
+        "scope.xacro",
+        "<robot name=\"s\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">
+  <xacro:macro name=\"set\" params=\"v\">
+    <xacro:property name=\"out\" value=\"${v}\" scope=\"parent\"/>
+    <xacro:property name=\"g\" value=\"${v * 2}\" scope=\"global\"/>
+  </xacro:macro>
+  <xacro:set v=\"3\"/>
+  <link name=\"l${out}_${g}\"/>
+  <xacro:macro name=\"rec\" params=\"n\">
+    <xacro:if value=\"${n > 0}\"><link name=\"r${n}\"/><xacro:rec n=\"${n - 1}\"/></xacro:if>
+  </xacro:macro>
+  <xacro:rec n=\"3\"/>
+</robot>
+",
+    ),
+    (
+        "include.xacro",
+        "<robot name=\"i\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">
+  <xacro:include filename=\"missing/*.xacro\" ns=\"none\"/>
+  <xacro:include filename=\"missing.xacro\" optional=\"true\"/>
+  <xacro:property name=\"unused\" value=\"${xacro.load_yaml('missing.yaml')}\"/>
+  <link name=\"$(optenv NO_SUCH_VARIABLE fallback)\"/>
+</robot>
+",
+    ),
+];
+
+/// Small YAML files as robot descriptions write them (UR's kinematics, joint limits), and YAML 1.1
+/// scalars PyYAML resolves differently from YAML 1.2.
+const YAML_SEEDS: [(&str, &str); 4] = [
+    (
+        "kinematics.yaml",
+        "kinematics:\n  shoulder:\n    x: 0\n    y: 0\n    z: 0.1625\n    roll: 0\n    pitch: 0\n    yaw: 0\n  hash: calib_12345\n",
+    ),
+    (
+        "limits.yaml",
+        "joint_limits:\n  shoulder_pan:\n    has_velocity_limits: true\n    max_position: !degrees  360.0\n    max_velocity: !degrees  180.0\n    min_position: !degrees -360.0\n  elbow:\n    max_effort: 150.0\n    length: !millimeters 425\n",
+    ),
+    (
+        "scalars.yaml",
+        "a: yes\nb: off\nc: 1e-3\nd: 1.0e-3\ne: 0755\nf: 0x1F\ng: ~\nh: .inf\ni: -.NaN\nj: '007'\nk: 1_000\nl: 2001-12-14\nm: [1, 2.5, 'x', {n: null}]\n",
+    ),
+    (
+        "anchors.yaml",
+        "base: &b {mass: 4.0, xyz: [0, 0, 0.5]}\narm:\n  <<: *b\n  mass: 2.0\nlist:\n  - *b\n  - |\n    block text\n  - >\n    folded\n",
+    ),
+];
+
+#[test]
+#[ignore = "writes fuzz/seeds/xacro and fuzz/seeds/yaml; run on purpose"]
+fn write_xacro_fuzz_seeds() {
+    let seeds = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds");
+    for (target, files) in [("xacro", &XACRO_SEEDS[..]), ("yaml", &YAML_SEEDS[..])] {
+        let dir = seeds.join(target);
+        std::fs::create_dir_all(&dir).expect("mkdir");
+        for (name, text) in files {
+            std::fs::write(dir.join(name), text).expect("write");
+        }
+    }
+}
+
+/// The xacro and yaml fuzzing seeds go through the fuzz targets' code (expansion, URDF scan, the
+/// write-back splice; load_yaml and printing): nothing panics. The seeds on disk must be the ones
+/// these constants write.
+#[test]
+fn xacro_fuzz_seeds_replay() {
+    let seeds = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds");
+    let tmp = tempfile::tempdir().expect("tempdir");
+    for (name, text) in XACRO_SEEDS {
+        let on_disk = std::fs::read_to_string(seeds.join("xacro").join(name)).expect("seed");
+        assert_eq!(
+            on_disk, text,
+            "fuzz/seeds/xacro/{name} is stale: regenerate"
+        );
+        xacro_check::xacro(text.as_bytes(), tmp.path());
+    }
+    for (name, text) in YAML_SEEDS {
+        let on_disk = std::fs::read_to_string(seeds.join("yaml").join(name)).expect("seed");
+        assert_eq!(on_disk, text, "fuzz/seeds/yaml/{name} is stale: regenerate");
+        xacro_check::yaml(text.as_bytes(), tmp.path());
+    }
+}
+
+/// A corpus grown by `bash fuzz/run.sh SECONDS xacro yaml` (fuzz/corpus, not committed), replayed
+/// without instrumentation.
+#[test]
+#[ignore = "replays fuzz/corpus/xacro and fuzz/corpus/yaml after a fuzzing run"]
+fn xacro_fuzz_corpus_replay() {
+    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus");
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let mut n = 0;
+    for (target, one) in [
+        ("xacro", xacro_check::xacro as fn(&[u8], &Path)),
+        ("yaml", xacro_check::yaml),
+    ] {
+        let Ok(dir) = std::fs::read_dir(corpus.join(target)) else {
+            continue;
+        };
+        for entry in dir.flatten() {
+            one(&std::fs::read(entry.path()).expect("read"), tmp.path());
+            n += 1;
+        }
+    }
+    eprintln!("{n} inputs replayed");
 }

@@ -15,7 +15,9 @@
 //! Deliberate differences from xacro 2.1.1, all on inputs xacro refuses or mishandles:
 //! `$(dirname)` is the directory of the file being expanded (xacro 2.1.1 leaves its context unset
 //! and fails); Python's unbounded integers are 64-bit here (an overflow is an error, never a wrong
-//! value); `lambda` is refused with a message.
+//! value); `lambda` is refused with a message; an `xacro:attribute` whose value is not a string
+//! (`value="${3}"`) is written as Python's `str` of it (xacro 2.1.1 stops with an `AttributeError`
+//! while printing the document).
 //!
 //! Packages for `$(find pkg)` are found by the resolver meshes use
 //! ([`crate::urdf::resolve::PackageResolver`]); `package://` URIs stay as they are written. Every

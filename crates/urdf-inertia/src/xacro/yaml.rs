@@ -3,6 +3,8 @@
 //! (`!degrees 90`, `!millimeters 5`, …). Mappings become dotted dicts (`d.key` as well as
 //! `d['key']`). The events come from saphyr-parser (a maintained pure-Rust YAML parser); the
 //! resolution of plain scalars is PyYAML's, which saphyr's YAML 1.2 rules would change.
+//! One difference is deliberate: a timestamp (`2001-12-14`) stays a string, where PyYAML makes a
+//! `datetime.date` (printed `datetime.date(2001, 12, 14)`); description files use none.
 
 use super::value::{Dict, Value};
 use saphyr_parser::{Event, Parser, ScalarStyle, Tag};
