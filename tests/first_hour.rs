@@ -131,3 +131,291 @@ fn diff_names_the_cad_sign_of_products_before_mirrors() {
     assert_eq!(out.status.code(), Some(0), "{}", text(&out));
     assert!(!text(&out).contains("opposite sign"));
 }
+
+/// An ASCII STL of an axis-aligned cube of side `a` centred at the origin, wound outward.
+fn cube_stl(a: f64) -> String {
+    let h = a / 2.0;
+    let v = |i: usize| {
+        [
+            if i & 1 == 0 { -h } else { h },
+            if i & 2 == 0 { -h } else { h },
+            if i & 4 == 0 { -h } else { h },
+        ]
+    };
+    // Each face as two triangles, counter-clockwise seen from outside.
+    let quads = [
+        [0, 2, 3, 1], // z−
+        [4, 5, 7, 6], // z+
+        [0, 1, 5, 4], // y−
+        [2, 6, 7, 3], // y+
+        [0, 4, 6, 2], // x−
+        [1, 3, 7, 5], // x+
+    ];
+    let mut s = String::from("solid cube\n");
+    for q in quads {
+        for t in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
+            s.push_str("facet normal 0 0 0\nouter loop\n");
+            for i in t {
+                let p = v(i);
+                s.push_str(&format!("vertex {} {} {}\n", p[0], p[1], p[2]));
+            }
+            s.push_str("endloop\nendfacet\n");
+        }
+    }
+    s.push_str("endsolid cube\n");
+    s
+}
+
+/// A robot of two links: `base_link` (a 0.1 m box) and `battery` (meshes/big_battery.stl, a 0.1 m
+/// cube), in `dir`; returns the URDF's path.
+fn battery_robot(dir: &Path) -> String {
+    write(dir, "meshes/big_battery.stl", &cube_stl(0.1));
+    write(
+        dir,
+        "robot.urdf",
+        "<robot name=\"r\">\n  <link name=\"base_link\">\n    <collision><geometry><box size=\"0.1 0.1 0.1\"/></geometry></collision>\n  </link>\n  <link name=\"battery\">\n    <collision><geometry><mesh filename=\"meshes/big_battery.stl\"/></geometry></collision>\n  </link>\n</robot>\n",
+    )
+}
+
+/// The `<mass value>` of `link` in URDF text.
+fn mass_of(urdf: &str, link: &str) -> f64 {
+    let at = urdf.find(&format!("<link name=\"{link}\"")).expect("link");
+    let body = &urdf[at..];
+    let body = &body[..body.find("</link>").expect("end")];
+    let m = body.find("<mass value=\"").expect("mass") + 13;
+    body[m..m + body[m..].find('"').expect("quote")]
+        .parse()
+        .expect("number")
+}
+
+/// A density rule that matches nothing is named with its line and a near name; the battery then
+/// gets the default density (1000 kg/m³ × 0.001 m³ = 1 kg), as the warning says.
+#[test]
+fn density_rules_that_match_nothing_are_warnings() {
+    let tmp = tempfile::tempdir().unwrap();
+    let urdf = battery_robot(tmp.path());
+    let map = write(
+        tmp.path(),
+        "d.toml",
+        "default = 1000\n[links]\nbase_lnk = 2000\n[meshes]\n\"*batery*\" = 2500\n",
+    );
+    let out = run(&["fill", &urdf, "--density-map", &map]);
+    let s = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{s}");
+    assert!(
+        s.contains(&format!("{map}:3: [links] rule \"base_lnk\" matches no link: it is ignored; did you mean \"base_link\"?")),
+        "{s}"
+    );
+    assert!(
+        s.contains(&format!("{map}:5: [meshes] rule \"*batery*\" matches no collision mesh: it is ignored; did you mean \"*battery*\" (it matches `big_battery.stl`)?")),
+        "{s}"
+    );
+    let filled = String::from_utf8_lossy(&out.stdout);
+    assert!((mass_of(&filled, "battery") - 1.0).abs() < 1e-12);
+    assert!((mass_of(&filled, "base_link") - 1.0).abs() < 1e-12);
+    // Corrected, the rules are used and nothing is said.
+    let map = write(
+        tmp.path(),
+        "d.toml",
+        "default = 1000\n[links]\nbase_link = 2000\n[meshes]\n\"*battery*\" = 2500\n",
+    );
+    let out = run(&["fill", &urdf, "--density-map", &map]);
+    let s = String::from_utf8_lossy(&out.stderr);
+    assert!(!s.contains("matches no"), "{s}");
+    let filled = String::from_utf8_lossy(&out.stdout);
+    assert!((mass_of(&filled, "battery") - 2.5).abs() < 1e-12);
+    assert!((mass_of(&filled, "base_link") - 2.0).abs() < 1e-12);
+}
+
+/// `--only` matching nothing is an error before anything is written; `--skip` matching nothing a
+/// warning.
+#[test]
+fn only_and_skip_patterns_that_match_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let urdf = battery_robot(tmp.path());
+    let out_file = tmp.path().join("out.urdf");
+    let out = run(&[
+        "fill",
+        &urdf,
+        "--density",
+        "1000",
+        "--only",
+        "base_lnk",
+        "-o",
+        out_file.to_str().unwrap(),
+    ]);
+    let s = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{s}");
+    assert!(s.contains("--only `base_lnk`: no link matches"), "{s}");
+    assert!(s.contains("did you mean `--only base_link`?"), "{s}");
+    assert!(!out_file.exists());
+    // One of two patterns unused: a warning, the other still fills.
+    let out = run(&[
+        "fill",
+        &urdf,
+        "--density",
+        "1000",
+        "--only",
+        "base_link",
+        "--only",
+        "batery",
+        "--skip",
+        "nothing_*",
+    ]);
+    let s = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{s}");
+    assert!(
+        s.contains(
+            "--only `batery` matches no link: it does nothing; did you mean `--only battery`?"
+        ),
+        "{s}"
+    );
+    assert!(
+        s.contains("--skip `nothing_*` matches no link: it does nothing"),
+        "{s}"
+    );
+    // check, several files: a pattern unused in one file but used in the other is not reported.
+    let other = write(
+        tmp.path(),
+        "other.urdf",
+        "<robot name=\"o\"><link name=\"arm\"/></robot>",
+    );
+    let out = run(&["check", &urdf, &other, "--skip", "arm"]);
+    assert!(!text(&out).contains("matches no link"), "{}", text(&out));
+    let out = run(&["check", &urdf, &other, "--only", "leg"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+}
+
+/// `check` without densities still stats every collision mesh: a missing one is an error with the
+/// file, line, link, the path searched and the file one slip away.
+#[test]
+fn check_without_densities_finds_a_missing_mesh() {
+    let tmp = tempfile::tempdir().unwrap();
+    write(tmp.path(), "meshes/Forearm.STL", &cube_stl(0.1));
+    let urdf = write(
+        tmp.path(),
+        "robot.urdf",
+        "<robot name=\"r\">\n<link name=\"forearm\">\n<inertial><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial>\n<collision><geometry><mesh filename=\"meshes/forearm.stl\"/></geometry></collision>\n</link>\n</robot>\n",
+    );
+    let out = run(&["check", &urdf]);
+    let s = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{s}");
+    assert!(
+        s.contains(&format!(
+            "{urdf}:2: link `forearm`: collision 1 (line 4): mesh `meshes/forearm.stl` not found"
+        )),
+        "{s}"
+    );
+    assert!(
+        s.contains(&tmp.path().join("meshes/forearm.stl").display().to_string()),
+        "{s}"
+    );
+    assert!(s.contains("did you mean `Forearm.STL`?"), "{s}");
+}
+
+/// A robot with visual geometry only: fill says so and offers `--geometry collision,visual`,
+/// which computes the links from their visuals (a 0.1 × 0.2 × 0.3 box of 1000 kg/m³: 6 kg).
+#[test]
+fn a_visual_only_robot_is_named_and_can_be_filled_from_visuals() {
+    let tmp = tempfile::tempdir().unwrap();
+    let urdf = write(
+        tmp.path(),
+        "robot.urdf",
+        "<robot name=\"r\">\n  <link name=\"a\">\n    <visual><geometry><box size=\"0.1 0.2 0.3\"/></geometry></visual>\n  </link>\n  <link name=\"frame\"/>\n</robot>\n",
+    );
+    let out = run(&["fill", &urdf, "--density", "1000"]);
+    let s = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{s}");
+    assert!(s.contains("no link has collision geometry"), "{s}");
+    assert!(s.contains("--geometry collision,visual"), "{s}");
+    let out = run(&[
+        "fill",
+        &urdf,
+        "--density",
+        "1000",
+        "--geometry",
+        "collision,visual",
+    ]);
+    let s = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{s}");
+    assert!(s.contains("filled 1 link(s)"), "{s}");
+    assert!(
+        s.contains("link `a`: computed from its visual geometry"),
+        "{s}"
+    );
+    let filled = String::from_utf8_lossy(&out.stdout);
+    assert!((mass_of(&filled, "a") - 6.0).abs() < 1e-12, "{filled}");
+    assert!(!filled[filled.find("\"frame\"").unwrap()..].contains("<inertial>"));
+    // Collision geometry, where a link has it, still comes first.
+    let urdf = write(
+        tmp.path(),
+        "both.urdf",
+        "<robot name=\"r\"><link name=\"a\"><visual><geometry><box size=\"1 1 1\"/></geometry></visual><collision><geometry><box size=\"0.1 0.2 0.3\"/></geometry></collision></link></robot>",
+    );
+    let out = run(&[
+        "fill",
+        &urdf,
+        "--density",
+        "1000",
+        "--geometry",
+        "collision,visual",
+    ]);
+    assert!((mass_of(&String::from_utf8_lossy(&out.stdout), "a") - 6.0).abs() < 1e-12);
+    assert!(!text(&out).contains("visual geometry"));
+    let out = run(&[
+        "fill",
+        &urdf,
+        "--density",
+        "1000",
+        "--geometry",
+        "visual,collision",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+/// A mesh 20 m on a side (a millimetre export without `scale`) fails its link by default, with the
+/// `scale` hint, and nothing is written; `--allow-large-parts` accepts it (8000 m³ × 1000 kg/m³);
+/// `mesh` prints the same warning.
+#[test]
+fn a_part_over_ten_metres_fails_its_link() {
+    let tmp = tempfile::tempdir().unwrap();
+    let stl = write(tmp.path(), "meshes/hull.stl", &cube_stl(20.0));
+    let urdf = write(
+        tmp.path(),
+        "robot.urdf",
+        "<robot name=\"r\">\n<link name=\"hull\">\n<collision><geometry><mesh filename=\"meshes/hull.stl\"/></geometry></collision>\n</link>\n</robot>\n",
+    );
+    let out_file = tmp.path().join("out.urdf");
+    let out = run(&[
+        "fill",
+        &urdf,
+        "--density",
+        "1000",
+        "-o",
+        out_file.to_str().unwrap(),
+    ]);
+    let s = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{s}");
+    assert!(s.contains(&format!("{urdf}:2: link `hull`: collision 1 (line 3): the mesh is 34.6 m across: if it was exported in millimetres, give it scale=\"0.001 0.001 0.001\" (or pass --allow-large-parts")), "{s}");
+    assert!(!out_file.exists());
+    // check with densities fails the same way; diff too.
+    for cmd in ["check", "diff"] {
+        let out = run(&[cmd, &urdf, "--density", "1000"]);
+        assert_eq!(out.status.code(), Some(2), "{cmd}: {}", text(&out));
+    }
+    let out = run(&["fill", &urdf, "--density", "1000", "--allow-large-parts"]);
+    let s = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{s}");
+    assert!(s.contains("the mesh is 34.6 m across"), "{s}");
+    assert!((mass_of(&String::from_utf8_lossy(&out.stdout), "hull") - 8.0e6).abs() < 1e-3);
+    let out = run(&["mesh", &stl]);
+    let s = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{s}");
+    assert!(
+        s.contains("the mesh is 34.6 m across: if it was exported in millimetres"),
+        "{s}"
+    );
+    // Scaled to metres it is a 2 cm cube, and nothing is said.
+    let out = run(&["mesh", &stl, "--scale", "0.001", "0.001", "0.001"]);
+    assert!(!text(&out).contains("across"), "{}", text(&out));
+}

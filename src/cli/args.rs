@@ -79,6 +79,15 @@ pub struct SourceArgs {
     /// URDF_INERTIA_MAX_FILE_SIZE environment variable.
     #[arg(long, value_name = "SIZE")]
     pub max_file_size: Option<String>,
+    /// Which geometry a link's inertia is computed from, in order: `collision` (default), or
+    /// `collision,visual` (a link without collision geometry is computed from its visual geometry,
+    /// and marked so in the summary).
+    #[arg(long, value_name = "ROLES", default_value = "collision")]
+    pub geometry: String,
+    /// Accept parts over 10 m across (by default such a part fails its link: a mesh in millimetres
+    /// without `scale` weighs 10⁹ times too much).
+    #[arg(long)]
+    pub allow_large_parts: bool,
 }
 
 #[derive(Debug, Clone, ClapArgs)]

@@ -14,6 +14,7 @@ macro_rules! errln {
 mod args;
 mod compare;
 mod mesh_cmd;
+mod noops;
 pub mod output;
 mod robot_cmd;
 mod summary;

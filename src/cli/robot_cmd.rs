@@ -26,6 +26,10 @@ struct Sources {
     /// `--arg NAME:=VALUE` for xacro inputs.
     xacro_args: Vec<(String, String)>,
     options: FillOptions,
+    /// The density map's file (`--density-map`), for the rules that match nothing.
+    map_path: Option<PathBuf>,
+    /// `--geometry collision,visual`.
+    visual_fallback: bool,
 }
 
 fn density_map(s: &SourceArgs) -> Result<Option<DensityMap>, String> {
@@ -60,8 +64,19 @@ fn sources(s: &SourceArgs) -> Result<Sources, String> {
         .iter()
         .map(|a| xacro::parse_arg(a))
         .collect::<Result<Vec<_>, String>>()?;
+    let visual_fallback = match s.geometry.replace(' ', "").as_str() {
+        "collision" => false,
+        "collision,visual" => true,
+        other => {
+            return Err(format!(
+                "--geometry `{other}`: give `collision` (the default) or `collision,visual`"
+            ))
+        }
+    };
     Ok(Sources {
         map,
+        map_path: s.density_map.clone(),
+        visual_fallback,
         resolver: PackageResolver::new(&pkgs),
         xacro_args,
         options: FillOptions {
@@ -70,6 +85,7 @@ fn sources(s: &SourceArgs) -> Result<Sources, String> {
             skip: globs(&s.skip)?,
             missing_only: false,
             keep_mass: s.keep_mass,
+            allow_large_parts: s.allow_large_parts,
         },
     })
 }
@@ -257,24 +273,54 @@ fn run_command(config: Result<Config, String>) -> ExitStatus {
 fn run(config: &Config) -> Outcome {
     let mut cache = MeshCache::default();
     let mut outcome = Outcome::default();
+    let mut seen = super::noops::Seen::default();
     for path in &config.files {
-        outcome += run_one(config, path, &mut cache);
+        outcome += run_one(config, path, &mut cache, &mut seen);
     }
+    // One file's --only error stopped it before anything was computed (in `run_one`).
+    if config.files.len() > 1 && outcome.errors == 0 {
+        if let Some(e) = super::noops::only_error(&config.src.options, &seen) {
+            errln!("error: {e}");
+            outcome.errors += 1;
+        }
+    }
+    let map = config.src.map.as_ref().zip(config.src.map_path.as_deref());
+    print_diagnostics(
+        &super::noops::warnings(map, &config.src.options, &seen),
+        config.verbose,
+    );
     if matches!(config.mode, Mode::Check { .. }) && outcome.errors == 0 && outcome.problems > 0 {
         errln!("urdf-inertia check: {} problem(s) found; `urdf-inertia fill -i FILE --density-map …` computes correct values", outcome.problems);
     }
     outcome
 }
 
-fn run_one(config: &Config, path: &Path, cache: &mut MeshCache) -> Outcome {
+fn run_one(
+    config: &Config,
+    path: &Path,
+    cache: &mut MeshCache,
+    seen: &mut super::noops::Seen,
+) -> Outcome {
     let start = Instant::now();
-    let input = match read_input(path, &config.src, config.verbose) {
+    let mut input = match read_input(path, &config.src, config.verbose) {
         Ok(r) => r,
         Err(e) => {
             errln!("error: {e}");
             return Outcome::error();
         }
     };
+    if config.src.visual_fallback {
+        input.robot.use_visual_geometry();
+    } else if let Some(d) = super::noops::no_collision_geometry(&input.robot) {
+        print_diagnostics(&[d], config.verbose);
+    }
+    seen.record(&input.robot);
+    if config.files.len() == 1 {
+        if let Some(e) = super::noops::only_error(&config.src.options, seen) {
+            errln!("error: {e}");
+            return Outcome::error();
+        }
+    }
     let robot = &input.robot;
     let mut outcome = Outcome::default();
     if let Mode::Check { all_links } = config.mode {
@@ -284,6 +330,12 @@ fn run_one(config: &Config, path: &Path, cache: &mut MeshCache) -> Outcome {
         // Only `check` runs without densities: nothing is computed, but a collision that cannot be
         // is still an error.
         outcome.errors += check_collisions(&input, &config.src);
+        // Every collision mesh path must resolve (a stat, no reading).
+        let missing = fill::unresolved_meshes(robot, &config.src.resolver, &config.src.options);
+        for f in &missing {
+            errln!("error: {}: {f}", input.link_at(f.line, &f.link));
+        }
+        outcome.errors += missing.len();
         return outcome;
     };
     let src = &config.src;

@@ -74,6 +74,14 @@ pub enum Code {
     UrdfFrameInertial,
     /// UI301: a link's mass target is overridden by its parts' own `[meshes]` rules.
     DensityRuleOverridden,
+    /// UI302: a density-map rule that matches no link or mesh of the robots (a typo?), ignored.
+    DensityRuleUnused,
+    /// UI208: a `--skip` pattern that matches no link.
+    SelectionUnused,
+    /// UI209: no collision geometry in the whole robot (`--geometry collision,visual` offered).
+    NoCollisionGeometry,
+    /// UI210: a link filled from its visual geometry (`--geometry collision,visual`).
+    VisualGeometryUsed,
     /// UI401: parts of a link overlap: their common volume is counted twice.
     PartsOverlap,
     /// UI501: links that failed were left as they were (`--keep-going`).
@@ -82,7 +90,7 @@ pub enum Code {
 
 impl Code {
     /// Every code, in table order.
-    pub const ALL: [Code; 17] = [
+    pub const ALL: [Code; 21] = [
         Code::MeshRepaired,
         Code::MeshFacesDropped,
         Code::MeshWelded,
@@ -98,6 +106,10 @@ impl Code {
         Code::UrdfNoRobotName,
         Code::UrdfFrameInertial,
         Code::DensityRuleOverridden,
+        Code::DensityRuleUnused,
+        Code::SelectionUnused,
+        Code::NoCollisionGeometry,
+        Code::VisualGeometryUsed,
         Code::PartsOverlap,
         Code::OutputNotWritten,
     ];
@@ -120,6 +132,10 @@ impl Code {
             Code::UrdfNoRobotName => "UI206",
             Code::UrdfFrameInertial => "UI207",
             Code::DensityRuleOverridden => "UI301",
+            Code::DensityRuleUnused => "UI302",
+            Code::SelectionUnused => "UI208",
+            Code::NoCollisionGeometry => "UI209",
+            Code::VisualGeometryUsed => "UI210",
             Code::PartsOverlap => "UI401",
             Code::OutputNotWritten => "UI501",
         }
@@ -332,6 +348,8 @@ pub enum LinkErrorKind {
     Unrepresentable(String),
     /// `--keep-mass` on a `<mass>` (at `line`) that is no positive finite number: `value` as read.
     KeptMassInvalid { line: usize, value: String },
+    /// A mesh over 10 m across (likely millimetres without `scale`), without `--allow-large-parts`.
+    PartTooLarge(String),
 }
 
 impl LinkErrorKind {
@@ -345,6 +363,7 @@ impl LinkErrorKind {
             LinkErrorKind::MassTarget { .. } => "mass-target",
             LinkErrorKind::Unrepresentable(_) => "unrepresentable",
             LinkErrorKind::KeptMassInvalid { .. } => "invalid-kept-mass",
+            LinkErrorKind::PartTooLarge(_) => "part-too-large",
         }
     }
 }
@@ -388,6 +407,10 @@ impl fmt::Display for LinkError {
                 "{source} gives the link {mass} kg, but its parts with their own [meshes] rule already weigh {own_mass} kg"
             ),
             LinkErrorKind::Unrepresentable(m) => f.write_str(m),
+            LinkErrorKind::PartTooLarge(m) => write!(
+                f,
+                "collision {index} (line {cline}): {m} (or pass --allow-large-parts if the part really is that large)"
+            ),
             LinkErrorKind::KeptMassInvalid { line, value } => write!(
                 f,
                 "--keep-mass: <mass> on line {line}: {value} is not a positive number of kilograms; fix the value (a decimal with a point) or drop --keep-mass for this link"

@@ -13,7 +13,7 @@ use crate::diagnostic::{
 use crate::mass::{mat_vec, primitives, rpy_matrix, validity, MassProperties};
 pub use crate::mesh::cache::MeshCache;
 use crate::mesh::cache::Solids;
-use crate::mesh::health::{ErrorEstimate, HealthOptions, ModelError, Solid, ROUND_OFF_FLOOR};
+use crate::mesh::health::{ErrorEstimate, HealthOptions, ModelError, ROUND_OFF_FLOOR};
 use crate::overlap::{self, Overlap, PartShape, PlacedPart};
 use crate::urdf::resolve::PackageResolver;
 use crate::urdf::{Collision, Geometry, Inertial, Link, Robot};
@@ -42,6 +42,8 @@ pub struct FillOptions {
     pub missing_only: bool,
     /// Each link's existing `<mass>` is its mass target.
     pub keep_mass: bool,
+    /// `--allow-large-parts`: a mesh over 10 m across is a warning, not its link's error.
+    pub allow_large_parts: bool,
 }
 
 /// One collision element's contribution.
@@ -154,6 +156,44 @@ pub struct FillReport {
 /// with `--missing-only`, lacking a valid inertial.
 fn is_target(link: &Link, opts: &FillOptions) -> bool {
     selected(&link.name, opts) && !(opts.missing_only && existing_problems(link).is_empty())
+}
+
+/// The `--only` and `--skip` patterns that match none of `names` (the links of every robot of a
+/// run): a typo there fills or skips nothing without a word otherwise.
+pub fn unused_selection<'o>(opts: &'o FillOptions, names: &[&str]) -> (Vec<&'o str>, Vec<&'o str>) {
+    let unused = |globs: &'o [crate::density::Glob]| {
+        globs
+            .iter()
+            .filter(|g| !names.iter().any(|n| g.is_match(n)))
+            .map(crate::density::Glob::as_str)
+            .collect()
+    };
+    (unused(&opts.only), unused(&opts.skip))
+}
+
+/// Every collision mesh of the selected links whose path resolves to no file, as the error `fill`
+/// would give: a stat, no reading (what `check` does without densities).
+pub fn unresolved_meshes(
+    robot: &Robot,
+    resolver: &PackageResolver,
+    opts: &FillOptions,
+) -> Vec<LinkError> {
+    let mut out = Vec::new();
+    for link in robot.links.iter().filter(|l| selected(&l.name, opts)) {
+        for c in &link.collisions {
+            if let Geometry::Mesh { filename, .. } = &c.geometry {
+                if let Err(nf) = resolver.resolve(filename, &robot.path) {
+                    let kind = LinkErrorKind::MeshNotFound {
+                        uri: nf.uri,
+                        searched: nf.searched,
+                        hint: nf.hint,
+                    };
+                    out.push(link_error(link, c, kind));
+                }
+            }
+        }
+    }
+    out
 }
 
 /// Whether a link is selected by `--only` / `--skip` globs.
@@ -337,9 +377,11 @@ fn primitive_part(c: &Collision, what: String, unit: MassProperties, shape: Part
     }
 }
 
-/// The warning for a mesh so large it was likely exported in millimetres, if it is.
-fn millimetre_slip(solid: &Solid, scale: [f64; 3]) -> Option<String> {
-    let (lo, hi) = solid.vertices.iter().fold(
+/// The message for a mesh so large it was likely exported in millimetres (its corners `vertices`,
+/// already scaled by `scale`), if it is: a link's error by default, a warning with
+/// `--allow-large-parts`, and `mesh`'s warning.
+pub fn millimetre_slip(vertices: &[[f64; 3]], scale: [f64; 3]) -> Option<String> {
+    let (lo, hi) = vertices.iter().fold(
         ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
         |(lo, hi), p| {
             (
@@ -385,7 +427,11 @@ fn mesh_part(
         .get(&path, scale)
         .map_err(|e| link_error(link, c, LinkErrorKind::Mesh(e)))?;
     let mut diagnostics = diagnostic::mesh_health(&solid);
-    if let Some(m) = millimetre_slip(&solid, scale) {
+    if let Some(m) = millimetre_slip(&solid.vertices, scale) {
+        if !ctx.opts.allow_large_parts {
+            // 10⁹ times the mass, written without a word but a warning, is worse than no value.
+            return Err(link_error(link, c, LinkErrorKind::PartTooLarge(m)));
+        }
         diagnostics.push(Diagnostic::new(Code::MeshTooLarge, m));
     }
     for d in &mut diagnostics {
@@ -631,6 +677,12 @@ fn compute_link(
     );
     let size = diagonal(size.0, size.1);
     let mut diagnostics = densities.diagnostics;
+    if link.from_visual {
+        diagnostics.push(Diagnostic::new(
+            Code::VisualGeometryUsed,
+            "computed from its visual geometry (it has no collision geometry; --geometry collision,visual)",
+        ));
+    }
     let (overlap, message) = overlap_estimate(&mut parts);
     if let Some(message) = message {
         diagnostics.push(Diagnostic::new(Code::PartsOverlap, message));
