@@ -643,8 +643,10 @@ fn principal_frame_reproduces_the_tensor() {
         for a in 0..3 {
             for b in 0..3 {
                 let got: f64 = (0..3).map(|k| r[a][k] * dd[k] * r[b][k]).sum();
+                // Both are written within the input's precision (the demo's binary STLs store f32
+                // corners, known to 2⁻²⁴ relative): the rpy's rounding moves the tensor by as much.
                 assert!(
-                    (got - full[a][b]).abs() < 1e-12 * norm,
+                    (got - full[a][b]).abs() < 1e-6 * norm,
                     "{link}[{a}][{b}]: {got} vs {}",
                     full[a][b]
                 );
@@ -779,7 +781,9 @@ fn keep_mass_and_total_mass() {
     .iter()
     .map(|l| inertial_of(&text, l).unwrap().0)
     .sum();
-    assert!((sum - 20.0).abs() < 1e-12, "{sum}");
+    // Each mass is written within its input's precision (f32 STL corners: 2⁻²⁴ relative, a mass
+    // to about 2e-7).
+    assert!((sum - 20.0).abs() < 20.0 * 2e-7, "{sum}");
 }
 
 #[test]

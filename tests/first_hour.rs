@@ -419,3 +419,86 @@ fn a_part_over_ten_metres_fails_its_link() {
     let out = run(&["mesh", &stl, "--scale", "0.001", "0.001", "0.001"]);
     assert!(!text(&out).contains("across"), "{}", text(&out));
 }
+
+/// A binary STL (f32 corners) of the right-triangle prism with legs `a` (x) and `b` (y), from z = 0
+/// to `h`, wound outward.
+fn wedge_stl(a: f32, b: f32, h: f32) -> Vec<u8> {
+    let p = [
+        [0.0, 0.0, 0.0],
+        [a, 0.0, 0.0],
+        [0.0, b, 0.0],
+        [0.0, 0.0, h],
+        [a, 0.0, h],
+        [0.0, b, h],
+    ];
+    let tris: [[usize; 3]; 8] = [
+        [0, 2, 1],
+        [3, 4, 5],
+        [0, 1, 4],
+        [0, 4, 3],
+        [0, 3, 5],
+        [0, 5, 2],
+        [1, 2, 5],
+        [1, 5, 4],
+    ];
+    let mut out = vec![0u8; 80];
+    out.extend_from_slice(&(tris.len() as u32).to_le_bytes());
+    for t in tris {
+        out.extend_from_slice(&[0u8; 12]);
+        for i in t {
+            for x in p[i] {
+                out.extend_from_slice(&f32::to_le_bytes(x));
+            }
+        }
+        out.extend_from_slice(&[0u8; 2]);
+    }
+    out
+}
+
+/// The `xyz` of the `<origin>` in `link`'s `<inertial>`, as written.
+fn com_text(urdf: &str, link: &str) -> Vec<String> {
+    let at = urdf.find(&format!("<link name=\"{link}\"")).expect("link");
+    let body = &urdf[at..];
+    let i = body.find("<inertial>").expect("inertial");
+    let body = &body[i..];
+    let x = body.find("xyz=\"").expect("xyz") + 5;
+    body[x..x + body[x..].find('"').expect("quote")]
+        .split(' ')
+        .map(str::to_string)
+        .collect()
+}
+
+/// Written numbers are rounded within the input's own precision: a wedge whose f32 corners are
+/// 0.06, 0.03 and 0.04 has its COM at (0.02, 0.01, 0.02) as the file means it, though the f32
+/// values put it at 0.019999999552965164 for z (f32(0.04) / 2, computed here).
+#[test]
+fn f32_corners_write_the_decimals_the_file_means() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = tmp.path().join("wedge.stl");
+    std::fs::write(&p, wedge_stl(0.06, 0.03, 0.04)).unwrap();
+    let urdf = write(
+        tmp.path(),
+        "robot.urdf",
+        "<robot name=\"r\"><link name=\"w\"><collision><geometry><mesh filename=\"wedge.stl\"/></geometry></collision></link></robot>",
+    );
+    let out = run(&["fill", &urdf, "--density", "1000"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let filled = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(com_text(&filled, "w"), ["0.02", "0.01", "0.02"], "{filled}");
+    // Every bit: the f32 noise is really there.
+    let out = run(&["fill", &urdf, "--density", "1000", "--digits", "full"]);
+    let full = String::from_utf8_lossy(&out.stdout);
+    let z: f64 = com_text(&full, "w")[2].parse().unwrap();
+    assert_eq!(z, f64::from(0.04f32) / 2.0);
+    // The wedge's product of inertia keeps its digits: over the triangle the covariance of x and y
+    // is a·b/12 − (a/3)(b/3) = −a·b/36, so ixy = −∫xy dm = +m·a·b/36 with m = 1000 · a·b/2 · h
+    // = 0.036 kg: 1.8e-6.
+    let ixy = {
+        let i = filled.find("ixy=\"").unwrap() + 5;
+        filled[i..i + filled[i..].find('"').unwrap()]
+            .parse::<f64>()
+            .unwrap()
+    };
+    let want = 0.036 * 0.06 * 0.03 / 36.0;
+    assert!((ixy - want).abs() < 1e-6 * want.abs(), "{ixy} {want}");
+}

@@ -66,7 +66,12 @@ pub enum Spec {
 pub struct MapError {
     pub path: PathBuf,
     pub line: Option<usize>,
+    /// 1-based column (characters) of a TOML syntax error.
+    pub column: Option<usize>,
     pub message: String,
+    /// The offending line with a caret under the column, and a hint, as compilers show them (TOML
+    /// syntax errors).
+    pub snippet: Option<String>,
 }
 
 impl fmt::Display for MapError {
@@ -74,8 +79,48 @@ impl fmt::Display for MapError {
         write!(f, "{}", self.path.display())?;
         if let Some(l) = self.line {
             write!(f, ":{l}")?;
+            if let Some(c) = self.column {
+                write!(f, ":{c}")?;
+            }
         }
-        write!(f, ": {}", self.message)
+        write!(f, ": {}", self.message)?;
+        if let Some(s) = &self.snippet {
+            write!(f, "\n{s}")?;
+        }
+        Ok(())
+    }
+}
+
+/// A TOML syntax error at byte `at` of `text`: its line, column, the line with a caret, and a hint
+/// for the likeliest slip, an unquoted glob key (`*_link = …` must be `"*_link" = …`).
+fn syntax_error(text: &str, at: usize, path: &Path, message: &str) -> MapError {
+    let at = at.min(text.len());
+    let start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+    let end = text[start..].find('\n').map_or(text.len(), |i| start + i);
+    let line_text = text[start..end].trim_end_matches('\r');
+    let line = text[..start].matches('\n').count() + 1;
+    let column = text[start..at].chars().count() + 1;
+    let shown = crate::text::escape_control(line_text);
+    let gutter = " ".repeat(line.to_string().len());
+    let mut snippet = format!(
+        "{gutter} |\n{line} | {shown}\n{gutter} | {}^",
+        " ".repeat(column - 1)
+    );
+    let key = line_text.split('=').next().unwrap_or("").trim();
+    let quoted = key.starts_with('"') || key.starts_with('\'');
+    if line_text.contains('=') && !quoted && key.contains(['*', '?', '[', ']', '{', '}', '!']) {
+        let _ = write!(
+            snippet,
+            "\n{gutter} = hint: a key with glob characters must be quoted: \"{}\" = …",
+            crate::text::escape_control(key)
+        );
+    }
+    MapError {
+        path: path.into(),
+        line: Some(line),
+        column: Some(column),
+        message: message.trim_end().to_string(),
+        snippet: Some(snippet),
     }
 }
 
@@ -242,7 +287,9 @@ impl DensityMap {
         let cannot = |e: String| MapError {
             path: path.into(),
             line: None,
+            column: None,
             message: format!("cannot read the density map: {e}"),
+            snippet: None,
         };
         let bytes = crate::input::read_file(path).map_err(cannot)?;
         let text = String::from_utf8(bytes)
@@ -262,10 +309,14 @@ impl DensityMap {
         let err = |span: Option<Range<usize>>, message: String| MapError {
             path: path.into(),
             line: span.and_then(line_of),
+            column: None,
             message,
+            snippet: None,
         };
-        let raw: RawMap =
-            toml::from_str(text).map_err(|e| err(e.span(), e.message().to_string()))?;
+        let raw: RawMap = toml::from_str(text).map_err(|e| match e.span() {
+            Some(span) => syntax_error(text, span.start, path, e.message()),
+            None => err(None, e.message().to_string()),
+        })?;
 
         let materials = material_table(&raw.materials).map_err(|(span, m)| err(Some(span), m))?;
         let default = match &raw.default {
@@ -841,5 +892,25 @@ base_link = "aluminum"
             assert!(!w(p, n), "{p} {n}");
             assert!(!Glob::new(p).unwrap().is_match(n), "{p} {n}");
         }
+    }
+
+    #[test]
+    fn toml_errors_show_the_line_the_column_and_a_hint_for_glob_keys() {
+        let text = "default = 1000\n[links]\nbase_link = 2700\n*_finger = 1200\n";
+        let e = DensityMap::parse(text, Path::new("d.toml")).unwrap_err();
+        assert_eq!((e.line, e.column), (Some(4), Some(1)), "{e}");
+        let shown = e.to_string();
+        assert!(shown.starts_with("d.toml:4:1: "), "{shown}");
+        assert!(
+            shown.ends_with("\n  |\n4 | *_finger = 1200\n  | ^\n  = hint: a key with glob characters must be quoted: \"*_finger\" = …"),
+            "{shown}"
+        );
+        // Another slip: no hint, but the line and the caret under the column.
+        let e = DensityMap::parse("default = 1000\n[links]\na = 12 00\n", Path::new("d.toml"))
+            .unwrap_err();
+        assert_eq!(e.line, Some(3), "{e}");
+        let shown = e.to_string();
+        assert!(shown.contains("\n3 | a = 12 00\n"), "{shown}");
+        assert!(!shown.contains("hint"), "{shown}");
     }
 }

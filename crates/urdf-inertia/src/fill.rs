@@ -67,6 +67,9 @@ pub struct PartReport {
     pub error_estimate: f64,
     /// What the error estimate is made of (round-off, model error and its source).
     pub error: ErrorEstimate,
+    /// Relative precision of the input's coordinates: 2⁻²⁴ for a mesh stored in f32 (binary STL,
+    /// glTF), 0 for one whose corners are known to every f64 bit (a primitive, most text formats).
+    pub input_precision: f64,
 }
 
 /// A link whose inertial was computed.
@@ -114,6 +117,11 @@ impl LinkReport {
             index: self.index,
             props: self.computed,
             error: self.error_estimate(),
+            input_precision: self
+                .parts
+                .iter()
+                .map(|p| p.input_precision)
+                .fold(0.0, f64::max),
             size: self.size,
         }
     }
@@ -285,6 +293,8 @@ struct Part {
     faces: usize,
     error_estimate: f64,
     error: ErrorEstimate,
+    /// Relative precision of the input's coordinates ([`input_precision`]).
+    input_precision: f64,
     /// The solid in the link frame (for bounding boxes and the overlap estimate).
     placed: PlacedPart,
 }
@@ -366,6 +376,7 @@ fn primitive_part(c: &Collision, what: String, unit: MassProperties, shape: Part
         faces: 0,
         error_estimate: PRIMITIVE_ERROR.total(),
         error: PRIMITIVE_ERROR,
+        input_precision: 0.0,
         placed: PlacedPart {
             shape,
             rotation: r,
@@ -402,6 +413,30 @@ pub fn millimetre_slip(vertices: &[[f64; 3]], scale: [f64; 3]) -> Option<String>
     Some(format!(
         "the mesh is {extent:.1} m across{s}: if it was exported in millimetres, give it scale=\"0.001 0.001 0.001\""
     ))
+}
+
+/// The unit round-off of f32 (2⁻²⁴): how well a corner stored as an f32 is known, relative to
+/// itself.
+const F32_UNIT_ROUNDOFF: f64 = 1.0 / 16_777_216.0;
+
+/// The relative precision of a mesh's corners (`vertices`, already multiplied by `scale`): 2⁻²⁴ when
+/// every coordinate is an f32 times its axis's scale (the file stored f32: binary STL, most glTF),
+/// else 0 (known to every f64 bit, as far as the tool can tell). Written numbers are rounded within
+/// it, so an f32 corner of 0.02 writes as 0.02, not 0.0199999995529652.
+fn input_precision(vertices: &[[f64; 3]], scale: [f64; 3]) -> f64 {
+    // One multiplication rounded in f64: dividing by the scale recovers the f32 to within an f64
+    // ulp, which the f32 cast removes, and multiplying again gives the same f64.
+    #[allow(clippy::cast_possible_truncation)] // The point: whether the value survives f32.
+    let is_f32 = |x: f64, s: f64| s != 0.0 && f64::from((x / s) as f32) * s == x;
+    let all = !vertices.is_empty()
+        && vertices
+            .iter()
+            .all(|v| (0..3).all(|k| is_f32(v[k], scale[k])));
+    if all {
+        F32_UNIT_ROUNDOFF
+    } else {
+        0.0
+    }
 }
 
 /// A mesh collision: resolved, read, healed and integrated (through the cache).
@@ -450,6 +485,7 @@ fn mesh_part(
         faces: solid.faces_read,
         error_estimate: solid.error_estimate,
         error: solid.error,
+        input_precision: input_precision(&solid.vertices, scale),
         placed: PlacedPart {
             bbox: transformed_bbox(solid.vertices.iter().copied(), &r, t),
             volume: solid.unit.mass,
@@ -860,6 +896,7 @@ fn body(parts: &[Part], d: &Densities) -> (MassProperties, Vec<PartReport>) {
             density_source: source,
             error_estimate: p.error_estimate,
             error: p.error,
+            input_precision: p.input_precision,
         });
     }
     (bodies.into_iter().sum(), reports)

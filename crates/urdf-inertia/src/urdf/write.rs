@@ -21,6 +21,9 @@ pub struct LinkUpdate {
     pub props: MassProperties,
     /// Relative error bound of the values (volume and inertia), at least the round-off floor.
     pub error: f64,
+    /// Relative precision of the input's coordinates (2⁻²⁴ for f32 mesh data, else 0): numbers are
+    /// written within it as well as within `error`, so the input's own noise is not written.
+    pub input_precision: f64,
     /// The link's size (m): the scale of its centre of mass.
     pub size: f64,
 }
@@ -32,6 +35,7 @@ impl From<(usize, MassProperties)> for LinkUpdate {
             index,
             props,
             error: ROUND_OFF_FLOOR,
+            input_precision: 0.0,
             size: 0.0,
         }
     }
@@ -140,7 +144,7 @@ fn written(update: &LinkUpdate, opts: &WriteOptions) -> Result<Written, String> 
     } else {
         ([0.0; 3], mp.inertia)
     };
-    let error = text::rounding_tolerance(update.error);
+    let error = text::rounding_tolerance(update.error.max(update.input_precision));
     // The COM is known relative to the link's size or to its own coordinates, whichever is larger.
     let length = mp.com.iter().fold(update.size, |m, x| m.max(x.abs()));
     let floor = |x: f64, scale: f64| text::within(x, ROUND_OFF_FLOOR * scale);
