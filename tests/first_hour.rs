@@ -1,6 +1,7 @@
 //! The first hour on a real robot repository, as the real binary meets it: named causes, no silent
 //! no-ops, oversized parts, plain text. Every fixture is generated here.
 
+use std::fmt::Write as _;
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -157,7 +158,7 @@ fn cube_stl(a: f64) -> String {
             s.push_str("facet normal 0 0 0\nouter loop\n");
             for i in t {
                 let p = v(i);
-                s.push_str(&format!("vertex {} {} {}\n", p[0], p[1], p[2]));
+                let _ = writeln!(s, "vertex {} {} {}", p[0], p[1], p[2]);
             }
             s.push_str("endloop\nendfacet\n");
         }

@@ -842,7 +842,8 @@ base_link = "aluminum"
             "package://r/meshes/motor.stl",
         ];
         let unused = m.unused_rules(&links, &uris);
-        let got: Vec<(&str, &str, usize, Option<(String, String)>)> = unused
+        type Row<'a> = (&'a str, &'a str, usize, Option<(String, String)>);
+        let got: Vec<Row<'_>> = unused
             .iter()
             .map(|u| (u.section, u.pattern.as_str(), u.line, u.suggestion.clone()))
             .collect();
