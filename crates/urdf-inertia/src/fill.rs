@@ -420,19 +420,32 @@ pub fn millimetre_slip(vertices: &[[f64; 3]], scale: [f64; 3]) -> Option<String>
 const F32_UNIT_ROUNDOFF: f64 = 1.0 / 16_777_216.0;
 
 /// The relative precision of a mesh's corners (`vertices`, already multiplied by `scale`): 2⁻²⁴ when
-/// every coordinate is an f32 times its axis's scale (the file stored f32: binary STL, most glTF),
-/// else 0 (known to every f64 bit, as far as the tool can tell). Written numbers are rounded within
-/// it, so an f32 corner of 0.02 writes as 0.02, not 0.0199999995529652.
+/// every coordinate is an f32 times its axis's scale and some show f32 noise (the file stored f32:
+/// binary STL, most glTF), else 0 (known to every f64 bit, as far as the tool can tell: integer or
+/// dyadic corners, in any format, are exact). Written numbers are rounded within it, so an f32
+/// corner of 0.02 writes as 0.02, not 0.0199999995529652.
 fn input_precision(vertices: &[[f64; 3]], scale: [f64; 3]) -> f64 {
     // One multiplication rounded in f64: dividing by the scale recovers the f32 to within an f64
     // ulp, which the f32 cast removes, and multiplying again gives the same f64.
     #[allow(clippy::cast_possible_truncation)] // The point: whether the value survives f32.
-    let is_f32 = |x: f64, s: f64| s != 0.0 && f64::from((x / s) as f32) * s == x;
-    let all = !vertices.is_empty()
-        && vertices
-            .iter()
-            .all(|v| (0..3).all(|k| is_f32(v[k], scale[k])));
-    if all {
+    let as_f32 = |x: f64, s: f64| {
+        let v = (x / s) as f32;
+        (s != 0.0 && f64::from(v) * s == x).then_some(v)
+    };
+    // Noise: the f32's shortest decimal is shorter than the same value's as an f64 (0.02 against
+    // 0.019999999552965164). Looked for in the first corners only: the noise of f32 data shows at
+    // once, and a mesh without any is treated as exact (what it was before this check).
+    let noisy = |v: f32| v.to_string().len() < f64::from(v).to_string().len();
+    let mut noise = false;
+    for (i, p) in vertices.iter().enumerate() {
+        for k in 0..3 {
+            let Some(v) = as_f32(p[k], scale[k]) else {
+                return 0.0;
+            };
+            noise = noise || (i < 10_000 && noisy(v));
+        }
+    }
+    if noise {
         F32_UNIT_ROUNDOFF
     } else {
         0.0
@@ -1031,4 +1044,36 @@ fn overlap_estimate(parts: &mut [Part]) -> (Option<(f64, String, usize)>, Option
         crate::text::significant(e.bound, 2),
     );
     (Some((v, which, n)), Some(message))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn f32_corners_are_known_to_f32_precision_only_when_they_show_it() {
+        let f = |x: f32| f64::from(x);
+        // f32 noise (0.02 stored as f32): 2⁻²⁴.
+        let wedge = [
+            [0.0, 0.0, 0.0],
+            [f(0.06), 0.0, f(0.04)],
+            [0.0, f(0.03), 0.0],
+        ];
+        assert_eq!(input_precision(&wedge, [1.0; 3]), 1.0 / 16_777_216.0);
+        // The same through a scale: each coordinate an f32 times the scale, rounded once.
+        let s = [0.001, -0.001, 0.001];
+        let scaled = wedge.map(|p| [p[0] * s[0], p[1] * s[1], p[2] * s[2]]);
+        assert_eq!(input_precision(&scaled, s), 1.0 / 16_777_216.0);
+        // Integer or dyadic corners (an OBJ's `v 1 0 0`) are exact in any format.
+        let tet = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 0.5, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        assert_eq!(input_precision(&tet, [1.0; 3]), 0.0);
+        // f64 decimals (text formats): not f32 values, exact as far as the tool can tell.
+        let text = [[0.02, 0.0, 0.0], [0.0, 0.03, 0.0]];
+        assert_eq!(input_precision(&text, [1.0; 3]), 0.0);
+    }
 }
