@@ -643,8 +643,10 @@ fn principal_frame_reproduces_the_tensor() {
         for a in 0..3 {
             for b in 0..3 {
                 let got: f64 = (0..3).map(|k| r[a][k] * dd[k] * r[b][k]).sum();
+                // Both are written within the input's precision (the demo's binary STLs store f32
+                // corners, known to 2⁻²⁴ relative): the rpy's rounding moves the tensor by as much.
                 assert!(
-                    (got - full[a][b]).abs() < 1e-12 * norm,
+                    (got - full[a][b]).abs() < 1e-6 * norm,
                     "{link}[{a}][{b}]: {got} vs {}",
                     full[a][b]
                 );
@@ -779,7 +781,9 @@ fn keep_mass_and_total_mass() {
     .iter()
     .map(|l| inertial_of(&text, l).unwrap().0)
     .sum();
-    assert!((sum - 20.0).abs() < 1e-12, "{sum}");
+    // Each mass is written within its input's precision (f32 STL corners: 2⁻²⁴ relative, a mass
+    // to about 2e-7).
+    assert!((sum - 20.0).abs() < 20.0 * 2e-7, "{sum}");
 }
 
 #[test]
@@ -854,11 +858,19 @@ fn millimetre_meshes_without_scale_are_flagged() {
         .unwrap()
         .replace(" scale=\"0.001 0.001 0.001\"", "");
     std::fs::write(&urdf, text).unwrap();
-    let out = run(&["fill", urdf.to_str().unwrap(), "--density", "1000"]);
+    // By default the link fails (tests/first_hour.rs); accepted, the size stays a warning.
+    let out = run(&[
+        "fill",
+        urdf.to_str().unwrap(),
+        "--density",
+        "1000",
+        "--allow-large-parts",
+    ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(stderr.contains("warning[UI106]: package://demo_arm_description/meshes/shoulder.STL: exact: the mesh is 229.8 m across: if it was exported in millimetres, give it scale=\"0.001 0.001 0.001\" (link `shoulder_link`, collision 1)"), "{stderr}");
-    // diff and check show it too (they compute the same meshes).
+    // diff and check show it too (they compute the same meshes), with the same acceptance; without
+    // it the link fails there as well (UI710).
     let (_, map) = demo();
     for command in ["diff", "check"] {
         let out = run(&[
@@ -866,6 +878,15 @@ fn millimetre_meshes_without_scale_are_flagged() {
             urdf.to_str().unwrap(),
             "--density-map",
             map.to_str().unwrap(),
+        ]);
+        assert_eq!(out.status.code(), Some(2), "{command}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("error[UI710]"));
+        let out = run(&[
+            command,
+            urdf.to_str().unwrap(),
+            "--density-map",
+            map.to_str().unwrap(),
+            "--allow-large-parts",
         ]);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(stderr.contains("warning[UI106]: package://demo_arm_description/meshes/shoulder.STL: exact: the mesh is 229.8 m across"), "{command}: {stderr}");

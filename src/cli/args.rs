@@ -83,6 +83,15 @@ pub struct SourceArgs {
     /// (MemAvailable in /proc/meminfo). A mesh that would need more fails its links, named.
     #[arg(long, value_name = "SIZE")]
     pub max_memory: Option<String>,
+    /// Which geometry a link's inertia is computed from, in order: `collision` (default), or
+    /// `collision,visual` (a link without collision geometry is computed from its visual geometry,
+    /// and marked so in the summary).
+    #[arg(long, value_name = "ROLES", default_value = "collision")]
+    pub geometry: String,
+    /// Accept parts over 10 m across (by default such a part fails its link: a mesh in millimetres
+    /// without `scale` weighs 10⁹ times too much).
+    #[arg(long)]
+    pub allow_large_parts: bool,
     #[command(flatten)]
     pub diagnostics: DiagnosticArgs,
 }

@@ -121,6 +121,17 @@ fn causes(
     if !has_products(&computed.inertia) {
         return out;
     }
+    // CAD tools (SolidWorks' mass properties among them) report +∫xy dm where URDF wants −∫xy dm: the
+    // commonest real tensor slip, so it is named before the rarer mirrors. With one product alone it
+    // cannot be told from a mirror, and both are named.
+    let mut negated = computed.inertia;
+    for (i, j) in [(0usize, 1usize), (0, 2), (1, 2)] {
+        negated[i][j] = -negated[i][j];
+        negated[j][i] = -negated[j][i];
+    }
+    if relative(&scaled.inertia, &negated) < 0.05 {
+        out.push("products of inertia have the opposite sign (CAD convention: +∫xy dm)".into());
+    }
     for (axis, name) in [(0usize, "x"), (1, "y"), (2, "z")] {
         let mut m = computed.inertia;
         for j in (0..3).filter(|&j| j != axis) {
@@ -173,5 +184,88 @@ mod tests {
         );
         assert!(c.differs(0.05));
         assert!(!compare(&computed, &computed, 0.37).differs(0.05));
+    }
+
+    /// A 0.1 × 0.2 × 0.3 box turned about a skew axis, so all three products are non-zero.
+    fn turned_box() -> MassProperties {
+        let b = primitives::cuboid([0.1, 0.2, 0.3], 1000.0);
+        let r = urdf_inertia::mass::rpy_matrix([0.3, -0.4, 0.5]);
+        b.transformed(&r, [0.0; 3])
+    }
+
+    /// The tensor's products with their signs flipped per `sign[(0,1)], sign[(0,2)], sign[(1,2)]`,
+    /// built by hand (not through the code under test).
+    fn with_product_signs(mp: &MassProperties, s: [f64; 3]) -> MassProperties {
+        let mut out = *mp;
+        for (k, (i, j)) in [(0usize, 1usize), (0, 2), (1, 2)].into_iter().enumerate() {
+            out.inertia[i][j] *= s[k];
+            out.inertia[j][i] *= s[k];
+        }
+        out
+    }
+
+    #[test]
+    fn products_with_the_opposite_sign_are_the_cad_convention() {
+        let computed = turned_box();
+        // Every product clearly present (a mirror and the CAD slip can then be told apart).
+        for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+            assert!(computed.inertia[i][j].abs() > 0.01 * frobenius(&computed.inertia));
+        }
+        let cad = with_product_signs(&computed, [-1.0, -1.0, -1.0]);
+        let c = compare(&cad, &computed, 0.37);
+        assert!(c.differs(0.05));
+        assert_eq!(
+            c.causes,
+            vec![
+                "products of inertia have the opposite sign (CAD convention: +∫xy dm)".to_string()
+            ]
+        );
+        // The same slip on a link 2 % heavier is still named (the tensor is compared at one mass).
+        let c = compare(&cad.scaled(1.02), &computed, 0.37);
+        assert_eq!(c.causes.len(), 1, "{:?}", c.causes);
+        assert!(c.causes[0].contains("opposite sign"));
+    }
+
+    #[test]
+    fn a_truly_mirrored_tensor_gets_the_mirror_cause() {
+        let computed = turned_box();
+        // Mirrored in x: the x row's products change sign (xy and xz), yz keeps its sign.
+        let mirrored = with_product_signs(&computed, [-1.0, -1.0, 1.0]);
+        let c = compare(&mirrored, &computed, 0.37);
+        assert_eq!(
+            c.causes,
+            vec![
+                "products of inertia look mirrored in x (mesh mirrored, or scale sign lost?)"
+                    .to_string()
+            ]
+        );
+        // The other two mirrors likewise, each named by its own axis.
+        let c = compare(
+            &with_product_signs(&computed, [-1.0, 1.0, -1.0]),
+            &computed,
+            0.37,
+        );
+        assert_eq!(c.causes.len(), 1, "{:?}", c.causes);
+        assert!(c.causes[0].contains("mirrored in y"));
+        let c = compare(
+            &with_product_signs(&computed, [1.0, -1.0, -1.0]),
+            &computed,
+            0.37,
+        );
+        assert!(c.causes[0].contains("mirrored in z"), "{:?}", c.causes);
+    }
+
+    #[test]
+    fn one_product_alone_names_the_cad_slip_first() {
+        // Turned about z only: ixy alone, so flipping it is both the CAD slip and a mirror in x or y.
+        let b = primitives::cuboid([0.1, 0.2, 0.3], 1000.0);
+        let computed = b.transformed(&urdf_inertia::mass::rpy_matrix([0.0, 0.0, 0.5]), [0.0; 3]);
+        let c = compare(
+            &with_product_signs(&computed, [-1.0, 1.0, 1.0]),
+            &computed,
+            0.37,
+        );
+        assert!(c.causes[0].contains("opposite sign"), "{:?}", c.causes);
+        assert!(c.causes[1..].iter().all(|n| n.contains("mirrored")));
     }
 }

@@ -40,6 +40,9 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         errln!("error: {}: {why}", args.file.display());
         return ExitStatus::Error;
     }
+    if let Some(m) = urdf_inertia::fill::millimetre_slip(&solid.vertices, scale) {
+        errln!("warning: {}: {m}", args.file.display());
+    }
     let out = rounded(args, &solid, volume, density, &mp);
     let elapsed = start.elapsed();
     match args.format {

@@ -15,6 +15,7 @@ mod args;
 mod baseline;
 mod compare;
 mod mesh_cmd;
+mod noops;
 pub mod output;
 mod policy;
 mod robot_cmd;

@@ -30,6 +30,10 @@ struct Sources {
     options: FillOptions,
     /// `--max-memory`, or the machine's available memory.
     memory_budget: u64,
+    /// The density map's file (`--density-map`), for the rules that match nothing.
+    map_path: Option<PathBuf>,
+    /// `--geometry collision,visual`.
+    visual_fallback: bool,
 }
 
 /// `--max-memory`, or by default the memory the kernel reports available (Linux: MemAvailable in
@@ -89,8 +93,19 @@ fn sources(s: &SourceArgs, settings: &Settings) -> Result<Sources, String> {
         .iter()
         .map(|a| xacro::parse_arg(a))
         .collect::<Result<Vec<_>, String>>()?;
+    let visual_fallback = match s.geometry.replace(' ', "").as_str() {
+        "collision" => false,
+        "collision,visual" => true,
+        other => {
+            return Err(format!(
+                "--geometry `{other}`: give `collision` (the default) or `collision,visual`"
+            ))
+        }
+    };
     Ok(Sources {
         map,
+        map_path: s.density_map.clone(),
+        visual_fallback,
         resolver: PackageResolver::new(&pkgs),
         xacro_args,
         options: FillOptions {
@@ -99,6 +114,7 @@ fn sources(s: &SourceArgs, settings: &Settings) -> Result<Sources, String> {
             skip: globs(&s.skip)?,
             missing_only: false,
             keep_mass: s.keep_mass,
+            allow_large_parts: s.allow_large_parts,
         },
         memory_budget: memory_budget(s)?,
     })
@@ -337,9 +353,22 @@ fn run(config: &Config) -> Outcome {
         }
     }
     let mut problems = Vec::new();
+    let mut seen = super::noops::Seen::default();
     for path in &config.files {
-        outcome += run_one(config, path, &mut cache, &mut problems);
+        outcome += run_one(config, path, &mut cache, &mut problems, &mut seen);
     }
+    // One file's --only error stopped it before anything was computed (in `run_one`).
+    if config.files.len() > 1 && outcome.errors == 0 {
+        if let Some(e) = super::noops::only_error(&config.src.options, &seen) {
+            errln!("error: {e}");
+            outcome.errors += 1;
+        }
+    }
+    let map = config.src.map.as_ref().zip(config.src.map_path.as_deref());
+    print_diagnostics(
+        &super::noops::warnings(map, &config.src.options, &seen),
+        &config.policy,
+    );
     if matches!(config.mode, Mode::Check { .. }) {
         outcome.problems += report_problems(config, &problems, outcome.errors);
     }
@@ -408,15 +437,28 @@ fn run_one(
     path: &Path,
     cache: &mut MeshCache,
     problems: &mut Vec<Problem>,
+    seen: &mut super::noops::Seen,
 ) -> Outcome {
     let start = Instant::now();
-    let input = match read_input(path, &config.src, &config.policy) {
+    let mut input = match read_input(path, &config.src, &config.policy) {
         Ok(r) => r,
         Err(e) => {
             errln!("error: {e}");
             return Outcome::error();
         }
     };
+    if config.src.visual_fallback {
+        input.robot.use_visual_geometry();
+    } else if let Some(d) = super::noops::no_collision_geometry(&input.robot) {
+        print_diagnostics(&[d], &config.policy);
+    }
+    seen.record(&input.robot);
+    if config.files.len() == 1 {
+        if let Some(e) = super::noops::only_error(&config.src.options, seen) {
+            errln!("error: {e}");
+            return Outcome::error();
+        }
+    }
     let robot = &input.robot;
     let mut outcome = Outcome::default();
     if let Mode::Check { all_links } = config.mode {
@@ -428,6 +470,12 @@ fn run_one(
         // is still an error.
         outcome.errors += check_collisions(&input, &config.src);
         outcome.problems += promoted_notes;
+        // Every collision mesh path must resolve (a stat, no reading).
+        let missing = fill::unresolved_meshes(robot, &config.src.resolver, &config.src.options);
+        for f in &missing {
+            errln!("error: {}: {f}", input.link_at(f.line, &f.link));
+        }
+        outcome.errors += missing.len();
         return outcome;
     };
     let src = &config.src;

@@ -22,6 +22,7 @@
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::fmt;
+use std::fmt::Write as _;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
@@ -65,7 +66,12 @@ pub enum Spec {
 pub struct MapError {
     pub path: PathBuf,
     pub line: Option<usize>,
+    /// 1-based column (characters) of a TOML syntax error.
+    pub column: Option<usize>,
     pub message: String,
+    /// The offending line with a caret under the column, and a hint, as compilers show them (TOML
+    /// syntax errors).
+    pub snippet: Option<String>,
 }
 
 impl fmt::Display for MapError {
@@ -73,8 +79,48 @@ impl fmt::Display for MapError {
         write!(f, "{}", self.path.display())?;
         if let Some(l) = self.line {
             write!(f, ":{l}")?;
+            if let Some(c) = self.column {
+                write!(f, ":{c}")?;
+            }
         }
-        write!(f, ": {}", self.message)
+        write!(f, ": {}", self.message)?;
+        if let Some(s) = &self.snippet {
+            write!(f, "\n{s}")?;
+        }
+        Ok(())
+    }
+}
+
+/// A TOML syntax error at byte `at` of `text`: its line, column, the line with a caret, and a hint
+/// for the likeliest slip, an unquoted glob key (`*_link = …` must be `"*_link" = …`).
+fn syntax_error(text: &str, at: usize, path: &Path, message: &str) -> MapError {
+    let at = at.min(text.len());
+    let start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+    let end = text[start..].find('\n').map_or(text.len(), |i| start + i);
+    let line_text = text[start..end].trim_end_matches('\r');
+    let line = text[..start].matches('\n').count() + 1;
+    let column = text[start..at].chars().count() + 1;
+    let shown = crate::text::escape_control(line_text);
+    let gutter = " ".repeat(line.to_string().len());
+    let mut snippet = format!(
+        "{gutter} |\n{line} | {shown}\n{gutter} | {}^",
+        " ".repeat(column - 1)
+    );
+    let key = line_text.split('=').next().unwrap_or("").trim();
+    let quoted = key.starts_with('"') || key.starts_with('\'');
+    if line_text.contains('=') && !quoted && key.contains(['*', '?', '[', ']', '{', '}', '!']) {
+        let _ = write!(
+            snippet,
+            "\n{gutter} = hint: a key with glob characters must be quoted: \"{}\" = …",
+            crate::text::escape_control(key)
+        );
+    }
+    MapError {
+        path: path.into(),
+        line: Some(line),
+        column: Some(column),
+        message: message.trim_end().to_string(),
+        snippet: Some(snippet),
     }
 }
 
@@ -111,6 +157,8 @@ pub struct DensityMap {
 pub struct Rule {
     pub pattern: String,
     pub spec: Spec,
+    /// 1-based line of the rule in the map's text (0 when built without text).
+    pub line: usize,
 }
 
 /// The rules of one section, compiled once: exact keys in a hash map, the globs in two
@@ -178,6 +226,24 @@ impl RuleSet {
         &self.rules
     }
 
+    /// Marks in `used` every rule that matches `name` (and, for mesh rules, `uri`), whether or not
+    /// it is the one that wins.
+    fn mark_matches(&self, uri: &str, name: &str, used: &mut [bool]) {
+        for k in [uri, name] {
+            if let Some(&i) = self.exact.get(k) {
+                let r = &self.rules[i].pattern;
+                if r == name || (r.contains('/') && r == uri) {
+                    used[i] = true;
+                }
+            }
+        }
+        for (m, target) in [(&self.whole, uri), (&self.name, name)] {
+            for j in m.set.matches(target) {
+                used[m.rule[j]] = true;
+            }
+        }
+    }
+
     /// The rule for `name` (and, for mesh rules, its `uri`): an exact key first (the first written of
     /// the two kinds), then the longest matching glob (the first written on ties).
     fn best(&self, uri: &str, name: &str) -> Option<(&str, Spec)> {
@@ -221,7 +287,9 @@ impl DensityMap {
         let cannot = |e: String| MapError {
             path: path.into(),
             line: None,
+            column: None,
             message: format!("cannot read the density map: {e}"),
+            snippet: None,
         };
         let bytes = crate::input::read_file(path).map_err(cannot)?;
         let text = String::from_utf8(bytes)
@@ -241,10 +309,14 @@ impl DensityMap {
         let err = |span: Option<Range<usize>>, message: String| MapError {
             path: path.into(),
             line: span.and_then(line_of),
+            column: None,
             message,
+            snippet: None,
         };
-        let raw: RawMap =
-            toml::from_str(text).map_err(|e| err(e.span(), e.message().to_string()))?;
+        let raw: RawMap = toml::from_str(text).map_err(|e| match e.span() {
+            Some(span) => syntax_error(text, span.start, path, e.message()),
+            None => err(None, e.message().to_string()),
+        })?;
 
         let materials = material_table(&raw.materials).map_err(|(span, m)| err(Some(span), m))?;
         let default = match &raw.default {
@@ -259,8 +331,9 @@ impl DensityMap {
         if let Some(t) = &raw.total_mass {
             check_positive(*t.get_ref(), "total_mass").map_err(|m| err(Some(t.span()), m))?;
         }
-        let links = rules(&materials, "links", &raw.links, &err)?;
-        let meshes = rules(&materials, "meshes", &raw.meshes, &err)?;
+        let line = |span: Range<usize>| line_of(span).unwrap_or(0);
+        let links = rules(&materials, "links", &raw.links, &err, &line)?;
+        let meshes = rules(&materials, "meshes", &raw.meshes, &err, &line)?;
         Ok(DensityMap {
             default,
             total_mass: raw.total_mass.map(|t| *t.get_ref()),
@@ -280,6 +353,200 @@ impl DensityMap {
         let file = uri.rsplit('/').next().unwrap_or(uri);
         self.meshes.best(uri, file)
     }
+}
+
+/// A density-map rule that matched nothing in the robots of a run, and a near name, if one is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnusedRule {
+    /// `links` or `meshes`.
+    pub section: &'static str,
+    pub pattern: String,
+    /// 1-based line in the map.
+    pub line: usize,
+    /// A corrected key and the name it would match (`"*battery*"`, `big_battery.stl`).
+    pub suggestion: Option<(String, String)>,
+}
+
+impl UnusedRule {
+    /// The warning (UI302), located on the rule's line of the map at `path`.
+    pub fn diagnostic(&self, path: &Path) -> crate::diagnostic::Diagnostic {
+        use crate::diagnostic::{Code, Diagnostic, Location};
+        let what = if self.section == "links" {
+            "link"
+        } else {
+            "collision mesh"
+        };
+        let mut message = format!(
+            "[{}] rule \"{}\" matches no {what}: it is ignored",
+            self.section,
+            crate::text::escape_control(&self.pattern)
+        );
+        match &self.suggestion {
+            Some((key, name)) if key == name => {
+                let _ = write!(
+                    message,
+                    "; did you mean \"{}\"?",
+                    crate::text::escape_control(key)
+                );
+            }
+            Some((key, name)) => {
+                let _ = write!(
+                    message,
+                    "; did you mean \"{}\" (it matches `{}`)?",
+                    crate::text::escape_control(key),
+                    crate::text::escape_control(name)
+                );
+            }
+            None => {}
+        }
+        Diagnostic::new(Code::DensityRuleUnused, message).at(Location {
+            file: Some(path.to_path_buf()),
+            line: Some(self.line),
+            ..Location::default()
+        })
+    }
+}
+
+impl DensityMap {
+    /// The `[links]` and `[meshes]` rules that match none of `links` (link names) and none of
+    /// `mesh_uris` (collision mesh filename attributes), over every robot of a run, each with a
+    /// did-you-mean when a name is one edit (or a change of case) away. A rule that matches but never
+    /// wins (a more specific one does) is not reported: it is not a typo.
+    pub fn unused_rules(&self, links: &[&str], mesh_uris: &[&str]) -> Vec<UnusedRule> {
+        let mut used_links = vec![false; self.links.rules.len()];
+        for l in links {
+            self.links.mark_matches(l, l, &mut used_links);
+        }
+        let mut used_meshes = vec![false; self.meshes.rules.len()];
+        let file_names: Vec<&str> = mesh_uris
+            .iter()
+            .map(|u| u.rsplit('/').next().unwrap_or(u))
+            .collect();
+        for (u, f) in mesh_uris.iter().zip(&file_names) {
+            self.meshes.mark_matches(u, f, &mut used_meshes);
+        }
+        let mut out = Vec::new();
+        for (section, set, used, names) in [
+            ("links", &self.links, used_links, links),
+            ("meshes", &self.meshes, used_meshes, &file_names[..]),
+        ] {
+            for (r, _) in set.rules.iter().zip(used).filter(|(_, u)| !u) {
+                let names: &[&str] = if section == "meshes" && r.pattern.contains('/') {
+                    mesh_uris
+                } else {
+                    names
+                };
+                out.push(UnusedRule {
+                    section,
+                    pattern: r.pattern.clone(),
+                    line: r.line,
+                    suggestion: near_miss(&r.pattern, names),
+                });
+            }
+        }
+        out
+    }
+}
+
+/// A key one edit (or a change of case) from matching one of `names`: the corrected key and the
+/// name it matches. Keys with `[`, `{` or `\\` are not guessed at (only `*` and `?` are understood
+/// here), nor keys or name lists too long to try every edit of.
+pub fn near_miss(pattern: &str, names: &[&str]) -> Option<(String, String)> {
+    let p: Vec<char> = pattern.chars().collect();
+    if p.len() > 64 || names.len() > 20_000 || p.iter().any(|c| "[]{}\\".contains(*c)) {
+        return None;
+    }
+    let hit = |q: &[char], fold: bool| {
+        names.iter().find(|n| {
+            let n: Vec<char> = n.chars().collect();
+            wildcard(q, &n, fold)
+        })
+    };
+    if let Some(n) = hit(&p, true) {
+        let key = if p.contains(&'*') || p.contains(&'?') {
+            pattern.to_string()
+        } else {
+            (*n).to_string()
+        };
+        // Only the case differs: a glob names the name it would match with the case corrected.
+        return Some((
+            if key == pattern {
+                (*n).to_string()
+            } else {
+                key
+            },
+            (*n).to_string(),
+        ));
+    }
+    let mut alphabet: Vec<char> = names.iter().flat_map(|n| n.chars()).collect();
+    alphabet.sort_unstable();
+    alphabet.dedup();
+    let mut q = Vec::with_capacity(p.len() + 1);
+    for i in 0..=p.len() {
+        // Deletion of p[i].
+        if i < p.len() {
+            q.clear();
+            q.extend_from_slice(&p[..i]);
+            q.extend_from_slice(&p[i + 1..]);
+            if !q.is_empty() {
+                if let Some(n) = hit(&q, false) {
+                    return Some((q.iter().collect(), (*n).to_string()));
+                }
+            }
+        }
+        for &c in &alphabet {
+            // Insertion before p[i], then substitution of p[i].
+            q.clear();
+            q.extend_from_slice(&p[..i]);
+            q.push(c);
+            q.extend_from_slice(&p[i..]);
+            if let Some(n) = hit(&q, false) {
+                return Some((q.iter().collect(), (*n).to_string()));
+            }
+            if i < p.len() && p[i] != c {
+                q.clear();
+                q.extend_from_slice(&p[..i]);
+                q.push(c);
+                q.extend_from_slice(&p[i + 1..]);
+                if let Some(n) = hit(&q, false) {
+                    return Some((q.iter().collect(), (*n).to_string()));
+                }
+            }
+        }
+    }
+    None
+}
+
+/// Whether `name` matches `pattern` with `*` (any run) and `?` (one character), optionally ignoring
+/// ASCII case: the classic two-pointer match with one backtrack point, linear in practice.
+fn wildcard(pattern: &[char], name: &[char], fold: bool) -> bool {
+    let eq = |a: char, b: char| {
+        if fold {
+            a.eq_ignore_ascii_case(&b)
+        } else {
+            a == b
+        }
+    };
+    let (mut p, mut n) = (0, 0);
+    let mut star: Option<(usize, usize)> = None;
+    while n < name.len() {
+        if p < pattern.len()
+            && (pattern[p] == '?' || (pattern[p] != '*' && eq(pattern[p], name[n])))
+        {
+            p += 1;
+            n += 1;
+        } else if p < pattern.len() && pattern[p] == '*' {
+            star = Some((p, n));
+            p += 1;
+        } else if let Some((sp, sn)) = star {
+            p = sp + 1;
+            n = sn + 1;
+            star = Some((sp, sn + 1));
+        } else {
+            return false;
+        }
+    }
+    pattern[p..].iter().all(|&c| c == '*')
 }
 
 /// The built-in materials with the map's `[materials]` added (names compare case-insensitively). An
@@ -389,6 +656,7 @@ fn rules(
     section: &str,
     table: &BTreeMap<String, Spanned<toml::Value>>,
     err: &impl Fn(Option<Range<usize>>, String) -> MapError,
+    line: &impl Fn(Range<usize>) -> usize,
 ) -> Result<RuleSet, MapError> {
     let mut entries: Vec<(&String, &Spanned<toml::Value>)> = table.iter().collect();
     entries.sort_by_key(|(_, v)| v.span().start);
@@ -400,6 +668,7 @@ fn rules(
                 .map(|spec| Rule {
                     pattern: k.clone(),
                     spec,
+                    line: line(v.span()),
                 })
                 .map_err(|m| err(Some(v.span()), m))
         })
@@ -561,5 +830,88 @@ base_link = "aluminum"
         let e = DensityMap::parse("[links]\n\"a[\" = 1000\n", Path::new("d.toml")).unwrap_err();
         assert_eq!(e.line, Some(2), "{e}");
         assert!(e.message.contains("not a valid glob"), "{e}");
+    }
+
+    #[test]
+    fn rules_that_match_nothing_are_named_with_a_near_name() {
+        let text = "default = 1000\n[links]\n\"*_link\" = 1.0\nbase_lnk = 2.0\n\"Wrist\" = 3.0\n\"arm_*\" = 4.0\n[meshes]\n\"*batery*\" = 5.0\n\"*motor*\" = 6.0\n\"meshes/x/*.stl\" = 7.0\n";
+        let m = DensityMap::parse(text, Path::new("d.toml")).unwrap();
+        let links = ["base_link", "wrist", "arm_link"];
+        let uris = [
+            "package://r/meshes/big_battery.stl",
+            "package://r/meshes/motor.stl",
+        ];
+        let unused = m.unused_rules(&links, &uris);
+        type Row<'a> = (&'a str, &'a str, usize, Option<(String, String)>);
+        let got: Vec<Row<'_>> = unused
+            .iter()
+            .map(|u| (u.section, u.pattern.as_str(), u.line, u.suggestion.clone()))
+            .collect();
+        let s = |a: &str, b: &str| Some((a.to_string(), b.to_string()));
+        assert_eq!(
+            got,
+            vec![
+                ("links", "base_lnk", 4, s("base_link", "base_link")),
+                ("links", "Wrist", 5, s("wrist", "wrist")),
+                ("meshes", "*batery*", 8, s("*battery*", "big_battery.stl")),
+                ("meshes", "meshes/x/*.stl", 10, None),
+            ]
+        );
+        let d = unused[2].diagnostic(Path::new("d.toml"));
+        assert_eq!(
+            d.render(),
+            "warning[UI302]: d.toml:8: [meshes] rule \"*batery*\" matches no collision mesh: it is ignored; did you mean \"*battery*\" (it matches `big_battery.stl`)?"
+        );
+        // A rule that matches is not reported, even when a more specific one wins.
+        assert!(m
+            .unused_rules(
+                &["base_lnk", "Wrist", "arm_link"],
+                &["meshes/x/batery.stl", "m/motor.stl"]
+            )
+            .is_empty());
+    }
+
+    #[test]
+    fn wildcard_matches_like_the_glob() {
+        let w = |p: &str, n: &str| {
+            let p: Vec<char> = p.chars().collect();
+            let n: Vec<char> = n.chars().collect();
+            wildcard(&p, &n, false)
+        };
+        for (p, n) in [
+            ("*", ""),
+            ("a*b", "ab"),
+            ("a*b", "axxb"),
+            ("*a*", "bab"),
+            ("a?c", "abc"),
+            ("**x", "yx"),
+        ] {
+            assert!(w(p, n), "{p} {n}");
+            assert!(Glob::new(p).unwrap().is_match(n), "{p} {n}");
+        }
+        for (p, n) in [("a*b", "abc"), ("a?c", "ac"), ("*x", "xy")] {
+            assert!(!w(p, n), "{p} {n}");
+            assert!(!Glob::new(p).unwrap().is_match(n), "{p} {n}");
+        }
+    }
+
+    #[test]
+    fn toml_errors_show_the_line_the_column_and_a_hint_for_glob_keys() {
+        let text = "default = 1000\n[links]\nbase_link = 2700\n*_finger = 1200\n";
+        let e = DensityMap::parse(text, Path::new("d.toml")).unwrap_err();
+        assert_eq!((e.line, e.column), (Some(4), Some(1)), "{e}");
+        let shown = e.to_string();
+        assert!(shown.starts_with("d.toml:4:1: "), "{shown}");
+        assert!(
+            shown.ends_with("\n  |\n4 | *_finger = 1200\n  | ^\n  = hint: a key with glob characters must be quoted: \"*_finger\" = …"),
+            "{shown}"
+        );
+        // Another slip: no hint, but the line and the caret under the column.
+        let e = DensityMap::parse("default = 1000\n[links]\na = 12 00\n", Path::new("d.toml"))
+            .unwrap_err();
+        assert_eq!(e.line, Some(3), "{e}");
+        let shown = e.to_string();
+        assert!(shown.contains("\n3 | a = 12 00\n"), "{shown}");
+        assert!(!shown.contains("hint"), "{shown}");
     }
 }

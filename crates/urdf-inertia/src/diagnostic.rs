@@ -78,6 +78,14 @@ pub enum Code {
     UrdfFrameInertial,
     /// UI301: a link's mass target is overridden by its parts' own `[meshes]` rules.
     DensityRuleOverridden,
+    /// UI302: a density-map rule that matches no link or mesh of the robots (a typo?), ignored.
+    DensityRuleUnused,
+    /// UI303: an `--only`/`--skip` pattern that matches no link.
+    SelectionUnused,
+    /// UI210: no collision geometry in the whole robot (`--geometry collision,visual` offered).
+    NoCollisionGeometry,
+    /// UI211: a link filled from its visual geometry (`--geometry collision,visual`).
+    VisualGeometryUsed,
     /// UI401: parts of a link overlap: their common volume is counted twice.
     PartsOverlap,
     /// UI501: links that failed were left as they were (`--keep-going`).
@@ -115,13 +123,16 @@ pub enum Code {
     ErrorMissingDensity,
     /// UI708: the density map's `total_mass` cannot be met.
     ErrorTotalMass,
+    /// UI710: a part over 10 m across (likely millimetres without `scale`), refused without
+    /// `--allow-large-parts`.
+    ErrorPartTooLarge,
     /// UI709: a link's values cannot be written validly (`--digits N` rounding broke the tensor).
     ErrorWrite,
 }
 
 impl Code {
     /// Every code, in table order.
-    pub const ALL: [Code; 34] = [
+    pub const ALL: [Code; 39] = [
         Code::MeshRepaired,
         Code::MeshFacesDropped,
         Code::MeshWelded,
@@ -139,6 +150,10 @@ impl Code {
         Code::XacroWarning,
         Code::XacroNoLinks,
         Code::DensityRuleOverridden,
+        Code::DensityRuleUnused,
+        Code::SelectionUnused,
+        Code::NoCollisionGeometry,
+        Code::VisualGeometryUsed,
         Code::PartsOverlap,
         Code::OutputNotWritten,
         Code::OutputNotInSource,
@@ -156,6 +171,7 @@ impl Code {
         Code::ErrorMissingDensity,
         Code::ErrorTotalMass,
         Code::ErrorWrite,
+        Code::ErrorPartTooLarge,
     ];
 
     /// The stable code, `UI101` …
@@ -176,6 +192,10 @@ impl Code {
             Code::UrdfNoRobotName => "UI206",
             Code::UrdfFrameInertial => "UI207",
             Code::DensityRuleOverridden => "UI301",
+            Code::DensityRuleUnused => "UI302",
+            Code::SelectionUnused => "UI303",
+            Code::NoCollisionGeometry => "UI210",
+            Code::VisualGeometryUsed => "UI211",
             Code::PartsOverlap => "UI401",
             Code::OutputNotWritten => "UI501",
             Code::XacroWarning => "UI208",
@@ -195,6 +215,7 @@ impl Code {
             Code::ErrorMissingDensity => "UI707",
             Code::ErrorTotalMass => "UI708",
             Code::ErrorWrite => "UI709",
+            Code::ErrorPartTooLarge => "UI710",
         }
     }
 
@@ -234,7 +255,8 @@ impl Code {
             | Code::ErrorKeptMass
             | Code::ErrorMissingDensity
             | Code::ErrorTotalMass
-            | Code::ErrorWrite => Severity::Error,
+            | Code::ErrorWrite
+            | Code::ErrorPartTooLarge => Severity::Error,
             _ => Severity::Warning,
         }
     }
@@ -438,6 +460,8 @@ pub enum LinkErrorKind {
     Unrepresentable(String),
     /// `--keep-mass` on a `<mass>` (at `line`) that is no positive finite number: `value` as read.
     KeptMassInvalid { line: usize, value: String },
+    /// A mesh over 10 m across (likely millimetres without `scale`), without `--allow-large-parts`.
+    PartTooLarge(String),
 }
 
 impl LinkErrorKind {
@@ -451,6 +475,7 @@ impl LinkErrorKind {
             LinkErrorKind::MassTarget { .. } => "mass-target",
             LinkErrorKind::Unrepresentable(_) => "unrepresentable",
             LinkErrorKind::KeptMassInvalid { .. } => "invalid-kept-mass",
+            LinkErrorKind::PartTooLarge(_) => "part-too-large",
         }
     }
 
@@ -463,6 +488,7 @@ impl LinkErrorKind {
             LinkErrorKind::MassTarget { .. } => Code::ErrorMassTarget,
             LinkErrorKind::Unrepresentable(_) => Code::ErrorUnrepresentable,
             LinkErrorKind::KeptMassInvalid { .. } => Code::ErrorKeptMass,
+            LinkErrorKind::PartTooLarge(_) => Code::ErrorPartTooLarge,
         }
     }
 }
@@ -506,6 +532,10 @@ impl fmt::Display for LinkError {
                 "{source} gives the link {mass} kg, but its parts with their own [meshes] rule already weigh {own_mass} kg"
             ),
             LinkErrorKind::Unrepresentable(m) => f.write_str(m),
+            LinkErrorKind::PartTooLarge(m) => write!(
+                f,
+                "collision {index} (line {cline}): {m} (or pass --allow-large-parts if the part really is that large)"
+            ),
             LinkErrorKind::KeptMassInvalid { line, value } => write!(
                 f,
                 "--keep-mass: <mass> on line {line}: {value} is not a positive number of kilograms; fix the value (a decimal with a point) or drop --keep-mass for this link"

@@ -13,7 +13,7 @@ use crate::diagnostic::{
 use crate::mass::{mat_vec, primitives, rpy_matrix, validity, MassProperties};
 pub use crate::mesh::cache::MeshCache;
 use crate::mesh::cache::Solids;
-use crate::mesh::health::{ErrorEstimate, HealthOptions, ModelError, Solid, ROUND_OFF_FLOOR};
+use crate::mesh::health::{ErrorEstimate, HealthOptions, ModelError, ROUND_OFF_FLOOR};
 use crate::overlap::{self, Overlap, PartShape, PlacedPart};
 use crate::urdf::resolve::PackageResolver;
 use crate::urdf::{Collision, Geometry, Inertial, Link, Robot};
@@ -42,6 +42,8 @@ pub struct FillOptions {
     pub missing_only: bool,
     /// Each link's existing `<mass>` is its mass target.
     pub keep_mass: bool,
+    /// `--allow-large-parts`: a mesh over 10 m across is a warning, not its link's error.
+    pub allow_large_parts: bool,
 }
 
 /// One collision element's contribution.
@@ -65,6 +67,9 @@ pub struct PartReport {
     pub error_estimate: f64,
     /// What the error estimate is made of (round-off, model error and its source).
     pub error: ErrorEstimate,
+    /// Relative precision of the input's coordinates: 2⁻²⁴ for a mesh stored in f32 (binary STL,
+    /// glTF), 0 for one whose corners are known to every f64 bit (a primitive, most text formats).
+    pub input_precision: f64,
 }
 
 /// A link whose inertial was computed.
@@ -112,6 +117,11 @@ impl LinkReport {
             index: self.index,
             props: self.computed,
             error: self.error_estimate(),
+            input_precision: self
+                .parts
+                .iter()
+                .map(|p| p.input_precision)
+                .fold(0.0, f64::max),
             size: self.size,
         }
     }
@@ -154,6 +164,44 @@ pub struct FillReport {
 /// with `--missing-only`, lacking a valid inertial.
 fn is_target(link: &Link, opts: &FillOptions) -> bool {
     selected(&link.name, opts) && !(opts.missing_only && existing_problems(link).is_empty())
+}
+
+/// The `--only` and `--skip` patterns that match none of `names` (the links of every robot of a
+/// run): a typo there fills or skips nothing without a word otherwise.
+pub fn unused_selection<'o>(opts: &'o FillOptions, names: &[&str]) -> (Vec<&'o str>, Vec<&'o str>) {
+    let unused = |globs: &'o [crate::density::Glob]| {
+        globs
+            .iter()
+            .filter(|g| !names.iter().any(|n| g.is_match(n)))
+            .map(crate::density::Glob::as_str)
+            .collect()
+    };
+    (unused(&opts.only), unused(&opts.skip))
+}
+
+/// Every collision mesh of the selected links whose path resolves to no file, as the error `fill`
+/// would give: a stat, no reading (what `check` does without densities).
+pub fn unresolved_meshes(
+    robot: &Robot,
+    resolver: &PackageResolver,
+    opts: &FillOptions,
+) -> Vec<LinkError> {
+    let mut out = Vec::new();
+    for link in robot.links.iter().filter(|l| selected(&l.name, opts)) {
+        for c in &link.collisions {
+            if let Geometry::Mesh { filename, .. } = &c.geometry {
+                if let Err(nf) = resolver.resolve(filename, &robot.path) {
+                    let kind = LinkErrorKind::MeshNotFound {
+                        uri: nf.uri,
+                        searched: nf.searched,
+                        hint: nf.hint,
+                    };
+                    out.push(link_error(link, c, kind));
+                }
+            }
+        }
+    }
+    out
 }
 
 /// Whether a link is selected by `--only` / `--skip` globs.
@@ -245,6 +293,8 @@ struct Part {
     faces: usize,
     error_estimate: f64,
     error: ErrorEstimate,
+    /// Relative precision of the input's coordinates ([`input_precision`]).
+    input_precision: f64,
     /// The solid in the link frame (for bounding boxes and the overlap estimate).
     placed: PlacedPart,
 }
@@ -326,6 +376,7 @@ fn primitive_part(c: &Collision, what: String, unit: MassProperties, shape: Part
         faces: 0,
         error_estimate: PRIMITIVE_ERROR.total(),
         error: PRIMITIVE_ERROR,
+        input_precision: 0.0,
         placed: PlacedPart {
             shape,
             rotation: r,
@@ -337,9 +388,11 @@ fn primitive_part(c: &Collision, what: String, unit: MassProperties, shape: Part
     }
 }
 
-/// The warning for a mesh so large it was likely exported in millimetres, if it is.
-fn millimetre_slip(solid: &Solid, scale: [f64; 3]) -> Option<String> {
-    let (lo, hi) = solid.vertices.iter().fold(
+/// The message for a mesh so large it was likely exported in millimetres (its corners `vertices`,
+/// already scaled by `scale`), if it is: a link's error by default, a warning with
+/// `--allow-large-parts`, and `mesh`'s warning.
+pub fn millimetre_slip(vertices: &[[f64; 3]], scale: [f64; 3]) -> Option<String> {
+    let (lo, hi) = vertices.iter().fold(
         ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
         |(lo, hi), p| {
             (
@@ -360,6 +413,43 @@ fn millimetre_slip(solid: &Solid, scale: [f64; 3]) -> Option<String> {
     Some(format!(
         "the mesh is {extent:.1} m across{s}: if it was exported in millimetres, give it scale=\"0.001 0.001 0.001\""
     ))
+}
+
+/// The unit round-off of f32 (2⁻²⁴): how well a corner stored as an f32 is known, relative to
+/// itself.
+const F32_UNIT_ROUNDOFF: f64 = 1.0 / 16_777_216.0;
+
+/// The relative precision of a mesh's corners (`vertices`, already multiplied by `scale`): 2⁻²⁴ when
+/// every coordinate is an f32 times its axis's scale and some show f32 noise (the file stored f32:
+/// binary STL, most glTF), else 0 (known to every f64 bit, as far as the tool can tell: integer or
+/// dyadic corners, in any format, are exact). Written numbers are rounded within it, so an f32
+/// corner of 0.02 writes as 0.02, not 0.0199999995529652.
+fn input_precision(vertices: &[[f64; 3]], scale: [f64; 3]) -> f64 {
+    // One multiplication rounded in f64: dividing by the scale recovers the f32 to within an f64
+    // ulp, which the f32 cast removes, and multiplying again gives the same f64.
+    #[allow(clippy::cast_possible_truncation)] // The point: whether the value survives f32.
+    let as_f32 = |x: f64, s: f64| {
+        let v = (x / s) as f32;
+        (s != 0.0 && f64::from(v) * s == x).then_some(v)
+    };
+    // Noise: the f32's shortest decimal is shorter than the same value's as an f64 (0.02 against
+    // 0.019999999552965164). Looked for in the first corners only: the noise of f32 data shows at
+    // once, and a mesh without any is treated as exact (what it was before this check).
+    let noisy = |v: f32| v.to_string().len() < f64::from(v).to_string().len();
+    let mut noise = false;
+    for (i, p) in vertices.iter().enumerate() {
+        for k in 0..3 {
+            let Some(v) = as_f32(p[k], scale[k]) else {
+                return 0.0;
+            };
+            noise = noise || (i < 10_000 && noisy(v));
+        }
+    }
+    if noise {
+        F32_UNIT_ROUNDOFF
+    } else {
+        0.0
+    }
 }
 
 /// A mesh collision: resolved, read, healed and integrated (through the cache).
@@ -385,7 +475,11 @@ fn mesh_part(
         .get(&path, scale)
         .map_err(|e| link_error(link, c, LinkErrorKind::Mesh(e)))?;
     let mut diagnostics = diagnostic::mesh_health(&solid);
-    if let Some(m) = millimetre_slip(&solid, scale) {
+    if let Some(m) = millimetre_slip(&solid.vertices, scale) {
+        if !ctx.opts.allow_large_parts {
+            // 10⁹ times the mass, written without a word but a warning, is worse than no value.
+            return Err(link_error(link, c, LinkErrorKind::PartTooLarge(m)));
+        }
         diagnostics.push(Diagnostic::new(Code::MeshTooLarge, m));
     }
     for d in &mut diagnostics {
@@ -404,6 +498,7 @@ fn mesh_part(
         faces: solid.faces_read,
         error_estimate: solid.error_estimate,
         error: solid.error,
+        input_precision: input_precision(&solid.vertices, scale),
         placed: PlacedPart {
             bbox: transformed_bbox(solid.vertices.iter().copied(), &r, t),
             volume: solid.unit.mass,
@@ -631,6 +726,12 @@ fn compute_link(
     );
     let size = diagonal(size.0, size.1);
     let mut diagnostics = densities.diagnostics;
+    if link.from_visual {
+        diagnostics.push(Diagnostic::new(
+            Code::VisualGeometryUsed,
+            "computed from its visual geometry (it has no collision geometry; --geometry collision,visual)",
+        ));
+    }
     let (overlap, message) = overlap_estimate(&mut parts);
     if let Some(message) = message {
         diagnostics.push(Diagnostic::new(Code::PartsOverlap, message));
@@ -808,6 +909,7 @@ fn body(parts: &[Part], d: &Densities) -> (MassProperties, Vec<PartReport>) {
             density_source: source,
             error_estimate: p.error_estimate,
             error: p.error,
+            input_precision: p.input_precision,
         });
     }
     (bodies.into_iter().sum(), reports)
@@ -942,4 +1044,36 @@ fn overlap_estimate(parts: &mut [Part]) -> (Option<(f64, String, usize)>, Option
         crate::text::significant(e.bound, 2),
     );
     (Some((v, which, n)), Some(message))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn f32_corners_are_known_to_f32_precision_only_when_they_show_it() {
+        let f = |x: f32| f64::from(x);
+        // f32 noise (0.02 stored as f32): 2⁻²⁴.
+        let wedge = [
+            [0.0, 0.0, 0.0],
+            [f(0.06), 0.0, f(0.04)],
+            [0.0, f(0.03), 0.0],
+        ];
+        assert_eq!(input_precision(&wedge, [1.0; 3]), 1.0 / 16_777_216.0);
+        // The same through a scale: each coordinate an f32 times the scale, rounded once.
+        let s = [0.001, -0.001, 0.001];
+        let scaled = wedge.map(|p| [p[0] * s[0], p[1] * s[1], p[2] * s[2]]);
+        assert_eq!(input_precision(&scaled, s), 1.0 / 16_777_216.0);
+        // Integer or dyadic corners (an OBJ's `v 1 0 0`) are exact in any format.
+        let tet = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 0.5, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        assert_eq!(input_precision(&tet, [1.0; 3]), 0.0);
+        // f64 decimals (text formats): not f32 values, exact as far as the tool can tell.
+        let text = [[0.02, 0.0, 0.0], [0.0, 0.03, 0.0]];
+        assert_eq!(input_precision(&text, [1.0; 3]), 0.0);
+    }
 }

@@ -36,10 +36,23 @@ impl std::fmt::Display for Violation {
             ),
             Violation::TriangleInequality { moments, excess } => write!(
                 f,
-                "principal moments {}, {}, {} break the triangle inequality (largest exceeds the sum of the others by {} of it)",
-                sig(moments[0], 7), sig(moments[1], 7), sig(moments[2], 7), sig(*excess, 4)
+                "principal moments {}, {}, {} break the triangle inequality: no body has them (the largest is {}% more than the sum of the other two)",
+                sig(moments[0], 7), sig(moments[1], 7), sig(moments[2], 7), sig(*excess * 100.0 * largest_over_rest(moments), 3)
             ),
         }
+    }
+}
+
+/// The largest principal moment over the sum of the other two: `excess` (relative to the largest)
+/// becomes a share of that sum, the number a person checks (0.3 against 0.1 + 0.1: 50% more).
+fn largest_over_rest(m: &[f64; 3]) -> f64 {
+    let mut s = *m;
+    s.sort_by(f64::total_cmp);
+    let rest = s[0] + s[1];
+    if rest > 0.0 {
+        s[2] / rest
+    } else {
+        f64::INFINITY
     }
 }
 

@@ -141,18 +141,26 @@ impl ErrorEstimate {
         self.round_off + self.model
     }
 
-    /// One line for people: `3.1e-16 (round-off)` or `2.0e-4 (model: caps; round-off 3.1e-16)`.
+    /// One line for people: `3.1e-16 (round-off)` or `2.0e-4 (mesh repair: holes capped; round-off
+    /// 3.1e-16)`.
     pub fn describe(&self) -> String {
+        // Plain words for people; `name()` stays the short key for JSON.
+        let cause = match self.source {
+            ModelError::None => "none",
+            ModelError::Cracks => "cracks between faces",
+            ModelError::Orientation => "faces re-oriented",
+            ModelError::Caps => "holes capped",
+            ModelError::Hull => "replaced by its convex hull",
+        };
         if !self.total().is_finite() {
-            return format!("unbounded (model: {})", self.source.name());
+            return format!("unbounded (mesh repair: {cause})");
         }
         if self.source == ModelError::None || self.model == 0.0 {
             format!("{:.1e} (round-off)", self.total())
         } else {
             format!(
-                "{:.1e} (model: {}; round-off {:.1e})",
+                "{:.1e} (mesh repair: {cause}; round-off {:.1e})",
                 self.total(),
-                self.source.name(),
                 self.round_off
             )
         }

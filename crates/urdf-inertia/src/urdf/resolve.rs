@@ -105,10 +105,11 @@ impl PackageResolver {
             if let Some(p) = searched.iter().find(|p| !inner.is_empty() && p.exists()) {
                 return Ok(p.clone());
             }
+            let hint = near_file(&searched).unwrap_or_else(|| format!("pass --package-path {pkg}=DIR (DIR is the package's directory), or set ROS_PACKAGE_PATH"));
             return Err(NotFound {
                 uri: uri.to_string(),
                 searched,
-                hint: format!("pass --package-path {pkg}=DIR (DIR is the package's directory), or set ROS_PACKAGE_PATH"),
+                hint,
             });
         }
         if uri.contains("$(") || uri.contains("${") {
@@ -149,10 +150,14 @@ impl PackageResolver {
         if path.exists() {
             Ok(path)
         } else {
+            let searched = vec![path];
+            let hint = near_file(&searched).unwrap_or_else(|| {
+                "check the path (relative paths are relative to the URDF's directory)".into()
+            });
             Err(NotFound {
                 uri: uri.to_string(),
-                searched: vec![path],
-                hint: "check the path (relative paths are relative to the URDF's directory)".into(),
+                searched,
+                hint,
             })
         }
     }
@@ -228,6 +233,75 @@ impl PackageResolver {
             None => searched.push(base.join(format!("..(each parent)/{pkg}"))),
         }
         Ok(out)
+    }
+}
+
+/// `did you mean …?` for a missing file whose name differs from a file in the same directory only
+/// in case or by one edit (an inserted, dropped or changed character): the commonest slips in a
+/// hand-written mesh path. Only directories that exist are listed, each once.
+fn near_file(searched: &[PathBuf]) -> Option<String> {
+    let mut seen = std::collections::HashSet::new();
+    for p in searched {
+        let (Some(dir), Some(name)) = (p.parent(), p.file_name().and_then(|n| n.to_str())) else {
+            continue;
+        };
+        if !seen.insert(dir.to_path_buf()) {
+            continue;
+        }
+        let Ok(entries) = std::fs::read_dir(dir) else {
+            continue;
+        };
+        // A directory of a million files is not worth listing for a hint.
+        let mut best: Option<(usize, String)> = None;
+        for e in entries.take(100_000).flatten() {
+            let Some(other) = e.file_name().to_str().map(str::to_string) else {
+                continue;
+            };
+            let rank = if other.eq_ignore_ascii_case(name) {
+                0
+            } else if one_edit(&other, name) {
+                1
+            } else {
+                continue;
+            };
+            if best
+                .as_ref()
+                .is_none_or(|(r, n)| rank < *r || (rank == *r && other < *n))
+            {
+                best = Some((rank, other));
+            }
+        }
+        if let Some((_, other)) = best {
+            return Some(format!(
+                "did you mean `{}`? (in {})",
+                crate::text::escape_control(&other),
+                crate::text::escape_control(&dir.display().to_string())
+            ));
+        }
+    }
+    None
+}
+
+/// Whether `a` and `b` differ by exactly one inserted, dropped or changed character.
+fn one_edit(a: &str, b: &str) -> bool {
+    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    let (short, long) = if a.len() <= b.len() {
+        (&a, &b)
+    } else {
+        (&b, &a)
+    };
+    if long.len() - short.len() > 1 || a == b {
+        return false;
+    }
+    let head = short
+        .iter()
+        .zip(long.iter())
+        .take_while(|(x, y)| x == y)
+        .count();
+    if short.len() == long.len() {
+        short[head + 1..] == long[head + 1..]
+    } else {
+        short[head..] == long[head + 1..]
     }
 }
 
@@ -366,5 +440,35 @@ mod tests {
         assert_eq!(percent_decode("a%2"), "a%2");
         let nf = r.resolve("package://nope/meshes/a.stl", &urdf).unwrap_err();
         assert!(nf.hint.contains("--package-path nope=DIR"));
+    }
+
+    #[test]
+    fn a_missing_mesh_names_the_file_one_slip_away() {
+        let tmp = tempfile::tempdir().expect("tempdir");
+        std::fs::create_dir_all(tmp.path().join("meshes")).expect("mkdir");
+        for f in ["Forearm.STL", "wrist.stl", "base.stl"] {
+            std::fs::write(tmp.path().join("meshes").join(f), "solid x\nendsolid x\n")
+                .expect("write");
+        }
+        let urdf = tmp.path().join("robot.urdf");
+        let r = PackageResolver::new(&[]);
+        let hint = |uri: &str| r.resolve(uri, &urdf).unwrap_err().hint;
+        // Case only.
+        assert!(hint("meshes/forearm.stl").starts_with("did you mean `Forearm.STL`?"));
+        // One dropped, one inserted, one changed character.
+        assert!(hint("meshes/wrst.stl").starts_with("did you mean `wrist.stl`?"));
+        assert!(hint("meshes/wristt.stl").starts_with("did you mean `wrist.stl`?"));
+        assert!(hint("meshes/wrist.stk").starts_with("did you mean `wrist.stl`?"));
+        // Two edits away: the usual hint.
+        assert!(hint("meshes/wr.stl").starts_with("check the path"));
+        // Through a package:// URI too.
+        std::fs::write(
+            tmp.path().join("package.xml"),
+            "<package><name>p</name></package>",
+        )
+        .expect("write");
+        assert!(hint("package://p/meshes/bse.stl").starts_with("did you mean `base.stl`?"));
+        assert!(one_edit("ab", "abc") && one_edit("abc", "axc") && !one_edit("abc", "abc"));
+        assert!(!one_edit("abcd", "ab") && !one_edit("abc", "bca"));
     }
 }

@@ -127,6 +127,11 @@ pub struct Link {
     /// Further `<inertial>` elements, which urdfdom ignores (only their spans are read: `fill` removes them).
     pub extra_inertials: Vec<InertialSpan>,
     pub collisions: Vec<Collision>,
+    /// The `<visual>` elements, read as collisions are (without their warnings): what
+    /// `--geometry collision,visual` computes a link from when it has no collision geometry.
+    pub visuals: Vec<Collision>,
+    /// Whether `collisions` were taken from `visuals` ([`Robot::use_visual_geometry`]).
+    pub from_visual: bool,
 }
 
 impl Link {
@@ -151,6 +156,32 @@ pub struct Robot {
     pub encoding: SourceEncoding,
     /// Warnings and notes, in file order, located in this file.
     pub notes: Vec<Diagnostic>,
+}
+
+impl Robot {
+    /// Whether no link has collision geometry while some have visual geometry (a visual-only
+    /// robot: `fill` would compute nothing).
+    pub fn visual_only(&self) -> bool {
+        !self.links.iter().any(Link::has_collision_geometry)
+            && self
+                .links
+                .iter()
+                .any(|l| l.visuals.iter().any(|v| !v.geometry.is_zero_size()))
+    }
+
+    /// `--geometry collision,visual`: each link without collision geometry gets its visual
+    /// geometry as its collisions (marked [`Link::from_visual`]); the names of those links.
+    pub fn use_visual_geometry(&mut self) -> Vec<String> {
+        let mut out = Vec::new();
+        for l in &mut self.links {
+            if !l.has_collision_geometry() && l.visuals.iter().any(|v| !v.geometry.is_zero_size()) {
+                l.collisions = l.visuals.clone();
+                l.from_visual = true;
+                out.push(l.name.clone());
+            }
+        }
+        out
+    }
 }
 
 /// Why a URDF cannot be read.
@@ -256,6 +287,9 @@ pub fn scan_bytes(bytes: Vec<u8>, path: &Path) -> Result<Robot, UrdfError> {
 
 /// The `<collision>` being read.
 struct CollisionInProgress {
+    /// A `<visual>`: read the same way, its warnings left out (urdfdom's rules for collisions are
+    /// what the tool checks; visuals are read only for `--geometry collision,visual`).
+    visual: bool,
     index: usize,
     line: usize,
     name: Option<String>,
@@ -438,7 +472,7 @@ impl<'t> Scanner<'t> {
                     finish_link(link, &mut self.links, &mut self.notes);
                 }
             }
-            (2, "collision") => {
+            (2, "collision" | "visual") => {
                 finish_collision(self.collision.take(), &mut self.current, &mut self.notes);
             }
             (2, "inertial") => {
@@ -456,7 +490,10 @@ impl<'t> Scanner<'t> {
         if name.starts_with("xacro:") {
             self.xacro.get_or_insert(tag.line);
         }
-        let in_collision = self.stack.get(2).is_some_and(|s| s == "collision");
+        let in_collision = self
+            .stack
+            .get(2)
+            .is_some_and(|s| s == "collision" || s == "visual");
         match (self.stack.len(), name) {
             (0, "robot") => {
                 self.robot_name = Some(tag.a.get("name").cloned().unwrap_or_default());
@@ -500,6 +537,8 @@ impl<'t> Scanner<'t> {
             inertial: None,
             extra_inertials: Vec::new(),
             collisions: Vec::new(),
+            visuals: Vec::new(),
+            from_visual: false,
         };
         if tag.empty {
             finish_link(link, &mut self.links, &mut self.notes);
@@ -517,9 +556,17 @@ impl<'t> Scanner<'t> {
             }
         }
         match child {
-            "collision" => {
-                let index = self.current.as_ref().map_or(1, |l| l.collisions.len() + 1);
+            "collision" | "visual" => {
+                let visual = child == "visual";
+                let index = self.current.as_ref().map_or(1, |l| {
+                    1 + if visual {
+                        l.visuals.len()
+                    } else {
+                        l.collisions.len()
+                    }
+                });
                 self.collision = Some(CollisionInProgress {
+                    visual,
                     index,
                     line: tag.line,
                     name: tag.a.get("name").cloned(),
@@ -572,6 +619,7 @@ impl<'t> Scanner<'t> {
                     Err(m) => c.error = Some(Geometry::Invalid { line, message: xacro_hint(format!("<origin> {m}")) }),
                 }
             }
+            Some(_) if c.visual => {}
             Some(first) => self.notes.push(warning(line, &self.current, format!("collision {}: a second <origin> is ignored (urdfdom reads the first, on line {first}); remove one", c.index))),
         }
     }
@@ -580,7 +628,7 @@ impl<'t> Scanner<'t> {
     fn collision_geometry(&mut self, line: usize) {
         if let Some(c) = self.collision.as_mut() {
             c.geometries += 1;
-            if c.geometries > 1 {
+            if c.geometries > 1 && !c.visual {
                 self.notes.push(warning(line, &self.current, format!("collision {}: a second <geometry> is ignored (urdfdom reads the first); give each shape its own <collision>", c.index)));
             }
         }
@@ -604,6 +652,7 @@ impl<'t> Scanner<'t> {
                 };
                 c.shape = Some((geometry, g.to_string(), line));
             }
+            Some(_) if c.visual => {}
             Some((_, first, first_line)) => {
                 let message = if g == "origin" {
                     format!("collision {}: <origin> inside <geometry> is ignored (as urdfdom does): an origin belongs in <collision>, before <geometry>", c.index)
@@ -776,6 +825,7 @@ fn finish_collision(
     let geometry = match (c.error, c.shape) {
         (Some(e), _) => e,
         (None, Some((g, _, _))) => g,
+        (None, None) if c.visual => return,
         (None, None) => {
             let what = if c.geometries == 0 {
                 "has no <geometry>"
@@ -791,7 +841,12 @@ fn finish_collision(
             return;
         }
     };
-    link.collisions.push(Collision {
+    let list = if c.visual {
+        &mut link.visuals
+    } else {
+        &mut link.collisions
+    };
+    list.push(Collision {
         index: c.index,
         name: c.name,
         line: c.line,

@@ -21,6 +21,9 @@ pub struct LinkUpdate {
     pub props: MassProperties,
     /// Relative error bound of the values (volume and inertia), at least the round-off floor.
     pub error: f64,
+    /// Relative precision of the input's coordinates (2⁻²⁴ for f32 mesh data, else 0): numbers are
+    /// written within it as well as within `error`, so the input's own noise is not written.
+    pub input_precision: f64,
     /// The link's size (m): the scale of its centre of mass.
     pub size: f64,
 }
@@ -32,6 +35,7 @@ impl From<(usize, MassProperties)> for LinkUpdate {
             index,
             props,
             error: ROUND_OFF_FLOOR,
+            input_precision: 0.0,
             size: 0.0,
         }
     }
@@ -140,7 +144,7 @@ fn written(update: &LinkUpdate, opts: &WriteOptions) -> Result<Written, String> 
     } else {
         ([0.0; 3], mp.inertia)
     };
-    let error = text::rounding_tolerance(update.error);
+    let error = text::rounding_tolerance(update.error.max(update.input_precision));
     // The COM is known relative to the link's size or to its own coordinates, whichever is larger.
     let length = mp.com.iter().fold(update.size, |m, x| m.max(x.abs()));
     let floor = |x: f64, scale: f64| text::within(x, ROUND_OFF_FLOOR * scale);
@@ -206,33 +210,104 @@ pub fn tidy_moments(moments: [f64; 3], error: f64, digits: Digits) -> [f64; 3] {
     }
 }
 
-/// The text of an `<inertial>` element for `update`, indented for its place.
+/// How the file writes its `<inertial>` elements, followed by the ones written: the end of an empty
+/// element (`/>` or ` />`), the order of `<origin>`'s and `<inertia>`'s attributes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InertialStyle {
+    close: &'static str,
+    rpy_first: bool,
+    /// Indices into ixx, ixy, ixz, iyy, iyz, izz, in the file's order.
+    order: [usize; 6],
+}
+
+impl Default for InertialStyle {
+    fn default() -> Self {
+        InertialStyle {
+            close: "/>",
+            rpy_first: false,
+            order: [0, 1, 2, 3, 4, 5],
+        }
+    }
+}
+
+const INERTIA_KEYS: [&str; 6] = ["ixx", "ixy", "ixz", "iyy", "iyz", "izz"];
+
+impl InertialStyle {
+    /// The style of the robot's first existing `<inertial>` (each part read where it is written;
+    /// the default where the file has none).
+    pub fn of(robot: &Robot) -> Self {
+        let mut style = InertialStyle::default();
+        let Some(span) = robot.links.iter().find_map(|l| l.inertial.as_ref()) else {
+            return style;
+        };
+        let body = robot.text.get(span.start..span.end).unwrap_or("");
+        // The position of attribute `key` in `tag`, as a whole name followed by `=`.
+        let attr = |tag: &str, key: &str| {
+            tag.match_indices(key).map(|(i, _)| i).find(|&i| {
+                tag[..i].ends_with(char::is_whitespace)
+                    && tag[i + key.len()..].trim_start().starts_with('=')
+            })
+        };
+        let tag = |name: &str| {
+            let start = body.find(&format!("<{name}"))?;
+            let rest = &body[start..];
+            Some(&rest[..rest.find('>')? + 1])
+        };
+        if let Some(t) = tag("inertia ") {
+            if let Some(before) = t.strip_suffix("/>") {
+                style.close = if before.ends_with(char::is_whitespace) {
+                    " />"
+                } else {
+                    "/>"
+                };
+            }
+            let at: Vec<Option<usize>> = INERTIA_KEYS.iter().map(|k| attr(t, k)).collect();
+            if at.iter().all(Option::is_some) {
+                let mut order = [0, 1, 2, 3, 4, 5];
+                order.sort_by_key(|&k| at[k]);
+                style.order = order;
+            }
+        }
+        if let Some(t) = tag("origin ") {
+            if let (Some(x), Some(r)) = (attr(t, "xyz"), attr(t, "rpy")) {
+                style.rpy_first = r < x;
+            }
+        }
+        style
+    }
+}
+
+/// The text of an `<inertial>` element for `update`, indented for its place, in `style`.
 pub fn inertial_text(
     update: &LinkUpdate,
     opts: &WriteOptions,
     indent: &str,
     unit: &str,
     nl: &str,
+    style: &InertialStyle,
 ) -> Result<String, String> {
     let w = written(update, opts)?;
     let n = |x: f64| text::shortest(x);
     let t = &w.tensor;
     let inner = format!("{indent}{unit}");
+    let xyz = format!("xyz=\"{} {} {}\"", n(w.com[0]), n(w.com[1]), n(w.com[2]));
+    let rpy = format!("rpy=\"{} {} {}\"", n(w.rpy[0]), n(w.rpy[1]), n(w.rpy[2]));
+    let origin = if style.rpy_first {
+        format!("{rpy} {xyz}")
+    } else {
+        format!("{xyz} {rpy}")
+    };
+    let values = [t[0][0], t[0][1], t[0][2], t[1][1], t[1][2], t[2][2]];
+    let inertia: Vec<String> = style
+        .order
+        .iter()
+        .map(|&k| format!("{}=\"{}\"", INERTIA_KEYS[k], n(values[k])))
+        .collect();
+    let close = style.close;
     Ok(format!(
-        "<inertial>{nl}{inner}<origin xyz=\"{} {} {}\" rpy=\"{} {} {}\"/>{nl}{inner}<mass value=\"{}\"/>{nl}{inner}<inertia ixx=\"{}\" ixy=\"{}\" ixz=\"{}\" iyy=\"{}\" iyz=\"{}\" izz=\"{}\"/>{nl}{indent}</inertial>",
-        n(w.com[0]),
-        n(w.com[1]),
-        n(w.com[2]),
-        n(w.rpy[0]),
-        n(w.rpy[1]),
-        n(w.rpy[2]),
+        "<inertial>{nl}{inner}<origin {origin}{close}{nl}{inner}<mass value=\"{}\"{close}{nl}{inner}<inertia {}{close}{nl}{indent}</inertial>",
         n(w.mass),
-        n(t[0][0]),
-        n(t[0][1]),
-        n(t[0][2]),
-        n(t[1][1]),
-        n(t[1][2]),
-        n(t[2][2]),
+        inertia.join(" "),
     ))
 }
 
@@ -284,8 +359,9 @@ pub fn splice(
 ) -> Result<String, Vec<WriteError>> {
     let mut edits: Vec<(usize, usize, String)> = Vec::new();
     let mut errors = Vec::new();
+    let style = InertialStyle::of(robot);
     for update in updates {
-        match link_edits(robot, update, opts) {
+        match link_edits(robot, update, opts, &style) {
             Ok(e) => edits.extend(e),
             Err(message) => errors.push(WriteError {
                 index: update.index,
@@ -316,6 +392,7 @@ fn link_edits(
     robot: &Robot,
     update: &LinkUpdate,
     opts: &WriteOptions,
+    style: &InertialStyle,
 ) -> Result<Vec<(usize, usize, String)>, String> {
     let link = &robot.links[update.index];
     let unit = indent_unit(link);
@@ -325,7 +402,7 @@ fn link_edits(
         .unwrap_or_else(|| format!("{}{unit}", link.indent));
     let Some(span) = &link.inertial else {
         // Insert as the link's first child, on its own line after the start tag.
-        let text = inertial_text(update, opts, &child_indent, &unit, robot.newline)?;
+        let text = inertial_text(update, opts, &child_indent, &unit, robot.newline, style)?;
         return Ok(vec![(
             link.open_end,
             link.open_end,
@@ -339,7 +416,7 @@ fn link_edits(
     } else {
         &child_indent
     };
-    let text = inertial_text(update, opts, indent, &unit, robot.newline)?;
+    let text = inertial_text(update, opts, indent, &unit, robot.newline, style)?;
     let mut edits = vec![(span.start, span.end, text)];
     for extra in &link.extra_inertials {
         let (start, end) = removal_span(&robot.text, extra.start, extra.end);
@@ -387,5 +464,43 @@ mod tests {
         ];
         let r = tidy_tensor(&t, 1e-3);
         assert!(valid(&r), "{r:?}");
+    }
+
+    #[test]
+    fn a_new_inertial_follows_the_files_style() {
+        let text = "<robot name=\"r\">\n  <link name=\"a\">\n    <inertial>\n      <origin rpy=\"0 0 0\" xyz=\"0 0 0\" />\n      <mass value=\"1\" />\n      <inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\" />\n    </inertial>\n  </link>\n  <link name=\"b\">\n    <collision><geometry><box size=\"1 1 1\"/></geometry></collision>\n  </link>\n</robot>\n";
+        let robot = crate::urdf::scan(text.to_string(), std::path::Path::new("r.urdf")).unwrap();
+        let style = InertialStyle::of(&robot);
+        assert_eq!(
+            style,
+            InertialStyle {
+                close: " />",
+                rpy_first: true,
+                order: [0, 3, 5, 1, 2, 4],
+            }
+        );
+        let mp = MassProperties {
+            mass: 2.0,
+            com: [0.5, 0.0, 0.0],
+            inertia: [[3.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 5.0]],
+        };
+        let out = splice(
+            &robot,
+            &[LinkUpdate::from((1, mp))],
+            &WriteOptions::default(),
+        )
+        .unwrap();
+        assert!(
+            out.contains("<origin rpy=\"0 0 0\" xyz=\"0.5 0 0\" />\n      <mass value=\"2\" />\n      <inertia ixx=\"3\" iyy=\"4\" izz=\"5\" ixy=\"0\" ixz=\"0\" iyz=\"0\" />"),
+            "{out}"
+        );
+        // A file without inertials gets the usual order and `/>`.
+        let bare = crate::urdf::scan(
+            text.replace("<inertial>", "<!--")
+                .replace("</inertial>", "-->"),
+            std::path::Path::new("r.urdf"),
+        )
+        .unwrap();
+        assert_eq!(InertialStyle::of(&bare), InertialStyle::default());
     }
 }
