@@ -66,6 +66,7 @@ fn sources(s: &SourceArgs) -> Result<Sources, String> {
         xacro_args,
         options: FillOptions {
             strict: s.strict,
+            open_mesh: super::args::OpenMesh::model(s.open_mesh),
             only: globs(&s.only)?,
             skip: globs(&s.skip)?,
             missing_only: false,

@@ -8,7 +8,7 @@
 //! them.
 
 use crate::mesh::health::{HealthKind, Rung, Solid};
-use crate::mesh::MeshError;
+use crate::mesh::{MeshError, MeshErrorKind};
 use serde::{Serialize, Serializer};
 use std::fmt;
 use std::fmt::Write as _;
@@ -58,6 +58,10 @@ pub enum Code {
     MeshTooLarge,
     /// UI107: faces dropped in pairs, a face and its reverse (they cancel in the integral).
     MeshFacesCancelled,
+    /// UI108: an open mesh whose flat caps cannot be trusted, or that encloses no volume however its
+    /// holes are closed, and no model for open meshes was chosen (`--open-mesh`): the part fails.
+    /// Carried by the link's error ([`LinkError::code`]).
+    MeshNoSolid,
     /// UI201: an element urdfdom ignores (a second `<origin>`, `<geometry>`, shape, `<inertial>`).
     UrdfIgnoredElement,
     /// UI202: a `<collision>` without a shape, ignored.
@@ -82,7 +86,7 @@ pub enum Code {
 
 impl Code {
     /// Every code, in table order.
-    pub const ALL: [Code; 17] = [
+    pub const ALL: [Code; 18] = [
         Code::MeshRepaired,
         Code::MeshFacesDropped,
         Code::MeshWelded,
@@ -90,6 +94,7 @@ impl Code {
         Code::MeshReaderNote,
         Code::MeshTooLarge,
         Code::MeshFacesCancelled,
+        Code::MeshNoSolid,
         Code::UrdfIgnoredElement,
         Code::UrdfEmptyCollision,
         Code::UrdfZeroVolume,
@@ -112,6 +117,7 @@ impl Code {
             Code::MeshReaderNote => "UI105",
             Code::MeshTooLarge => "UI106",
             Code::MeshFacesCancelled => "UI107",
+            Code::MeshNoSolid => "UI108",
             Code::UrdfIgnoredElement => "UI201",
             Code::UrdfEmptyCollision => "UI202",
             Code::UrdfZeroVolume => "UI203",
@@ -335,16 +341,30 @@ pub enum LinkErrorKind {
 }
 
 impl LinkErrorKind {
-    /// A short stable name for JSON: `invalid-geometry`, `mesh-not-found`, `mesh`, `mass-target`,
-    /// `unrepresentable`, `invalid-kept-mass`.
+    /// A short stable name for JSON: `invalid-geometry`, `mesh-not-found`, `mesh`, `open-mesh`,
+    /// `mass-target`, `unrepresentable`, `invalid-kept-mass`.
     pub fn name(&self) -> &'static str {
         match self {
             LinkErrorKind::InvalidGeometry { .. } => "invalid-geometry",
             LinkErrorKind::MeshNotFound { .. } => "mesh-not-found",
+            LinkErrorKind::Mesh(e) if matches!(e.kind, MeshErrorKind::NoSolid(_)) => "open-mesh",
             LinkErrorKind::Mesh(_) => "mesh",
             LinkErrorKind::MassTarget { .. } => "mass-target",
             LinkErrorKind::Unrepresentable(_) => "unrepresentable",
             LinkErrorKind::KeptMassInvalid { .. } => "invalid-kept-mass",
+        }
+    }
+}
+
+impl LinkError {
+    /// The diagnostic code of the failure, where it has one (UI108: an open mesh with no solid to
+    /// trust).
+    pub fn code(&self) -> Option<Code> {
+        match &*self.kind {
+            LinkErrorKind::Mesh(e) if matches!(e.kind, MeshErrorKind::NoSolid(_)) => {
+                Some(Code::MeshNoSolid)
+            }
+            _ => None,
         }
     }
 }
