@@ -185,13 +185,19 @@ impl<'a> Quickhull<'a> {
                 for e in 0..3 {
                     let (a, b) = (v[e], v[(e + 1) % 3]);
                     let n = self.edges[&(b, a)];
-                    let vis = *seen.entry(n).or_insert_with(|| self.sees(n as usize, eye));
-                    if vis {
-                        if !visible.contains(&n) {
-                            visible.push(n);
+                    // Each neighbour is tested once; a visible one is queued when first seen.
+                    match seen.get(&n) {
+                        Some(true) => {}
+                        Some(false) => horizon.push((a, b)),
+                        None => {
+                            let vis = self.sees(n as usize, eye);
+                            seen.insert(n, vis);
+                            if vis {
+                                visible.push(n);
+                            } else {
+                                horizon.push((a, b));
+                            }
                         }
-                    } else {
-                        horizon.push((a, b));
                     }
                 }
             }
