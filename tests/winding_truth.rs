@@ -218,27 +218,20 @@ fn run(args: &[&str]) -> std::process::Output {
         .expect("run")
 }
 
-/// The real binary: an open mesh whose caps cannot be trusted fails its link with UI108 (JSON kind
-/// `open-mesh`), `--open-mesh hull` fills it with the hull; a flat plate beside a box contributes
-/// nothing, with a UI203 note.
-#[test]
-fn open_mesh_flag_and_code_through_the_binary() {
-    let tmp = tempfile::tempdir().expect("tempdir");
+/// A robot of two links in `dir`: `shell`, an open box whose caps are not trusted, and `marker`, a
+/// box beside a flat plate.
+fn open_robot(dir: &Path) -> std::path::PathBuf {
     let (v, f) = moved_box();
     let open = without_side(&v, &without_side(&v, &f, 2, true), 0, true);
-    write_obj(&tmp.path().join("open.obj"), &v, &open);
+    write_obj(&dir.join("open.obj"), &v, &open);
     let plate_v = [
         [0.0, 0.0, 0.0],
         [0.1, 0.0, 0.0],
         [0.1, 0.1, 0.0],
         [0.0, 0.1, 0.0],
     ];
-    write_obj(
-        &tmp.path().join("plate.obj"),
-        &plate_v,
-        &[[0, 1, 2], [0, 2, 3]],
-    );
-    let urdf = tmp.path().join("robot.urdf");
+    write_obj(&dir.join("plate.obj"), &plate_v, &[[0, 1, 2], [0, 2, 3]]);
+    let urdf = dir.join("robot.urdf");
     std::fs::write(
         &urdf,
         r#"<robot name="r">
@@ -252,6 +245,16 @@ fn open_mesh_flag_and_code_through_the_binary() {
 "#,
     )
     .expect("write");
+    urdf
+}
+
+/// The real binary: an open mesh whose caps cannot be trusted fails its link with UI108 (JSON kind
+/// `open-mesh`), `--open-mesh hull` fills it with the hull; a flat plate beside a box contributes
+/// nothing, with a UI203 note.
+#[test]
+fn open_mesh_flag_and_code_through_the_binary() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let urdf = open_robot(tmp.path());
     let out = tmp.path().join("out.urdf");
     let base = [
         "fill",

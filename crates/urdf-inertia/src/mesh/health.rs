@@ -1278,7 +1278,7 @@ fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result<Sol
             .bound(&unit, &vertices)
             .relative;
         // An unbounded cap is still what `--open-mesh caps` asks for, with its bound.
-        if !(volume > 0.0) || relative.is_nan() {
+        if volume.is_nan() || volume <= 0.0 || relative.is_nan() {
             continue;
         }
         let plan = CappedSolid {
