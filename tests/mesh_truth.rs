@@ -54,6 +54,12 @@ fn every_estimate_bounds_the_real_error() {
     for case in wild::cases() {
         let o = match wild::run(&case) {
             Ok(o) => o,
+            // An open mesh whose caps cannot be trusted gives no numbers by default (UI108):
+            // nothing claimed, nothing to bound.
+            Err(e) if case.expect == Expect::Bounded && e.contains("UI108") => {
+                println!("{:<55} no solid (UI108)", case.name);
+                continue;
+            }
             Err(e) => {
                 failures.push(format!("{}: {e}", case.name));
                 continue;
@@ -158,7 +164,8 @@ fn needles_through_the_mesh_command() {
 #[test]
 fn large_error_estimates_do_not_round_numbers_away() {
     let tmp = tempfile::tempdir().expect("tempdir");
-    // A unit cube without its top, one top corner raised 0.1: flat caps are uncertain by a few %.
+    // A unit cube without its top, one top corner raised 0.1: flat caps are uncertain by a few %
+    // (above the 1e-3 they are trusted to, so asked for with `--open-mesh caps`).
     let mut obj = String::new();
     for i in 0..8 {
         let z = f64::from((i >> 2) & 1) + if i == 7 { 0.1 } else { 0.0 };
@@ -188,6 +195,8 @@ fn large_error_estimates_do_not_round_numbers_away() {
             "1",
             "--digits",
             digits,
+            "--open-mesh",
+            "caps",
         ]);
         let text = String::from_utf8(stdout).expect("utf-8");
         let mass: f64 = text

@@ -181,6 +181,7 @@ def main():
     rows = []
     explained = []
     failures = []
+    expected_failures = []
     all_rungs = {}
     shipped_notes = []
     t_all = time.time()
@@ -193,10 +194,18 @@ def main():
         filled = urdf.with_name(urdf.name + ".filled")
         stripped.write_text(strip_inertials(text), encoding="utf-8")
         t0 = time.time()
-        proc = subprocess.run(
-            [args.binary, "fill", str(stripped), "--density", str(DENSITY), "-o", str(filled), "--format", "json",
-             "--package-path", f"example-robot-data={share / 'example-robot-data'}"],
-            capture_output=True, text=True)
+        command = [args.binary, "fill", str(stripped), "--density", str(DENSITY), "-o", str(filled), "--format", "json",
+                   "--package-path", f"example-robot-data={share / 'example-robot-data'}"]
+        proc = subprocess.run(command, capture_output=True, text=True)
+        no_solid = [l for l in proc.stderr.splitlines() if "UI108" in l]
+        if proc.returncode != 0 and no_solid:
+            # Open meshes whose caps cannot be trusted fail their links by default (UI108): the
+            # expected outcome, listed. The comparison with pinocchio then asks for the convex hull
+            # explicitly (an upper bound; such joints are explained, coal integrating the open surface).
+            which = sorted({f"{m.group(1)} ({Path(m.group(2)).name})" for m in
+                            (re.search(r"link `([^`]*)`: collision \d+ \(line \d+\): (.*?): UI108", l) for l in no_solid) if m})
+            expected_failures.append(f"| {rel} | {len(no_solid)} | {', '.join(which)[:600]} |")
+            proc = subprocess.run(command + ["--open-mesh", "hull"], capture_output=True, text=True)
         seconds = time.time() - t0
         (work / (str(rel).replace("/", "__") + ".log")).write_text(proc.stderr)
         if proc.returncode != 0:
@@ -349,6 +358,18 @@ def main():
         "|---|---|---|---|",
     ]
     lines += explained or ["| - | - | - | none |"]
+    lines += [
+        "",
+        "## Expected failures: open meshes with no solid to trust (UI108)",
+        "",
+        "By default `fill` fails a link whose open mesh's flat caps cannot be trusted (bound above 1e-3) "
+        "instead of silently taking its convex hull. These URDFs were then filled again with "
+        "`--open-mesh hull` (an explicit upper bound) for the comparisons above.",
+        "",
+        "| URDF | links failing by default | links (mesh) |",
+        "|---|---|---|",
+    ]
+    lines += expected_failures or ["| - | - | none |"]
     lines += [
         "",
         "## Shipped (CAD) inertials against computed ones (informational)",

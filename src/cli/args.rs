@@ -47,6 +47,27 @@ pub enum Format {
     Json,
 }
 
+/// `--open-mesh`: what an open mesh whose flat caps cannot be trusted becomes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum OpenMesh {
+    /// Flat caps over the holes, whatever their bound (the estimate carries it).
+    Caps,
+    /// The convex hull of the vertices the faces use: an upper bound on the solid.
+    Hull,
+}
+
+impl OpenMesh {
+    /// The library's model for the flag (absent: fail the part, UI108).
+    pub fn model(flag: Option<OpenMesh>) -> urdf_inertia::mesh::open::OpenMeshModel {
+        use urdf_inertia::mesh::open::OpenMeshModel;
+        match flag {
+            None => OpenMeshModel::Trusted,
+            Some(OpenMesh::Caps) => OpenMeshModel::Caps,
+            Some(OpenMesh::Hull) => OpenMeshModel::Hull,
+        }
+    }
+}
+
 /// Where densities come from and where meshes are found: shared by fill, diff and check.
 #[derive(Debug, Clone, ClapArgs)]
 pub struct SourceArgs {
@@ -69,6 +90,11 @@ pub struct SourceArgs {
     /// Treat every repaired mesh (re-wound, flipped, convex hull) as an error.
     #[arg(long)]
     pub strict: bool,
+    /// An open mesh whose flat caps cannot be trusted (bound above 1e-3) fails its link (UI108)
+    /// unless a model is chosen: `caps` (used with their bound) or `hull` (the convex hull, an upper
+    /// bound).
+    #[arg(long, value_enum, value_name = "caps|hull")]
+    pub open_mesh: Option<OpenMesh>,
     /// Only these links (glob, repeatable).
     #[arg(long, value_name = "GLOB")]
     pub only: Vec<String>,
@@ -229,6 +255,10 @@ pub struct MeshArgs {
     /// Treat every repaired mesh as an error.
     #[arg(long)]
     pub strict: bool,
+    /// An open mesh whose flat caps cannot be trusted is an error (UI108) unless a model is chosen:
+    /// `caps` or `hull` (an upper bound).
+    #[arg(long, value_enum, value_name = "caps|hull")]
+    pub open_mesh: Option<OpenMesh>,
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
     /// Digits of the numbers: `auto` (default: the shortest decimal within the solid's error

@@ -21,6 +21,7 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         scale,
         HealthOptions {
             strict: args.strict,
+            open_mesh: super::args::OpenMesh::model(args.open_mesh),
         },
     ) {
         Ok(s) => s,

@@ -110,6 +110,7 @@ fn sources(s: &SourceArgs, settings: &Settings) -> Result<Sources, String> {
         xacro_args,
         options: FillOptions {
             strict: s.strict,
+            open_mesh: super::args::OpenMesh::model(s.open_mesh),
             only: globs(&s.only)?,
             skip: globs(&s.skip)?,
             missing_only: false,

@@ -9,7 +9,7 @@
 //! "Diagnostics" table lists them.
 
 use crate::mesh::health::{HealthKind, Rung, Solid};
-use crate::mesh::MeshError;
+use crate::mesh::{MeshError, MeshErrorKind};
 use serde::{Serialize, Serializer};
 use std::fmt;
 use std::fmt::Write as _;
@@ -62,6 +62,10 @@ pub enum Code {
     MeshTooLarge,
     /// UI107: faces dropped in pairs, a face and its reverse (they cancel in the integral).
     MeshFacesCancelled,
+    /// UI108: an open mesh whose flat caps cannot be trusted, or that encloses no volume however its
+    /// holes are closed, and no model for open meshes was chosen (`--open-mesh`): the part fails.
+    /// Carried by the link's error ([`LinkError::code`]).
+    MeshNoSolid,
     /// UI201: an element urdfdom ignores (a second `<origin>`, `<geometry>`, shape, `<inertial>`).
     UrdfIgnoredElement,
     /// UI202: a `<collision>` without a shape, ignored.
@@ -132,7 +136,7 @@ pub enum Code {
 
 impl Code {
     /// Every code, in table order.
-    pub const ALL: [Code; 39] = [
+    pub const ALL: [Code; 40] = [
         Code::MeshRepaired,
         Code::MeshFacesDropped,
         Code::MeshWelded,
@@ -140,6 +144,7 @@ impl Code {
         Code::MeshReaderNote,
         Code::MeshTooLarge,
         Code::MeshFacesCancelled,
+        Code::MeshNoSolid,
         Code::UrdfIgnoredElement,
         Code::UrdfEmptyCollision,
         Code::UrdfZeroVolume,
@@ -184,6 +189,7 @@ impl Code {
             Code::MeshReaderNote => "UI105",
             Code::MeshTooLarge => "UI106",
             Code::MeshFacesCancelled => "UI107",
+            Code::MeshNoSolid => "UI108",
             Code::UrdfIgnoredElement => "UI201",
             Code::UrdfEmptyCollision => "UI202",
             Code::UrdfZeroVolume => "UI203",
@@ -230,7 +236,9 @@ impl Code {
     /// `--warn-as-error` promote, and `check`'s problems (6xx), which `--ignore` may silence; not
     /// the errors (7xx).
     pub fn is_error(self) -> bool {
-        self.as_str().starts_with("UI7")
+        // UI108 (an open mesh with no solid to trust) fails its part like the UI7xx errors; its
+        // number keeps it beside the other mesh codes.
+        self.as_str().starts_with("UI7") || self == Code::MeshNoSolid
     }
 
     /// The code's severity.
@@ -256,7 +264,8 @@ impl Code {
             | Code::ErrorMissingDensity
             | Code::ErrorTotalMass
             | Code::ErrorWrite
-            | Code::ErrorPartTooLarge => Severity::Error,
+            | Code::ErrorPartTooLarge
+            | Code::MeshNoSolid => Severity::Error,
             _ => Severity::Warning,
         }
     }
@@ -465,12 +474,13 @@ pub enum LinkErrorKind {
 }
 
 impl LinkErrorKind {
-    /// A short stable name for JSON: `invalid-geometry`, `mesh-not-found`, `mesh`, `mass-target`,
-    /// `unrepresentable`, `invalid-kept-mass`.
+    /// A short stable name for JSON: `invalid-geometry`, `mesh-not-found`, `mesh`, `open-mesh`,
+    /// `mass-target`, `unrepresentable`, `invalid-kept-mass`.
     pub fn name(&self) -> &'static str {
         match self {
             LinkErrorKind::InvalidGeometry { .. } => "invalid-geometry",
             LinkErrorKind::MeshNotFound { .. } => "mesh-not-found",
+            LinkErrorKind::Mesh(e) if matches!(e.kind, MeshErrorKind::NoSolid(_)) => "open-mesh",
             LinkErrorKind::Mesh(_) => "mesh",
             LinkErrorKind::MassTarget { .. } => "mass-target",
             LinkErrorKind::Unrepresentable(_) => "unrepresentable",
@@ -484,6 +494,9 @@ impl LinkErrorKind {
         match self {
             LinkErrorKind::InvalidGeometry { .. } => Code::ErrorInvalidGeometry,
             LinkErrorKind::MeshNotFound { .. } => Code::ErrorMeshNotFound,
+            LinkErrorKind::Mesh(e) if matches!(e.kind, MeshErrorKind::NoSolid(_)) => {
+                Code::MeshNoSolid
+            }
             LinkErrorKind::Mesh(_) => Code::ErrorMesh,
             LinkErrorKind::MassTarget { .. } => Code::ErrorMassTarget,
             LinkErrorKind::Unrepresentable(_) => Code::ErrorUnrepresentable,

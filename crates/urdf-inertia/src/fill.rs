@@ -35,6 +35,8 @@ const PRIMITIVE_ERROR: ErrorEstimate = ErrorEstimate {
 #[derive(Debug, Clone, Default)]
 pub struct FillOptions {
     pub strict: bool,
+    /// What an open mesh whose caps cannot be trusted becomes (`--open-mesh`).
+    pub open_mesh: crate::mesh::open::OpenMeshModel,
     /// `--only` / `--skip`: links selected by name, compiled once.
     pub only: Vec<crate::density::Glob>,
     pub skip: Vec<crate::density::Glob>,
@@ -677,10 +679,12 @@ fn compute_links<'r>(
     let mesh_files = files.len();
     let health = HealthOptions {
         strict: opts.strict,
+        open_mesh: opts.open_mesh,
     };
     let results = cache.load_and_run(&needs, health, |t, solids| {
         let (li, link) = targets[t];
-        link_parts(link, ctx, solids).and_then(|parts| compute_link(li, link, parts, map, opts))
+        link_parts(link, ctx, solids)
+            .and_then(|(parts, flat)| compute_link(li, link, parts, flat, map, opts))
     });
     let links = targets.iter().map(|(_, link)| *link).zip(results).collect();
     (mesh_files, links)
@@ -692,13 +696,61 @@ struct ComputedLink {
     faces: usize,
 }
 
-/// A link's parts (its collisions but the zero-size ones), or the first that fails.
-fn link_parts(link: &Link, ctx: &Context<'_>, solids: &Solids<'_>) -> Result<Vec<Part>, LinkError> {
-    link.collisions
+/// A link's parts (its collisions but the zero-size ones), or the first that fails; with the notes
+/// of the meshes that enclose no volume (a flat plate, a two-sided sheet), which contribute nothing
+/// as a zero-size primitive does (UI203). A link left with no part fails with the first such mesh's
+/// error: it has nothing to compute from.
+fn link_parts(
+    link: &Link,
+    ctx: &Context<'_>,
+    solids: &Solids<'_>,
+) -> Result<(Vec<Part>, Vec<Diagnostic>), LinkError> {
+    let mut parts = Vec::new();
+    let mut flat = Vec::new();
+    let mut first_flat = None;
+    for c in link
+        .collisions
         .iter()
         .filter(|c| !c.geometry.is_zero_size())
-        .map(|c| geometry_part(link, c, ctx, solids))
-        .collect()
+    {
+        match geometry_part(link, c, ctx, solids) {
+            Ok(p) => parts.push(p),
+            Err(e) => {
+                let Some((path, volume, bbox)) = is_flat(&e) else {
+                    return Err(e);
+                };
+                let message = format!(
+                    "collision {}: {} encloses no volume ({} m³ against a bounding box of {} m³: a flat plate or a two-sided sheet); it contributes nothing, as a zero-size shape does",
+                    c.index,
+                    crate::text::escape_control(&path),
+                    crate::text::significant(volume, 4),
+                    crate::text::significant(bbox, 4)
+                );
+                let note = Diagnostic::new(Code::UrdfZeroVolume, message);
+                flat.push(note.at(part_location(link, c)));
+                first_flat.get_or_insert(e);
+            }
+        }
+    }
+    match first_flat {
+        Some(e) if parts.is_empty() => Err(e),
+        _ => Ok((parts, flat)),
+    }
+}
+
+/// The mesh (its path, volume and bounding-box volume) when a part failed only because its mesh
+/// encloses no volume (not because it is beyond f64's range: that is another error).
+fn is_flat(e: &LinkError) -> Option<(String, f64, f64)> {
+    match &*e.kind {
+        LinkErrorKind::Mesh(m) => match m.kind {
+            crate::mesh::MeshErrorKind::ZeroVolume {
+                volume,
+                bbox_volume,
+            } => Some((m.path.display().to_string(), volume, bbox_volume)),
+            _ => None,
+        },
+        _ => None,
+    }
 }
 
 /// One link: its parts, their densities, the body, the overlap estimate. `Ok(None)` when the link has
@@ -708,6 +760,7 @@ fn compute_link(
     index: usize,
     link: &Link,
     mut parts: Vec<Part>,
+    flat: Vec<Diagnostic>,
     map: &DensityMap,
     opts: &FillOptions,
 ) -> LinkResult {
@@ -743,6 +796,7 @@ fn compute_link(
             ..Location::default()
         });
     }
+    diagnostics.extend(flat);
     let density_based = matches!(densities.link_spec, Some((_, Spec::Density(_))))
         && densities.own.iter().all(Option::is_none);
     let report = LinkReport {

@@ -247,8 +247,17 @@ fn broken_meshes_take_the_documented_rung() {
         "{:?}",
         s.warnings
     );
-    assert!(mesh::load_solid(&p, [1.0; 3], HealthOptions { strict: true }).is_err());
-    // Top and one side missing: an L-shaped, far from flat hole → convex hull, with the numbers.
+    assert!(mesh::load_solid(
+        &p,
+        [1.0; 3],
+        HealthOptions {
+            strict: true,
+            ..HealthOptions::default()
+        }
+    )
+    .is_err());
+    // Top and one side missing: an L-shaped, far from flat hole → no solid to trust by default
+    // (UI108), the convex hull with the numbers when asked for.
     let open2: Vec<[u32; 3]> = open
         .iter()
         .copied()
@@ -256,7 +265,17 @@ fn broken_meshes_take_the_documented_rung() {
         .collect();
     assert_eq!(open2.len(), 8);
     let p = write(d, "open2.stl", &write_binary(b"open", &v, &open2));
-    let s = mesh::load_solid(&p, [1.0; 3], HealthOptions::default()).unwrap();
+    let e = mesh::load_solid(&p, [1.0; 3], HealthOptions::default()).unwrap_err();
+    assert!(matches!(e.kind, MeshErrorKind::NoSolid(_)), "{e}");
+    assert!(
+        e.to_string().contains("UI108") && e.to_string().contains("--open-mesh hull"),
+        "{e}"
+    );
+    let hull = HealthOptions {
+        open_mesh: mesh::open::OpenMeshModel::Hull,
+        ..HealthOptions::default()
+    };
+    let s = mesh::load_solid(&p, [1.0; 3], hull).unwrap();
     match &s.rung {
         Rung::ConvexHull {
             boundary_edges,
@@ -288,9 +307,16 @@ fn broken_meshes_take_the_documented_rung() {
     );
     assert!((s.unit.mass - 0.5 * 0.25 * 0.125).abs() < 1e-15);
     assert!(matches!(
-        mesh::load_solid(&p, [1.0; 3], HealthOptions { strict: true })
-            .unwrap_err()
-            .kind,
+        mesh::load_solid(
+            &p,
+            [1.0; 3],
+            HealthOptions {
+                strict: true,
+                ..HealthOptions::default()
+            }
+        )
+        .unwrap_err()
+        .kind,
         MeshErrorKind::Strict(_)
     ));
     // Inside-out box → inverted, exact numbers.

@@ -12,20 +12,23 @@
 //!    component is made consistent, then turned outward by its signed volume.
 //! 4. [`Rung::Inverted`]: closed and consistent but wound inward (negative volume): flipped.
 //! 5. Open (boundary edges) or non-manifold, after orienting what the manifold edges allow:
-//!    * [`Rung::Capped`]: each boundary loop is closed by a fan from its centroid. When the bound
-//!      the caps leave on volume and inertia (below) is under 1e-3, the capped mesh is used; above
-//!      that, the convex hull is built too and the one with the smaller bound wins. When the caps'
-//!      bound is below 1e-12 (the "holes" are slivers), the triangles are integrated as stored and
-//!      the rung is [`Rung::Welded`].
+//!    * [`Rung::Capped`]: each boundary loop is closed by a fan from its centroid, used when the
+//!      bound the caps leave on volume and inertia (below) is under 1e-3
+//!      ([`super::open::TRUSTED_CAPS`]). When the caps' bound is below 1e-12 (the "holes" are
+//!      slivers), the triangles are integrated as stored and the rung is [`Rung::Welded`].
 //!    * [`Rung::NonManifold`]: no boundary edges but edges shared by three or more faces: the surface
 //!      still bounds a region, integrated as it is (a region enclosed twice counts twice).
-//!    * [`Rung::ConvexHull`] otherwise: the convex hull of its vertices.
+//!    * Otherwise the mesh defines no solid to trust: the model the user chose for open meshes
+//!      ([`OpenMeshModel`]: the caps whatever their bound, or [`Rung::ConvexHull`], the hull of the
+//!      vertices the faces use, an upper bound), or by default an error
+//!      ([`MeshErrorKind::NoSolid`]). The hull is never a silent last resort.
 //! 6. No volume against the round-off of its faces: an error.
 //!
 //! Every solid carries an [`ErrorEstimate`]: a bound on the relative error of its volume and central
 //! inertia, made of the integration's round-off and, below the exact rungs, the model error (how far
 //! the solid integrated can be from the surface stored). See [`ModelError`] for each term.
 
+use super::open::{NoSolid, OpenMeshModel};
 use super::{hull, weld, MeshError, MeshErrorKind, RawMesh};
 use crate::mass::integrals::{bounding_box_centre, volume_integrals, VolumeIntegrals};
 use crate::mass::{frobenius, IntegrationOptions, MassProperties, Polygons};
@@ -241,13 +244,15 @@ pub struct Solid {
 pub struct HealthOptions {
     /// Every rung below [`Rung::Welded`] is an error.
     pub strict: bool,
+    /// What an open mesh whose caps cannot be trusted becomes (`--open-mesh`).
+    pub open_mesh: OpenMeshModel,
 }
 
 /// A solid's volume below this many f64 round-offs of its faces' contributions counts as empty.
 const ZERO_VOLUME_ROUNDOFFS: f64 = 1e3;
 
-/// Largest relative bound of the caps for which a capped mesh is used without trying the hull.
-const CAPPED: f64 = 1e-3;
+/// Largest relative bound of the caps for which a capped mesh is used without asking.
+const CAPPED: f64 = super::open::TRUSTED_CAPS;
 
 /// Caps whose uncertainty is below this (relative) close slivers, not holes: integrate as stored.
 const SLIVERS: f64 = 1e-12;
@@ -1280,7 +1285,8 @@ fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result<Sol
         let relative = caps_model(&caps, cracks, winding.nested)
             .bound(&unit, &vertices)
             .relative;
-        if !(volume > 0.0 && relative.is_finite()) {
+        // An unbounded cap is still what `--open-mesh caps` asks for, with its bound.
+        if volume.is_nan() || volume <= 0.0 || relative.is_nan() {
             continue;
         }
         let plan = CappedSolid {
@@ -1297,13 +1303,37 @@ fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) -> Result<Sol
             fallback = Some((relative, winding, plan));
         }
     }
-    // Caps too uncertain to trust outright: the convex hull, unless its own bound is worse.
-    let Some((relative, winding, plan)) = fallback else {
-        return convex_hull(ladder, &w, te, &what);
+    // Caps too uncertain to trust: the model the user chose, or no solid (never a silent hull).
+    let no_solid = |caps_bound| {
+        MeshError::new(
+            ladder.path,
+            None,
+            MeshErrorKind::NoSolid(NoSolid {
+                what: what.clone(),
+                caps_bound,
+            }),
+        )
     };
-    match convex_hull(ladder.clone(), &w, te, &what) {
-        Ok(hull) if hull.error_estimate < relative => Ok(hull),
-        _ => with_caps(ladder, w, te, winding, plan, &what),
+    match (ladder.options.open_mesh, fallback) {
+        (OpenMeshModel::Hull, _) => convex_hull(ladder, &w, te, &what),
+        (OpenMeshModel::Caps, Some((_, winding, plan))) => {
+            with_caps(ladder, w, te, winding, plan, &what)
+        }
+        (OpenMeshModel::Trusted, Some((relative, ..))) => Err(no_solid(Some(relative))),
+        // No closing encloses a volume: a flat plate or a two-sided sheet has none to speak of (the
+        // part contributes nothing); anything else defines no solid.
+        (_, None) if super::open::encloses_nothing(&w.vertices, &w.stored) => {
+            let (lo, hi) = bbox(&w.vertices);
+            Err(MeshError::new(
+                ladder.path,
+                None,
+                MeshErrorKind::ZeroVolume {
+                    volume: signed_volume(&w.vertices, &w.stored),
+                    bbox_volume: (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]),
+                },
+            ))
+        }
+        (_, None) => Err(no_solid(None)),
     }
 }
 
@@ -1435,7 +1465,8 @@ fn convex_hull(
     // The stored surface's signed volume, and how much it moves over reference points in the box.
     let own = signed_volume(&w.vertices, &w.stored);
     let moves = vector_area(&w.vertices, &w.stored) * diag / 6.0;
-    let (hv, ht) = hull::convex_hull(&w.vertices).map_err(|err| match err {
+    // The hull of the vertices the faces use: unused stored positions are not the surface's.
+    let (hv, ht) = hull::convex_hull_of_used(&w.vertices, &w.stored).map_err(|err| match err {
         hull::HullError::Degenerate => MeshError::new(
             ladder.path,
             None,
@@ -1443,19 +1474,6 @@ fn convex_hull(
                 volume: own,
                 bbox_volume: (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]),
             },
-        ),
-        hull::HullError::Failed(m) => MeshError::new(
-            ladder.path,
-            None,
-            MeshErrorKind::Hull(format!("the mesh is {what}, and its convex hull failed: {m}")),
-        ),
-        hull::HullError::TooManyPoints(n) => MeshError::new(
-            ladder.path,
-            None,
-            MeshErrorKind::Hull(format!(
-                "the mesh is {what}, and its convex hull (the last resort) would need {n} candidate points, over the limit of {} that bounds its memory",
-                hull::MAX_POINTS
-            )),
         ),
     })?;
     let hull_faces = Polygons::from_triangles(&ht);
@@ -1476,7 +1494,7 @@ fn convex_hull(
             "not bounded: the mesh's own volume is too uncertain to compare".to_string()
         };
         Some(format!(
-            "mesh is {what}; used its convex hull ({nv} vertices, volume {hull_volume:.6e} m³). The mesh's own signed volume is {own:.6e} m³ ({share:+.1}% of the hull) and moves by up to {moves:.2e} m³ with the reference point, so it is not a solid; the hull's numbers are {bound}"
+            "mesh is {what}; used its convex hull as `--open-mesh hull` asks ({nv} vertices, volume {hull_volume:.6e} m³): an upper bound, as the solid the surface encloses lies inside it. The mesh's own signed volume is {own:.6e} m³ ({share:+.1}% of the hull) and moves by up to {moves:.2e} m³ with the reference point, so it is not a solid; the hull's numbers are {bound}"
         ))
     };
     let rung = Rung::ConvexHull {
@@ -1823,13 +1841,21 @@ mod tests {
     // Corpus finding: a capped mesh reported an unbounded estimate when a small part lay far away.
     #[test]
     fn caps_bound_does_not_grow_with_far_parts() {
+        // The bound (about 4e-3) is above the 1e-3 caps are trusted to: asked for explicitly.
+        let caps = HealthOptions {
+            open_mesh: OpenMeshModel::Caps,
+            ..HealthOptions::default()
+        };
         for far in [10.0, 30.0, 1000.0] {
-            let s = make_solid(
+            let e = make_solid(
                 &open_cube_and_far_tetrahedron(far),
                 Path::new("t"),
                 HealthOptions::default(),
             )
-            .expect("solid");
+            .expect_err("not trusted by default");
+            assert!(matches!(e.kind, MeshErrorKind::NoSolid(_)), "{e}");
+            let s = make_solid(&open_cube_and_far_tetrahedron(far), Path::new("t"), caps)
+                .expect("solid");
             assert_eq!(s.rung.name(), "capped", "{far}");
             // The cap over the raised corner: 2 × 5e-4 (deviation) × 1 (area) = 1e-3 m³ of volume
             // at most 1.5 m from the cube's centre, against 1 m³ and the cube's inertia.

@@ -12,6 +12,7 @@ pub mod gltf;
 pub mod health;
 pub mod hull;
 pub mod obj;
+pub mod open;
 pub mod stl;
 pub mod weld;
 
@@ -110,6 +111,8 @@ pub enum MeshErrorKind {
     BadScale([f64; 3]),
     /// An open mesh whose convex hull could not be built either.
     Hull(String),
+    /// An open mesh with no solid to trust under the model chosen for open meshes (`--open-mesh`).
+    NoSolid(open::NoSolid),
     /// A reader or the healing panicked (a bug): caught, so that it fails only this mesh.
     Internal(String),
     /// A feature of the format urdf-inertia does not read (a glTF compression extension, ...), named.
@@ -147,6 +150,7 @@ impl fmt::Display for MeshError {
             ),
             MeshErrorKind::Strict(msg) => write!(f, "{msg} (an error under --strict)"),
             MeshErrorKind::Hull(msg) => write!(f, "{msg}; close the mesh or give the link a primitive collision shape"),
+            MeshErrorKind::NoSolid(why) => write!(f, "{why}"),
             MeshErrorKind::BadScale(s) => {
                 write!(f, "scale \"{} {} {}\" has a zero or non-finite factor", s[0], s[1], s[2])
             }

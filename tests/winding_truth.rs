@@ -1,0 +1,339 @@
+//! Open meshes: the model for meshes that do not close (`--open-mesh`), the hull of the vertices the
+//! faces use, and meshes of no volume, against exact rational integrals and analytic volumes.
+
+// The test helpers are the library tests' own (exact integrals, mesh generators).
+#[path = "../crates/urdf-inertia/tests/common/mod.rs"]
+mod common;
+
+use common::Mesh;
+use std::fmt::Write as _;
+use std::path::Path;
+use urdf_inertia::mass::Polygons;
+use urdf_inertia::mesh::health::{HealthOptions, Rung, Solid};
+use urdf_inertia::mesh::open::OpenMeshModel;
+use urdf_inertia::mesh::{MeshError, MeshErrorKind, RawMesh};
+
+fn solid(v: &[[f64; 3]], f: &[[u32; 3]], open_mesh: OpenMeshModel) -> Result<Solid, MeshError> {
+    let raw = RawMesh {
+        vertices: v.to_vec(),
+        faces: Polygons::from_triangles(f),
+        ..Default::default()
+    };
+    let options = HealthOptions {
+        open_mesh,
+        ..HealthOptions::default()
+    };
+    urdf_inertia::mesh::solid_from_raw(&raw, [1.0; 3], Path::new("open.obj"), options)
+}
+
+/// A box 0.3 × 0.2 × 0.1 moved off the origin.
+fn moved_box() -> Mesh {
+    let (v, f) = common::box_mesh([0.3, 0.2, 0.1]);
+    let v = v
+        .iter()
+        .map(|p| [p[0] + 1.25, p[1] - 0.5, p[2] + 0.75])
+        .collect();
+    (v, f)
+}
+
+/// The faces of `f` not lying wholly on the box's top (`top`) or bottom side along axis `k`.
+fn without_side(v: &[[f64; 3]], f: &[[u32; 3]], k: usize, top: bool) -> Vec<[u32; 3]> {
+    let extreme = v
+        .iter()
+        .map(|p| p[k])
+        .fold(if top { f64::MIN } else { f64::MAX }, |a, b| {
+            if top {
+                a.max(b)
+            } else {
+                a.min(b)
+            }
+        });
+    f.iter()
+        .copied()
+        .filter(|t| !t.iter().all(|&i| v[i as usize][k] == extreme))
+        .collect()
+}
+
+fn rel(got: f64, exact: &num_rational::BigRational) -> f64 {
+    common::rel_error(got, exact)
+}
+
+/// A box with its top face removed, capped flat: the cap is the removed face, so volume, COM and
+/// inertia are the closed box's to round-off, and the estimate bounds the real error.
+#[test]
+fn flat_cap_over_a_removed_face_is_exact() {
+    let (v, f) = moved_box();
+    let open = without_side(&v, &f, 2, true);
+    assert_eq!(open.len(), 10);
+    let s = solid(&v, &open, OpenMeshModel::default()).expect("capped");
+    assert!(
+        matches!(s.rung, Rung::Capped { holes: 1, .. }),
+        "{:?}",
+        s.rung
+    );
+    let exact = common::exact_mass(&common::exact_integrals(&v, &f));
+    let volume_error = rel(s.unit.mass, &exact.volume);
+    let inertia_error = common::inertia_error(&s.unit.inertia, &exact.inertia);
+    assert!(
+        volume_error <= s.error_estimate && inertia_error <= s.error_estimate,
+        "volume {volume_error:e}, inertia {inertia_error:e}, estimate {:e}",
+        s.error_estimate
+    );
+    assert!(s.error_estimate < 1e-12, "{}", s.error_estimate);
+}
+
+/// A box without its top and one side: the hole is an L, far from flat, so its caps are not
+/// trusted. By default no solid (UI108, naming the choices); `caps` uses them with their bound;
+/// `hull` gives the box (exactly: the hull of its corners) as an upper bound.
+#[test]
+fn untrusted_caps_fail_by_default_and_the_hull_is_explicit() {
+    let (v, f) = moved_box();
+    let open = without_side(&v, &without_side(&v, &f, 2, true), 0, true);
+    assert_eq!(open.len(), 8);
+    let e = solid(&v, &open, OpenMeshModel::Trusted).expect_err("no solid by default");
+    assert!(matches!(e.kind, MeshErrorKind::NoSolid(_)), "{e}");
+    let text = e.to_string();
+    for want in [
+        "UI108",
+        "open.obj",
+        "--open-mesh caps",
+        "--open-mesh hull",
+        "flat caps over its holes leave",
+    ] {
+        assert!(text.contains(want), "{want} not in {text}");
+    }
+    let caps = solid(&v, &open, OpenMeshModel::Caps).expect("caps when asked");
+    assert!(matches!(caps.rung, Rung::Capped { .. }), "{:?}", caps.rung);
+    assert!(caps.error_estimate > 1e-3, "{}", caps.error_estimate);
+    let hull = solid(&v, &open, OpenMeshModel::Hull).expect("hull when asked");
+    assert!(
+        matches!(hull.rung, Rung::ConvexHull { .. }),
+        "{:?}",
+        hull.rung
+    );
+    assert!(
+        hull.warnings.iter().any(|w| w.contains("an upper bound")),
+        "{:?}",
+        hull.warnings
+    );
+    let exact = common::exact_mass(&common::exact_integrals(&v, &f));
+    assert!(rel(hull.unit.mass, &exact.volume) < 1e-14);
+    assert!(common::inertia_error(&hull.unit.inertia, &exact.inertia) < 1e-13);
+}
+
+/// Stored positions no face uses do not widen the hull (a mesh that keeps the vertices of deleted
+/// parts: its hull was several times too large).
+#[test]
+fn hull_ignores_positions_no_face_uses() {
+    let (mut v, f) = moved_box();
+    let open = without_side(&v, &without_side(&v, &f, 2, true), 0, true);
+    let closed_volume = common::exact_mass(&common::exact_integrals(&v, &f)).volume;
+    v.extend([
+        [9.0, 9.0, 9.0],
+        [-9.0, 4.0, 2.0],
+        [3.0, -7.0, 1.0],
+        [0.0, 0.0, -8.0],
+    ]);
+    let hull = solid(&v, &open, OpenMeshModel::Hull).expect("hull");
+    assert!(
+        rel(hull.unit.mass, &closed_volume) < 1e-14,
+        "{}",
+        hull.unit.mass
+    );
+    assert_eq!(hull.vertices.len(), 8);
+}
+
+/// Half of a cylinder's side (a trough) of 11,000 segments: 22,002 boundary vertices on one loop
+/// that is far from flat (parry's quickhull refused such a mesh at 8,000 points). Default: no solid;
+/// with the hull: the half-prism over the 11,000-gon, 0.5·n·sin(π/n)·r²·L.
+#[test]
+fn hull_of_an_open_mesh_with_22k_boundary_vertices() {
+    let (n, r, l) = (11_000u32, 0.05, 0.4);
+    let mut v = Vec::new();
+    for i in 0..=n {
+        let a = std::f64::consts::PI * f64::from(i) / f64::from(n);
+        v.push([r * a.cos(), r * a.sin(), 0.0]);
+        v.push([r * a.cos(), r * a.sin(), l]);
+    }
+    let f: Vec<[u32; 3]> = (0..n)
+        .flat_map(|i| {
+            let (b0, t0, b1, t1) = (2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3);
+            [[b0, b1, t1], [b0, t1, t0]]
+        })
+        .collect();
+    let e = solid(&v, &f, OpenMeshModel::Trusted).expect_err("no solid by default");
+    assert!(matches!(e.kind, MeshErrorKind::NoSolid(_)), "{e}");
+    let hull = solid(&v, &f, OpenMeshModel::Hull).expect("hull");
+    let want = 0.5 * f64::from(n) * (std::f64::consts::PI / f64::from(n)).sin() * r * r * l;
+    assert!(
+        ((hull.unit.mass - want) / want).abs() < 1e-12,
+        "{} against {want}",
+        hull.unit.mass
+    );
+}
+
+/// A flat plate (one-sided or two-sided) has no volume: the mesh is a zero-volume error, which
+/// `fill` turns into a note (UI203) and a part that contributes nothing, as for a zero-size shape.
+#[test]
+fn flat_plates_have_no_volume() {
+    let v = [
+        [0.0, 0.0, 0.0],
+        [0.1, 0.0, 0.0],
+        [0.1, 0.1, 0.0],
+        [0.0, 0.1, 0.0],
+    ];
+    let one = [[0, 1, 2], [0, 2, 3]];
+    let two = [[0, 1, 2], [0, 2, 3], [0, 2, 1], [0, 3, 2]];
+    for faces in [&one[..], &two[..]] {
+        for model in [
+            OpenMeshModel::Trusted,
+            OpenMeshModel::Caps,
+            OpenMeshModel::Hull,
+        ] {
+            let e = solid(&v, faces, model).expect_err("flat");
+            assert!(
+                matches!(e.kind, MeshErrorKind::ZeroVolume { .. }),
+                "{model:?}: {e}"
+            );
+        }
+    }
+}
+
+/// Writes `(v, f)` as OBJ text (`{:?}` is the shortest text that reads back as the same f64).
+fn write_obj(path: &Path, v: &[[f64; 3]], f: &[[u32; 3]]) {
+    let mut obj = String::new();
+    for p in v {
+        let _ = writeln!(obj, "v {:?} {:?} {:?}", p[0], p[1], p[2]);
+    }
+    for t in f {
+        let _ = writeln!(obj, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    std::fs::write(path, obj).expect("write");
+}
+
+fn run(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
+        .args(args)
+        .output()
+        .expect("run")
+}
+
+/// A robot of two links in `dir`: `shell`, an open box whose caps are not trusted, and `marker`, a
+/// box beside a flat plate.
+fn open_robot(dir: &Path) -> std::path::PathBuf {
+    let (v, f) = moved_box();
+    let open = without_side(&v, &without_side(&v, &f, 2, true), 0, true);
+    write_obj(&dir.join("open.obj"), &v, &open);
+    let plate_v = [
+        [0.0, 0.0, 0.0],
+        [0.1, 0.0, 0.0],
+        [0.1, 0.1, 0.0],
+        [0.0, 0.1, 0.0],
+    ];
+    write_obj(&dir.join("plate.obj"), &plate_v, &[[0, 1, 2], [0, 2, 3]]);
+    let urdf = dir.join("robot.urdf");
+    std::fs::write(
+        &urdf,
+        r#"<robot name="r">
+  <link name="shell"><collision><geometry><mesh filename="open.obj"/></geometry></collision></link>
+  <link name="marker">
+    <collision><geometry><box size="0.1 0.2 0.3"/></geometry></collision>
+    <collision><geometry><mesh filename="plate.obj"/></geometry></collision>
+  </link>
+  <joint name="j" type="fixed"><parent link="shell"/><child link="marker"/></joint>
+</robot>
+"#,
+    )
+    .expect("write");
+    urdf
+}
+
+/// The real binary: an open mesh whose caps cannot be trusted fails its link with UI108 (JSON kind
+/// `open-mesh`), `--open-mesh hull` fills it with the hull; a flat plate beside a box contributes
+/// nothing, with a UI203 note.
+#[test]
+fn open_mesh_flag_and_code_through_the_binary() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let urdf = open_robot(tmp.path());
+    let out = tmp.path().join("out.urdf");
+    let base = [
+        "fill",
+        urdf.to_str().expect("utf-8"),
+        "--density",
+        "1000",
+        "--format",
+        "json",
+        "--digits",
+        "full",
+        "-o",
+        out.to_str().expect("utf-8"),
+    ];
+    // --keep-going: the JSON summary with the errors (and the marker link) is printed.
+    let mut keep_going = base.to_vec();
+    keep_going.push("--keep-going");
+    let o = run(&keep_going);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("UI108") && stderr.contains("--open-mesh hull"),
+        "{stderr}"
+    );
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+    let kinds: Vec<&str> = json["errors"]
+        .as_array()
+        .expect("errors")
+        .iter()
+        .filter_map(|e| e["kind"].as_str())
+        .collect();
+    assert_eq!(kinds, ["open-mesh"], "{json}");
+
+    let mut hull = base.to_vec();
+    hull.extend(["--open-mesh", "hull"]);
+    let o = run(&hull);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+    let links = json["links"].as_array().expect("links");
+    let mass = |name: &str| {
+        links
+            .iter()
+            .find(|l| l["link"] == name)
+            .and_then(|l| l["mass"].as_f64())
+            .expect("mass")
+    };
+    let box_volume = 0.3 * 0.2 * 0.1;
+    assert!((mass("shell") / (1000.0 * box_volume) - 1.0).abs() < 1e-12);
+    // The plate adds nothing: the marker is its box alone.
+    assert!((mass("marker") / (1000.0 * 0.1 * 0.2 * 0.3) - 1.0).abs() < 1e-12);
+    let marker = links
+        .iter()
+        .find(|l| l["link"] == "marker")
+        .expect("marker");
+    let notes = marker["notes"].to_string();
+    assert!(
+        notes.contains("UI203") && notes.contains("plate.obj"),
+        "{notes}"
+    );
+
+    // `mesh` takes the flag too.
+    let obj = tmp.path().join("open.obj");
+    let o = run(&["mesh", obj.to_str().expect("utf-8")]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("UI108"));
+    let o = run(&["mesh", obj.to_str().expect("utf-8"), "--open-mesh", "caps"]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
