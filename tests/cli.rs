@@ -1409,3 +1409,41 @@ fn check_baseline_fails_only_on_new_problems() {
     assert_eq!(out.status.code(), Some(0), "{}", stderr_of(&out));
     assert_eq!(check(&[]).status.code(), Some(0));
 }
+
+/// `check --format json` (what CI consumes): the same problems as the text lines, each with its
+/// file, link, code and message, and the counts; exit code as in text.
+#[test]
+fn check_format_json_lists_the_problems_of_the_text_output() {
+    let (urdf, _) = demo();
+    let u = urdf.to_str().unwrap();
+    let text = run(&["check", u]);
+    let json = run(&["check", u, "--format", "json"]);
+    assert_eq!(text.status.code(), Some(1));
+    assert_eq!(json.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_slice(&json.stdout).expect("JSON on stdout");
+    assert_eq!(v["schema_version"], 1);
+    let problems = v["problems"].as_array().expect("problems");
+    let lines: Vec<String> = String::from_utf8_lossy(&text.stdout)
+        .lines()
+        .map(str::to_string)
+        .collect();
+    assert_eq!(problems.len(), lines.len());
+    assert_eq!(v["problem_count"], lines.len());
+    for (p, line) in problems.iter().zip(&lines) {
+        let rebuilt = format!(
+            "{}: {} [{}]",
+            p["at"].as_str().unwrap(),
+            p["message"].as_str().unwrap(),
+            p["code"].as_str().unwrap()
+        );
+        assert_eq!(&rebuilt, line);
+        assert!(p["at"]
+            .as_str()
+            .unwrap()
+            .contains(p["link"].as_str().unwrap()));
+    }
+    // The demo's upper arm carries a tensor that breaks the triangle inequality (0.1, 0.1, 0.3).
+    assert!(problems
+        .iter()
+        .any(|p| p["link"] == "upper_arm_link" && p["code"] == "UI602"));
+}

@@ -285,9 +285,38 @@ def classify(pkg, urdf, message, pkgs, dom, mesh=None, link=None):
             axis = "xyz"[ext.index(0.0)]
             return "flat collision mesh (zero volume)", f"its vertices all lie in a plane: extent {ext[0]:.4g} × {ext[1]:.4g} × {ext[2]:.4g} m (zero along {axis})"
         return None, f"extent {ext}"
+    m = re.search(r"(\S+?\.(?:stl|obj|dae|glb|gltf)): UI108: mesh is", message, flags=re.I)
+    if m:
+        boundary, nonmanifold = mesh_edges(mesh or Path(m.group(1)))
+        if boundary or nonmanifold:
+            return ("open collision mesh: no solid to trust unless `--open-mesh caps|hull` is chosen (UI108)",
+                    f"assimp (coal 3.0.3) reads it with {boundary} boundary and {nonmanifold} non-manifold edges "
+                    "(corners welded where bit-identical)")
+        return None, "assimp (coal) reads a closed, manifold surface"
     if dom[0] is not None and ("cannot parse" in message or "malformed" in message.lower()):
         return "invalid URDF: urdfdom refuses it too", dom[0]
     return None, "no rule matches"
+
+
+def mesh_edges(path):
+    """(boundary, non-manifold) edge counts of a mesh as assimp reads it (through coal, independent of
+    urdf-inertia's readers), corners welded where their coordinates are bit-identical."""
+    import numpy as np
+    import coal
+
+    m = coal.MeshLoader().load(str(path), np.array([1.0, 1.0, 1.0]))
+    v = np.array(m.vertices())
+    if len(v) == 0:
+        return 0, 0
+    _, weld = np.unique(v, axis=0, return_inverse=True)
+    weld = weld.reshape(-1)
+    tris = np.array([[t[0], t[1], t[2]] for t in (m.tri_indices(i) for i in range(m.num_tris))], dtype=np.int64)
+    tris = weld[tris]
+    edges = np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]])
+    edges = edges[edges[:, 0] != edges[:, 1]]
+    edges.sort(axis=1)
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    return int((counts == 1).sum()), int((counts > 2).sum())
 
 
 def known_bug(rel, message):
@@ -424,7 +453,7 @@ def main():
                 if crc != 0:
                     # Only links fill could not compute may be reported; anything else contradicts fill.
                     bad = [ln for ln in ctext.splitlines() if ln.strip() and not any(f"`{l}`" in ln for l in failed_links)
-                           and not ln.startswith(("note", "  ", "urdf-inertia check:", "error: 1 link"))]
+                           and not ln.startswith(("note", "help:", "  ", "urdf-inertia check:", "error: 1 link"))]
                     if res["rc"] == 0 or bad:
                         r["check_problems"].append(f"{rel}: `check` exit {crc}: {clean(' / '.join(bad or ctext.splitlines())[:400], pkg)}")
                         unexplained.append(f"{rel}: check exit {crc}")

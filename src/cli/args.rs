@@ -237,6 +237,9 @@ pub struct CheckArgs {
     /// With --baseline FILE: record today's problems in it (as --write-baseline FILE).
     #[arg(long, requires = "baseline")]
     pub update: bool,
+    /// `json`: the problems as one JSON object on stdout (for CI), instead of a line each.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    pub format: Format,
 }
 
 #[derive(Debug, Clone, ClapArgs)]

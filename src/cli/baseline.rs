@@ -20,6 +20,31 @@ pub struct Problem {
     pub at: String,
 }
 
+/// `check --format json`: the problems that fail the run, each with its file, link, code, message
+/// and source location, and the counts (`schema_version` 1).
+pub fn problems_json(new: &[&Problem], known: usize, errors: usize) -> String {
+    let problems: Vec<serde_json::Value> = new
+        .iter()
+        .map(|p| {
+            serde_json::json!({
+                "file": p.file.display().to_string(),
+                "link": p.link,
+                "code": p.code,
+                "message": p.message,
+                "at": p.at,
+            })
+        })
+        .collect();
+    let v = serde_json::json!({
+        "schema_version": 1,
+        "problems": problems,
+        "problem_count": new.len(),
+        "known_in_baseline": known,
+        "errors": errors,
+    });
+    serde_json::to_string_pretty(&v).unwrap_or_default()
+}
+
 impl Problem {
     /// The line `check` prints: `FILE:LINE: link `NAME`: MESSAGE [UI601]` (the code last, as
     /// ESLint puts its rule: the line reads as before, and the code is there to look up or silence).

@@ -162,7 +162,7 @@ pub enum Mode {
     /// `fill`: splice them into the URDF.
     Write(WriteConfig),
     /// `check`: report invalid, missing or (with densities) differing `<inertial>` elements.
-    Check { all_links: bool },
+    Check { all_links: bool, format: Format },
     /// `diff`: show existing against computed.
     Diff { format: Format },
 }
@@ -269,6 +269,7 @@ impl Config {
         Ok(Config {
             mode: Mode::Check {
                 all_links: a.all_links,
+                format: a.format,
             },
             files: a.urdf.clone(),
             src,
@@ -401,8 +402,21 @@ fn report_problems(config: &Config, problems: &[Problem], errors: usize) -> usiz
             }
         };
     }
-    for p in &new {
-        outln!("{}", p.line());
+    if matches!(
+        config.mode,
+        Mode::Check {
+            format: Format::Json,
+            ..
+        }
+    ) {
+        outln!(
+            "{}",
+            super::baseline::problems_json(&new, known.len(), errors)
+        );
+    } else {
+        for p in &new {
+            outln!("{}", p.line());
+        }
     }
     if let Some(BaselineUse::Read(b)) = &config.baseline {
         if !known.is_empty() || !new.is_empty() {
@@ -462,7 +476,7 @@ fn run_one(
     }
     let robot = &input.robot;
     let mut outcome = Outcome::default();
-    if let Mode::Check { all_links } = config.mode {
+    if let Mode::Check { all_links, .. } = config.mode {
         check_existing(&input, config, all_links, problems);
     }
     let promoted_notes = promoted(&robot.notes);
