@@ -10,6 +10,7 @@
 pub mod density;
 pub mod diagnostic;
 pub mod fill;
+mod geometry;
 pub mod input;
 pub mod mass;
 pub mod mesh;

@@ -23,6 +23,7 @@
 //! (so a link of N overlapping parts costs O(N); the bound widens instead, and the estimate says
 //! so), and more than [`MAX_PAIRS`] overlapping pairs skip the estimate with a reason.
 
+use crate::geometry::{dot, sub};
 use crate::mass::{mat_vec, transpose, Mat3};
 use crate::mesh::health::Solid;
 use std::sync::Arc;
@@ -723,14 +724,6 @@ pub fn winding_number(solid: &Solid, q: [f64; 3]) -> f64 {
         }
     }
     total / (4.0 * std::f64::consts::PI)
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 fn norm(a: [f64; 3]) -> f64 {

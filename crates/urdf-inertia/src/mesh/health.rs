@@ -30,6 +30,7 @@
 
 use super::open::{NoSolid, OpenMeshModel};
 use super::{hull, weld, MeshError, MeshErrorKind, RawMesh};
+use crate::geometry::{cross, dot, sub};
 use crate::mass::integrals::{bounding_box_centre, volume_integrals, VolumeIntegrals};
 use crate::mass::{frobenius, IntegrationOptions, MassProperties, Polygons};
 use rustc_hash::FxHashMap;
@@ -1772,22 +1773,6 @@ fn polygon_area(vertices: &[[f64; 3]], face: &[u32]) -> f64 {
         }
     }
     dot(a, a).sqrt()
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {

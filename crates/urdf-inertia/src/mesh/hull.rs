@@ -9,6 +9,7 @@
 //! needed memory quadratic in coplanar points (40,000 points on four circles: 0.9 GB), and chull
 //! failed with `RoundOffError("concave")` on real meshes (go1 trunk.dae).
 
+use crate::geometry::{cross, dot, sub};
 use robust::{orient3d, Coord3D};
 use rustc_hash::FxHashMap;
 
@@ -268,22 +269,6 @@ fn argmax(p: &[[f64; 3]], key: impl Fn(&[f64; 3]) -> f64) -> usize {
         }
     }
     best.1
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 #[cfg(test)]
