@@ -13,7 +13,7 @@
 //! `CLICOLOR=0`, then a terminal whose `TERM` is not `dumb`). stdout (the URDF, tables, JSON) is
 //! never coloured.
 
-use std::io::{self, IsTerminal, Write};
+use std::io::{self, Write};
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 use std::sync::OnceLock;
 
@@ -86,23 +86,12 @@ pub fn err_line(line: &str) {
     }
 }
 
-/// Whether stderr gets colours: anstream's rules (`NO_COLOR`, `CLICOLOR_FORCE`, `CLICOLOR`, a
-/// terminal, `TERM=dumb`), decided once.
+/// Whether stderr gets colours, as anstream (clap's own) decides: `NO_COLOR`, `CLICOLOR_FORCE`,
+/// `CLICOLOR`, a terminal that supports colour; decided once.
 fn stderr_colour() -> bool {
     static CHOICE: OnceLock<bool> = OnceLock::new();
     *CHOICE.get_or_init(|| {
-        let set = |k: &str| std::env::var_os(k).is_some_and(|v| !v.is_empty());
-        let value = |k: &str| std::env::var(k).ok();
-        if set("NO_COLOR") {
-            return false;
-        }
-        if set("CLICOLOR_FORCE") && value("CLICOLOR_FORCE").as_deref() != Some("0") {
-            return true;
-        }
-        if value("CLICOLOR").as_deref() == Some("0") {
-            return false;
-        }
-        io::stderr().is_terminal() && value("TERM").as_deref() != Some("dumb")
+        anstream::AutoStream::choice(&io::stderr()) != anstream::ColorChoice::Never
     })
 }
 

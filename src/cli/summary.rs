@@ -9,7 +9,7 @@ use serde_json::json;
 use urdf_inertia::diagnostic::{Diagnostic, Provenance, Severity};
 use urdf_inertia::fill::{existing_props, FillReport, LinkReport, PartReport};
 use urdf_inertia::mass::MassProperties;
-use urdf_inertia::text::{self, shortest, significant, Digits};
+use urdf_inertia::text::{self, significant, Digits};
 use urdf_inertia::urdf::write::{tidy, tidy_moments};
 use urdf_inertia::urdf::Robot;
 
@@ -493,8 +493,10 @@ fn diff_row(r: &Row) {
         ),
         row_notes(r).join("; ")
     );
+    // Both sides with one formatter, seven significant digits: a table to compare by eye (the JSON
+    // and the written file keep every digit the estimate allows).
     let pe = moments(e, 0.0).map(|x| significant(x, 7));
-    let pc = moments(&l.computed, l.error_estimate()).map(shortest);
+    let pc = moments(&l.computed, l.error_estimate()).map(|x| significant(x, 7));
     outln!(
         "{:<28} principal moments existing {} {} {}, computed {} {} {}",
         "",
