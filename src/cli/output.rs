@@ -90,9 +90,8 @@ pub fn err_line(line: &str) {
 /// `CLICOLOR`, a terminal that supports colour; decided once.
 fn stderr_colour() -> bool {
     static CHOICE: OnceLock<bool> = OnceLock::new();
-    *CHOICE.get_or_init(|| {
-        anstream::AutoStream::choice(&io::stderr()) != anstream::ColorChoice::Never
-    })
+    *CHOICE
+        .get_or_init(|| anstream::AutoStream::choice(&io::stderr()) != anstream::ColorChoice::Never)
 }
 
 /// `line` (already sanitised: it holds no ESC of its own) with its head coloured as compilers do:
