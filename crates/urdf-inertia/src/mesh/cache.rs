@@ -143,11 +143,9 @@ impl MeshCache {
             }
             self.solids.remove(&key);
             self.usage.remove(&key);
+            // `read` keeps the file: it counts distinct files read, and whether a solid is read
+            // again is decided by `solids` alone (`missing`).
             held -= bytes;
-            // A file with no scale left is read again when asked for.
-            if !self.solids.keys().any(|(p, _)| *p == key.0) {
-                self.read.remove(&key.0);
-            }
         }
     }
 
