@@ -6,16 +6,14 @@
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use urdf_inertia::diagnostic::Code;
+use urdf_inertia::problem::InertialProblem;
 use urdf_inertia::text::escape_control;
 
-/// One problem `check` found in an existing `<inertial>`.
+/// One problem `check` found, with where to print it.
 #[derive(Debug, Clone)]
 pub struct Problem {
-    /// The URDF as given on the command line.
-    pub file: PathBuf,
-    pub link: String,
-    pub code: Code,
-    pub message: String,
+    /// The problem, typed (file, link, line, code, values).
+    pub problem: InertialProblem,
     /// `FILE:LINE: link `NAME`` (the source file and line for xacro).
     pub at: String,
 }
@@ -27,10 +25,10 @@ pub fn problems_json(new: &[&Problem], known: usize, errors: usize) -> String {
         .iter()
         .map(|p| {
             serde_json::json!({
-                "file": p.file.display().to_string(),
-                "link": p.link,
-                "code": p.code,
-                "message": p.message,
+                "file": p.problem.file.display().to_string(),
+                "link": p.problem.link,
+                "code": p.problem.code(),
+                "message": p.problem.kind.to_string(),
                 "at": p.at,
             })
         })
@@ -49,7 +47,12 @@ impl Problem {
     /// The line `check` prints: `FILE:LINE: link `NAME`: MESSAGE [UI601]` (the code last, as
     /// ESLint puts its rule: the line reads as before, and the code is there to look up or silence).
     pub fn line(&self) -> String {
-        format!("{}: {} [{}]", self.at, self.message, self.code)
+        format!(
+            "{}: {} [{}]",
+            self.at,
+            self.problem.kind,
+            self.problem.code()
+        )
     }
 }
 
@@ -97,9 +100,9 @@ fn field(s: &str) -> String {
 impl Baseline {
     fn key(&self, p: &Problem) -> (String, String, String) {
         (
-            relative(&self.dir, &p.file),
-            field(&p.link),
-            p.code.to_string(),
+            relative(&self.dir, &p.problem.file),
+            field(&p.problem.link),
+            p.problem.code().to_string(),
         )
     }
 
@@ -156,10 +159,10 @@ impl Baseline {
             .map(|p| {
                 format!(
                     "{}\t{}\t{}\t{}",
-                    relative(&dir, &p.file),
-                    field(&p.link),
-                    p.code,
-                    field(&p.message)
+                    relative(&dir, &p.problem.file),
+                    field(&p.problem.link),
+                    p.problem.code(),
+                    field(&p.problem.kind.to_string())
                 )
             })
             .collect();

@@ -13,7 +13,6 @@ macro_rules! errln {
 
 mod args;
 mod baseline;
-mod compare;
 mod mesh_cmd;
 mod noops;
 pub mod output;

@@ -4,17 +4,18 @@
 
 use super::args::{CheckArgs, DiffArgs, FillArgs, Format, SourceArgs};
 use super::baseline::{Baseline, Problem};
-use super::compare::{compare, Comparison};
 use super::policy::{Policy, Settings};
 use super::summary;
 use super::{write, ExitStatus};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use urdf_inertia::compare::{compare, Comparison};
 use urdf_inertia::density::{DensityMap, Glob};
 use urdf_inertia::diagnostic::{Code, Diagnostic, Location, Severity};
-use urdf_inertia::fill::{self, existing_problems, existing_props, FillOptions, FillReport};
+use urdf_inertia::fill::{self, existing_props, FillOptions, FillReport};
 use urdf_inertia::fill::{LinkReport, MeshCache};
 use urdf_inertia::mass::MassProperties;
+use urdf_inertia::problem::ProblemKind;
 use urdf_inertia::text::Digits;
 use urdf_inertia::urdf::resolve::PackageResolver;
 use urdf_inertia::urdf::write::{splice, LinkUpdate, WriteOptions};
@@ -514,7 +515,7 @@ fn run_one(
         }
         Mode::Check { .. } => {
             summary::computed_diagnostics(&report, &config.policy);
-            check_against_computed(&input, &rows, config, problems);
+            check_against_computed(&input, &report, config, problems);
             outcome.problems += promoted;
         }
     }
@@ -953,51 +954,28 @@ fn compare_all<'a>(robot: &Robot, report: &'a FillReport) -> Vec<Row<'a>> {
 }
 
 /// Problems of the existing `<inertial>` elements themselves (no computation needed), added to
-/// `problems`.
+/// `problems`; those of frames (links without collision geometry) are notes unless `--all-links`.
 fn check_existing(input: &Input, config: &Config, all_links: bool, problems: &mut Vec<Problem>) {
     let robot = &input.robot;
-    let mut problem = |code: Code, line: usize, link: &str, message: String| {
-        if config.policy.reports(code) {
-            problems.push(Problem {
-                file: robot.path.clone(),
-                link: link.to_string(),
-                code,
-                message,
-                at: input.link_at(line, link),
-            });
-        }
-    };
-    for link in robot
-        .links
-        .iter()
-        .filter(|l| fill::selected(&l.name, &config.src.options))
-    {
-        let Some(span) = &link.inertial else {
-            if link.has_collision_geometry() {
-                problem(
-                    Code::CheckMissingInertial,
-                    link.line,
-                    &link.name,
-                    "has collision geometry but no <inertial>".to_string(),
-                );
-            }
-            continue;
-        };
+    for p in urdf_inertia::problem::check(robot, &config.src.options) {
         // Several <inertial> elements are a problem whatever the link: the file says two things.
-        let duplicates = fill::duplicate_inertials(link);
-        for p in existing_problems(link) {
-            if !link.has_collision_geometry() && !all_links && duplicates.as_ref() != Some(&p) {
-                let note = Diagnostic::new(
-                    Code::UrdfFrameInertial,
-                    format!(
-                        "{} (no collision geometry, so fill cannot compute it): {p}",
-                        input.link_at(span.line, &link.name)
-                    ),
-                );
-                print_one(&config.policy, &note);
-            } else {
-                problem(Code::CheckInvalidInertial, span.line, &link.name, p);
-            }
+        let frame = robot
+            .links
+            .iter()
+            .find(|l| l.name == p.link)
+            .is_some_and(|l| !l.has_collision_geometry());
+        let at = input.link_at(p.line, &p.link);
+        if frame && !all_links && !matches!(p.kind, ProblemKind::Duplicates { .. }) {
+            let note = Diagnostic::new(
+                Code::UrdfFrameInertial,
+                format!(
+                    "{at} (no collision geometry, so fill cannot compute it): {}",
+                    p.kind
+                ),
+            );
+            print_one(&config.policy, &note);
+        } else if config.policy.reports(p.code()) {
+            problems.push(Problem { problem: p, at });
         }
     }
 }
@@ -1031,38 +1009,16 @@ fn check_collisions(input: &Input, src: &Sources) -> usize {
 /// `check_existing`), added to `problems`.
 fn check_against_computed(
     input: &Input,
-    rows: &[Row],
+    report: &FillReport,
     config: &Config,
     problems: &mut Vec<Problem>,
 ) {
-    let robot = &input.robot;
-    let tolerance = config.tolerance;
     if !config.policy.reports(Code::CheckDiffers) {
         return;
     }
-    for r in rows {
-        let (Some(e), Some(c)) = (&r.existing, &r.comparison) else {
-            continue;
-        };
-        let off = c.beyond(e, &r.link.computed, tolerance);
-        if off.is_empty() {
-            continue;
-        }
-        let causes = if c.causes.is_empty() {
-            String::new()
-        } else {
-            format!(" [{}]", c.causes.join("; "))
-        };
-        let line = robot.links[r.link.index]
-            .inertial
-            .as_ref()
-            .map_or(r.link.line, |s| s.line);
-        problems.push(Problem {
-            file: robot.path.clone(),
-            link: r.link.name.clone(),
-            code: Code::CheckDiffers,
-            message: format!("{}{causes} (tolerance {tolerance})", off.join("; ")),
-            at: input.link_at(line, &r.link.name),
-        });
+    let found = urdf_inertia::problem::check_computed(&input.robot, report, config.tolerance);
+    for p in found {
+        let at = input.link_at(p.line, &p.link);
+        problems.push(Problem { problem: p, at });
     }
 }

@@ -7,6 +7,7 @@
 //! xacro sources are expanded first ([`xacro`]), with a map back to their files and lines.
 #![forbid(unsafe_code)]
 
+pub mod compare;
 pub mod density;
 pub mod diagnostic;
 pub mod fill;
@@ -15,6 +16,7 @@ pub mod input;
 pub mod mass;
 pub mod mesh;
 pub mod overlap;
+pub mod problem;
 pub mod text;
 pub mod threads;
 pub mod urdf;

@@ -1,11 +1,15 @@
 //! Existing `<inertial>` against computed: one comparison, one set of thresholds, shared by `check` and
 //! `diff`.
 
-use urdf_inertia::mass::{frobenius, validity, MassProperties, Mat3};
-use urdf_inertia::text::significant;
+use crate::mass::validity::{self, Violation};
+use crate::mass::{frobenius, MassProperties, Mat3};
+use crate::text::significant;
+use serde::Serialize;
+use std::fmt;
 
 /// Existing against computed, for one link.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Comparison {
     /// Existing mass over computed mass.
     pub mass_ratio: f64,
@@ -16,37 +20,81 @@ pub struct Comparison {
     /// Likely causes of a difference (unit slips, tensor about the origin, mirrored products).
     pub causes: Vec<String>,
     /// Why the existing values cannot belong to a body, if they cannot.
-    pub invalid: Vec<String>,
+    pub invalid: Vec<Violation>,
+}
+
+/// One way existing mass properties differ from computed ones by more than a tolerance.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "quantity", rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum Difference {
+    /// The masses (kg) and existing over computed.
+    Mass {
+        existing: f64,
+        computed: f64,
+        ratio: f64,
+    },
+    /// The distance of the centres of mass over the link's size.
+    CentreOfMass { relative_distance: f64 },
+    /// The Frobenius norm of the tensor difference over the computed tensor's.
+    Inertia { relative_difference: f64 },
+}
+
+impl fmt::Display for Difference {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Difference::Mass {
+                existing,
+                computed,
+                ratio,
+            } => write!(
+                f,
+                "mass {} kg, computed {} kg (ratio {})",
+                significant(*existing, 7),
+                significant(*computed, 7),
+                significant(*ratio, 4)
+            ),
+            Difference::CentreOfMass { relative_distance } => write!(
+                f,
+                "centre of mass {} of the link's size from the computed one",
+                significant(*relative_distance, 4)
+            ),
+            Difference::Inertia {
+                relative_difference,
+            } => write!(
+                f,
+                "inertia differs from the computed one by {} (relative)",
+                significant(*relative_difference, 4)
+            ),
+        }
+    }
 }
 
 impl Comparison {
-    /// What differs by more than `tolerance` (relative), each as a sentence; empty when nothing does.
+    /// What differs by more than `tolerance` (relative); empty when nothing does.
     pub fn beyond(
         &self,
         existing: &MassProperties,
         computed: &MassProperties,
         tolerance: f64,
-    ) -> Vec<String> {
+    ) -> Vec<Difference> {
         let mut off = Vec::new();
         if (self.mass_ratio - 1.0).abs() > tolerance {
-            off.push(format!(
-                "mass {} kg, computed {} kg (ratio {})",
-                significant(existing.mass, 7),
-                significant(computed.mass, 7),
-                significant(self.mass_ratio, 4)
-            ));
+            off.push(Difference::Mass {
+                existing: existing.mass,
+                computed: computed.mass,
+                ratio: self.mass_ratio,
+            });
         }
         if self.com_distance > tolerance {
-            off.push(format!(
-                "centre of mass {} of the link's size from the computed one",
-                significant(self.com_distance, 4)
-            ));
+            off.push(Difference::CentreOfMass {
+                relative_distance: self.com_distance,
+            });
         }
         if self.inertia_difference > tolerance {
-            off.push(format!(
-                "inertia differs from the computed one by {} (relative)",
-                significant(self.inertia_difference, 4)
-            ));
+            off.push(Difference::Inertia {
+                relative_difference: self.inertia_difference,
+            });
         }
         off
     }
@@ -147,7 +195,8 @@ fn causes(
     out
 }
 
-/// Compares existing mass properties with computed ones of a link of diagonal `size`.
+/// Compares existing mass properties with computed ones of a link whose bounding box has the
+/// diagonal `size` (m): the centre-of-mass distance is relative to it.
 pub fn compare(existing: &MassProperties, computed: &MassProperties, size: f64) -> Comparison {
     let mass_ratio = existing.mass / computed.mass;
     let dc = [0, 1, 2].map(|k| existing.com[k] - computed.com[k]);
@@ -159,17 +208,14 @@ pub fn compare(existing: &MassProperties, computed: &MassProperties, size: f64) 
         com_distance,
         inertia_difference,
         causes: causes(existing, computed, mass_ratio, inertia_difference),
-        invalid: validity::check(existing, validity::DEFAULT_TOLERANCE)
-            .iter()
-            .map(ToString::to_string)
-            .collect(),
+        invalid: validity::check(existing, validity::DEFAULT_TOLERANCE),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use urdf_inertia::mass::primitives;
+    use crate::mass::primitives;
 
     #[test]
     fn diagonal_tensors_are_never_called_mirrored() {
@@ -189,7 +235,7 @@ mod tests {
     /// A 0.1 × 0.2 × 0.3 box turned about a skew axis, so all three products are non-zero.
     fn turned_box() -> MassProperties {
         let b = primitives::cuboid([0.1, 0.2, 0.3], 1000.0);
-        let r = urdf_inertia::mass::rpy_matrix([0.3, -0.4, 0.5]);
+        let r = crate::mass::rpy_matrix([0.3, -0.4, 0.5]);
         b.transformed(&r, [0.0; 3])
     }
 
@@ -259,7 +305,7 @@ mod tests {
     fn one_product_alone_names_the_cad_slip_first() {
         // Turned about z only: ixy alone, so flipping it is both the CAD slip and a mirror in x or y.
         let b = primitives::cuboid([0.1, 0.2, 0.3], 1000.0);
-        let computed = b.transformed(&urdf_inertia::mass::rpy_matrix([0.0, 0.0, 0.5]), [0.0; 3]);
+        let computed = b.transformed(&crate::mass::rpy_matrix([0.0, 0.0, 0.5]), [0.0; 3]);
         let c = compare(
             &with_product_signs(&computed, [-1.0, 1.0, 1.0]),
             &computed,
