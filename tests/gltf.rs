@@ -112,11 +112,10 @@ fn box_through_glb_data_uri_and_external_bin() {
         b.gltf_external("box%20data.bin").as_bytes(),
     ));
     // A missing external buffer names the file.
-    let e = mesh::read(&write(
-        d,
-        "missing.gltf",
-        b.gltf_external("nowhere.bin").as_bytes(),
-    ))
+    let e = mesh::read(
+        &write(d, "missing.gltf", b.gltf_external("nowhere.bin").as_bytes()),
+        urdf_inertia::input::DEFAULT_MAX_FILE_SIZE,
+    )
     .unwrap_err();
     assert!(matches!(e.kind, MeshErrorKind::Io(_)), "{e}");
     assert!(e.to_string().contains("nowhere.bin"), "{e}");
@@ -158,7 +157,7 @@ fn strips_fans_and_unindexed_primitives() {
     ]);
     let p = write(d, "lines.glb", &b.glb());
     assert_reference_box(&p);
-    let raw = mesh::read(&p).unwrap();
+    let raw = mesh::read(&p, urdf_inertia::input::DEFAULT_MAX_FILE_SIZE).unwrap();
     assert_eq!(
         raw.notes
             .iter()
@@ -333,7 +332,7 @@ fn scene_selection() {
     b.scenes.clear();
     let p = write(tmp.path(), "noscene.glb", &b.glb());
     assert_reference_box(&p);
-    assert!(mesh::read(&p)
+    assert!(mesh::read(&p, urdf_inertia::input::DEFAULT_MAX_FILE_SIZE)
         .unwrap()
         .notes
         .iter()
@@ -352,7 +351,11 @@ fn compression_and_sparse_are_refused_by_name() {
         let mut b = box_builder(SIZE, CENTRE, json!({}));
         b.extensions_used = vec![ext.into()];
         b.extensions_required = vec![ext.into()];
-        let e = mesh::read(&write(d, &format!("{ext}.glb"), &b.glb())).unwrap_err();
+        let e = mesh::read(
+            &write(d, &format!("{ext}.glb"), &b.glb()),
+            urdf_inertia::input::DEFAULT_MAX_FILE_SIZE,
+        )
+        .unwrap_err();
         assert!(matches!(e.kind, MeshErrorKind::Unsupported(_)), "{e}");
         assert!(e.to_string().contains(ext), "{e}");
         assert!(
@@ -364,12 +367,20 @@ fn compression_and_sparse_are_refused_by_name() {
     let mut b = box_builder(SIZE, CENTRE, json!({}));
     b.extensions_used = vec!["KHR_draco_mesh_compression".into()];
     b.accessors[0].as_object_mut().unwrap().remove("bufferView");
-    let e = mesh::read(&write(d, "draco_used.glb", &b.glb())).unwrap_err();
+    let e = mesh::read(
+        &write(d, "draco_used.glb", &b.glb()),
+        urdf_inertia::input::DEFAULT_MAX_FILE_SIZE,
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("KHR_draco_mesh_compression"), "{e}");
     // A sparse POSITION accessor.
     let mut b = box_builder(SIZE, CENTRE, json!({}));
     b.accessors[0]["sparse"] = json!({"count": 1, "indices": {"bufferView": 1, "componentType": U16}, "values": {"bufferView": 0}});
-    let e = mesh::read(&write(d, "sparse.glb", &b.glb())).unwrap_err();
+    let e = mesh::read(
+        &write(d, "sparse.glb", &b.glb()),
+        urdf_inertia::input::DEFAULT_MAX_FILE_SIZE,
+    )
+    .unwrap_err();
     assert!(matches!(e.kind, MeshErrorKind::Unsupported(_)), "{e}");
     assert!(e.to_string().contains("sparse"), "{e}");
     // A material-only required extension does not change geometry: accepted.
@@ -387,12 +398,17 @@ fn broken_files_are_errors_never_panics() {
     let p = tmp.path().join("t.glb");
     // Every truncation of a GLB is an error; past the headers, a truncation named as such.
     for n in 0..glb.len() {
-        let e = mesh::gltf::parse(&glb[..n], &p).unwrap_err();
+        let e = mesh::gltf::parse(&glb[..n], &p, urdf_inertia::input::DEFAULT_MAX_FILE_SIZE)
+            .unwrap_err();
         if n >= 20 {
             assert!(matches!(e.kind, MeshErrorKind::Truncated(_)), "{n}: {e}");
         }
     }
-    let e = mesh::read(&write(tmp.path(), "half.glb", &glb[..glb.len() / 2])).unwrap_err();
+    let e = mesh::read(
+        &write(tmp.path(), "half.glb", &glb[..glb.len() / 2]),
+        urdf_inertia::input::DEFAULT_MAX_FILE_SIZE,
+    )
+    .unwrap_err();
     assert!(
         e.to_string().contains("half.glb") && e.to_string().contains("truncated"),
         "{e}"
@@ -400,12 +416,14 @@ fn broken_files_are_errors_never_panics() {
     // An accessor reaching past its buffer, an index past the vertices.
     let mut bad = b.clone();
     bad.accessors[0]["count"] = json!(1000);
-    let e = mesh::gltf::parse(&bad.glb(), &p).unwrap_err();
+    let e =
+        mesh::gltf::parse(&bad.glb(), &p, urdf_inertia::input::DEFAULT_MAX_FILE_SIZE).unwrap_err();
     assert!(matches!(e.kind, MeshErrorKind::Truncated(_)), "{e}");
     let mut bad = b.clone();
     let idx = bad.indices(&[0, 1, 99], U32);
     bad.meshes[0]["primitives"][0]["indices"] = json!(idx);
-    let e = mesh::gltf::parse(&bad.glb(), &p).unwrap_err();
+    let e =
+        mesh::gltf::parse(&bad.glb(), &p, urdf_inertia::input::DEFAULT_MAX_FILE_SIZE).unwrap_err();
     assert!(
         matches!(
             e.kind,
@@ -432,7 +450,7 @@ fn broken_files_are_errors_never_panics() {
                     _ => m.insert(i, b"0123456789-.e,:[]{}\""[(rng.next_u64() % 20) as usize]),
                 }
             }
-            let _ = mesh::gltf::parse(&m, &p);
+            let _ = mesh::gltf::parse(&m, &p, urdf_inertia::input::DEFAULT_MAX_FILE_SIZE);
         }
     }
 }

@@ -973,7 +973,7 @@ fn overlap_of_a_sliver_cone_and_a_box_has_bounded_memory() {
     let report = urdf_inertia::fill::compute(
         &robot,
         &urdf_inertia::density::DensityMap::uniform(1000.0),
-        &urdf_inertia::urdf::resolve::PackageResolver::new(&[]),
+        &urdf_inertia::urdf::resolve::PackageResolver::new(),
         &Default::default(),
     );
     let grown = peak_rss().saturating_sub(before);
@@ -1088,7 +1088,7 @@ fn fill_on_threads(
         let r = urdf_inertia::fill::compute(
             robot,
             &urdf_inertia::density::DensityMap::uniform(1000.0),
-            &urdf_inertia::urdf::resolve::PackageResolver::new(&[]),
+            &urdf_inertia::urdf::resolve::PackageResolver::new(),
             &Default::default(),
         );
         let updates: Vec<_> = r.links.iter().map(|l| l.update()).collect();
@@ -1318,7 +1318,11 @@ fn fuzz_one(target: &str, data: &[u8]) -> Result<(), String> {
             &dir.join("f.dae"),
         ),
         "gltf" => heal(
-            mesh::gltf::parse(data, &dir.join("f.gltf")),
+            mesh::gltf::parse(
+                data,
+                &dir.join("f.gltf"),
+                urdf_inertia::input::DEFAULT_MAX_FILE_SIZE,
+            ),
             &dir.join("f.gltf"),
         ),
         "urdf" => {

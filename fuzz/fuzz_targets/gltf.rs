@@ -9,5 +9,5 @@ use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
     let path = Path::new("/nonexistent-fuzz-dir/fuzz.gltf");
-    common::heal(urdf_inertia::mesh::gltf::parse(data, path), path);
+    common::heal(urdf_inertia::mesh::gltf::parse(data, path, urdf_inertia::input::DEFAULT_MAX_FILE_SIZE), path);
 });

@@ -18,7 +18,7 @@ const LOAD_YAML: &str = r#"<robot xmlns:xacro="http://www.ros.org/wiki/xacro" na
 "#;
 
 fn expand(path: &Path, dir: &Path) -> Option<xacro::Expansion> {
-    let resolver = PackageResolver::new(&[]);
+    let resolver = PackageResolver::new();
     let opts = Options {
         args: Vec::new(),
         resolver: &resolver,

@@ -108,7 +108,7 @@ impl Baseline {
 
     /// Reads a baseline; a missing file is an error that says how to make one.
     pub fn read(path: &Path) -> Result<Baseline, String> {
-        let bytes = urdf_inertia::input::read_file(path).map_err(|e| {
+        let bytes = urdf_inertia::input::read_file(path, super::max_file_size()).map_err(|e| {
             format!(
                 "{}: cannot read the baseline: {e}; `urdf-inertia check FILES --write-baseline {}` records today's problems",
                 path.display(),

@@ -4,7 +4,7 @@ use super::args::{Format, MeshArgs};
 use super::ExitStatus;
 use serde_json::json;
 use urdf_inertia::mass::{MassProperties, Principal};
-use urdf_inertia::mesh::{self, health::HealthOptions, health::Solid};
+use urdf_inertia::mesh::{self, health::Solid};
 use urdf_inertia::text::{round_significant, shortest, within, Digits};
 
 pub fn run(args: &MeshArgs) -> ExitStatus {
@@ -16,14 +16,11 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         return ExitStatus::Error;
     }
     let start = std::time::Instant::now();
-    let solid = match mesh::load_solid(
-        &args.file,
-        scale,
-        HealthOptions {
-            strict: args.strict,
-            open_mesh: super::args::OpenMesh::model(args.open_mesh),
-        },
-    ) {
+    let options = mesh::LoadOptions::default()
+        .strict(args.strict)
+        .open_mesh(super::args::OpenMesh::model(args.open_mesh))
+        .max_file_size(super::max_file_size());
+    let solid = match mesh::load_solid(&args.file, scale, options) {
         Ok(s) => s,
         Err(e) => {
             errln!("error: {e}");

@@ -37,6 +37,49 @@ pub enum ExitStatus {
     Error = 2,
 }
 
+/// The environment variable that sets the limit on one input file when `--max-file-size` is not given.
+const MAX_FILE_SIZE_ENV: &str = "URDF_INERTIA_MAX_FILE_SIZE";
+
+/// The run's limit on one input file, decided once from the command line and the environment
+/// before any command starts; the library is handed it wherever it reads.
+static MAX_FILE_SIZE: std::sync::OnceLock<u64> = std::sync::OnceLock::new();
+
+/// The limit on one input file: `--max-file-size`, else `URDF_INERTIA_MAX_FILE_SIZE`, else the
+/// library's default.
+pub fn max_file_size() -> u64 {
+    MAX_FILE_SIZE
+        .get()
+        .copied()
+        .unwrap_or(urdf_inertia::input::DEFAULT_MAX_FILE_SIZE)
+}
+
+/// Parses `--package-path NAME=DIR`.
+pub fn parse_package_arg(arg: &str) -> Result<(String, std::path::PathBuf), String> {
+    match arg.split_once('=') {
+        Some((name, dir)) if !name.is_empty() && !dir.is_empty() => {
+            Ok((name.to_string(), std::path::PathBuf::from(dir)))
+        }
+        _ => Err(format!("--package-path `{arg}` should be NAME=DIR")),
+    }
+}
+
+/// The package resolver of a run: `--package-path` packages first, then `ROS_PACKAGE_PATH` and
+/// `AMENT_PREFIX_PATH` from the environment (the library reads no environment).
+pub fn package_resolver(
+    packages: &[(String, std::path::PathBuf)],
+) -> urdf_inertia::urdf::resolve::PackageResolver {
+    let split = |var: &str| -> Vec<std::path::PathBuf> {
+        std::env::var_os(var)
+            .map(|v| std::env::split_paths(&v).collect())
+            .unwrap_or_default()
+    };
+    urdf_inertia::urdf::resolve::PackageResolver::new()
+        .with_packages(packages)
+        .with_ros_package_path(split("ROS_PACKAGE_PATH"))
+        .with_ament_prefix_path(split("AMENT_PREFIX_PATH"))
+        .with_max_file_size(max_file_size())
+}
+
 /// Parses the command line and runs the command; returns the exit code.
 pub fn main() -> i32 {
     let args = match Args::try_parse() {
@@ -59,13 +102,15 @@ pub fn main() -> i32 {
         Command::Check(c) => c.source.max_file_size.clone(),
         Command::Xacro(x) => x.max_file_size.clone(),
     };
-    let from_env = std::env::var(urdf_inertia::input::MAX_FILE_SIZE_ENV).ok();
+    let from_env = std::env::var(MAX_FILE_SIZE_ENV).ok();
     if let Some((what, s)) = max_size
         .map(|s| ("--max-file-size", s))
-        .or(from_env.map(|s| (urdf_inertia::input::MAX_FILE_SIZE_ENV, s)))
+        .or(from_env.map(|s| (MAX_FILE_SIZE_ENV, s)))
     {
         match urdf_inertia::input::parse_size(&s) {
-            Ok(n) => urdf_inertia::input::set_max_file_size(n),
+            Ok(n) => {
+                let _ = MAX_FILE_SIZE.set(n);
+            }
             Err(e) => {
                 errln!("error: {what}: {e}");
                 return ExitStatus::Error as i32;

@@ -226,7 +226,7 @@ fn config_key(s: &Settings, key: &str) -> String {
 }
 
 fn read_config(path: &Path) -> Result<(FileConfig, Settings), String> {
-    let bytes = urdf_inertia::input::read_file(path)
+    let bytes = urdf_inertia::input::read_file(path, super::max_file_size())
         .map_err(|e| format!("{}: cannot read the configuration: {e}", path.display()))?;
     let text = String::from_utf8(bytes)
         .map_err(|_| format!("{}: the configuration is not UTF-8", path.display()))?;

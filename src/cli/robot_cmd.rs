@@ -53,10 +53,12 @@ fn memory_budget(s: &SourceArgs) -> Result<u64, String> {
 
 fn density_map(s: &SourceArgs, settings: &Settings) -> Result<Option<DensityMap>, String> {
     Ok(match (&s.density_map, s.density) {
-        (Some(p), _) => Some(DensityMap::load(p).map_err(|e| e.to_string())?),
+        (Some(p), _) => {
+            Some(DensityMap::load(p, super::max_file_size()).map_err(|e| e.to_string())?)
+        }
         (None, None) if settings.density_map.is_some() => {
             let p = settings.density_map.as_deref().unwrap_or(Path::new(""));
-            Some(DensityMap::load(p).map_err(|e| {
+            Some(DensityMap::load(p, super::max_file_size()).map_err(|e| {
                 let file = settings
                     .file
                     .as_ref()
@@ -87,7 +89,7 @@ fn sources(s: &SourceArgs, settings: &Settings) -> Result<Sources, String> {
         .package_path
         .iter()
         .chain(&settings.package_path)
-        .map(|p| PackageResolver::parse_package_arg(p))
+        .map(|p| super::parse_package_arg(p))
         .collect::<Result<Vec<_>, String>>()?;
     let xacro_args = s
         .xacro_args
@@ -107,7 +109,7 @@ fn sources(s: &SourceArgs, settings: &Settings) -> Result<Sources, String> {
         map,
         map_path: s.density_map.clone(),
         visual_fallback,
-        resolver: PackageResolver::new(&pkgs),
+        resolver: super::package_resolver(&pkgs),
         xacro_args,
         options: FillOptions {
             strict: s.strict,
@@ -344,7 +346,8 @@ fn run_command(config: Result<Config, String>) -> ExitStatus {
 
 /// The pipeline: every URDF read, computed (with densities), compared, then handed to the mode.
 fn run(config: &Config) -> Outcome {
-    let mut cache = MeshCache::with_memory_budget(config.src.memory_budget);
+    let mut cache = MeshCache::with_memory_budget(config.src.memory_budget)
+        .with_max_file_size(super::max_file_size());
     let mut outcome = Outcome::default();
     if let Some(f) = &config.config_file {
         let d = Diagnostic::new(
@@ -581,11 +584,11 @@ impl Input {
 fn read_input(path: &Path, src: &Sources, policy: &Policy) -> Result<Input, String> {
     let stdin = path.as_os_str() == "-";
     let bytes = if stdin {
-        urdf_inertia::input::read_rest(std::io::stdin().lock(), Vec::new())
+        urdf_inertia::input::read_rest(std::io::stdin().lock(), Vec::new(), super::max_file_size())
             .map_err(|e| format!("stdin: cannot read the URDF: {e}"))?
     } else {
         write::remember_before_reading(path);
-        urdf_inertia::input::read_file(path)
+        urdf_inertia::input::read_file(path, super::max_file_size())
             .map_err(|e| format!("{}: cannot read the URDF: {e}", path.display()))?
     };
     if stdin {

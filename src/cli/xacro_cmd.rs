@@ -3,7 +3,6 @@
 
 use super::args::XacroArgs;
 use super::ExitStatus;
-use urdf_inertia::urdf::resolve::PackageResolver;
 use urdf_inertia::xacro;
 
 pub fn run(a: &XacroArgs) -> ExitStatus {
@@ -16,7 +15,7 @@ pub fn run(a: &XacroArgs) -> ExitStatus {
         let pkgs = a
             .package_path
             .iter()
-            .map(|p| PackageResolver::parse_package_arg(p))
+            .map(|p| super::parse_package_arg(p))
             .collect::<Result<Vec<_>, String>>()?;
         Ok((args, pkgs))
     })();
@@ -27,7 +26,7 @@ pub fn run(a: &XacroArgs) -> ExitStatus {
             return ExitStatus::Error;
         }
     };
-    let resolver = PackageResolver::new(&pkgs);
+    let resolver = super::package_resolver(&pkgs);
     let opts = xacro::Options::from_process(args, &resolver);
     match xacro::expand_file(&a.file, &opts) {
         Ok(e) => {

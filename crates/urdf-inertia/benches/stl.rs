@@ -63,7 +63,12 @@ fn read(c: &mut Criterion) {
             for (name, path) in [("binary", &binary), ("ascii", &ascii)] {
                 let id = BenchmarkId::new(format!("{name}, {threads} thread(s)"), n);
                 group.bench_with_input(id, path, |b, path| {
-                    b.iter(|| pool.install(|| stl::read(black_box(path)).map(|m| m.faces.len())))
+                    b.iter(|| {
+                        pool.install(|| {
+                            stl::read(black_box(path), urdf_inertia::input::DEFAULT_MAX_FILE_SIZE)
+                                .map(|m| m.faces.len())
+                        })
+                    })
                 });
             }
         }

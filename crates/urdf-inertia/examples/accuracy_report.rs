@@ -599,7 +599,8 @@ fn main() -> std::io::Result<()> {
     let file = std::env::temp_dir().join(format!("urdf-inertia-bench-{}.stl", std::process::id()));
     std::fs::write(&file, &bytes)?;
     let secs = time(3.0, || {
-        urdf_inertia::mesh::read(&file).map_or(0, |m| m.faces.len())
+        urdf_inertia::mesh::read(&file, urdf_inertia::input::DEFAULT_MAX_FILE_SIZE)
+            .map_or(0, |m| m.faces.len())
     });
     let _ = std::fs::remove_file(&file);
     writeln!(md, "Binary STL file, {} faces ({:.1} MB), read and parsed (page cache warm): {:.1} ms, {:.0} MB/s, {:.1} M faces/s.", f.len(), bytes.len() as f64 / 1e6, secs * 1e3, bytes.len() as f64 / 1e6 / secs, f.len() as f64 / 1e6 / secs).ok();
@@ -658,7 +659,7 @@ fn corpus(md: &mut String, share: &std::path::Path) {
     use urdf_inertia::urdf::resolve::PackageResolver;
     let robots = share.join("example-robot-data/robots");
     let urdfs = urdfs_under(&robots);
-    let resolver = PackageResolver::new(&[(
+    let resolver = PackageResolver::new().with_packages(&[(
         "example-robot-data".into(),
         share.join("example-robot-data"),
     )]);
@@ -1171,8 +1172,12 @@ fn pipeline_section(md: &mut String) -> std::io::Result<()> {
         let tris: Vec<[u32; 3]> = raw.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
         let exact = exact_mass(&exact_integrals(&raw.vertices, &tris));
         let t0 = Instant::now();
-        let ours =
-            urdf_inertia::mesh::load_solid(&file, [1.0; 3], Default::default()).expect("solid");
+        let ours = urdf_inertia::mesh::load_solid(
+            &file,
+            [1.0; 3],
+            urdf_inertia::mesh::LoadOptions::default(),
+        )
+        .expect("solid");
         let ours_secs = t0.elapsed().as_secs_f64();
         let script = r#"
 import json, sys, time

@@ -282,8 +282,8 @@ impl DensityMap {
         }
     }
 
-    /// Reads and validates a density map file.
-    pub fn load(path: &Path) -> Result<Self, MapError> {
+    /// Reads and validates a density map file no larger than `max_file_size` bytes.
+    pub fn load(path: &Path, max_file_size: u64) -> Result<Self, MapError> {
         let cannot = |e: String| MapError {
             path: path.into(),
             line: None,
@@ -291,7 +291,8 @@ impl DensityMap {
             message: format!("cannot read the density map: {e}"),
             snippet: None,
         };
-        let bytes = crate::input::read_file(path).map_err(cannot)?;
+        let bytes =
+            crate::input::read_file(path, max_file_size).map_err(|e| cannot(e.to_string()))?;
         let text = String::from_utf8(bytes)
             .map_err(|e| cannot(format!("not UTF-8 (byte {})", e.utf8_error().valid_up_to())))?;
         Self::parse(&text, path)

@@ -1,33 +1,56 @@
 //! Reading input files with two guards: only regular files are read (a FIFO would hang, `/dev/zero`
-//! or `/dev/urandom` never end), and no more than a size limit, 1 GiB by default, set with
-//! `--max-file-size` or the `URDF_INERTIA_MAX_FILE_SIZE` environment variable (the CLI reads both).
+//! or `/dev/urandom` never end), and no more than a size limit the caller passes
+//! ([`DEFAULT_MAX_FILE_SIZE`], 1 GiB, unless it says otherwise; the command line takes it from
+//! `--max-file-size` or `URDF_INERTIA_MAX_FILE_SIZE`). The library keeps no limit of its own: each
+//! reader is handed the limit by whoever started the work (the mesh cache, the package resolver,
+//! xacro's options, the density map's loader).
 //!
 //! This is the one way the library reads a file: URDFs, meshes, glTF buffers, density maps and
 //! `package.xml` all go through [`read_file`] or [`open_file`] (a test in tests/regression.rs puts a
-//! FIFO and a `/dev/zero` symlink at each); a new reader (xacro includes, YAML) uses them too. The
-//! `_within` forms take the limit as an argument, for callers that carry their own.
+//! FIFO and a `/dev/zero` symlink at each); a new reader (xacro includes, YAML) uses them too.
 
+use std::fmt;
 use std::fs::{self, File};
 use std::io::Read;
 use std::path::Path;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The default limit on one input file: 1 GiB.
 pub const DEFAULT_MAX_FILE_SIZE: u64 = 1 << 30;
 
-/// The environment variable that sets the limit when `--max-file-size` is not given.
-pub const MAX_FILE_SIZE_ENV: &str = "URDF_INERTIA_MAX_FILE_SIZE";
-
-static MAX_FILE_SIZE: AtomicU64 = AtomicU64::new(DEFAULT_MAX_FILE_SIZE);
-
-/// Sets the process-wide limit on the size of one input file, in bytes.
-pub fn set_max_file_size(bytes: u64) {
-    MAX_FILE_SIZE.store(bytes, Ordering::Relaxed);
+/// Why a file could not be read; the message names no path (callers name the file and what it is).
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum InputError {
+    /// Not a regular file: a directory, a FIFO, a device, a socket.
+    NotRegular {
+        /// What it is instead (`a directory`, `a FIFO`, …).
+        kind: &'static str,
+    },
+    /// Larger than the limit the caller passed, in bytes.
+    TooLarge { limit: u64 },
+    /// The operating system's error, as text.
+    Io(String),
 }
 
-/// The process-wide limit on the size of one input file, in bytes.
-pub fn max_file_size() -> u64 {
-    MAX_FILE_SIZE.load(Ordering::Relaxed)
+impl fmt::Display for InputError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            InputError::NotRegular { kind } => write!(f, "is not a regular file ({kind})"),
+            InputError::TooLarge { limit } => write!(
+                f,
+                "is larger than the limit of {limit} bytes (raise it with --max-file-size or URDF_INERTIA_MAX_FILE_SIZE)"
+            ),
+            InputError::Io(e) => f.write_str(e),
+        }
+    }
+}
+
+impl std::error::Error for InputError {}
+
+impl From<std::io::Error> for InputError {
+    fn from(e: std::io::Error) -> Self {
+        InputError::Io(e.to_string())
+    }
 }
 
 /// Parses a size: bytes, or a number with a `K`, `M` or `G` suffix (powers of 1024).
@@ -86,74 +109,45 @@ fn special_kind(_: fs::FileType) -> &'static str {
     "not a file"
 }
 
-/// The whole content of a regular file no larger than [`max_file_size`]. The error says why, without
-/// the path (callers name the file and what it is).
-pub fn read_file(path: &Path) -> Result<Vec<u8>, String> {
-    read_file_within(path, max_file_size())
+/// The whole content of a regular file no larger than `limit` bytes.
+pub fn read_file(path: &Path, limit: u64) -> Result<Vec<u8>, InputError> {
+    let (file, len) = open_file(path, limit)?;
+    read_rest(file, Vec::with_capacity(len as usize), limit)
 }
 
-/// [`read_file`] with the size limit `limit` instead of the process-wide one.
-pub fn read_file_within(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
-    let (file, len) = open_file_within(path, limit)?;
-    read_rest_within(file, Vec::with_capacity(len as usize), limit)
-}
-
-/// A regular file no larger than [`max_file_size`], opened for reading, and its length: for readers
+/// A regular file no larger than `limit` bytes, opened for reading, and its length: for readers
 /// that stream a big file instead of holding all of it (then they must read no more than the
 /// length, and treat a shorter file as truncated).
-pub fn open_file(path: &Path) -> Result<(File, u64), String> {
-    open_file_within(path, max_file_size())
-}
-
-/// [`open_file`] with the size limit `limit` instead of the process-wide one.
-pub fn open_file_within(path: &Path, limit: u64) -> Result<(File, u64), String> {
+pub fn open_file(path: &Path, limit: u64) -> Result<(File, u64), InputError> {
     let regular = |meta: &fs::Metadata| {
         if meta.is_file() {
             Ok(())
         } else {
-            Err(format!(
-                "is not a regular file ({})",
-                kind(meta.file_type())
-            ))
+            Err(InputError::NotRegular {
+                kind: kind(meta.file_type()),
+            })
         }
     };
     // Checked before opening: opening a FIFO for reading blocks until someone writes.
-    regular(&fs::metadata(path).map_err(|e| e.to_string())?)?;
-    let file = File::open(path).map_err(|e| e.to_string())?;
-    let meta = file.metadata().map_err(|e| e.to_string())?;
+    regular(&fs::metadata(path)?)?;
+    let file = File::open(path)?;
+    let meta = file.metadata()?;
     regular(&meta)?;
     if meta.len() > limit {
-        return Err(too_large(limit));
+        return Err(InputError::TooLarge { limit });
     }
     Ok((file, meta.len()))
 }
 
-/// Appends the rest of `file` to `bytes`, up to [`max_file_size`] in all (a file can grow after its
-/// size was checked).
-pub fn read_rest(file: impl Read, bytes: Vec<u8>) -> Result<Vec<u8>, String> {
-    read_rest_within(file, bytes, max_file_size())
-}
-
-/// [`read_rest`] with the size limit `limit` instead of the process-wide one.
-pub fn read_rest_within(
-    file: impl Read,
-    mut bytes: Vec<u8>,
-    limit: u64,
-) -> Result<Vec<u8>, String> {
+/// Appends the rest of `file` to `bytes`, up to `limit` bytes in all (a file can grow after its
+/// size was checked; stdin has no size).
+pub fn read_rest(file: impl Read, mut bytes: Vec<u8>, limit: u64) -> Result<Vec<u8>, InputError> {
     let room = limit.saturating_sub(bytes.len() as u64);
-    file.take(room.saturating_add(1))
-        .read_to_end(&mut bytes)
-        .map_err(|e| e.to_string())?;
+    file.take(room.saturating_add(1)).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > limit {
-        return Err(too_large(limit));
+        return Err(InputError::TooLarge { limit });
     }
     Ok(bytes)
-}
-
-fn too_large(limit: u64) -> String {
-    format!(
-        "is larger than the limit of {limit} bytes (raise it with --max-file-size or {MAX_FILE_SIZE_ENV})"
-    )
 }
 
 #[cfg(test)]
@@ -175,19 +169,23 @@ mod tests {
         let tmp = tempfile::tempdir().expect("tempdir");
         let p = tmp.path().join("f");
         std::fs::write(&p, [7u8; 100]).expect("write");
-        assert_eq!(read_file_within(&p, 100).map(|b| b.len()), Ok(100));
-        assert!(read_file_within(&p, 99)
-            .unwrap_err()
-            .contains("larger than the limit of 99 bytes"));
+        assert_eq!(read_file(&p, 100).map(|b| b.len()), Ok(100));
+        assert_eq!(
+            read_file(&p, 99).unwrap_err(),
+            InputError::TooLarge { limit: 99 }
+        );
     }
 
     #[test]
     fn devices_and_directories_are_refused() {
-        assert!(read_file(Path::new("/dev/zero"))
+        let limit = DEFAULT_MAX_FILE_SIZE;
+        assert!(read_file(Path::new("/dev/zero"), limit)
             .unwrap_err()
+            .to_string()
             .contains("is not a regular file (a character device)"));
-        assert!(read_file(Path::new("/"))
+        assert!(read_file(Path::new("/"), limit)
             .unwrap_err()
+            .to_string()
             .contains("is not a regular file (a directory)"));
     }
 }

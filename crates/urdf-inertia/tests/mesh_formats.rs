@@ -591,7 +591,7 @@ fn chunked_parallel_weld_is_the_sequential_weld() {
         let (whole, streamed) = pool.install(|| {
             (
                 mesh::stl::parse(&bytes, &path).expect("parse"),
-                mesh::read(&path).expect("read"),
+                mesh::read(&path, urdf_inertia::input::DEFAULT_MAX_FILE_SIZE).expect("read"),
             )
         });
         for m in [whole, streamed] {

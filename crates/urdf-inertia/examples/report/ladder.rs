@@ -76,7 +76,8 @@ fn corpus(md: &mut String, share: &Path) {
     let mut rungs = std::collections::BTreeMap::<String, usize>::new();
     let mut rows = Vec::new();
     for f in &files {
-        let Ok(raw) = urdf_inertia::mesh::read(f) else {
+        let Ok(raw) = urdf_inertia::mesh::read(f, urdf_inertia::input::DEFAULT_MAX_FILE_SIZE)
+        else {
             *rungs.entry("error".into()).or_default() += 1;
             continue;
         };

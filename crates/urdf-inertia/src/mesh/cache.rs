@@ -25,6 +25,8 @@ pub struct MeshCache {
     usage: HashMap<SolidKey, (u64, u64)>,
     calls: u64,
     memory_budget: u64,
+    /// The largest mesh file read, in bytes.
+    max_file_size: u64,
     pub load_time: Duration,
     pub integrate_time: Duration,
 }
@@ -96,9 +98,18 @@ impl MeshCache {
             usage: HashMap::new(),
             calls: 0,
             memory_budget: bytes,
+            max_file_size: crate::input::DEFAULT_MAX_FILE_SIZE,
             load_time: Duration::ZERO,
             integrate_time: Duration::ZERO,
         }
+    }
+
+    /// The same, reading no mesh file larger than `bytes` (a glTF's buffers together as well);
+    /// [`crate::input::DEFAULT_MAX_FILE_SIZE`] unless set.
+    #[must_use]
+    pub fn with_max_file_size(mut self, bytes: u64) -> Self {
+        self.max_file_size = bytes;
+        self
     }
 
     /// Bytes the held solids take.
@@ -189,13 +200,14 @@ impl MeshCache {
             index: &index,
             done: &done,
             options,
+            max_file_size: self.max_file_size,
         };
         let load = |w: usize| {
             let (size, path, scales) = &work[w];
             let loaded = if self.memory_budget != u64::MAX && peaks[w] > room {
                 refused(path, scales, peaks[w], *size, room)
             } else {
-                load_file(path, scales, options)
+                load_file(path, scales, options, self.max_file_size)
             };
             let _ = done[w].set(loaded);
         };
@@ -384,6 +396,7 @@ pub struct Solids<'a> {
     index: &'a HashMap<&'a PathBuf, usize>,
     done: &'a [std::sync::OnceLock<LoadedFile>],
     options: HealthOptions,
+    max_file_size: u64,
 }
 
 impl Solids<'_> {
@@ -398,7 +411,12 @@ impl Solids<'_> {
             .or_else(|| self.cached.get(&(path.clone(), bits)));
         match found {
             Some(solid) => solid.clone(),
-            None => load_file(path, &[scale], self.options).1.remove(0).1,
+            None => {
+                load_file(path, &[scale], self.options, self.max_file_size)
+                    .1
+                    .remove(0)
+                    .1
+            }
         }
     }
 }
@@ -406,9 +424,14 @@ impl Solids<'_> {
 /// A file read and its scales healed: the path, the solids, read and heal times.
 type LoadedFile = (PathBuf, SolidsByScale, Duration, Duration);
 
-fn load_file(path: &Path, scales: &[[f64; 3]], options: HealthOptions) -> LoadedFile {
+fn load_file(
+    path: &Path,
+    scales: &[[f64; 3]],
+    options: HealthOptions,
+    max_file_size: u64,
+) -> LoadedFile {
     let t0 = Instant::now();
-    let raw = read(path);
+    let raw = read(path, max_file_size);
     let t1 = Instant::now();
     let solids = heal_scales(raw, scales, path, options);
     // The raw mesh has ended, before the next file of this thread is read.

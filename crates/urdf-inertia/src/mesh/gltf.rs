@@ -151,6 +151,7 @@ fn load_buffers(
     blob: Option<Vec<u8>>,
     path: &Path,
     meshopt_used: bool,
+    max_file_size: u64,
 ) -> Result<Vec<Buffer>, MeshError> {
     let mut out = Vec::new();
     let blob = blob.map(Rc::new);
@@ -170,17 +171,15 @@ fn load_buffers(
             gltf::buffer::Source::Uri(uri) => match by_uri.get(uri) {
                 Some(data) => Rc::clone(data),
                 None => {
-                    let data = Rc::new(read_uri(uri, path, buffer.index())?);
+                    let data = Rc::new(read_uri(uri, path, buffer.index(), max_file_size)?);
                     total = total.saturating_add(data.len() as u64);
-                    if total > crate::input::max_file_size() {
+                    if total > max_file_size {
                         return Err(MeshError::new(
                             path,
                             None,
                             MeshErrorKind::Io(format!(
-                                "buffer {}: the file's buffers together are larger than the limit of {} bytes (raise it with --max-file-size or {})",
+                                "buffer {}: the file's buffers together are larger than the limit of {max_file_size} bytes (raise it with --max-file-size or URDF_INERTIA_MAX_FILE_SIZE)",
                                 buffer.index(),
-                                crate::input::max_file_size(),
-                                crate::input::MAX_FILE_SIZE_ENV
                             )),
                         ));
                     }
@@ -210,7 +209,12 @@ fn load_buffers(
     Ok(out)
 }
 
-fn read_uri(uri: &str, path: &Path, index: usize) -> Result<Vec<u8>, MeshError> {
+fn read_uri(
+    uri: &str,
+    path: &Path,
+    index: usize,
+    max_file_size: u64,
+) -> Result<Vec<u8>, MeshError> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (header, payload) = rest
             .split_once(',')
@@ -257,7 +261,7 @@ fn read_uri(uri: &str, path: &Path, index: usize) -> Result<Vec<u8>, MeshError> 
         .unwrap_or(Path::new("."))
         .join(decoded.as_ref());
     // Through the same guard as every input: regular files only, at most --max-file-size.
-    crate::input::read_file(&file).map_err(|e| {
+    crate::input::read_file(&file, max_file_size).map_err(|e| {
         MeshError::new(
             path,
             None,
@@ -567,10 +571,13 @@ fn check_glb_header(bytes: &[u8], path: &Path) -> Result<(), MeshError> {
 }
 
 /// Parses a .gltf or .glb file into one mesh in the file's frame (see the module docs for the convention).
-pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
+/// External buffers are read relative to `path`, all of them together no larger than `max_file_size`.
+pub fn parse(bytes: &[u8], path: &Path, max_file_size: u64) -> Result<RawMesh, MeshError> {
     check_glb_header(bytes, path)?;
     // Offsets are checked before every read; the guard turns any panic left in the crate into an error.
-    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| parse_checked(bytes, path))) {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        parse_checked(bytes, path, max_file_size)
+    })) {
         Ok(result) => result,
         Err(_) => Err(syntax(
             path,
@@ -580,7 +587,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
 }
 
 /// Parses a glTF document whose GLB header was checked; may panic inside the crate (see [`parse`]).
-fn parse_checked(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
+fn parse_checked(bytes: &[u8], path: &Path, max_file_size: u64) -> Result<RawMesh, MeshError> {
     let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(bytes)
         .map_err(|e| syntax(path, format!("not a valid glTF file: {e}")))?;
     let mut root = document.into_json();
@@ -588,7 +595,7 @@ fn parse_checked(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     // Material-only required extensions are accepted above; the crate's validation would refuse them.
     root.extensions_required.clear();
     let doc = gltf::Document::from_json(root).map_err(|e| syntax(path, format!("{e}")))?;
-    let buffers = load_buffers(&doc, blob, path, meshopt_used)?;
+    let buffers = load_buffers(&doc, blob, path, meshopt_used, max_file_size)?;
 
     let mut out = RawMesh {
         faces: Polygons::new(),

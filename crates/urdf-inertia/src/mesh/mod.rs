@@ -191,12 +191,13 @@ fn catching_panics<T>(
     })
 }
 
-/// Reads a mesh file of any supported format (by extension).
-pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
-    catching_panics(path, || read_unguarded(path))
+/// Reads a mesh file of any supported format (by extension), no larger than `max_file_size` bytes
+/// (a glTF's external buffers together as well).
+pub fn read(path: &Path, max_file_size: u64) -> Result<RawMesh, MeshError> {
+    catching_panics(path, || read_unguarded(path, max_file_size))
 }
 
-fn read_unguarded(path: &Path) -> Result<RawMesh, MeshError> {
+fn read_unguarded(path: &Path, max_file_size: u64) -> Result<RawMesh, MeshError> {
     let format = MeshFormat::from_path(path).ok_or_else(|| {
         let ext = path
             .extension()
@@ -206,17 +207,17 @@ fn read_unguarded(path: &Path) -> Result<RawMesh, MeshError> {
     })?;
     if format == MeshFormat::Stl {
         // Streamed: a big binary file is never held whole.
-        let mesh = stl::read(path)?;
+        let mesh = stl::read(path, max_file_size)?;
         validate(&mesh, path)?;
         return Ok(mesh);
     }
-    let bytes = crate::input::read_file(path)
-        .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e)))?;
+    let bytes = crate::input::read_file(path, max_file_size)
+        .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e.to_string())))?;
     let mesh = match format {
         MeshFormat::Stl => stl::parse(&bytes, path)?,
         MeshFormat::Obj => obj::parse(&bytes, path)?,
         MeshFormat::Collada => collada::parse(&bytes, path)?,
-        MeshFormat::Gltf => gltf::parse(&bytes, path)?,
+        MeshFormat::Gltf => gltf::parse(&bytes, path, max_file_size)?,
     };
     validate(&mesh, path)?;
     Ok(mesh)
@@ -287,14 +288,68 @@ fn scale_keeps_distinct(vertices: &[[f64; 3]], scale: [f64; 3]) -> bool {
         && vertices.iter().flatten().all(|&x| f64::from(x as f32) == x)
 }
 
-/// Reads, scales and heals a mesh file: the solid the mass core integrates, with its provenance.
+/// How a mesh file becomes a solid: the repair ladder's options and the limit on the file's size.
+#[derive(Debug, Clone, Copy)]
+#[non_exhaustive]
+pub struct LoadOptions {
+    /// The repair ladder's options (`strict`, what an open mesh becomes).
+    pub health: health::HealthOptions,
+    /// The largest file read, in bytes ([`crate::input::DEFAULT_MAX_FILE_SIZE`] by default).
+    pub max_file_size: u64,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions {
+            health: health::HealthOptions::default(),
+            max_file_size: crate::input::DEFAULT_MAX_FILE_SIZE,
+        }
+    }
+}
+
+impl LoadOptions {
+    /// Every repair below a welded mesh is an error.
+    #[must_use]
+    pub fn strict(mut self, strict: bool) -> Self {
+        self.health.strict = strict;
+        self
+    }
+
+    /// What an open mesh whose caps cannot be trusted becomes.
+    #[must_use]
+    pub fn open_mesh(mut self, model: open::OpenMeshModel) -> Self {
+        self.health.open_mesh = model;
+        self
+    }
+
+    /// The largest file read, in bytes.
+    #[must_use]
+    pub fn max_file_size(mut self, bytes: u64) -> Self {
+        self.max_file_size = bytes;
+        self
+    }
+}
+
+/// The default limit on the file's size.
+impl From<health::HealthOptions> for LoadOptions {
+    fn from(health: health::HealthOptions) -> Self {
+        LoadOptions {
+            health,
+            ..LoadOptions::default()
+        }
+    }
+}
+
+/// Reads, scales and heals a mesh file: the solid the mass core integrates, with its provenance and
+/// its error estimate.
 pub fn load_solid(
     path: &Path,
     scale: [f64; 3],
-    options: health::HealthOptions,
+    options: impl Into<LoadOptions>,
 ) -> Result<health::Solid, MeshError> {
-    let raw = read(path)?;
-    solid_from_owned(raw, scale, path, options)
+    let options = options.into();
+    let raw = read(path, options.max_file_size)?;
+    solid_from_owned(raw, scale, path, options.health)
 }
 
 /// Scales and heals an already read mesh (a file used with several scales is read once).

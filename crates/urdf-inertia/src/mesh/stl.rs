@@ -139,9 +139,9 @@ fn binary(bytes: &[u8], n: usize, header_count: Option<usize>) -> RawMesh {
 /// pieces of a few megabytes, each welded as it arrives, so the file is never held whole:
 /// on a 1.3 M-face file (65.5 MB) that saves the 65.5 MB buffer, and the page faults of filling it.
 /// Anything else is read whole and given to [`parse`].
-pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
-    let (file, len) = crate::input::open_file(path)
-        .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e)))?;
+pub fn read(path: &Path, max_file_size: u64) -> Result<RawMesh, MeshError> {
+    let (file, len) = crate::input::open_file(path, max_file_size)
+        .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e.to_string())))?;
     read_split(file, len, path, CHUNK, None)
 }
 
@@ -183,7 +183,9 @@ pub fn read_split(
             let rest = source.take(len.saturating_sub(head.len() as u64));
             return ascii_stream(head, rest, path, ASCII_PIECE, ASCII_CHUNK);
         }
-        let bytes = crate::input::read_rest(source, head).map_err(io)?;
+        // No more than the length checked when the file was opened.
+        let rest = source.take(len.saturating_sub(head.len() as u64));
+        let bytes = crate::input::read_rest(rest, head, len).map_err(|e| io(e.to_string()))?;
         return parse(&bytes, path);
     }
     let n = n as usize;

@@ -1,20 +1,24 @@
 //! Mesh URIs to files: `package://NAME/rest` (also `package:///NAME/rest`), `file://`, and plain paths
 //! relative to the URDF.
 //!
-//! A package is looked up, in order: `--package-path NAME=DIR` (DIR is the package's own directory),
-//! then each entry of `ROS_PACKAGE_PATH` (a package directory itself, or a tree containing it), then each
-//! `AMENT_PREFIX_PATH` prefix's `share/NAME`, then walking up from the URDF's directory to a directory
-//! that is the package (holds a `package.xml` naming it, or is named like it) or that contains one.
+//! A package is looked up, in order: the packages given by name (`--package-path NAME=DIR`; DIR is the
+//! package's own directory), then each entry of the ROS package path (a package directory itself, or a
+//! tree containing it), then each ament prefix's `share/NAME`, then walking up from the URDF's
+//! directory to a directory that is the package (holds a `package.xml` naming it, or is named like it)
+//! or that contains one. The resolver reads no environment: the command line passes
+//! `ROS_PACKAGE_PATH` and `AMENT_PREFIX_PATH` in.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// How to find packages.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct PackageResolver {
     explicit: HashMap<String, PathBuf>,
     ros_package_path: Vec<PathBuf>,
     ament_prefix_path: Vec<PathBuf>,
+    /// The largest `package.xml` read, in bytes.
+    max_file_size: u64,
     cache: Found,
 }
 
@@ -41,6 +45,12 @@ impl Clone for Found {
     }
 }
 
+impl Default for PackageResolver {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 /// A mesh URI that names no existing file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NotFound {
@@ -51,33 +61,53 @@ pub struct NotFound {
 }
 
 impl PackageResolver {
-    /// From `NAME=DIR` arguments and the environment.
-    pub fn new(package_paths: &[(String, PathBuf)]) -> Self {
-        let split = |var: &str| -> Vec<PathBuf> {
-            std::env::var_os(var)
-                .map(|v| {
-                    std::env::split_paths(&v)
-                        .filter(|p| !p.as_os_str().is_empty())
-                        .collect()
-                })
-                .unwrap_or_default()
-        };
+    /// A resolver that knows no package by name and no search path: `package://NAME` is found by
+    /// walking up from the URDF's directory alone.
+    pub fn new() -> Self {
         PackageResolver {
-            explicit: package_paths.iter().cloned().collect(),
-            ros_package_path: split("ROS_PACKAGE_PATH"),
-            ament_prefix_path: split("AMENT_PREFIX_PATH"),
-            cache: Default::default(),
+            explicit: HashMap::new(),
+            ros_package_path: Vec::new(),
+            ament_prefix_path: Vec::new(),
+            max_file_size: crate::input::DEFAULT_MAX_FILE_SIZE,
+            cache: Found::default(),
         }
     }
 
-    /// Parses `NAME=DIR`.
-    pub fn parse_package_arg(arg: &str) -> Result<(String, PathBuf), String> {
-        match arg.split_once('=') {
-            Some((name, dir)) if !name.is_empty() && !dir.is_empty() => {
-                Ok((name.to_string(), PathBuf::from(dir)))
-            }
-            _ => Err(format!("--package-path `{arg}` should be NAME=DIR")),
-        }
+    /// The same, with packages given by name and directory (looked up first).
+    #[must_use]
+    pub fn with_packages(mut self, packages: &[(String, PathBuf)]) -> Self {
+        self.explicit.extend(packages.iter().cloned());
+        self
+    }
+
+    /// The same, with the entries of a ROS package path (`ROS_PACKAGE_PATH`), each a package
+    /// directory or a tree containing packages; empty entries are skipped.
+    #[must_use]
+    pub fn with_ros_package_path(mut self, dirs: impl IntoIterator<Item = PathBuf>) -> Self {
+        self.ros_package_path
+            .extend(dirs.into_iter().filter(|p| !p.as_os_str().is_empty()));
+        self
+    }
+
+    /// The same, with ament prefixes (`AMENT_PREFIX_PATH`), whose `share/NAME` is package `NAME`;
+    /// empty entries are skipped.
+    #[must_use]
+    pub fn with_ament_prefix_path(mut self, dirs: impl IntoIterator<Item = PathBuf>) -> Self {
+        self.ament_prefix_path
+            .extend(dirs.into_iter().filter(|p| !p.as_os_str().is_empty()));
+        self
+    }
+
+    /// The same, reading no `package.xml` larger than `bytes`.
+    #[must_use]
+    pub fn with_max_file_size(mut self, bytes: u64) -> Self {
+        self.max_file_size = bytes;
+        self
+    }
+
+    /// The largest file read while resolving, in bytes (xacro reads its includes with it too).
+    pub fn max_file_size(&self) -> u64 {
+        self.max_file_size
     }
 
     /// The file a mesh URI names, relative to the URDF at `urdf`.
@@ -199,7 +229,7 @@ impl PackageResolver {
             out.push(d.clone());
         }
         for root in &self.ros_package_path {
-            if is_package(root, pkg)? {
+            if is_package(root, pkg, self.max_file_size)? {
                 out.push(root.clone());
             } else {
                 let cand = root.join(pkg);
@@ -223,7 +253,7 @@ impl PackageResolver {
         let found = match found {
             Some(f) => f,
             None => {
-                let f = walk_up(base, pkg);
+                let f = walk_up(base, pkg, self.max_file_size);
                 self.cache.lock().insert(key, f.clone());
                 f
             }
@@ -333,10 +363,10 @@ pub fn percent_decode(s: &str) -> String {
 /// Whether `dir` is package `pkg`: its `package.xml` names it, or the directory has the package's name.
 /// A `package.xml` that is there but cannot be read through the input guard (a FIFO, a symlink to
 /// `/dev/zero`, a file over the size limit) is an error naming it, not a hang or a read without end.
-fn is_package(dir: &Path, pkg: &str) -> Result<bool, String> {
+fn is_package(dir: &Path, pkg: &str, max_file_size: u64) -> Result<bool, String> {
     let xml = dir.join("package.xml");
     if xml.exists() {
-        let bytes = crate::input::read_file(&xml).map_err(|e| {
+        let bytes = crate::input::read_file(&xml, max_file_size).map_err(|e| {
             format!(
                 "{} {e}; remove or fix it (urdf-inertia reads it to find package `{pkg}`)",
                 xml.display()
@@ -352,7 +382,7 @@ fn is_package(dir: &Path, pkg: &str) -> Result<bool, String> {
     Ok(dir.file_name().and_then(|n| n.to_str()) == Some(pkg))
 }
 
-fn walk_up(base: &Path, pkg: &str) -> Result<Option<PathBuf>, String> {
+fn walk_up(base: &Path, pkg: &str, max_file_size: u64) -> Result<Option<PathBuf>, String> {
     // `robot.urdf` given relative to the working directory: its folder is "", which is ".".
     let base = if base.as_os_str().is_empty() {
         Path::new(".")
@@ -362,7 +392,7 @@ fn walk_up(base: &Path, pkg: &str) -> Result<Option<PathBuf>, String> {
     let start = std::fs::canonicalize(base).unwrap_or_else(|_| base.to_path_buf());
     let mut dir = Some(start.as_path());
     while let Some(d) = dir {
-        if is_package(d, pkg)? {
+        if is_package(d, pkg, max_file_size)? {
             return Ok(Some(d.to_path_buf()));
         }
         let child = d.join(pkg);
@@ -391,7 +421,7 @@ mod tests {
         .expect("write");
         std::fs::write(pkg.join("meshes/a.stl"), "solid x\nendsolid x\n").expect("write");
         let urdf = pkg.join("urdf/robot.urdf");
-        let r = PackageResolver::new(&[]);
+        let r = PackageResolver::new();
         // Walking up from the URDF finds the package.
         assert!(r
             .resolve("package://my_robot_description/meshes/a.stl", &urdf)
@@ -401,7 +431,7 @@ mod tests {
             .is_ok());
         // Explicit path.
         let elsewhere = tmp.path().join("robot.urdf");
-        let r2 = PackageResolver::new(&[("other".into(), pkg.clone())]);
+        let r2 = PackageResolver::new().with_packages(&[("other".into(), pkg.clone())]);
         assert_eq!(
             r2.resolve("package://other/meshes/a.stl", &elsewhere)
                 .expect("explicit"),
@@ -451,7 +481,7 @@ mod tests {
                 .expect("write");
         }
         let urdf = tmp.path().join("robot.urdf");
-        let r = PackageResolver::new(&[]);
+        let r = PackageResolver::new();
         let hint = |uri: &str| r.resolve(uri, &urdf).unwrap_err().hint;
         // Case only.
         assert!(hint("meshes/forearm.stl").starts_with("did you mean `Forearm.STL`?"));

@@ -240,8 +240,9 @@ impl<'o> Expander<'o> {
         if let Some(k) = self.files.iter().position(|f| f.path == path) {
             return Ok(k);
         }
-        let bytes =
-            crate::input::read_file(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let limit = self.opts.resolver.max_file_size();
+        let bytes = crate::input::read_file(&path, limit)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
         let (text, encoding) = crate::urdf::encoding::decode(bytes)
             .map_err(|e| format!("{}:{}:{}: {}", path.display(), e.line, e.column, e.message))?;
         self.files.push(SourceFile {

@@ -26,7 +26,7 @@ impl Files {
         args: &[(&str, &str)],
         env: &[(&str, &str)],
     ) -> Result<Expansion, XacroError> {
-        let resolver = PackageResolver::new(&[]);
+        let resolver = PackageResolver::new();
         let opts = Options {
             args: args
                 .iter()

@@ -235,7 +235,9 @@ pub fn bases() -> Vec<(String, Mesh)> {
         "wrist_wedge.stl",
         "upper_arm.obj",
     ] {
-        let raw = urdf_inertia::mesh::read(&demo.join(name)).expect("demo mesh");
+        let raw =
+            urdf_inertia::mesh::read(&demo.join(name), urdf_inertia::input::DEFAULT_MAX_FILE_SIZE)
+                .expect("demo mesh");
         let w = urdf_inertia::mesh::weld::exact(&raw.vertices, &raw.faces);
         out.push((format!("demo {name}"), (w.vertices, w.faces.triangles())));
     }
