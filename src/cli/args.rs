@@ -58,8 +58,8 @@ pub enum OpenMesh {
 
 impl OpenMesh {
     /// The library's model for the flag (absent: fail the part, UI108).
-    pub fn model(flag: Option<OpenMesh>) -> urdf_inertia::mesh::open::OpenMeshModel {
-        use urdf_inertia::mesh::open::OpenMeshModel;
+    pub fn model(flag: Option<OpenMesh>) -> urdf_inertia::OpenMeshModel {
+        use urdf_inertia::OpenMeshModel;
         match flag {
             None => OpenMeshModel::Trusted,
             Some(OpenMesh::Caps) => OpenMeshModel::Caps,

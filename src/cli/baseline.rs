@@ -6,8 +6,8 @@
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use urdf_inertia::diagnostic::Code;
-use urdf_inertia::problem::InertialProblem;
 use urdf_inertia::text::escape_control;
+use urdf_inertia::InertialProblem;
 
 /// One problem `check` found, with where to print it.
 #[derive(Debug, Clone)]

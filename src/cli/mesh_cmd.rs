@@ -3,9 +3,9 @@
 use super::args::{Format, MeshArgs};
 use super::ExitStatus;
 use serde_json::json;
-use urdf_inertia::mass::{MassProperties, Principal};
-use urdf_inertia::mesh::{self, health::Solid};
 use urdf_inertia::text::{round_significant, shortest, within, Digits};
+use urdf_inertia::{LoadOptions, Solid};
+use urdf_inertia::{MassProperties, Principal};
 
 pub fn run(args: &MeshArgs) -> ExitStatus {
     let scale = match args.scale.as_deref() {
@@ -16,11 +16,11 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         return ExitStatus::Error;
     }
     let start = std::time::Instant::now();
-    let options = mesh::LoadOptions::default()
+    let options = LoadOptions::default()
         .strict(args.strict)
         .open_mesh(super::args::OpenMesh::model(args.open_mesh))
         .max_file_size(super::max_file_size());
-    let solid = match mesh::load_solid(&args.file, scale, options) {
+    let solid = match urdf_inertia::load_solid(&args.file, scale, options) {
         Ok(s) => s,
         Err(e) => {
             errln!("error: {e}");
@@ -34,11 +34,11 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         (None, None) => 1.0,
     };
     let mp = solid.unit.scaled(density);
-    if let Some(why) = urdf_inertia::fill::unrepresentable(&mp) {
+    if let Some(why) = urdf_inertia::unrepresentable(&mp) {
         errln!("error: {}: {why}", args.file.display());
         return ExitStatus::Error;
     }
-    if let Some(m) = urdf_inertia::fill::millimetre_slip(&solid.vertices, scale) {
+    if let Some(m) = urdf_inertia::millimetre_slip(&solid.vertices, scale) {
         errln!("warning: {}: {m}", args.file.display());
     }
     let out = rounded(args, &solid, volume, density, &mp);

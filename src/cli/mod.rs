@@ -67,13 +67,13 @@ pub fn parse_package_arg(arg: &str) -> Result<(String, std::path::PathBuf), Stri
 /// `AMENT_PREFIX_PATH` from the environment (the library reads no environment).
 pub fn package_resolver(
     packages: &[(String, std::path::PathBuf)],
-) -> urdf_inertia::urdf::resolve::PackageResolver {
+) -> urdf_inertia::PackageResolver {
     let split = |var: &str| -> Vec<std::path::PathBuf> {
         std::env::var_os(var)
             .map(|v| std::env::split_paths(&v).collect())
             .unwrap_or_default()
     };
-    urdf_inertia::urdf::resolve::PackageResolver::new()
+    urdf_inertia::PackageResolver::new()
         .with_packages(packages)
         .with_ros_package_path(split("ROS_PACKAGE_PATH"))
         .with_ament_prefix_path(split("AMENT_PREFIX_PATH"))
@@ -124,7 +124,7 @@ pub fn main() -> i32 {
         Command::Check(c) => robot_cmd::check(&c),
         Command::Xacro(x) => xacro_cmd::run(&x),
     };
-    if let Some(note) = urdf_inertia::threads::note() {
+    if let Some(note) = urdf_inertia::thread_note() {
         errln!(
             "warning[{}]: {note}",
             urdf_inertia::diagnostic::Code::RunThreads

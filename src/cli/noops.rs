@@ -2,11 +2,11 @@
 //! the robots of a run, and a robot with no collision geometry at all.
 
 use std::path::Path;
-use urdf_inertia::density::{near_miss, DensityMap};
 use urdf_inertia::diagnostic::{Code, Diagnostic, Location};
-use urdf_inertia::fill::{unused_selection, FillOptions};
 use urdf_inertia::text::escape_control;
-use urdf_inertia::urdf::{Geometry, Robot};
+use urdf_inertia::{near_miss, DensityMap};
+use urdf_inertia::{unused_selection, FillOptions};
+use urdf_inertia::{Geometry, Robot};
 
 /// The link names and collision mesh URIs of every robot of a run (a rule or pattern is unused only
 /// when it matches nothing in any of them: pre-commit passes several URDFs of one repository).

@@ -7,7 +7,7 @@ use serde::Deserialize;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use urdf_inertia::diagnostic::{Code, Diagnostic, Severity};
-use urdf_inertia::fill::FillReport;
+use urdf_inertia::FillReport;
 
 /// The configuration file's name.
 pub const CONFIG_FILE: &str = "urdf-inertia.toml";

@@ -9,18 +9,18 @@ use super::summary;
 use super::{write, ExitStatus};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use urdf_inertia::compare::{compare, Comparison};
-use urdf_inertia::density::{DensityMap, Glob};
 use urdf_inertia::diagnostic::{Code, Diagnostic, Location, Severity};
-use urdf_inertia::fill::{self, existing_props, FillOptions, FillReport};
-use urdf_inertia::fill::{LinkReport, MeshCache};
-use urdf_inertia::mass::MassProperties;
-use urdf_inertia::problem::ProblemKind;
 use urdf_inertia::text::Digits;
-use urdf_inertia::urdf::resolve::PackageResolver;
-use urdf_inertia::urdf::write::{splice, LinkUpdate, WriteOptions};
-use urdf_inertia::urdf::{scan_bytes, Geometry, Robot};
+use urdf_inertia::write::{splice, LinkUpdate, WriteOptions};
 use urdf_inertia::xacro::{self, Expansion};
+use urdf_inertia::MassProperties;
+use urdf_inertia::PackageResolver;
+use urdf_inertia::ProblemKind;
+use urdf_inertia::{compare, Comparison};
+use urdf_inertia::{existing_props, FillOptions, FillReport};
+use urdf_inertia::{scan_bytes, Geometry, Robot};
+use urdf_inertia::{DensityMap, Glob};
+use urdf_inertia::{LinkReport, MeshCache};
 
 /// Validated sources: densities (if any), package paths, link selection.
 struct Sources {
@@ -490,7 +490,8 @@ fn run_one(
         outcome.errors += check_collisions(&input, &config.src);
         outcome.problems += promoted_notes;
         // Every collision mesh path must resolve (a stat, no reading).
-        let missing = fill::unresolved_meshes(robot, &config.src.resolver, &config.src.options);
+        let missing =
+            urdf_inertia::unresolved_meshes(robot, &config.src.resolver, &config.src.options);
         for f in &missing {
             errln!("error: {}: {f}", input.link_at(f.line, &f.link));
         }
@@ -498,7 +499,7 @@ fn run_one(
         return outcome;
     };
     let src = &config.src;
-    let mut report = fill::compute_with(robot, map, &src.resolver, &src.options, cache);
+    let mut report = urdf_inertia::compute_with(robot, map, &src.resolver, &src.options, cache);
     config.policy.apply_report(&mut report);
     print_failures(&input, &report);
     outcome.errors += report.error_count();
@@ -960,7 +961,7 @@ fn compare_all<'a>(robot: &Robot, report: &'a FillReport) -> Vec<Row<'a>> {
 /// `problems`; those of frames (links without collision geometry) are notes unless `--all-links`.
 fn check_existing(input: &Input, config: &Config, all_links: bool, problems: &mut Vec<Problem>) {
     let robot = &input.robot;
-    for p in urdf_inertia::problem::check(robot, &config.src.options) {
+    for p in urdf_inertia::check(robot, &config.src.options) {
         // Several <inertial> elements are a problem whatever the link: the file says two things.
         let frame = robot
             .links
@@ -991,7 +992,7 @@ fn check_collisions(input: &Input, src: &Sources) -> usize {
     for link in robot
         .links
         .iter()
-        .filter(|l| fill::selected(&l.name, &src.options))
+        .filter(|l| urdf_inertia::selected(&l.name, &src.options))
     {
         for c in &link.collisions {
             if let Geometry::Invalid { line, message } = &c.geometry {
@@ -1019,7 +1020,7 @@ fn check_against_computed(
     if !config.policy.reports(Code::CheckDiffers) {
         return;
     }
-    let found = urdf_inertia::problem::check_computed(&input.robot, report, config.tolerance);
+    let found = urdf_inertia::check_computed(&input.robot, report, config.tolerance);
     for p in found {
         let at = input.link_at(p.line, &p.link);
         problems.push(Problem { problem: p, at });

@@ -7,11 +7,11 @@ use super::policy::Policy;
 use super::robot_cmd::Row;
 use serde_json::json;
 use urdf_inertia::diagnostic::{Diagnostic, Provenance, Severity};
-use urdf_inertia::fill::{existing_props, FillReport, LinkReport, PartReport};
-use urdf_inertia::mass::MassProperties;
 use urdf_inertia::text::{self, significant, Digits};
-use urdf_inertia::urdf::write::{tidy, tidy_moments};
-use urdf_inertia::urdf::Robot;
+use urdf_inertia::write::{tidy, tidy_moments};
+use urdf_inertia::MassProperties;
+use urdf_inertia::Robot;
+use urdf_inertia::{existing_props, FillReport, LinkReport, PartReport};
 
 /// Wall times of a fill, s.
 #[derive(Debug, Clone, Copy)]

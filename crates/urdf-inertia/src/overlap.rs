@@ -23,6 +23,7 @@
 //! (so a link of N overlapping parts costs O(N); the bound widens instead, and the estimate says
 //! so), and more than [`MAX_PAIRS`] overlapping pairs skip the estimate with a reason.
 
+#[cfg(any(test, feature = "internals"))]
 use crate::geometry::{dot, sub};
 use crate::mass::{mat_vec, transpose, Mat3};
 use crate::mesh::health::Solid;
@@ -304,6 +305,7 @@ impl WholeMeshBound {
 impl MeshLocator {
     /// Buckets `solid`'s triangles within [`LOCATOR_ENTRIES`] references; a mesh of more triangles than
     /// that gets one bucket holding them all.
+    #[cfg(any(test, feature = "internals"))]
     pub fn new(solid: &Solid) -> Self {
         Self::with_budget(solid, LOCATOR_ENTRIES).unwrap_or_else(|| {
             let triangles: Vec<_> = corners(solid).collect();
@@ -314,6 +316,7 @@ impl MeshLocator {
 
     /// Buckets `solid`'s triangles on the finest grid (at most 256 × 256, about four triangles per
     /// cell) whose buckets hold at most `entries` references in all; `None` if none does.
+    #[cfg(any(test, feature = "internals"))]
     pub fn with_budget(solid: &Solid, entries: usize) -> Option<Self> {
         let mut triangles: Vec<_> = corners(solid).collect();
         if triangles.len() > entries {
@@ -533,11 +536,13 @@ impl MeshLocator {
     }
 
     /// Cells per axis of the bucket grid.
+    #[cfg(any(test, feature = "internals"))]
     pub fn grid(&self) -> usize {
         self.grid
     }
 
     /// Triangle references held by all buckets.
+    #[cfg(any(test, feature = "internals"))]
     pub fn entries(&self) -> usize {
         self.entries.len()
     }
@@ -708,6 +713,7 @@ impl PlacedPart {
 }
 
 /// The winding number of a closed, outward surface around `q`: 1 inside, 0 outside.
+#[cfg(any(test, feature = "internals"))]
 pub fn winding_number(solid: &Solid, q: [f64; 3]) -> f64 {
     let mut total = 0.0;
     for face in solid.faces.iter() {
@@ -726,6 +732,7 @@ pub fn winding_number(solid: &Solid, q: [f64; 3]) -> f64 {
     total / (4.0 * std::f64::consts::PI)
 }
 
+#[cfg(any(test, feature = "internals"))]
 fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
 }

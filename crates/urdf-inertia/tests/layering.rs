@@ -42,3 +42,34 @@ fn the_library_tree_has_no_binary_dependencies() {
         );
     }
 }
+
+/// The binary uses the library's facade alone. Its own build (`cargo install`, `cargo build -p
+/// urdf-inertia-cli`) enforces that, as the implementation modules are private; but `cargo test`
+/// builds it with the `internals` feature its tests enable, so this test reads its sources for a
+/// path into a private module.
+#[test]
+fn the_binary_names_no_private_module() {
+    let private = [
+        "compare", "density", "error", "fill", "mass", "mesh", "overlap", "problem", "threads",
+        "urdf",
+    ];
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../src");
+    let mut files = vec![src.join("main.rs")];
+    let cli = std::fs::read_dir(src.join("cli")).expect("src/cli");
+    files.extend(cli.filter_map(Result::ok).map(|e| e.path()));
+    let mut found = Vec::new();
+    for f in files
+        .iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "rs"))
+    {
+        let text = std::fs::read_to_string(f).expect("read");
+        for (n, line) in text.lines().enumerate() {
+            for m in &private {
+                if line.contains(&format!("urdf_inertia::{m}::")) {
+                    found.push(format!("{}:{}: {}", f.display(), n + 1, line.trim()));
+                }
+            }
+        }
+    }
+    assert!(found.is_empty(), "{}", found.join("\n"));
+}

@@ -40,7 +40,9 @@ pub struct VolumeIntegrals {
 /// How sums over faces are accumulated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Summation {
-    /// One running sum per integral, as in the paper.
+    /// One running sum per integral, as in the paper (the tests' and the accuracy report's
+    /// reference).
+    #[cfg(any(test, feature = "internals"))]
     Plain,
     /// Blocks of faces summed plainly, block totals added with an error-free two-sum (Neumaier style).
     Compensated,
@@ -58,6 +60,7 @@ pub struct IntegrationOptions {
 
 impl IntegrationOptions {
     /// The paper as published: integrals about the origin, plain running sums.
+    #[cfg(any(test, feature = "internals"))]
     pub const fn paper() -> Self {
         Self {
             reference: Some([0.0; 3]),
@@ -205,9 +208,11 @@ impl Accumulator {
         }
     }
 
+    #[cfg(any(test, feature = "internals"))]
     #[inline(always)]
     fn add(&mut self, x: &[f64; 10]) {
         match self.summation {
+            #[cfg(any(test, feature = "internals"))]
             Summation::Plain => {
                 for k in 0..10 {
                     self.sum[k] += x[k];
@@ -230,6 +235,7 @@ impl Accumulator {
     #[inline(always)]
     fn add_batch(&mut self, t: &[[f64; LANES]; 10], len: usize) {
         match self.summation {
+            #[cfg(any(test, feature = "internals"))]
             Summation::Plain => {
                 for k in 0..10 {
                     let mut s = self.sum[k];
@@ -642,6 +648,7 @@ impl Batch {
 /// The face normal is Newell's (the exact area vector of the polygon's projections), so a slightly
 /// non-planar polygon gets the best-fit plane; a zero-area face contributes nothing.
 /// Indices must be in range (the mesh layer checks them).
+#[cfg(any(test, feature = "internals"))]
 pub fn mirtich_polygons(
     vertices: &[[f64; 3]],
     faces: &Polygons,
@@ -664,6 +671,7 @@ pub fn mirtich_polygons(
 }
 
 /// A face's unit normal from Newell's formula (robust for non-planar polygons), or `None` for zero area.
+#[cfg(any(test, feature = "internals"))]
 fn unit_normal(p: &[[f64; 3]]) -> Option<[f64; 3]> {
     // Newell's normal: twice the vector area.
     let mut n = [0.0f64; 3];
@@ -682,6 +690,7 @@ fn unit_normal(p: &[[f64; 3]]) -> Option<[f64; 3]> {
 
 /// Mirtich's (α, β, γ): γ is the axis of the largest normal component (the best-conditioned
 /// projection); α, β follow cyclically (right-handed).
+#[cfg(any(test, feature = "internals"))]
 fn projection_axes(n: &[f64; 3]) -> (usize, usize, usize) {
     if n[0].abs() > n[1].abs() && n[0].abs() > n[2].abs() {
         (1, 2, 0)
@@ -693,6 +702,7 @@ fn projection_axes(n: &[f64; 3]) -> (usize, usize, usize) {
 }
 
 /// One face's contribution to the (not yet halved/thirded) sums of Figure 4, or `None` for zero area.
+#[cfg(any(test, feature = "internals"))]
 fn polygon_terms(p: &[[f64; 3]]) -> Option<[f64; 10]> {
     let n = unit_normal(p)?;
     let (ax, bx, cx) = projection_axes(&n);
@@ -770,6 +780,7 @@ fn polygon_terms(p: &[[f64; 3]]) -> Option<[f64; 10]> {
 
 /// Figure 6: the integrals over the face's projection onto the α-β plane, as
 /// `[π1, πα, πβ, πα², παβ, πβ², πα³, πα²β, παβ², πβ³]`.
+#[cfg(any(test, feature = "internals"))]
 fn projection_integrals(p: &[[f64; 3]], ax: usize, bx: usize) -> [f64; 10] {
     let (mut p1, mut pa, mut pb, mut paa, mut pab, mut pbb) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     let (mut paaa, mut paab, mut pabb, mut pbbb) = (0.0, 0.0, 0.0, 0.0);
@@ -970,7 +981,7 @@ impl VolumeIntegrals {
     }
 
     /// The integrals as an array in the paper's order `T1, Tx, Ty, Tz, Tx², Ty², Tz², Txy, Tyz, Tzx`.
-    pub fn to_array(&self) -> [f64; 10] {
+    pub fn to_array(self) -> [f64; 10] {
         [
             self.t1, self.t[0], self.t[1], self.t[2], self.t2[0], self.t2[1], self.t2[2],
             self.tp[0], self.tp[1], self.tp[2],

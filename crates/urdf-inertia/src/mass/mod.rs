@@ -23,7 +23,9 @@ pub mod validity;
 use std::iter::Sum;
 use std::ops::Add;
 
-pub use integrals::{IntegrationOptions, Polygons, Summation, VolumeIntegrals};
+#[cfg(any(test, feature = "internals"))]
+pub use integrals::Summation;
+pub use integrals::{IntegrationOptions, Polygons, VolumeIntegrals};
 
 /// A 3×3 matrix as rows.
 pub type Mat3 = [[f64; 3]; 3];

@@ -902,6 +902,7 @@ fn reach(unit: &MassProperties, vertices: &[[f64; 3]]) -> f64 {
 
 /// Turns a scaled mesh into a solid by the ladder in the module docs, its coordinates taken as f64
 /// values (see [`heal`] for meshes stored in f32 or as decimals).
+#[cfg(any(test, feature = "internals"))]
 pub fn make_solid(mesh: &RawMesh, path: &Path, options: HealthOptions) -> Result<Solid, MeshError> {
     heal(Cow::Borrowed(mesh), path, options, |_| weld::Precision::F64)
 }

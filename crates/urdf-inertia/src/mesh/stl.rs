@@ -20,6 +20,7 @@
 use super::weld::VertexTable;
 use super::{parse_f64, short_decimal, MeshError, MeshErrorKind, RawMesh};
 use crate::mass::Polygons;
+#[cfg(any(test, feature = "internals"))]
 use std::fmt::Write as _;
 use std::io::Read as _;
 use std::path::Path;
@@ -820,6 +821,7 @@ fn ascii_vertex<'a>(
 }
 
 /// Writes a binary STL (used by tests and fixture generators).
+#[cfg(any(test, feature = "internals"))]
 pub fn write_binary(header: &[u8], vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<u8> {
     let mut out = vec![0u8; 80];
     out[..header.len().min(80)].copy_from_slice(&header[..header.len().min(80)]);
@@ -837,6 +839,7 @@ pub fn write_binary(header: &[u8], vertices: &[[f64; 3]], triangles: &[[u32; 3]]
 }
 
 /// Writes an ASCII STL (used by tests and fixture generators).
+#[cfg(any(test, feature = "internals"))]
 pub fn write_ascii(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> String {
     let mut s = String::from("solid fixture\n");
     for t in triangles {

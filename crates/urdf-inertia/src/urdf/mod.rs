@@ -7,6 +7,7 @@
 //! skipped and kept byte for byte. What is read follows urdfdom (see [`scan`]); the text may be UTF-8,
 //! UTF-16 or a declared single-byte encoding (see [`encoding`]).
 
+mod build;
 pub mod encoding;
 pub mod resolve;
 pub mod scan;
