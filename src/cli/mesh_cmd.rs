@@ -97,15 +97,13 @@ fn rounded(
     );
     let pr = mp.principal();
     let largest = pr.moments[2].abs();
-    let mp = MassProperties {
-        mass: round(mp.mass, err * mp.mass),
-        com: mp.com.map(|x| round(x, err * length)),
-        inertia: mp.inertia.map(|r| r.map(|x| round(x, err * largest))),
-    };
-    let pr = Principal {
-        moments: pr.moments.map(|x| round(x, err * largest)),
-        axes: pr.axes,
-    };
+    let mp = MassProperties::new(
+        round(mp.mass, err * mp.mass),
+        mp.com.map(|x| round(x, err * length)),
+        mp.inertia.map(|r| r.map(|x| round(x, err * largest))),
+    );
+    let mut pr = pr;
+    pr.moments = pr.moments.map(|x| round(x, err * largest));
     Rounded {
         volume,
         density,

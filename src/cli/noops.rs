@@ -117,9 +117,6 @@ pub fn no_collision_geometry(robot: &Robot) -> Option<Diagnostic> {
                 "no link has collision geometry, so nothing is computed; {visual} link(s) have visual geometry: `--geometry collision,visual` computes a link without collision geometry from its visual geometry"
             ),
         )
-        .at(Location {
-            file: Some(robot.path.clone()),
-            ..Location::default()
-        }),
+        .at(Location::in_file(robot.path.clone())),
     )
 }

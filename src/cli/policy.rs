@@ -184,6 +184,7 @@ impl Policy {
             Severity::Error => true,
             Severity::Warning => !self.quiet,
             Severity::Note => self.verbose && !self.quiet,
+            _ => true,
         }
     }
 

@@ -636,10 +636,7 @@ fn read_input(path: &Path, src: &Sources, policy: &Policy) -> Result<Input, Stri
             Code::XacroNoLinks,
             "expands to no links (a file of macros?): its links are checked through the top-level xacro files that include it",
         )
-        .at(Location {
-            file: Some(path.to_path_buf()),
-            ..Location::default()
-        });
+        .at(Location::in_file(path));
         print_diagnostics(&policy.apply(&note).into_iter().collect::<Vec<_>>(), policy);
     }
     let mut input = Input {
@@ -778,10 +775,9 @@ fn write_into_sources(
     policy: &Policy,
 ) -> Result<usize, ExitStatus> {
     let robot = &input.robot;
-    let options = WriteOptions {
-        digits: w.digits,
-        principal: w.principal,
-    };
+    let mut options = WriteOptions::default();
+    options.digits = w.digits;
+    options.principal = w.principal;
     // Per source file: the links written there (span, update).
     let mut per_file: std::collections::BTreeMap<usize, Vec<(usize, usize, LinkUpdate)>> =
         Default::default();
@@ -824,7 +820,9 @@ fn write_into_sources(
             .iter()
             .filter_map(|(s, _, u)| {
                 let index = source.links.iter().position(|l| l.start == *s)?;
-                Some(LinkUpdate { index, ..*u })
+                let mut u = *u;
+                u.index = index;
+                Some(u)
             })
             .collect();
         let text = splice(&source, &updates, &options).map_err(|errors| {
@@ -861,10 +859,7 @@ fn write_into_sources(
 
 /// Warnings about the run as a whole: a robot without a name, links left as they were.
 fn run_diagnostics(robot: &Robot, report: &FillReport) -> Vec<Diagnostic> {
-    let at = || Location {
-        file: Some(robot.path.clone()),
-        ..Location::default()
-    };
+    let at = || Location::in_file(robot.path.clone());
     let mut out = Vec::new();
     // A file of xacro macros expands to a nameless robot with no links: pre-commit passes every
     // such file to the hooks, where the name warning would be noise on each run.
@@ -895,10 +890,9 @@ fn run_diagnostics(robot: &Robot, report: &FillReport) -> Vec<Diagnostic> {
 /// The URDF with the computed links spliced in, in the file's own encoding.
 fn spliced(robot: &Robot, report: &FillReport, w: &WriteConfig) -> Result<Vec<u8>, ExitStatus> {
     let updates: Vec<LinkUpdate> = report.links.iter().map(LinkReport::update).collect();
-    let options = WriteOptions {
-        digits: w.digits,
-        principal: w.principal,
-    };
+    let mut options = WriteOptions::default();
+    options.digits = w.digits;
+    options.principal = w.principal;
     let text = splice(robot, &updates, &options).map_err(|errors| {
         for e in errors {
             let link = &robot.links[e.index];

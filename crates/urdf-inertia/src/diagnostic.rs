@@ -17,6 +17,7 @@ use std::path::PathBuf;
 
 /// How much a diagnostic matters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[non_exhaustive]
 pub enum Severity {
     /// Worth knowing, needs no action; printed with `--verbose` or in JSON.
     Note,
@@ -285,6 +286,7 @@ impl Serialize for Code {
 
 /// Where a diagnostic points; every part is optional.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+#[non_exhaustive]
 pub struct Location {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub file: Option<PathBuf>,
@@ -298,8 +300,19 @@ pub struct Location {
     pub collision: Option<usize>,
 }
 
+impl Location {
+    /// A location in `file` alone (no line, link or collision).
+    pub fn in_file(file: impl Into<PathBuf>) -> Location {
+        Location {
+            file: Some(file.into()),
+            ..Location::default()
+        }
+    }
+}
+
 /// One warning or note.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct Diagnostic {
     pub severity: Severity,
     pub code: Code,
@@ -368,6 +381,7 @@ impl Diagnostic {
 
 /// What a part's numbers were computed from.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Provenance {
     /// A box, cylinder, sphere or capsule: exact formulas.
     Primitive,
@@ -427,6 +441,7 @@ pub fn mesh_health(solid: &Solid) -> Vec<Diagnostic> {
 
 /// A collision of a link: its 1-based index and line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct CollisionRef {
     pub index: usize,
     pub line: usize,
@@ -434,6 +449,7 @@ pub struct CollisionRef {
 
 /// Why one link could not be computed (the others still are).
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct LinkError {
     pub link: String,
     /// Line of the `<link>`.

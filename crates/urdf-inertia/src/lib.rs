@@ -66,7 +66,7 @@ pub use fill::{
     PartReport, Timing,
 };
 pub use mass::{primitives, rpy_matrix, MassProperties, Mat3, Principal};
-pub use mesh::health::{ErrorEstimate, HealthOptions, Rung, Solid};
+pub use mesh::health::{ErrorEstimate, Rung, Solid};
 pub use mesh::open::OpenMeshModel;
 pub use mesh::{load_solid, LoadOptions, MeshError, MeshErrorKind};
 pub use problem::{check, check_computed, InertialProblem, ProblemKind};

@@ -140,11 +140,7 @@ fn algebra_on_random_bodies() {
         let want = mat_mul(&mat_mul(&r, &base.inertia), &transpose(&r));
         let (_, dc, di) = rel_diff(
             &got,
-            &MassProperties {
-                mass: base.mass,
-                com: urdf_inertia::mass::mat_vec(&r, base.com),
-                inertia: want,
-            },
+            &MassProperties::new(base.mass, urdf_inertia::mass::mat_vec(&r, base.com), want),
         );
         assert!(dc < 1e-14 && di < 1e-13, "rotation {dc:e} {di:e}");
         // Translation moves only the COM.

@@ -32,6 +32,7 @@ pub type Mat3 = [[f64; 3]; 3];
 
 /// Mass, centre of mass and the full inertia tensor about the centre of mass.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct MassProperties {
     /// kg.
     pub mass: f64,
@@ -43,12 +44,19 @@ pub struct MassProperties {
 
 /// Principal moments (ascending) and the principal axes as the columns of a rotation (right-handed).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Principal {
     pub moments: [f64; 3],
     pub axes: Mat3,
 }
 
 impl MassProperties {
+    /// Mass (kg), centre of mass (m) and the inertia tensor about the centre of mass (kg·m²), in
+    /// the axes of the frame the centre of mass is given in.
+    pub fn new(mass: f64, com: [f64; 3], inertia: Mat3) -> MassProperties {
+        MassProperties { mass, com, inertia }
+    }
+
     /// Nothing: the identity of `+`.
     pub const ZERO: MassProperties = MassProperties {
         mass: 0.0,

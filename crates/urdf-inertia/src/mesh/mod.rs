@@ -78,6 +78,7 @@ impl MeshFormat {
 
 /// Why a mesh file could not become a solid.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct MeshError {
     pub path: PathBuf,
     /// 1-based line, where the format has lines.

@@ -53,6 +53,7 @@ impl Default for PackageResolver {
 
 /// A mesh URI that names no existing file.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct NotFound {
     pub uri: String,
     /// Every place looked at, in order.

@@ -6,6 +6,7 @@ use crate::text::{self, Digits};
 
 /// How numbers and frames are written.
 #[derive(Debug, Clone, Copy, Default)]
+#[non_exhaustive]
 pub struct WriteOptions {
     /// How many digits (default: the shortest decimal within each value's error estimate).
     pub digits: Digits,
@@ -15,6 +16,7 @@ pub struct WriteOptions {
 
 /// One link's new `<inertial>`: the mass properties in link coordinates and how well they are known.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct LinkUpdate {
     /// Index into `Robot::links`.
     pub index: usize,
@@ -43,6 +45,7 @@ impl From<(usize, MassProperties)> for LinkUpdate {
 
 /// A link whose `<inertial>` cannot be written as asked.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct WriteError {
     /// Index into `Robot::links`.
     pub index: usize,
