@@ -80,6 +80,28 @@ pub fn package_resolver(
         .with_max_file_size(max_file_size())
 }
 
+/// Parses `NAME:=VALUE` (a xacro argument on the command line).
+pub fn parse_xacro_arg(s: &str) -> Result<(String, String), String> {
+    match s.split_once(":=") {
+        Some((k, v)) if !k.is_empty() => Ok((k.to_string(), v.to_string())),
+        _ => Err(format!("`{s}` is not a xacro argument: write NAME:=VALUE")),
+    }
+}
+
+/// xacro's options for this process: its environment (`$(env)`, `$(optenv)`) and working directory
+/// (`$(cwd)`), which the library does not read itself.
+pub fn xacro_options<'r>(
+    args: Vec<(String, String)>,
+    resolver: &'r urdf_inertia::PackageResolver,
+) -> urdf_inertia::xacro::Options<'r> {
+    urdf_inertia::xacro::Options {
+        args,
+        resolver,
+        env: std::env::vars().collect(),
+        cwd: std::env::current_dir().unwrap_or_default(),
+    }
+}
+
 /// Parses the command line and runs the command; returns the exit code.
 pub fn main() -> i32 {
     let args = match Args::try_parse() {

@@ -94,7 +94,7 @@ fn sources(s: &SourceArgs, settings: &Settings) -> Result<Sources, String> {
     let xacro_args = s
         .xacro_args
         .iter()
-        .map(|a| xacro::parse_arg(a))
+        .map(|a| super::parse_xacro_arg(a))
         .collect::<Result<Vec<_>, String>>()?;
     let visual_fallback = match s.geometry.replace(' ', "").as_str() {
         "collision" => false,
@@ -604,7 +604,7 @@ fn read_input(path: &Path, src: &Sources, policy: &Policy) -> Result<Input, Stri
         print_diagnostics(&robot.notes, policy);
         return Ok(Input { robot, xacro: None });
     }
-    let opts = xacro::Options::from_process(src.xacro_args.clone(), &src.resolver);
+    let opts = super::xacro_options(src.xacro_args.clone(), &src.resolver);
     let x = xacro::expand_file(path, &opts).map_err(|e| e.to_string())?;
     let mut warnings: Vec<Diagnostic> = x
         .warnings

@@ -10,7 +10,7 @@ pub fn run(a: &XacroArgs) -> ExitStatus {
         let args = a
             .args
             .iter()
-            .map(|s| xacro::parse_arg(s))
+            .map(|s| super::parse_xacro_arg(s))
             .collect::<Result<Vec<_>, String>>()?;
         let pkgs = a
             .package_path
@@ -27,7 +27,7 @@ pub fn run(a: &XacroArgs) -> ExitStatus {
         }
     };
     let resolver = super::package_resolver(&pkgs);
-    let opts = xacro::Options::from_process(args, &resolver);
+    let opts = super::xacro_options(args, &resolver);
     match xacro::expand_file(&a.file, &opts) {
         Ok(e) => {
             for w in &e.warnings {

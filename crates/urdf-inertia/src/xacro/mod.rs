@@ -74,26 +74,6 @@ pub struct Options<'r> {
     pub cwd: PathBuf,
 }
 
-impl<'r> Options<'r> {
-    /// Options from this process's environment and working directory.
-    pub fn from_process(args: Vec<(String, String)>, resolver: &'r PackageResolver) -> Self {
-        Options {
-            args,
-            resolver,
-            env: std::env::vars().collect(),
-            cwd: std::env::current_dir().unwrap_or_default(),
-        }
-    }
-}
-
-/// Parses `NAME:=VALUE` (a xacro argument on the command line).
-pub fn parse_arg(s: &str) -> Result<(String, String), String> {
-    match s.split_once(":=") {
-        Some((k, v)) if !k.is_empty() => Ok((k.to_string(), v.to_string())),
-        _ => Err(format!("`{s}` is not a xacro argument: write NAME:=VALUE")),
-    }
-}
-
 /// What a file read during the expansion is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FileKind {
