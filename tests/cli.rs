@@ -1442,8 +1442,16 @@ fn check_format_json_lists_the_problems_of_the_text_output() {
             .unwrap()
             .contains(p["link"].as_str().unwrap()));
     }
-    // The demo's upper arm carries a tensor that breaks the triangle inequality (0.1, 0.1, 0.3).
-    assert!(problems
+    // The demo's upper arm carries a tensor that breaks the triangle inequality (0.1, 0.1, 0.3),
+    // typed: the kind and the principal moments, on the line of its <inertial>.
+    let upper = problems
         .iter()
-        .any(|p| p["link"] == "upper_arm_link" && p["code"] == "UI602"));
+        .find(|p| p["link"] == "upper_arm_link" && p["code"] == "UI602")
+        .expect("the upper arm's problem");
+    assert_eq!(upper["kind"], "invalid_tensor");
+    assert!(upper["line"].as_u64().is_some_and(|l| l > 0));
+    assert!(upper["at"]
+        .as_str()
+        .unwrap()
+        .ends_with(&format!(":{}: link `upper_arm_link`", upper["line"])));
 }

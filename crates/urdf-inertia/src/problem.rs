@@ -16,6 +16,7 @@ use std::path::PathBuf;
 #[non_exhaustive]
 pub struct InertialProblem {
     /// The URDF the link is in ([`Robot::path`]).
+    #[serde(serialize_with = "path_text")]
     pub file: PathBuf,
     /// The link's name.
     pub link: String,
@@ -59,6 +60,10 @@ pub enum ProblemKind {
         causes: Vec<String>,
         tolerance: f64,
     },
+}
+
+fn path_text<S: serde::Serializer>(p: &std::path::Path, s: S) -> Result<S::Ok, S::Error> {
+    s.collect_str(&p.display())
 }
 
 fn as_text<S: serde::Serializer>(v: &Violation, s: S) -> Result<S::Ok, S::Error> {
