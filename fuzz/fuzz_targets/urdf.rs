@@ -10,9 +10,7 @@ fuzz_target!(|data: &[u8]| {
     let Ok(robot) = urdf_inertia::urdf::scan_bytes(data.to_vec(), path) else {
         return;
     };
-    for link in &robot.links {
-        let _ = urdf_inertia::fill::existing_problems(link);
-    }
+    let _ = urdf_inertia::check(&robot, &urdf_inertia::FillOptions::default());
     let updates: Vec<_> = (0..robot.links.len())
         .map(|i| (i, urdf_inertia::mass::primitives::sphere(0.1, 1000.0)).into())
         .collect();

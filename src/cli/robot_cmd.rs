@@ -105,21 +105,20 @@ fn sources(s: &SourceArgs, settings: &Settings) -> Result<Sources, String> {
             ))
         }
     };
+    let mut options = FillOptions::default();
+    options.strict = s.strict;
+    options.open_mesh = super::args::OpenMesh::model(s.open_mesh);
+    options.only = globs(&s.only)?;
+    options.skip = globs(&s.skip)?;
+    options.keep_mass = s.keep_mass;
+    options.allow_large_parts = s.allow_large_parts;
     Ok(Sources {
         map,
         map_path: s.density_map.clone(),
         visual_fallback,
         resolver: super::package_resolver(&pkgs),
         xacro_args,
-        options: FillOptions {
-            strict: s.strict,
-            open_mesh: super::args::OpenMesh::model(s.open_mesh),
-            only: globs(&s.only)?,
-            skip: globs(&s.skip)?,
-            missing_only: false,
-            keep_mass: s.keep_mass,
-            allow_large_parts: s.allow_large_parts,
-        },
+        options,
         memory_budget: memory_budget(s)?,
     })
 }

@@ -63,6 +63,7 @@ pub enum Spec {
 
 /// A density map error, with the line of the TOML it concerns.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct MapError {
     pub path: PathBuf,
     pub line: Option<usize>,
@@ -143,6 +144,7 @@ struct RawMap {
 
 /// A validated density map.
 #[derive(Debug, Clone, Default, PartialEq)]
+#[non_exhaustive]
 pub struct DensityMap {
     pub default: Option<f64>,
     pub total_mass: Option<f64>,
@@ -694,6 +696,7 @@ pub const MAX_GLOB_LEN: usize = 4096;
 /// `[!a-z]`, `{a,b}` and `**`, with its text for messages. Used by `--only`, `--skip` and the density
 /// map's keys.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct Glob {
     glob: globset::Glob,
     matcher: globset::GlobMatcher,
@@ -701,8 +704,11 @@ pub struct Glob {
 
 impl Glob {
     /// Compiles `pattern`; an invalid or over-long pattern is an error saying why.
-    pub fn new(pattern: &str) -> Result<Glob, String> {
-        let glob = parse_glob(pattern)?;
+    pub fn new(pattern: &str) -> Result<Glob, crate::Error> {
+        let glob = parse_glob(pattern).map_err(|message| crate::Error::Pattern {
+            pattern: pattern.to_string(),
+            message,
+        })?;
         let matcher = glob.compile_matcher();
         Ok(Glob { glob, matcher })
     }

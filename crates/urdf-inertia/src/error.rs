@@ -25,7 +25,7 @@ pub enum Error {
     Mesh(MeshError),
     /// A density map that cannot be read or is not valid.
     DensityMap(MapError),
-    /// A `--only`/`--skip` style pattern that is not a glob.
+    /// A link or mesh name pattern that is not a glob (the message names it).
     Pattern { pattern: String, message: String },
     /// One link that could not be computed.
     Link(LinkError),
@@ -43,7 +43,7 @@ impl fmt::Display for Error {
             Error::Xacro(e) => e.fmt(f),
             Error::Mesh(e) => e.fmt(f),
             Error::DensityMap(e) => e.fmt(f),
-            Error::Pattern { pattern, message } => write!(f, "`{pattern}`: {message}"),
+            Error::Pattern { message, .. } => f.write_str(message),
             Error::Link(e) => e.fmt(f),
             Error::Robot(e) => e.fmt(f),
             Error::Write(e) => write!(f, "link {}: {}", e.index, e.message),

@@ -33,6 +33,7 @@ const PRIMITIVE_ERROR: ErrorEstimate = ErrorEstimate {
 
 /// What to compute.
 #[derive(Debug, Clone, Default)]
+#[non_exhaustive]
 pub struct FillOptions {
     pub strict: bool,
     /// What an open mesh whose caps cannot be trusted becomes (`--open-mesh`).
@@ -50,6 +51,7 @@ pub struct FillOptions {
 
 /// One collision element's contribution.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct PartReport {
     /// 1-based collision index in the link.
     pub collision: usize,
@@ -76,6 +78,7 @@ pub struct PartReport {
 
 /// A link whose inertial was computed.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct LinkReport {
     /// Index into `Robot::links`.
     pub index: usize,
@@ -131,6 +134,7 @@ impl LinkReport {
 
 /// Wall time per stage.
 #[derive(Debug, Clone, Copy, Default)]
+#[non_exhaustive]
 pub struct Timing {
     pub load: Duration,
     pub integrate: Duration,
@@ -145,6 +149,7 @@ impl FillReport {
 
 /// Everything `fill`, `diff` and `check` need to report.
 #[derive(Debug, Clone, Default)]
+#[non_exhaustive]
 pub struct FillReport {
     pub links: Vec<LinkReport>,
     /// Links that could not be computed.
@@ -165,7 +170,8 @@ pub struct FillReport {
 /// Whether `fill` computes this link (it must also have collision geometry): selected by the globs and,
 /// with `--missing-only`, lacking a valid inertial.
 fn is_target(link: &Link, opts: &FillOptions) -> bool {
-    selected(&link.name, opts) && !(opts.missing_only && existing_problems(link).is_empty())
+    selected(&link.name, opts)
+        && !(opts.missing_only && crate::problem::link_problems(link).is_empty())
 }
 
 /// The `--only` and `--skip` patterns that match none of `names` (the links of every robot of a
@@ -224,63 +230,6 @@ pub fn existing_props(inertial: &Inertial) -> Option<MassProperties> {
         inertia: local,
     };
     Some(mp.transformed(&r, inertial.origin.xyz))
-}
-
-/// The problem of a link with several `<inertial>` elements: urdfdom reads the first and ignores the
-/// rest, so the file says two things.
-pub fn duplicate_inertials(link: &Link) -> Option<String> {
-    let first = link.inertial.as_ref()?;
-    if link.extra_inertials.is_empty() {
-        return None;
-    }
-    let lines: Vec<String> = link
-        .extra_inertials
-        .iter()
-        .map(|s| s.line.to_string())
-        .collect();
-    Some(format!(
-        "{} <inertial> elements: urdfdom reads the first (line {}) and ignores the rest (line {}); remove them, or let `fill` replace them all with one",
-        1 + link.extra_inertials.len(),
-        first.line,
-        lines.join(", ")
-    ))
-}
-
-/// Problems of a link's existing `<inertial>` (missing parts, unreadable numbers, physical validity).
-///
-/// One exception: an all-zero inertial (mass 0, zero tensor) on a link *without* collision geometry is
-/// the usual way to write a massless frame (IMU, tool or sensor frames on fixed joints) and is accepted.
-pub fn existing_problems(link: &Link) -> Vec<String> {
-    let Some(span) = &link.inertial else {
-        return vec!["no <inertial>".into()];
-    };
-    let mut out: Vec<String> = duplicate_inertials(link).into_iter().collect();
-    if !link.has_collision_geometry()
-        && span.problem.is_none()
-        && span.value.mass == Some(0.0)
-        && span
-            .value
-            .inertia
-            .is_none_or(|i| i.iter().all(|x| *x == 0.0))
-    {
-        return out;
-    }
-    if let Some(p) = &span.problem {
-        out.push(format!("<inertial> cannot be read: {p}"));
-        return out;
-    }
-    if span.value.mass.is_none() {
-        out.push("<inertial> has no <mass>".into());
-    }
-    if span.value.inertia.is_none() {
-        out.push("<inertial> has no <inertia>".into());
-    }
-    if let Some(mp) = existing_props(&span.value) {
-        for v in validity::check(&mp, validity::DEFAULT_TOLERANCE) {
-            out.push(v.to_string());
-        }
-    }
-    out
 }
 
 /// One collision, resolved and integrated at density 1, in the link frame.

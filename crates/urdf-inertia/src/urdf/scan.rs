@@ -22,6 +22,7 @@ pub use super::encoding::SourceEncoding;
 
 /// A pose: translation and URDF roll-pitch-yaw (fixed axes X, Y, Z).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[non_exhaustive]
 pub struct Pose {
     pub xyz: [f64; 3],
     pub rpy: [f64; 3],
@@ -29,6 +30,7 @@ pub struct Pose {
 
 /// A collision geometry as the URDF gives it.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Geometry {
     Mesh {
         filename: String,
@@ -76,6 +78,7 @@ impl Geometry {
 
 /// One `<collision>` of a link.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Collision {
     /// 1-based position among the link's collisions.
     pub index: usize,
@@ -87,6 +90,7 @@ pub struct Collision {
 
 /// An existing `<inertial>` as parsed (missing parts are `None`).
 #[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
 pub struct Inertial {
     pub origin: Pose,
     pub mass: Option<f64>,
@@ -96,6 +100,7 @@ pub struct Inertial {
 
 /// The existing `<inertial>` of a link: where it is and what it says.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct InertialSpan {
     pub start: usize,
     pub end: usize,
@@ -110,6 +115,7 @@ pub struct InertialSpan {
 
 /// A `<link>` with everything the tool needs.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Link {
     pub name: String,
     pub line: usize,
@@ -144,6 +150,7 @@ impl Link {
 
 /// A scanned URDF.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct Robot {
     pub path: PathBuf,
     pub name: String,
@@ -186,6 +193,7 @@ impl Robot {
 
 /// Why a URDF cannot be read.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct UrdfError {
     pub path: PathBuf,
     pub line: usize,
