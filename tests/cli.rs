@@ -1449,6 +1449,8 @@ fn check_format_json_lists_the_problems_of_the_text_output() {
         .find(|p| p["link"] == "upper_arm_link" && p["code"] == "UI602")
         .expect("the upper arm's problem");
     assert_eq!(upper["kind"], "invalid_tensor");
+    let broken = &upper["violation"]["triangle_inequality"];
+    assert_eq!(broken["moments"], serde_json::json!([0.1, 0.1, 0.3]));
     assert!(upper["line"].as_u64().is_some_and(|l| l > 0));
     assert!(upper["at"]
         .as_str()

@@ -65,6 +65,7 @@ pub use fill::{
     unresolved_meshes, unused_selection, FillOptions, FillReport, LinkReport, MeshCache,
     PartReport, Timing,
 };
+pub use mass::validity::Violation;
 pub use mass::{primitives, rpy_matrix, MassProperties, Mat3, Principal};
 pub use mesh::health::{ErrorEstimate, Rung, Solid};
 pub use mesh::open::OpenMeshModel;

@@ -49,10 +49,7 @@ pub enum ProblemKind {
     NoInertia,
     /// Its values cannot belong to a body (not finite, mass ≤ 0, tensor not positive definite,
     /// triangle inequality broken).
-    InvalidTensor {
-        #[serde(serialize_with = "as_text")]
-        violation: Violation,
-    },
+    InvalidTensor { violation: Violation },
     /// It differs from the computed one by more than `tolerance` (relative).
     Differs {
         differences: Vec<Difference>,
@@ -64,10 +61,6 @@ pub enum ProblemKind {
 
 fn path_text<S: serde::Serializer>(p: &std::path::Path, s: S) -> Result<S::Ok, S::Error> {
     s.collect_str(&p.display())
-}
-
-fn as_text<S: serde::Serializer>(v: &Violation, s: S) -> Result<S::Ok, S::Error> {
-    s.collect_str(v)
 }
 
 impl InertialProblem {

@@ -7,7 +7,9 @@ use super::{jacobi, MassProperties};
 use crate::text::significant as sig;
 
 /// One way in which mass properties cannot belong to a physical body.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
 pub enum Violation {
     /// A NaN or infinite value.
     NotFinite,
