@@ -1,0 +1,414 @@
+//! ASCII STL, parsed in chunks cut at `facet` lines, in parallel, with the sequential parse's result.
+
+use super::Keyword;
+use crate::mass::Polygons;
+use crate::mesh::weld::VertexTable;
+use crate::mesh::{parse_f64, short_decimal, MeshError, MeshErrorKind, RawMesh};
+use std::io::Read as _;
+use std::path::Path;
+
+/// Parses ASCII STL held in memory; errors carry the line. The same reader as [`ascii_stream`]'s,
+/// fed the whole text at once.
+pub(super) fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
+    let mut reader = Ascii::new(path, ASCII_CHUNK);
+    reader.feed(bytes);
+    reader.finish()
+}
+
+/// Reads ASCII STL from `head` (the bytes already read) and then `source`, in pieces of `piece`
+/// bytes ([`ASCII_PIECE`]; chunks of `chunk`, [`ASCII_CHUNK`]): memory is the mesh and one piece (a
+/// line longer than a piece is held whole), not the file. The result, errors included, is
+/// [`ascii`]'s on the whole text.
+pub(super) fn ascii_stream(
+    head: Vec<u8>,
+    mut source: impl std::io::Read,
+    path: &Path,
+    piece: usize,
+    chunk: usize,
+) -> Result<RawMesh, MeshError> {
+    let mut reader = Ascii::new(path, chunk);
+    let mut buf = head;
+    loop {
+        // Top the piece up to its size (twice what is held when one line is longer).
+        let want = piece.max(2 * buf.len());
+        let before = buf.len();
+        (&mut source)
+            .take((want - before) as u64)
+            .read_to_end(&mut buf)
+            .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e.to_string())))?;
+        let end = buf.len() == before;
+        if end {
+            reader.feed(&buf);
+            return reader.finish();
+        }
+        // Whole lines only; the rest waits for the next piece.
+        let Some(cut) = memchr::memrchr(b'\n', &buf).map(|i| i + 1) else {
+            continue;
+        };
+        reader.feed(&buf[..cut]);
+        if reader.utf8.is_some() {
+            return reader.finish();
+        }
+        buf.drain(..cut);
+    }
+}
+
+/// Bytes of ASCII STL read at a time by [`ascii_stream`].
+pub(super) const ASCII_PIECE: usize = 4 << 20;
+
+/// Bytes of ASCII STL parsed as one chunk (in parallel, each welded on its own, as binary records).
+pub(super) const ASCII_CHUNK: usize = 512 << 10;
+
+/// What a line left for the next: inside `outer loop` … `endloop`, and the corners since `outer`.
+#[derive(Debug, Clone, Default, PartialEq)]
+struct AsciiState {
+    in_loop: bool,
+    current: Vec<u32>,
+}
+
+/// One chunk of whole lines parsed on its own: vertices welded within it in order of first
+/// appearance, faces as indices into them (plus `base`).
+struct AsciiChunk {
+    vertices: Vec<[f64; 3]>,
+    indices: Vec<u32>,
+    /// Corners of each face.
+    sizes: Vec<u32>,
+    /// Lines started in the chunk (its `\n`s, and one for a last line without one).
+    lines: usize,
+    end: AsciiState,
+    /// A `vertex` or `endloop` came before the chunk's first `outer`: the result depends on the
+    /// state the chunk started in.
+    dependent: bool,
+    /// An `outer` began a facet in the chunk.
+    outer: bool,
+    /// The first error: the line within the chunk (from 1) and what.
+    error: Option<(usize, MeshErrorKind)>,
+    /// Not UTF-8 from this byte of the chunk on.
+    utf8: Option<usize>,
+}
+
+/// Parses whole lines of ASCII STL starting in `start`, numbering new vertices from `base`.
+#[allow(clippy::too_many_lines)] // one match over the line kinds, each with its error
+fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
+    let mut out = AsciiChunk {
+        vertices: Vec::new(),
+        indices: Vec::new(),
+        sizes: Vec::new(),
+        lines: 0,
+        end: start,
+        dependent: false,
+        outer: false,
+        error: None,
+        utf8: None,
+    };
+    if let Err(e) = std::str::from_utf8(text) {
+        out.utf8 = Some(e.valid_up_to());
+        return out;
+    }
+    // About 250 bytes a facet, half a new vertex a facet.
+    let mut table = VertexTable::with_capacity(text.len() / 400 + 16);
+    out.indices.reserve(text.len() / 80);
+    out.sizes.reserve(text.len() / 240);
+    let AsciiState {
+        mut in_loop,
+        mut current,
+    } = std::mem::take(&mut out.end);
+    let mut rest = text;
+    while !rest.is_empty() {
+        let (line, after) = match memchr::memchr(b'\n', rest) {
+            Some(i) => (&rest[..i], &rest[i + 1..]),
+            None => (rest, &rest[rest.len()..]),
+        };
+        rest = after;
+        out.lines += 1;
+        let mut words = AsciiWords { rest: line };
+        let Some(word) = words.next() else { continue };
+        let lineno = out.lines;
+        let fail = |kind| Some((lineno, kind));
+        match Keyword::of(word) {
+            Keyword::Vertex => {
+                out.dependent |= !out.outer;
+                if !in_loop {
+                    out.error = fail(MeshErrorKind::Syntax(
+                        "`vertex` outside `outer loop`".into(),
+                    ));
+                    break;
+                }
+                match words.vertex() {
+                    Ok(p) => current.push(base + table.insert(p)),
+                    Err(kind) => {
+                        out.error = fail(kind);
+                        break;
+                    }
+                }
+            }
+            Keyword::Outer => {
+                out.outer = true;
+                in_loop = true;
+                current.clear();
+            }
+            Keyword::EndLoop => {
+                out.dependent |= !out.outer;
+                in_loop = false;
+                if current.len() < 3 {
+                    out.error = fail(MeshErrorKind::Syntax(format!(
+                        "a facet with {} vertices",
+                        current.len()
+                    )));
+                    break;
+                }
+                out.indices.extend_from_slice(&current);
+                out.sizes.push(current.len() as u32);
+            }
+            Keyword::Ignored => {}
+            Keyword::Other => {
+                out.error = fail(MeshErrorKind::Syntax(format!(
+                    "unexpected `{}` in ASCII STL",
+                    String::from_utf8_lossy(word)
+                )));
+                break;
+            }
+        }
+    }
+    out.vertices = table.into_vertices();
+    out.end = AsciiState { in_loop, current };
+    out
+}
+
+/// The words of an ASCII STL line: runs of bytes between ASCII whitespace (what
+/// `split_ascii_whitespace` gives).
+struct AsciiWords<'a> {
+    rest: &'a [u8],
+}
+
+impl<'a> Iterator for AsciiWords<'a> {
+    type Item = &'a [u8];
+
+    fn next(&mut self) -> Option<&'a [u8]> {
+        let start = self.rest.iter().position(|b| !b.is_ascii_whitespace())?;
+        let rest = &self.rest[start..];
+        let len = rest
+            .iter()
+            .position(|b| b.is_ascii_whitespace())
+            .unwrap_or(rest.len());
+        let (word, after) = rest.split_at(len);
+        self.rest = after;
+        Some(word)
+    }
+}
+
+impl AsciiWords<'_> {
+    /// The three coordinates after `vertex` (−0.0 folded into 0.0, so that both weld:
+    /// `RawMesh::welded`). A short decimal is scanned in place; any other word is cut out and
+    /// parsed as [`parse_f64`] parses it.
+    fn vertex(&mut self) -> Result<[f64; 3], MeshErrorKind> {
+        let mut p = [0.0; 3];
+        for c in p.iter_mut() {
+            let skip = self
+                .rest
+                .iter()
+                .position(|b| !b.is_ascii_whitespace())
+                .unwrap_or(self.rest.len());
+            self.rest = &self.rest[skip..];
+            let fast = short_decimal(self.rest)
+                .filter(|&(_, n)| self.rest.get(n).is_none_or(|b| b.is_ascii_whitespace()));
+            *c = match fast {
+                Some((x, n)) => {
+                    self.rest = &self.rest[n..];
+                    x
+                }
+                None => {
+                    let w = self.next().ok_or_else(|| {
+                        MeshErrorKind::Syntax("`vertex` needs three coordinates".into())
+                    })?;
+                    // The chunk is UTF-8 and `w` is cut at ASCII bytes, so `from_utf8` succeeds.
+                    let w = std::str::from_utf8(w).unwrap_or_default();
+                    parse_f64(w)
+                        .ok_or_else(|| MeshErrorKind::Syntax(format!("`{w}` is not a number")))?
+                }
+            };
+            if !c.is_finite() {
+                return Err(MeshErrorKind::NotFinite);
+            }
+            *c += 0.0;
+        }
+        Ok(p)
+    }
+}
+
+/// An ASCII STL reader fed whole lines (and at the end the last line, with or without its `\n`).
+///
+/// Each feed is cut into chunks of about [`ASCII_CHUNK`] bytes at lines that begin a `facet`,
+/// parsed and welded on their own in parallel (rayon), as if each began outside a facet; then the
+/// chunks are taken in order, and one whose start did matter (a `vertex` or `endloop` before its
+/// first `outer`, in a file with `facet` inside a loop) and did not hold is parsed again from the
+/// state the one before left. The chunks' vertices are welded across chunks at the end
+/// ([`crate::mesh::weld::join`]): the result is the one sequential parse's, bit for bit, for any thread
+/// count.
+pub(super) struct Ascii<'p> {
+    path: &'p Path,
+    /// Bytes a chunk: [`ASCII_CHUNK`], but for the tests.
+    chunk: usize,
+    vertices: Vec<[f64; 3]>,
+    indices: Vec<u32>,
+    starts: Vec<u32>,
+    state: AsciiState,
+    /// Lines before the next feed.
+    lines: usize,
+    /// Bytes before the next feed.
+    offset: usize,
+    /// The first syntax error: the line and what. Later text is only checked to be UTF-8 (that
+    /// error would be reported instead, as the whole-text reader checks it first).
+    error: Option<(usize, MeshErrorKind)>,
+    /// The first byte that is not UTF-8: reading stops.
+    utf8: Option<usize>,
+}
+
+impl<'p> Ascii<'p> {
+    pub(super) fn new(path: &'p Path, chunk: usize) -> Self {
+        Ascii {
+            path,
+            chunk: chunk.max(1),
+            vertices: Vec::new(),
+            indices: Vec::new(),
+            starts: vec![0],
+            state: AsciiState::default(),
+            lines: 0,
+            offset: 0,
+            error: None,
+            utf8: None,
+        }
+    }
+
+    pub(super) fn feed(&mut self, text: &[u8]) {
+        use rayon::prelude::*;
+        if self.utf8.is_some() {
+            return;
+        }
+        let offset = self.offset;
+        self.offset += text.len();
+        if self.error.is_some() {
+            if let Err(e) = std::str::from_utf8(text) {
+                self.utf8 = Some(offset + e.valid_up_to());
+            }
+            return;
+        }
+        let chunks = facet_chunks(text, self.chunk);
+        let parsed: Vec<AsciiChunk> = chunks
+            .par_iter()
+            .map(|c| ascii_chunk(c, AsciiState::default(), 0))
+            .collect();
+        let mut at = offset;
+        for (text, mut chunk) in chunks.iter().zip(parsed) {
+            let here = at;
+            at += text.len();
+            if self.error.is_none() {
+                if chunk.dependent && self.state != AsciiState::default() {
+                    let start = std::mem::take(&mut self.state);
+                    chunk = ascii_chunk(text, start, self.vertices.len() as u32);
+                } else {
+                    let base = self.vertices.len() as u32;
+                    chunk.indices.iter_mut().for_each(|i| *i += base);
+                    chunk.end.current.iter_mut().for_each(|i| *i += base);
+                }
+            }
+            if let Some(u) = chunk.utf8 {
+                self.utf8 = Some(here + u);
+                return;
+            }
+            if self.error.is_some() {
+                continue;
+            }
+            if let Some((line, kind)) = chunk.error {
+                self.error = Some((self.lines + line, kind));
+                continue;
+            }
+            self.vertices.extend_from_slice(&chunk.vertices);
+            let mut s = *self.starts.last().unwrap_or(&0);
+            for &n in &chunk.sizes {
+                s += n;
+                self.starts.push(s);
+            }
+            self.indices.extend_from_slice(&chunk.indices);
+            // A chunk that neither began a facet nor touched the state leaves it as it was.
+            if chunk.outer || chunk.dependent {
+                self.state = chunk.end;
+            }
+            self.lines += chunk.lines;
+        }
+    }
+
+    pub(super) fn finish(self) -> Result<RawMesh, MeshError> {
+        if let Some(at) = self.utf8 {
+            return Err(MeshError::new(
+                self.path,
+                None,
+                MeshErrorKind::Syntax(format!("ASCII STL is not valid UTF-8 at byte {at}")),
+            ));
+        }
+        if let Some((line, kind)) = self.error {
+            return Err(MeshError::new(self.path, Some(line), kind));
+        }
+        if self.state.in_loop {
+            return Err(MeshError::new(
+                self.path,
+                Some(self.lines),
+                MeshErrorKind::Truncated("ASCII STL ends inside a facet".into()),
+            ));
+        }
+        let mut indices = self.indices;
+        let vertices = crate::mesh::weld::join(self.vertices, &mut indices, None);
+        Ok(RawMesh {
+            vertices,
+            faces: Polygons {
+                indices,
+                starts: self.starts,
+            },
+            notes: Vec::new(),
+            warnings: Vec::new(),
+            welded: true,
+        })
+    }
+}
+
+/// `text` cut into chunks of about `size` bytes, each but the last ending with a `\n` before a line
+/// whose first word is `facet` (outside a facet, in a well-formed file), or (when none comes within
+/// 64 KiB) before any line.
+fn facet_chunks(text: &[u8], size: usize) -> Vec<&[u8]> {
+    let mut out = Vec::new();
+    let mut from = 0;
+    while text.len() - from > size {
+        let target = from + size;
+        let mut cut = None;
+        let mut first = None;
+        let mut at = target;
+        while let Some(i) = memchr::memchr(b'\n', &text[at..]) {
+            let next = at + i + 1;
+            first.get_or_insert(next);
+            let line = &text[next..];
+            let word = line
+                .iter()
+                .position(|&b| !matches!(b, b' ' | b'\t' | b'\r' | b'\x0c'))
+                .map_or(&line[line.len()..], |w| &line[w..]);
+            if word
+                .get(..5)
+                .is_some_and(|w| w.eq_ignore_ascii_case(b"facet"))
+                && word.get(5).is_none_or(|b| b.is_ascii_whitespace())
+            {
+                cut = Some(next);
+                break;
+            }
+            if next - target > 64 << 10 {
+                break;
+            }
+            at = next;
+        }
+        let Some(cut) = cut.or(first).filter(|&c| c < text.len()) else {
+            break;
+        };
+        out.push(&text[from..cut]);
+        from = cut;
+    }
+    out.push(&text[from..]);
+    out
+}
