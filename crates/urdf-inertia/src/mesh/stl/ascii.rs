@@ -107,6 +107,7 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
     }
     // About 250 bytes a facet, half a new vertex a facet.
     let mut table = VertexTable::with_capacity(text.len() / 400 + 16);
+    let mut seen = SeenLines::with_capacity(text.len() / 400 + 16);
     out.indices.reserve(text.len() / 80);
     out.sizes.reserve(text.len() / 240);
     let AsciiState {
@@ -134,13 +135,25 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
                     ));
                     break;
                 }
-                match words.vertex() {
-                    Ok(p) => current.push(base + table.insert(p)),
-                    Err(kind) => {
-                        out.error = fail(kind);
-                        break;
-                    }
-                }
+                // The coordinates are a function of the line's text after `vertex`: a text seen
+                // before in the chunk is the vertex it gave then, unparsed (each vertex of a closed
+                // mesh is written at its six or so corners).
+                let key = words.rest;
+                let index = match seen.get(key) {
+                    Some(i) => i,
+                    None => match words.vertex() {
+                        Ok(p) => {
+                            let i = table.insert(p);
+                            seen.insert(key, i);
+                            i
+                        }
+                        Err(kind) => {
+                            out.error = fail(kind);
+                            break;
+                        }
+                    },
+                };
+                current.push(base + index);
             }
             Keyword::Outer => {
                 out.outer = true;
@@ -173,6 +186,88 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
     out.vertices = table.into_vertices();
     out.end = AsciiState { in_loop, current };
     out
+}
+
+/// The vertex lines of a chunk already parsed, by their text after `vertex`, and the vertex each
+/// gave: an open-addressing table of slices of the chunk's text (the text is the key, so a hit is
+/// exactly the vertex a parse would give, and a miss parses and welds as before).
+struct SeenLines<'t> {
+    lines: Vec<(&'t [u8], u32)>,
+    /// 0: empty; else `tag << 32 | (index into lines + 1)`.
+    slots: Vec<u64>,
+    /// 64 − log2(slots.len()): the slot is the top bits of the hash.
+    shift: u32,
+}
+
+impl<'t> SeenLines<'t> {
+    fn with_capacity(expected: usize) -> Self {
+        let size = (2 * expected).next_power_of_two().max(16);
+        SeenLines {
+            lines: Vec::with_capacity(expected),
+            slots: vec![0; size],
+            shift: 64 - size.trailing_zeros(),
+        }
+    }
+
+    /// The slot of `key`: where it is, or the empty one where it would go.
+    fn find(&self, key: &[u8], h: u64) -> (usize, Option<u32>) {
+        let tag = h << 32;
+        let mask = self.slots.len() - 1;
+        let mut s = (h >> self.shift) as usize;
+        loop {
+            let slot = self.slots[s];
+            if slot == 0 {
+                return (s, None);
+            }
+            if slot & 0xffff_ffff_0000_0000 == tag {
+                let (text, vertex) = self.lines[(slot as u32 - 1) as usize];
+                if text == key {
+                    return (s, Some(vertex));
+                }
+            }
+            s = (s + 1) & mask;
+        }
+    }
+
+    fn get(&self, key: &[u8]) -> Option<u32> {
+        self.find(key, line_hash(key)).1
+    }
+
+    /// Records that `key` (not yet seen) gave `vertex`.
+    fn insert(&mut self, key: &'t [u8], vertex: u32) {
+        let (s, _) = self.find(key, line_hash(key));
+        self.lines.push((key, vertex));
+        self.slots[s] = (line_hash(key) << 32) | self.lines.len() as u64;
+        if 2 * self.lines.len() > self.slots.len() {
+            let size = 2 * self.slots.len();
+            self.slots = vec![0; size];
+            self.shift = 64 - size.trailing_zeros();
+            for (i, &(text, _)) in self.lines.iter().enumerate() {
+                let (s, _) = self.find(text, line_hash(text));
+                self.slots[s] = (line_hash(text) << 32) | (i as u64 + 1);
+            }
+        }
+    }
+}
+
+/// A hash of a line's bytes, eight at a time, every bit mixed into the top (the slot) and the
+/// bottom (the tag).
+fn line_hash(b: &[u8]) -> u64 {
+    const K: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut h = b.len() as u64;
+    let mut words = b.chunks_exact(8);
+    for c in &mut words {
+        let mut w = [0u8; 8];
+        w.copy_from_slice(c);
+        h = (h.rotate_left(23) ^ u64::from_le_bytes(w)).wrapping_mul(K);
+    }
+    let tail = words.remainder();
+    let mut w = [0u8; 8];
+    w[..tail.len()].copy_from_slice(tail);
+    h = (h.rotate_left(23) ^ u64::from_le_bytes(w)).wrapping_mul(K);
+    h ^= h >> 29;
+    h = h.wrapping_mul(K);
+    h ^ (h >> 32)
 }
 
 /// The words of an ASCII STL line: runs of bytes between ASCII whitespace (what
