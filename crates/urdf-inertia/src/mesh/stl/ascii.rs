@@ -88,14 +88,13 @@ struct AsciiChunk {
 }
 
 /// Parses whole lines of ASCII STL starting in `start`, numbering new vertices from `base`.
-#[allow(clippy::too_many_lines)] // one match over the line kinds, each with its error
 fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
     let mut out = AsciiChunk {
         vertices: Vec::new(),
         indices: Vec::new(),
         sizes: Vec::new(),
         lines: 0,
-        end: start,
+        end: AsciiState::default(),
         dependent: false,
         outer: false,
         error: None,
@@ -103,17 +102,20 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
     };
     if let Err(e) = std::str::from_utf8(text) {
         out.utf8 = Some(e.valid_up_to());
+        out.end = start;
         return out;
     }
     // About 250 bytes a facet, half a new vertex a facet.
-    let mut table = VertexTable::with_capacity(text.len() / 400 + 16);
-    let mut seen = SeenLines::with_capacity(text.len() / 400 + 16);
     out.indices.reserve(text.len() / 80);
     out.sizes.reserve(text.len() / 240);
-    let AsciiState {
-        mut in_loop,
-        mut current,
-    } = std::mem::take(&mut out.end);
+    let mut p = ChunkParse {
+        out,
+        table: VertexTable::with_capacity(text.len() / 400 + 16),
+        seen: SeenLines::with_capacity(text.len() / 400 + 16),
+        in_loop: start.in_loop,
+        current: start.current,
+        base,
+    };
     let mut rest = text;
     while !rest.is_empty() {
         let (line, after) = match memchr::memchr(b'\n', rest) {
@@ -121,71 +123,91 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
             None => (rest, &rest[rest.len()..]),
         };
         rest = after;
-        out.lines += 1;
+        p.out.lines += 1;
         let mut words = AsciiWords { rest: line };
         let Some(word) = words.next() else { continue };
-        let lineno = out.lines;
-        let fail = |kind| Some((lineno, kind));
+        if let Err(kind) = p.line(word, words) {
+            p.out.error = Some((p.out.lines, kind));
+            break;
+        }
+    }
+    let mut out = p.out;
+    out.vertices = p.table.into_vertices();
+    out.end = AsciiState {
+        in_loop: p.in_loop,
+        current: p.current,
+    };
+    out
+}
+
+/// A chunk being parsed: what it has produced, its welds, and the facet it is in.
+struct ChunkParse<'t> {
+    out: AsciiChunk,
+    table: VertexTable,
+    seen: SeenLines<'t>,
+    in_loop: bool,
+    /// The corners since `outer`.
+    current: Vec<u32>,
+    /// The number of the chunk's first new vertex.
+    base: u32,
+}
+
+impl<'t> ChunkParse<'t> {
+    /// One line, whose first word is `word` and the rest `words`.
+    #[inline]
+    fn line(&mut self, word: &[u8], words: AsciiWords<'t>) -> Result<(), MeshErrorKind> {
         match Keyword::of(word) {
             Keyword::Vertex => {
-                out.dependent |= !out.outer;
-                if !in_loop {
-                    out.error = fail(MeshErrorKind::Syntax(
+                self.out.dependent |= !self.out.outer;
+                if !self.in_loop {
+                    return Err(MeshErrorKind::Syntax(
                         "`vertex` outside `outer loop`".into(),
                     ));
-                    break;
                 }
-                // The coordinates are a function of the line's text after `vertex`: a text seen
-                // before in the chunk is the vertex it gave then, unparsed (each vertex of a closed
-                // mesh is written at its six or so corners).
-                let key = words.rest;
-                let index = match seen.get(key) {
-                    Some(i) => i,
-                    None => match words.vertex() {
-                        Ok(p) => {
-                            let i = table.insert(p);
-                            seen.insert(key, i);
-                            i
-                        }
-                        Err(kind) => {
-                            out.error = fail(kind);
-                            break;
-                        }
-                    },
-                };
-                current.push(base + index);
+                let index = self.vertex(words)?;
+                self.current.push(self.base + index);
             }
             Keyword::Outer => {
-                out.outer = true;
-                in_loop = true;
-                current.clear();
+                self.out.outer = true;
+                self.in_loop = true;
+                self.current.clear();
             }
             Keyword::EndLoop => {
-                out.dependent |= !out.outer;
-                in_loop = false;
-                if current.len() < 3 {
-                    out.error = fail(MeshErrorKind::Syntax(format!(
+                self.out.dependent |= !self.out.outer;
+                self.in_loop = false;
+                if self.current.len() < 3 {
+                    return Err(MeshErrorKind::Syntax(format!(
                         "a facet with {} vertices",
-                        current.len()
+                        self.current.len()
                     )));
-                    break;
                 }
-                out.indices.extend_from_slice(&current);
-                out.sizes.push(current.len() as u32);
+                self.out.indices.extend_from_slice(&self.current);
+                self.out.sizes.push(self.current.len() as u32);
             }
             Keyword::Ignored => {}
             Keyword::Other => {
-                out.error = fail(MeshErrorKind::Syntax(format!(
+                return Err(MeshErrorKind::Syntax(format!(
                     "unexpected `{}` in ASCII STL",
                     String::from_utf8_lossy(word)
                 )));
-                break;
             }
         }
+        Ok(())
     }
-    out.vertices = table.into_vertices();
-    out.end = AsciiState { in_loop, current };
-    out
+
+    /// The chunk's index of the vertex after `vertex`. The coordinates are a function of the line's
+    /// text after the keyword: a text seen before in the chunk is the vertex it gave then, unparsed
+    /// (each vertex of a closed mesh is written at its six or so corners).
+    #[inline]
+    fn vertex(&mut self, mut words: AsciiWords<'t>) -> Result<u32, MeshErrorKind> {
+        let key = words.rest;
+        if let Some(i) = self.seen.get(key) {
+            return Ok(i);
+        }
+        let i = self.table.insert(words.vertex()?);
+        self.seen.insert(key, i);
+        Ok(i)
+    }
 }
 
 /// The vertex lines of a chunk already parsed, by their text after `vertex`, and the vertex each
