@@ -124,8 +124,7 @@ pub(crate) fn two_prod(a: f64, b: f64) -> (f64, f64) {
 ///
 /// Without FMA, Dekker's TwoProduct with Veltkamp's splitting instead of `mul_add`: on baseline x86-64
 /// (no `fma` in `rustc --print cfg`) `mul_add` is a call into libm that blocks vectorisation of the
-/// accurate-face path (with the lane-wise evaluation: ~53 → ~28 ns/face at 4k–67k faces, bench
-/// kernel-accurate on a shared machine; callgrind 621 → 473 instructions/face). Both give the same `e`:
+/// accurate-face path (figures: docs/benchmarks.md, "Figures behind choices in the code"). Both give the same `e`:
 /// the product's rounding error is representable and each computes it exactly, so the results are bit
 /// for bit those of the FMA version, unless a split overflows (|a| or |b| above ~2^996) or a partial
 /// product underflows (|a·b| below ~2^-969), far outside what a mesh's coordinates relative to its

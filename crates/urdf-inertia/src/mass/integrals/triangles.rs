@@ -40,10 +40,8 @@ pub(super) trait KernelLoop {
 /// targets baseline x86-64): AVX2 (4 lanes instead of SSE2's 2) and FMA through pulp's safe
 /// dispatch. Every path performs the same IEEE operations in the same order (no contraction into
 /// FMA; the exact products are exact either way), so the bits do not depend on the CPU
-/// (`kernel_paths_agree` checks it). Measured with callgrind (instructions per face, one core,
-/// the SSE2 build against this dispatch): triangle kernel 184 → 121, polygon fan 225 → 157,
-/// kernel-accurate plate 473 → 396; criterion on a loaded shared 2-core EPYC: kernel/ours ~15 → ~12
-/// ns/face, the thin plate ~28–42 → ~33–39 ns/face (noise of ±30%).
+/// (`kernel_paths_agree` checks it). The dispatch takes a third fewer instructions per face than
+/// the SSE2 build (figures: docs/benchmarks.md, "Figures behind choices in the code").
 #[inline(always)]
 pub(super) fn run_kernel<L: KernelLoop>(kernel: L) -> RawSums {
     #[cfg(target_arch = "x86_64")]
@@ -159,9 +157,7 @@ impl Batch {
         // Ogita, Rump and Oishi, in a tree). Each product's own error terms (q's rounding, and a_i
         // times the rounding of b_j·c_k) are below eps·|q|: summed plainly they add an error of order
         // 12·eps²·Σ|q|, the size of Sum2's own second-order term. Against the 18 two-sums in a chain
-        // before: the same bound, and on the 66,560-face thin plate of bench kernel-accurate (one
-        // thread) 400 → 153 instructions per face (callgrind; the fast path takes 117) and 27 → 12 ns
-        // per face (fast path 8–10 ns, a shared machine).
+        // before: the same bound at well under half the work (figures: docs/benchmarks.md, "Figures behind choices in the code").
         let mut q = [[0.0; LANES]; 6];
         let mut small = [0.0; LANES];
         for (t, &(i, j, k, sign)) in TRIPLE_TERMS.iter().enumerate() {

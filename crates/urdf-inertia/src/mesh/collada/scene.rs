@@ -135,7 +135,7 @@ impl Instancer<'_> {
         let check_unit = self.unit != 1.0;
         for p in v {
             // `mass::mat_vec`'s sums in its order, written out: its `[0, 1, 2].map` is a call here
-            // (`core::array::try_map` in profiles), 7 of the 37 M instructions placing go1's trunk.dae.
+            // (`core::array::try_map` in profiles; figures: docs/benchmarks.md, "Figures behind choices in the code").
             let q = [
                 a[0][0] * p[0] + a[0][1] * p[1] + a[0][2] * p[2],
                 a[1][0] * p[0] + a[1][1] * p[1] + a[1][2] * p[2],
@@ -158,8 +158,8 @@ impl Instancer<'_> {
         }
         // A mirroring node transform reverses the faces' orientation.
         let mirrored = affine::mirrors(xf);
-        // Appended in bulk, not a face at a time (a `Vec` per face was 130 of the 1,167 M instructions
-        // go1's trunk.dae took to read).
+        // Appended in bulk, not a face at a time: a `Vec` per face was a tenth of reading a large
+        // file (figures: docs/benchmarks.md, "Figures behind choices in the code").
         let out = &mut self.out.faces;
         if out.starts.is_empty() {
             out.starts.push(0);

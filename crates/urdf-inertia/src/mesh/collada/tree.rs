@@ -41,7 +41,7 @@ impl El {
         }
     }
     /// The element's text as bytes, as stored: numbers are ASCII, so they need no UTF-8 decoding
-    /// (`from_utf8_lossy` took 5 instructions a byte of go1's trunk.dae, 133 M of its 1,167 M).
+    /// (which was a tenth of reading a large file; figures: docs/benchmarks.md, "Figures behind choices in the code").
     pub(super) fn raw_text<'a>(&'a self, bytes: &'a [u8]) -> &'a [u8] {
         match &self.text {
             Text::None => b"",
@@ -197,9 +197,8 @@ fn add_text(top: &mut El, piece: &[u8], pos: usize, bytes: &[u8]) {
 ///
 /// Words are runs of bytes between ASCII whitespace (what `split_ascii_whitespace` gave on the decoded
 /// text: an invalid byte is never whitespace, and its word is no number either way); a short decimal
-/// is scanned where it stands, anything else is cut out and parsed by `str::parse`. go1's trunk.dae
-/// (28 MB, 2.6 M numbers): reading its geometry took 941 M instructions with `from_utf8_lossy`,
-/// `split_ascii_whitespace` and `str::parse`, 533 M so.
+/// is scanned where it stands, anything else is cut out and parsed by `str::parse` (figures against
+/// `from_utf8_lossy`, `split_ascii_whitespace` and `str::parse`: docs/benchmarks.md, "Figures behind choices in the code").
 pub(super) fn each_number<'a>(
     el: &'a El,
     text: &'a [u8],

@@ -13,8 +13,8 @@
 //!
 //! Why not stl_io (the brief's choice): measured on example-robot-data 6.0.0, stl_io 0.8 reads all 410 STL
 //! files with the same face counts as this reader, so it does not fail real files. This reader is kept
-//! because it parses a 1.3 M-face binary file 3.6× faster (153 ms against 556 ms: stl_io merges vertices
-//! while reading, and the health step welds anyway), gives ASCII errors a line number, and reports a
+//! because it parses binary files several times faster (stl_io merges vertices while reading, and the
+//! health step welds anyway; figures: docs/benchmarks.md, "Figures behind choices in the code"), gives ASCII errors a line number, and reports a
 //! truncated or miscounted binary file with the numbers a user needs.
 
 use super::{MeshError, MeshErrorKind, RawMesh};
@@ -188,7 +188,8 @@ pub fn read_split(
     }
     let n = n as usize;
     let mut reader = Binary::new(n, chunk, runs);
-    // No bigger than the file: zeroing a 3.3 MB buffer for every small STL was 2.5% of filling ERD.
+    // No bigger than the file: zeroing a buffer of several megabytes for every small STL showed in
+    // profiles of filling a whole robot collection (figures: docs/benchmarks.md, "Figures behind choices in the code").
     let mut buf = vec![0u8; 50 * n.min(chunk * PIECE)];
     let mut left = n;
     while left > 0 {

@@ -92,9 +92,8 @@ impl VertexTable {
 /// vertices in order of first appearance and rewrites `indices` to them: what one table fed the
 /// vertices in order gives, bit for bit.
 ///
-/// One table over all vertices is what this replaces: on the 1.3 M-face binary STL (32 MB of table
-/// and vertices against a 32 MB L3 shared by the machine) its inserts were DRAM and TLB misses,
-/// 55–65 ms of a 0.26 s run, and 0.77 s at 10 M faces; this takes 18–23 ms and 0.52 s. Here the
+/// One table over all vertices is what this replaces: once table and vertices outgrow the L3 cache
+/// its inserts are DRAM and TLB misses (figures: docs/benchmarks.md, "Figures behind choices in the code"). Here the
 /// vertices are first partitioned by the top bits of their hash into at most 256 runs (8 bytes each:
 /// the hash's low half and the position), so each run is welded in its own small table (in
 /// parallel); a run keeps file order, so its first copy of a vertex is the first in the file.

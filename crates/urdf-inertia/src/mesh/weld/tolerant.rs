@@ -51,8 +51,7 @@ impl Precision {
 
 /// [`significant_digits`] where [`Precision::of`] needs it: exact up to 9, 10 for any count above.
 /// Found by asking which decimal of 9 digits reads back as `x` (Clinger's exact fast path) instead
-/// of formatting `x`: formatting took 16% of healing the 48 k-face borinot base (a DAE of 6-digit
-/// decimals, ~150 ns per coordinate).
+/// of formatting `x`, which was a sixth of healing a mesh of 6-digit decimals (figures: docs/benchmarks.md, "Figures behind choices in the code").
 fn digits_up_to_ten(x: f64) -> usize {
     if x == 0.0 {
         return 0;
@@ -84,7 +83,7 @@ fn nine_digits(x: f64) -> Option<Option<u64>> {
     let x = x.abs();
     // floor(log10 x) is e or e + 1 for e = floor(e2·log10 2), e2 the binary exponent (78913/2^18 is
     // log10 2 to 1e-7; the shift floors): no log10, floor or round calls, which are library calls on
-    // baseline x86-64 (the 48 k-face borinot DAE: 12% of its healing went to them).
+    // baseline x86-64 (figures: docs/benchmarks.md, "Figures behind choices in the code").
     let e2 = ((x.to_bits() >> 52) & 0x7ff) as i32 - 1023;
     let e = (e2 * 78_913) >> 18;
     // Rounds to the nearest integer (ties to even) for 0 ≤ y < 2^52: adding 2^52 leaves no fraction
@@ -217,8 +216,8 @@ pub fn tolerant(vertices: &[[f64; 3]], tol: Tolerance) -> TolerantWeld {
     };
     // Representatives per block of 2×2×2 cells as linked lists: the first in `head`, the rest
     // through `next`. The 27 cells around a vertex's own span exactly two blocks along each axis, so
-    // 8 lookups replace 27 (the misses of those lookups were nearly all of this function: 14% of
-    // healing the 48 k-face borinot base); a representative found counts only if its own cell is one
+    // 8 lookups replace 27 (the misses of those lookups were nearly all of this function; figures:
+    // docs/benchmarks.md, "Figures behind choices in the code"); a representative found counts only if its own cell is one
     // of the 27, and ties in distance go the way the 27-cell scan went (cells in (dx, dy, dz) order,
     // the latest representative of a cell first), so the result is that scan's.
     let block = |c: [i64; 3]| c.map(|x| x.div_euclid(2));
