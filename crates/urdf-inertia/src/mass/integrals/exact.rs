@@ -122,13 +122,13 @@ pub(crate) fn two_prod(a: f64, b: f64) -> (f64, f64) {
 /// Exact product: `p + e == a * b` (barring overflow and underflow); `FMA`: the code runs where
 /// hardware FMA is enabled (the build, or the x86-64-v3 kernel of [`run_kernel`]).
 ///
-/// Without FMA, Dekker's TwoProduct with Veltkamp's splitting instead of `mul_add`: on baseline x86-64
-/// (no `fma` in `rustc --print cfg`) `mul_add` is a call into libm that blocks vectorisation of the
-/// accurate-face path (figures: docs/benchmarks.md, "Figures behind choices in the code"). Both give the same `e`:
-/// the product's rounding error is representable and each computes it exactly, so the results are bit
-/// for bit those of the FMA version, unless a split overflows (|a| or |b| above ~2^996) or a partial
-/// product underflows (|a·b| below ~2^-969), far outside what a mesh's coordinates relative to its
-/// centre produce.
+/// Without FMA, Dekker's TwoProduct with Veltkamp's splitting instead of `mul_add`: on baseline
+/// x86-64 (no `fma` in `rustc --print cfg`) `mul_add` is a call into libm that blocks vectorisation
+/// of the accurate-face path (figures: docs/benchmarks.md, "Figures behind choices in the code").
+/// Both give the same `e`: the product's rounding error is representable and each computes it
+/// exactly, so the results are bit for bit those of the FMA version, unless a split overflows (|a|
+/// or |b| above ~2^996) or a partial product underflows (|a·b| below ~2^-969), far outside what a
+/// mesh's coordinates relative to its centre produce.
 #[inline(always)]
 pub(super) fn two_prod_in<const FMA: bool>(a: f64, b: f64) -> (f64, f64) {
     let p = a * b;

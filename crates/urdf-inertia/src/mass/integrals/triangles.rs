@@ -155,9 +155,10 @@ impl Batch {
         // The six leading products q cancel: they are summed with error-free two-sums, pairwise
         // (depth 3 instead of a chain of 6), and every rounding error is kept in `comp` (Sum2 of
         // Ogita, Rump and Oishi, in a tree). Each product's own error terms (q's rounding, and a_i
-        // times the rounding of b_j·c_k) are below eps·|q|: summed plainly they add an error of order
-        // 12·eps²·Σ|q|, the size of Sum2's own second-order term. Against the 18 two-sums in a chain
-        // before: the same bound at well under half the work (figures: docs/benchmarks.md, "Figures behind choices in the code").
+        // times the rounding of b_j·c_k) are below eps·|q|: summed plainly they add an error of
+        // order 12·eps²·Σ|q|, the size of Sum2's own second-order term. Against the 18 two-sums in
+        // a chain before: the same bound at well under half the work (figures: docs/benchmarks.md,
+        // "Figures behind choices in the code").
         let mut q = [[0.0; LANES]; 6];
         let mut small = [0.0; LANES];
         for (t, &(i, j, k, sign)) in TRIPLE_TERMS.iter().enumerate() {

@@ -235,7 +235,8 @@ fn read_triangles(
     let (mut at, mut slot) = (0usize, 0usize);
     let mut words = Numbers { rest: text };
     loop {
-        // Only the VERTEX index is converted (figures: docs/benchmarks.md, "Figures behind choices in the code").
+        // Only the VERTEX index is converted (figures: docs/benchmarks.md, "Figures behind choices
+        // in the code").
         if slot == input.voff {
             match words.next() {
                 Some(x) => corner[at] = x.map_err(|w| not_a_number(p, w, path))?,

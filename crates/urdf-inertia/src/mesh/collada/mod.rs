@@ -67,16 +67,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         },
         notes: Vec::new(),
     };
-    let scene = root
-        .child("scene")
-        .and_then(|s| s.child("instance_visual_scene"))
-        .and_then(|i| i.attr("url"))
-        .and_then(|u| by_id.get(u.trim_start_matches('#')).copied())
-        .or_else(|| {
-            root.child("library_visual_scenes")
-                .and_then(|l| l.child("visual_scene"))
-        });
-    match scene {
+    match visual_scene(root, &by_id) {
         Some(scene) => add_scene(scene, &by_id, &mut inst)?,
         None => {
             if let Some(lib) = root.child("library_geometries") {
@@ -113,6 +104,18 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         }
     }
     Ok(out)
+}
+
+/// The scene's `<instance_visual_scene>`, else the first `<visual_scene>` of the library, if any.
+fn visual_scene<'a>(root: &'a El, by_id: &HashMap<&str, &'a El>) -> Option<&'a El> {
+    root.child("scene")
+        .and_then(|s| s.child("instance_visual_scene"))
+        .and_then(|i| i.attr("url"))
+        .and_then(|u| by_id.get(u.trim_start_matches('#')).copied())
+        .or_else(|| {
+            root.child("library_visual_scenes")
+                .and_then(|l| l.child("visual_scene"))
+        })
 }
 
 /// Metres per unit: `<unit meter="s">`'s value, 1 without the element or the attribute. Anything but

@@ -135,7 +135,8 @@ impl Instancer<'_> {
         let check_unit = self.unit != 1.0;
         for p in v {
             // `mass::mat_vec`'s sums in its order, written out: its `[0, 1, 2].map` is a call here
-            // (`core::array::try_map` in profiles; figures: docs/benchmarks.md, "Figures behind choices in the code").
+            // (`core::array::try_map` in profiles; figures: docs/benchmarks.md, "Figures behind
+            // choices in the code").
             let q = [
                 a[0][0] * p[0] + a[0][1] * p[1] + a[0][2] * p[2],
                 a[1][0] * p[0] + a[1][1] * p[1] + a[1][2] * p[2],

@@ -41,7 +41,8 @@ impl El {
         }
     }
     /// The element's text as bytes, as stored: numbers are ASCII, so they need no UTF-8 decoding
-    /// (which was a tenth of reading a large file; figures: docs/benchmarks.md, "Figures behind choices in the code").
+    /// (which was a tenth of reading a large file; figures: docs/benchmarks.md, "Figures behind
+    /// choices in the code").
     pub(super) fn raw_text<'a>(&'a self, bytes: &'a [u8]) -> &'a [u8] {
         match &self.text {
             Text::None => b"",
@@ -195,10 +196,11 @@ fn add_text(top: &mut El, piece: &[u8], pos: usize, bytes: &[u8]) {
 
 /// The numbers of an element's text, one at a time (a `<p>` of millions of indices is never a list).
 ///
-/// Words are runs of bytes between ASCII whitespace (what `split_ascii_whitespace` gave on the decoded
-/// text: an invalid byte is never whitespace, and its word is no number either way); a short decimal
-/// is scanned where it stands, anything else is cut out and parsed by `str::parse` (figures against
-/// `from_utf8_lossy`, `split_ascii_whitespace` and `str::parse`: docs/benchmarks.md, "Figures behind choices in the code").
+/// Words are runs of bytes between ASCII whitespace (what `split_ascii_whitespace` gave on the
+/// decoded text: an invalid byte is never whitespace, and its word is no number either way); a
+/// short decimal is scanned where it stands, anything else is cut out and parsed by `str::parse`
+/// (figures against `from_utf8_lossy`, `split_ascii_whitespace` and `str::parse`:
+/// docs/benchmarks.md, "Figures behind choices in the code").
 pub(super) fn each_number<'a>(
     el: &'a El,
     text: &'a [u8],

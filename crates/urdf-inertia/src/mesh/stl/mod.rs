@@ -11,11 +11,12 @@
 //! and the result is one sequential parse's, bit for bit (the ASCII reader is tested against the
 //! whole-text reader it replaced, kept in the tests).
 //!
-//! Why not stl_io (the brief's choice): measured on example-robot-data 6.0.0, stl_io 0.8 reads all 410 STL
-//! files with the same face counts as this reader, so it does not fail real files. This reader is kept
-//! because it parses binary files several times faster (stl_io merges vertices while reading, and the
-//! health step welds anyway; figures: docs/benchmarks.md, "Figures behind choices in the code"), gives ASCII errors a line number, and reports a
-//! truncated or miscounted binary file with the numbers a user needs.
+//! Why not stl_io (the brief's choice): measured on example-robot-data 6.0.0, stl_io 0.8 reads all
+//! 410 STL files with the same face counts as this reader, so it does not fail real files. This
+//! reader is kept because it parses binary files several times faster (stl_io merges vertices while
+//! reading, and the health step welds anyway; figures: docs/benchmarks.md, "Figures behind choices
+//! in the code"), gives ASCII errors a line number, and reports a truncated or miscounted binary
+//! file with the numbers a user needs.
 
 use super::{MeshError, MeshErrorKind, RawMesh};
 use std::fmt::Write as _;
@@ -189,7 +190,8 @@ pub fn read_split(
     let n = n as usize;
     let mut reader = Binary::new(n, chunk, runs);
     // No bigger than the file: zeroing a buffer of several megabytes for every small STL showed in
-    // profiles of filling a whole robot collection (figures: docs/benchmarks.md, "Figures behind choices in the code").
+    // profiles of filling a whole robot collection (figures: docs/benchmarks.md, "Figures behind
+    // choices in the code").
     let mut buf = vec![0u8; 50 * n.min(chunk * PIECE)];
     let mut left = n;
     while left > 0 {

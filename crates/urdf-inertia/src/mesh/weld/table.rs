@@ -93,11 +93,11 @@ impl VertexTable {
 /// vertices in order gives, bit for bit.
 ///
 /// One table over all vertices is what this replaces: once table and vertices outgrow the L3 cache
-/// its inserts are DRAM and TLB misses (figures: docs/benchmarks.md, "Figures behind choices in the code"). Here the
-/// vertices are first partitioned by the top bits of their hash into at most 256 runs (8 bytes each:
-/// the hash's low half and the position), so each run is welded in its own small table (in
-/// parallel); a run keeps file order, so its first copy of a vertex is the first in the file.
-/// Numbers then follow in one pass in file order.
+/// its inserts are DRAM and TLB misses (figures: docs/benchmarks.md, "Figures behind choices in the
+/// code"). Here the vertices are first partitioned by the top bits of their hash into at most 256
+/// runs (8 bytes each: the hash's low half and the position), so each run is welded in its own
+/// small table (in parallel); a run keeps file order, so its first copy of a vertex is the first in
+/// the file. Numbers then follow in one pass in file order.
 ///
 /// `runs` forces the number of runs (clamped to 1–256), for tests and the `stl_stream` fuzz target:
 /// the inputs they can afford have a few thousand vertices at most, one run by the choice here.

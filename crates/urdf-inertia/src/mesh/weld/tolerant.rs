@@ -51,7 +51,8 @@ impl Precision {
 
 /// [`significant_digits`] where [`Precision::of`] needs it: exact up to 9, 10 for any count above.
 /// Found by asking which decimal of 9 digits reads back as `x` (Clinger's exact fast path) instead
-/// of formatting `x`, which was a sixth of healing a mesh of 6-digit decimals (figures: docs/benchmarks.md, "Figures behind choices in the code").
+/// of formatting `x`, which was a sixth of healing a mesh of 6-digit decimals (figures:
+/// docs/benchmarks.md, "Figures behind choices in the code").
 fn digits_up_to_ten(x: f64) -> usize {
     if x == 0.0 {
         return 0;
@@ -217,9 +218,10 @@ pub fn tolerant(vertices: &[[f64; 3]], tol: Tolerance) -> TolerantWeld {
     // Representatives per block of 2×2×2 cells as linked lists: the first in `head`, the rest
     // through `next`. The 27 cells around a vertex's own span exactly two blocks along each axis, so
     // 8 lookups replace 27 (the misses of those lookups were nearly all of this function; figures:
-    // docs/benchmarks.md, "Figures behind choices in the code"); a representative found counts only if its own cell is one
-    // of the 27, and ties in distance go the way the 27-cell scan went (cells in (dx, dy, dz) order,
-    // the latest representative of a cell first), so the result is that scan's.
+    // docs/benchmarks.md, "Figures behind choices in the code"); a representative found counts only
+    // if its own cell is one of the 27, and ties in distance go the way the 27-cell scan went (cells
+    // in (dx, dy, dz) order, the latest representative of a cell first), so the result is that
+    // scan's.
     let block = |c: [i64; 3]| c.map(|x| x.div_euclid(2));
     let mut head: FxHashMap<[i64; 3], u32> =
         FxHashMap::with_capacity_and_hasher(n, Default::default());
