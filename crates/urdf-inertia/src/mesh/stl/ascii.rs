@@ -231,46 +231,59 @@ impl<'t> SeenLines<'t> {
         }
     }
 
-    /// The slot of `key`: where it is, or the empty one where it would go.
-    fn find(&self, key: &[u8], h: u64) -> (usize, Option<u32>) {
+    /// Where `key` is (its vertex), or the empty slot where it would go; neither when the probe
+    /// runs past [`MAX_PROBES`] slots.
+    fn find(&self, key: &[u8], h: u64) -> (Option<usize>, Option<u32>) {
         let tag = h << 32;
         let mask = self.slots.len() - 1;
         let mut s = (h >> self.shift) as usize;
-        loop {
+        for _ in 0..MAX_PROBES {
             let slot = self.slots[s];
             if slot == 0 {
-                return (s, None);
+                return (Some(s), None);
             }
             if slot & 0xffff_ffff_0000_0000 == tag {
                 let (text, vertex) = self.lines[(slot as u32 - 1) as usize];
                 if text == key {
-                    return (s, Some(vertex));
+                    return (Some(s), Some(vertex));
                 }
             }
             s = (s + 1) & mask;
         }
+        (None, None)
     }
 
     fn get(&self, key: &[u8]) -> Option<u32> {
         self.find(key, line_hash(key)).1
     }
 
-    /// Records that `key` (not yet seen) gave `vertex`.
+    /// Records that `key` (not yet seen) gave `vertex`, unless its probe is too long: then the line
+    /// is simply parsed again wherever it comes back.
     fn insert(&mut self, key: &'t [u8], vertex: u32) {
-        let (s, _) = self.find(key, line_hash(key));
+        let h = line_hash(key);
+        let (Some(s), _) = self.find(key, h) else {
+            return;
+        };
         self.lines.push((key, vertex));
-        self.slots[s] = (line_hash(key) << 32) | self.lines.len() as u64;
+        self.slots[s] = (h << 32) | self.lines.len() as u64;
         if 2 * self.lines.len() > self.slots.len() {
             let size = 2 * self.slots.len();
             self.slots = vec![0; size];
             self.shift = 64 - size.trailing_zeros();
             for (i, &(text, _)) in self.lines.iter().enumerate() {
-                let (s, _) = self.find(text, line_hash(text));
-                self.slots[s] = (line_hash(text) << 32) | (i as u64 + 1);
+                let h = line_hash(text);
+                if let (Some(s), _) = self.find(text, h) {
+                    self.slots[s] = (h << 32) | (i as u64 + 1);
+                }
             }
         }
     }
 }
+
+/// Slots a lookup in [`SeenLines`] probes at most: the table is at most half full, so an honest
+/// file's probes are a few slots; a file made for its hash to collide gets its lines parsed (as
+/// without the table) instead of a lookup that grows with the chunk.
+const MAX_PROBES: usize = 32;
 
 /// A hash of a line's bytes, eight at a time, every bit mixed into the top (the slot) and the
 /// bottom (the tag).
@@ -528,4 +541,29 @@ fn facet_chunks(text: &[u8], size: usize) -> Vec<&[u8]> {
     }
     out.push(&text[from..]);
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every line recorded is found with its vertex through the table's growth, a line never
+    /// recorded is not, and texts that differ only in their last byte or their length are apart.
+    #[test]
+    fn seen_lines_give_back_what_was_recorded() {
+        let texts: Vec<String> = (0..20_000)
+            .map(|i| format!(" {}.000000e-01 2.5e+00 {}", i % 977, i / 977))
+            .collect();
+        let mut seen = SeenLines::with_capacity(4);
+        for (i, t) in texts.iter().enumerate() {
+            assert_eq!(seen.get(t.as_bytes()), None, "{t}");
+            seen.insert(t.as_bytes(), i as u32);
+        }
+        for (i, t) in texts.iter().enumerate() {
+            assert_eq!(seen.get(t.as_bytes()), Some(i as u32), "{t}");
+        }
+        assert_eq!(seen.get(b" 1.000000e-01 2.5e+00 1 "), None);
+        assert_eq!(seen.get(b" 1.000000e-01 2.5e+00 "), None);
+        assert_eq!(seen.get(b""), None);
+    }
 }
