@@ -168,8 +168,8 @@ fn reach(p: &[[f64; 3]; 3]) -> f64 {
 
 /// The range of cells a closed interval `[a, b]` meets along axis `k` of a grid.
 fn cells(a: f64, b: f64, lo: f64, cell: f64, grid: usize) -> (usize, usize) {
-    // The cast saturates (below 0 and NaN give 0): `floor().max(0.0)`'s cell without its libm call
-    // (floor was 1.7% of the ERD fill).
+    // The cast saturates (below 0 and NaN give 0): `floor().max(0.0)`'s cell without its libm call,
+    // which showed in profiles (docs/benchmarks.md).
     let index = |x: f64| (((x - lo) / cell) as usize).min(grid - 1);
     // A little slack: a point on a cell border goes to the upper cell, and rounding must not lose it.
     let pad = 1e-7 * cell;
@@ -587,9 +587,9 @@ mod tests {
             .expect("solid")
     }
 
-    /// Issue 13: slivers go only into the cells their projection meets, the references stay within the
-    /// budget (a coarser grid otherwise), and points are still located right, those level with the
-    /// slivers' shared edges included.
+    /// Bounded buckets: slivers go only into the cells their projection meets, the references stay
+    /// within the budget (a coarser grid otherwise), and points are still located right, those
+    /// level with the slivers' shared edges included.
     #[test]
     fn sliver_buckets_stay_within_the_budget() {
         let solid = cone(4096);
@@ -625,9 +625,10 @@ mod tests {
         }
     }
 
-    /// Issue 14: a locator over only the triangles that can decide points of a region answers as the
-    /// whole-mesh one and as the winding number at many random points of that region, and the cost
-    /// bound from its pass bounds the whole-mesh locator's cost (the grid size depends on it).
+    /// A region suffices: a locator over only the triangles that can decide points of a region
+    /// answers as the whole-mesh one and as the winding number at many random points of that
+    /// region, and the cost bound from its pass bounds the whole-mesh locator's cost (the grid size
+    /// depends on it).
     #[test]
     fn a_region_locator_agrees_with_the_winding_number() {
         let solid = cone(500);

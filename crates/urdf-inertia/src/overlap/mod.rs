@@ -16,12 +16,11 @@
 //! by a 32³ grid of the cells their triangles' bounding boxes meet), plus the boxes' meeting of
 //! pairs overlapping too little to be sampled.
 //!
-//! Bounded work and memory: a triangle is put only in the buckets its projection meets (a sliver
-//! crosses a row of cells, not its bounding box of cells), the buckets hold at most
-//! [`LOCATOR_ENTRIES`] triangle references (fewer, larger buckets otherwise), the samples per part
-//! shrink so that all point tests stay within [`POINT_TEST_BUDGET`], a cap no minimum grid overrides
-//! (so a link of N overlapping parts costs O(N); the bound widens instead, and the estimate says
-//! so), and more than [`MAX_PAIRS`] overlapping pairs skip the estimate with a reason.
+//! Bounded work and memory: the point tests are [`crate::mesh::inside`]'s (bounded buckets), the
+//! samples per part shrink so that all point tests stay within [`POINT_TEST_BUDGET`], a cap no
+//! minimum grid overrides (so a link of N overlapping parts costs O(N); the bound widens instead,
+//! and the estimate says so), and more than [`MAX_PAIRS`] overlapping pairs skip the estimate with a
+//! reason.
 
 use crate::mesh::health::Solid;
 use std::sync::Arc;
@@ -79,8 +78,8 @@ pub struct OverlapEstimate {
     /// cell's volume; elsewhere it is exact), and twice the box meeting of every pair too little
     /// overlapping to be sampled. Coarser grids make it wider.
     pub bound: f64,
-    /// The work cap ([`POINT_TEST_BUDGET`]) set a grid coarser than [`GRID`] (many or costly parts):
-    /// the bound is wider than the finest grid's.
+    /// The work cap ([`POINT_TEST_BUDGET`]) set a grid coarser than [`GRID`] (many or costly
+    /// parts): the bound is wider than the finest grid's.
     pub capped: bool,
 }
 
@@ -129,8 +128,8 @@ fn estimate_within(parts: &mut [PlacedPart], budget: usize) -> Overlap {
     let bounds: Vec<usize> = bounds.into_iter().flatten().collect();
     // The grid size is from the whole-mesh locators' cost (outputs must not depend on how points
     // are located), as bounded by the pass that picks the triangles. (Counting it exactly where the
-    // bound allows a coarser grid than the finest was a second pass over every mesh: a fifth of the
-    // time of 100 overlapping convex pieces, for a grid one or two samples finer.)
+    // bound allows a coarser grid than the finest was a second pass over every mesh, costly for a grid
+    // one or two samples finer: docs/benchmarks.md.)
     let n = grid_size(&bounds, &nb, &involved, budget);
     let parts: &[PlacedPart] = parts;
     let results: Vec<PartSample> = involved

@@ -9,9 +9,9 @@ fn box_overlap(a: &PlacedPart, b: &PlacedPart) -> f64 {
         .product()
 }
 
-/// For each part, the parts whose bounding boxes share more than 1% of the smaller one's volume with
-/// its own: a sweep along the axis where the boxes are most spread, so that far apart parts are never
-/// compared. `None` past [`MAX_PAIRS`] pairs.
+/// For each part, the parts whose bounding boxes share more than 1% of the smaller one's volume
+/// with its own: a sweep along the axis where the boxes are most spread, so that far apart parts
+/// are never compared. `None` past [`MAX_PAIRS`] pairs.
 pub(super) fn neighbours(parts: &[PlacedPart]) -> Option<(Vec<Vec<usize>>, f64)> {
     let usable: Vec<usize> = (0..parts.len())
         .filter(|&i| {
@@ -111,34 +111,20 @@ pub(super) struct PartSample {
     pub(super) uncertain: f64,
 }
 
-/// Samples part `i` on an `n`³ grid over its [`region`]. A cell that no surface of the part or of a
-/// neighbour whose box it meets crosses has one covering count throughout, which its centre's
-/// sample gets exactly; every other cell's sample is off by less than the cell's volume.
-#[allow(clippy::too_many_lines)] // one pass over the cells: masks, sample and verdict together
-pub(super) fn sample_part(
+/// For each neighbour of part `i` whose box meets the sampled region, along each axis as bits
+/// (`n` ≤ 24): the samples within its box (a point is in the box iff its three bits are set), and
+/// the cells that meet its box. This is the box test per point and neighbour, done n times per axis
+/// instead of n³.
+type Masks = Vec<(usize, [u32; 3], [u32; 3])>;
+
+fn neighbour_masks(
     parts: &[PlacedPart],
     nb: &[Vec<usize>],
     i: usize,
-    n: usize,
-) -> PartSample {
-    let p = &parts[i];
-    let (lo, hi) = region(parts, nb, i);
-    let cell_volume = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]) / (n * n * n) as f64;
-    let half = [0, 1, 2].map(|k| 0.5 * (hi[k] - lo[k]) / n as f64);
-    // The surfaces are tested against each cell's core, the cell shrunk by `SHRINK` of its size: a
-    // face on a cell's border (common: regions end at faces) leaves the core alone, and the shell
-    // around the cores, a `3 SHRINK` part of the volume, counts as uncertain throughout.
-    let core = half.map(|h| h * (1.0 - SHRINK));
-    // The sample coordinates along each axis, and for each neighbour the samples within its box along
-    // each axis as bits (`n` ≤ 24): a point is in the box iff its three bits are set. This is the
-    // box test per point and neighbour, done n times per axis instead of n³. Likewise the cells
-    // that meet its box.
-    let axes = [0, 1, 2].map(|k| {
-        (0..n)
-            .map(|a| lo[k] + (hi[k] - lo[k]) * (a as f64 + 0.5) / n as f64)
-            .collect::<Vec<f64>>()
-    });
-    let masks: Vec<(usize, [u32; 3], [u32; 3])> = nb[i]
+    axes: &[Vec<f64>; 3],
+    half: [f64; 3],
+) -> Masks {
+    nb[i]
         .iter()
         .map(|&j| {
             let b = &parts[j].bbox;
@@ -155,13 +141,71 @@ pub(super) fn sample_part(
             (j, points, cells)
         })
         .filter(|(_, _, m)| m.iter().all(|&m| m != 0))
-        .collect();
-    let mut out = PartSample {
-        shared: 0.0,
-        found: false,
-        most: 1,
-        uncertain: 0.0,
-    };
+        .collect()
+}
+
+/// One cell of part `p`'s grid, of centre `x` and core half sides `core`, at position `c` along the
+/// row whose neighbours' masks are `row` (neighbour, samples in its box, cells meeting its box):
+/// whether a surface may cross the core, and how many parts cover the centre when `p` does and the
+/// centre is in some neighbour's box (`None` otherwise: covered once at most).
+fn sample_cell(
+    parts: &[PlacedPart],
+    p: &PlacedPart,
+    row: &[(usize, u32, u32)],
+    x: [f64; 3],
+    core: [f64; 3],
+    c: usize,
+) -> (bool, Option<usize>) {
+    // A core the part's surface misses is all outside the part or all inside it; outside, the part
+    // covers none of it, whatever the neighbours do.
+    let own = p.classify(x, core);
+    if own == Some(false) {
+        return (false, None);
+    }
+    let inside = own.unwrap_or_else(|| p.contains(x));
+    // Each neighbour whose box the cell meets: whether its surface may cross the core, and (where
+    // the centre is in its box) whether it covers the centre, which its verdict on the core already
+    // says when there is one.
+    let mut crossed = own.is_none();
+    let mut k = 1;
+    let mut in_a_box = false;
+    for r in row.iter().filter(|r| r.2 >> c & 1 == 1) {
+        let v = parts[r.0].classify(x, core);
+        crossed |= v.is_none();
+        if r.1 >> c & 1 == 1 {
+            in_a_box = true;
+            if inside && v.unwrap_or_else(|| parts[r.0].contains(x)) {
+                k += 1;
+            }
+        }
+    }
+    (crossed, (inside && in_a_box).then_some(k))
+}
+
+/// Samples part `i` on an `n`³ grid over its [`region`]. A cell that no surface of the part or of a
+/// neighbour whose box it meets crosses has one covering count throughout, which its centre's
+/// sample gets exactly; every other cell's sample is off by less than the cell's volume.
+pub(super) fn sample_part(
+    parts: &[PlacedPart],
+    nb: &[Vec<usize>],
+    i: usize,
+    n: usize,
+) -> PartSample {
+    let p = &parts[i];
+    let (lo, hi) = region(parts, nb, i);
+    let cell_volume = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]) / (n * n * n) as f64;
+    let half = [0, 1, 2].map(|k| 0.5 * (hi[k] - lo[k]) / n as f64);
+    // The surfaces are tested against each cell's core, the cell shrunk by `SHRINK` of its size: a
+    // face on a cell's border (common: regions end at faces) leaves the core alone, and the shell
+    // around the cores, a `3 SHRINK` part of the volume, counts as uncertain throughout.
+    let core = half.map(|h| h * (1.0 - SHRINK));
+    let axes = [0, 1, 2].map(|k| {
+        (0..n)
+            .map(|a| lo[k] + (hi[k] - lo[k]) * (a as f64 + 0.5) / n as f64)
+            .collect::<Vec<f64>>()
+    });
+    let masks = neighbour_masks(parts, nb, i, &axes, half);
+    let mut most = 1;
     let mut sum = 0.0;
     let mut uncertain = 0usize;
     let mut row: Vec<(usize, u32, u32)> = Vec::with_capacity(masks.len());
@@ -184,47 +228,23 @@ pub(super) fn sample_part(
                 let c = cs.trailing_zeros() as usize;
                 cs &= cs - 1;
                 let x = [axes[0][a], axes[1][b], axes[2][c]];
-                // A core the part's surface misses is all outside the part or all inside it; outside,
-                // the part covers none of it, whatever the neighbours do.
-                let own = p.classify(x, core);
-                if own == Some(false) {
-                    continue;
+                let (crossed, cover) = sample_cell(parts, p, &row, x, core, c);
+                uncertain += usize::from(crossed);
+                if let Some(k) = cover {
+                    most = most.max(k);
+                    sum += 1.0 - 1.0 / k as f64;
                 }
-                let inside = own.unwrap_or_else(|| p.contains(x));
-                // Each neighbour whose box the cell meets: whether its surface may cross the core,
-                // and (where the centre is in its box) whether it covers the centre, which its
-                // verdict on the core already says when there is one.
-                let mut crossed = own.is_none();
-                let mut k = 1;
-                let mut in_a_box = false;
-                for r in row.iter().filter(|r| r.2 >> c & 1 == 1) {
-                    let v = parts[r.0].classify(x, core);
-                    crossed |= v.is_none();
-                    if r.1 >> c & 1 == 1 {
-                        in_a_box = true;
-                        if inside && v.unwrap_or_else(|| parts[r.0].contains(x)) {
-                            k += 1;
-                        }
-                    }
-                }
-                if crossed {
-                    uncertain += 1;
-                }
-                // A centre in no neighbour's box is covered once at most.
-                if !inside || !in_a_box {
-                    continue;
-                }
-                out.most = out.most.max(k);
-                sum += 1.0 - 1.0 / k as f64;
             }
         }
     }
-    // A part shares at most its own volume: on a coarse grid, a sample can stand for more.
-    // (The true share lies in [0, volume], so this only brings the estimate closer to it.)
-    out.shared = (sum * cell_volume).min(p.volume);
-    out.found = out.most > 1;
-    out.uncertain = (uncertain as f64 + 3.0 * SHRINK * (n * n * n) as f64) * cell_volume;
-    out
+    PartSample {
+        // A part shares at most its own volume: on a coarse grid, a sample can stand for more.
+        // (The true share lies in [0, volume], so this only brings the estimate closer to it.)
+        shared: (sum * cell_volume).min(p.volume),
+        found: most > 1,
+        most,
+        uncertain: (uncertain as f64 + 3.0 * SHRINK * (n * n * n) as f64) * cell_volume,
+    }
 }
 
 /// How much of its size a cell's core is smaller than the cell, per side (see [`sample_part`]).
