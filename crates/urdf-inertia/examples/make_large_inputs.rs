@@ -11,7 +11,6 @@
 //!   decompositions write their hulls), so that each overlaps its lattice neighbours.
 
 #[path = "../tests/common/mod.rs"]
-#[allow(dead_code)] // the generators used here are a few of the tests' helpers
 mod common;
 
 use std::fmt::Write as _;
@@ -163,7 +162,9 @@ fn pieces(dir: &Path, n: u32) -> std::io::Result<()> {
     let side = (1..).find(|s: &usize| s * s * s >= n).unwrap_or(1);
     let (v, f) = common::icosphere(3);
     let mut rng = common::Rng(25);
-    let mut urdf = String::from("<?xml version=\"1.0\"?>\n<robot name=\"pieces\">\n  <link name=\"decomposed\">\n");
+    let mut urdf = String::from(
+        "<?xml version=\"1.0\"?>\n<robot name=\"pieces\">\n  <link name=\"decomposed\">\n",
+    );
     for i in 0..n {
         let axes = [0, 1, 2].map(|_| rng.range(0.55, 0.75));
         let rpy = [0, 1, 2].map(|_| rng.range(-1.0, 1.0));
