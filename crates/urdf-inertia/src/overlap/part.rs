@@ -43,7 +43,11 @@ impl PlacedPart {
     /// Where the box of centre `x` and half sides `h` (link frame) lies: `Some(true)` when every
     /// point of it is surely inside the solid, `Some(false)` when surely outside, `None` when the
     /// part's surface may cross it. A verdict is what [`Self::contains`] says of `x`.
-    pub(super) fn classify(&self, x: [f64; 3], h: [f64; 3]) -> Option<bool> {
+    ///
+    /// With `decide` false the caller wants only whether the surface may cross the box: a mesh then
+    /// answers `Some(false)` for a box its surface misses, inside or not, without the point test
+    /// that would tell which (primitives decide at no cost and answer as ever).
+    pub(super) fn classify(&self, x: [f64; 3], h: [f64; 3], decide: bool) -> Option<bool> {
         let rt = transpose(&self.rotation);
         let q = mat_vec(&rt, [0, 1, 2].map(|k| x[k] - self.translation[k]));
         // The box's bounding box in the part's frame, grown by far more than the rounding of `q`
@@ -88,7 +92,7 @@ impl PlacedPart {
                     [0, 1, 2].map(|k| q[k] - e[k]),
                     [0, 1, 2].map(|k| q[k] + e[k]),
                 );
-                (!surface.may_meet(&b)).then(|| locator.contains(q))
+                (!surface.may_meet(&b)).then(|| decide && locator.contains(q))
             }
         }
     }

@@ -158,25 +158,25 @@ fn sample_cell(
 ) -> (bool, Option<usize>) {
     // A core the part's surface misses is all outside the part or all inside it; outside, the part
     // covers none of it, whatever the neighbours do.
-    let own = p.classify(x, core);
+    let own = p.classify(x, core, true);
     if own == Some(false) {
         return (false, None);
     }
     let inside = own.unwrap_or_else(|| p.contains(x));
     // Each neighbour whose box the cell meets: whether its surface may cross the core, and (where
-    // the centre is in its box) whether it covers the centre, which its verdict on the core already
-    // says when there is one.
+    // the part covers the centre and the centre is in the neighbour's box) whether the neighbour
+    // covers it too, which its verdict on the core already says when there is one. Only then is
+    // that asked: elsewhere the answer would not be used, and a mesh's costs a point test.
     let mut crossed = own.is_none();
     let mut k = 1;
     let mut in_a_box = false;
     for r in row.iter().filter(|r| r.2 >> c & 1 == 1) {
-        let v = parts[r.0].classify(x, core);
+        let in_box = r.1 >> c & 1 == 1;
+        in_a_box |= in_box;
+        let v = parts[r.0].classify(x, core, inside && in_box);
         crossed |= v.is_none();
-        if r.1 >> c & 1 == 1 {
-            in_a_box = true;
-            if inside && v.unwrap_or_else(|| parts[r.0].contains(x)) {
-                k += 1;
-            }
+        if inside && in_box && v.unwrap_or_else(|| parts[r.0].contains(x)) {
+            k += 1;
         }
     }
     (crossed, (inside && in_a_box).then_some(k))
