@@ -11,6 +11,8 @@
 #   OLD_BIN=PATH           a second build (say, main's), run interleaved with the first; the table
 #                          then gives the ratio of the medians, this build / OLD_BIN
 #   PARTS="1 10 100"       the part counts
+#   INSTRUCTIONS=1         also count each build's instructions once per part count under
+#                          valgrind's cachegrind: exact and the same however loaded the machine is
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs="${1:-5}"
@@ -32,6 +34,12 @@ measure() {
   { time RAYON_NUM_THREADS=1 /usr/bin/time -f '%M' -o "$work/rss" "$1" fill "$2" --density 1000 \
     >/dev/null 2>&1; } 2>"$work/time.log"
   awk -v rss="$(cat "$work/rss")" '{ printf "%.3f %.3f %d\n", $1 + $2, $3, rss }' "$work/time.log"
+}
+
+# Instructions executed by `BIN fill URDF` on one thread (cachegrind's "I refs").
+instructions() {
+  RAYON_NUM_THREADS=1 valgrind --tool=cachegrind --cache-sim=no --cachegrind-out-file=/dev/null \
+    "$1" fill "$2" --density 1000 2>&1 >/dev/null | sed -n 's/.*I *refs: *//p' | tr -d ,
 }
 
 median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
@@ -71,7 +79,20 @@ for n in ${PARTS:-1 10 100 300 1000}; do
     awk -v n="$n" -v c1="$(sel new 2)" -v w1="$(sel new 3)" -v p="$(sel new 4)" -v s="$said" 'BEGIN {
       printf "| %d | %.1f ms | %.1f ms | %.1f MiB | %s |\n", n, 1000 * c1, 1000 * w1, p / 1024, s }'
   fi
+  if [ -n "${INSTRUCTIONS:-}" ]; then
+    i1=$(instructions "$new" "$urdf")
+    i0=0
+    if [ "${#builds[@]}" = 2 ]; then i0=$(instructions "$OLD_BIN" "$urdf"); fi
+    echo "$n $i1 $i0" >>"$work/instructions"
+  fi
   rm -f "$work"/pieces_"$n"*
 done
+if [ -s "$work/instructions" ]; then
+  echo
+  echo "| parts | instructions, this build | instructions, OLD_BIN | ratio |"
+  echo "| --- | --- | --- | --- |"
+  awk '{ printf "| %d | %.1f M | %.1f M | %s |\n", $1, $2 / 1e6, $3 / 1e6, ($3 > 0 ? sprintf("%.3f", $2 / $3) : "—") }' \
+    "$work/instructions"
+fi
 echo
 echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
