@@ -110,7 +110,8 @@ fn bits(c0: usize, c1: usize) -> u32 {
 }
 
 /// A triangle as [`MeshLocator::contains`] reads it: for each edge (opposite corner 0, 1, 2) the end
-/// its signed area is taken from, the edge vector from there, and whether the edge owns points on it
+/// its signed area is taken from, the edge vector from there (negated where the end is the other
+/// triangle's: see [`Self::new`]), and whether the edge owns points on it
 /// ([`edge_rule`]); and the corners' x. Computed once per triangle instead of once per point test.
 #[derive(Debug, Clone, Copy)]
 struct RayTriangle {
@@ -139,7 +140,12 @@ impl RayTriangle {
             let owns = edge_rule(a, b);
             let (o, f) = if owns { (a, b) } else { (b, a) };
             t.from[e] = [o[1], o[2]];
-            t.edge[e] = [f[1] - o[1], f[2] - o[2]];
+            // Negated for an edge taken from the other end: the area then comes out with this
+            // triangle's orientation, exactly the negation of the other triangle's (negating a
+            // factor negates a rounded product and difference exactly; only the sign of a zero
+            // can differ, which no test below tells apart), with no branch per point test.
+            let d = [f[1] - o[1], f[2] - o[2]];
+            t.edge[e] = if owns { d } else { [-d[0], -d[1]] };
             t.owns[e] = owns;
         }
         t
@@ -150,12 +156,7 @@ impl RayTriangle {
     /// opposite values: rounding must not put a point on that edge inside both or neither.
     fn orient(&self, e: usize, q: [f64; 3]) -> f64 {
         let ([oy, oz], [dy, dz]) = (self.from[e], self.edge[e]);
-        let area = dy * (q[2] - oz) - dz * (q[1] - oy);
-        if self.owns[e] {
-            area
-        } else {
-            -area
-        }
+        dy * (q[2] - oz) - dz * (q[1] - oy)
     }
 }
 
