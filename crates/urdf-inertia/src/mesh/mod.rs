@@ -11,6 +11,7 @@ pub mod collada;
 pub mod gltf;
 pub mod health;
 pub mod hull;
+pub mod inside;
 pub mod obj;
 pub mod open;
 pub mod stl;
