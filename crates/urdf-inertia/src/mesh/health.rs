@@ -29,7 +29,7 @@
 //! the solid integrated can be from the surface stored). See [`ModelError`] for each term.
 
 use super::open::{NoSolid, OpenMeshModel};
-use super::{hull, weld, MeshError, MeshErrorKind, RawMesh};
+use super::{hull, weld, winding_shells, MeshError, MeshErrorKind, RawMesh};
 use crate::geometry::{cross, dot, sub};
 use crate::mass::integrals::{bounding_box_centre, volume_integrals, VolumeIntegrals};
 use crate::mass::{frobenius, IntegrationOptions, MassProperties, Polygons};
@@ -109,6 +109,9 @@ pub enum ModelError {
     /// The convex hull instead of the mesh (|mesh − hull| / hull, with the mesh's own volume taken at
     /// its least favourable reference point).
     Hull,
+    /// Shells that touch or cut each other: the intersection of their bounding boxes, which a region
+    /// they both enclose lies in.
+    Overlap,
 }
 
 impl ModelError {
@@ -120,6 +123,7 @@ impl ModelError {
             ModelError::Orientation => "orientation",
             ModelError::Caps => "caps",
             ModelError::Hull => "convex hull",
+            ModelError::Overlap => "overlapping shells",
         }
     }
 }
@@ -155,6 +159,7 @@ impl ErrorEstimate {
             ModelError::Orientation => "faces re-oriented",
             ModelError::Caps => "holes capped",
             ModelError::Hull => "replaced by its convex hull",
+            ModelError::Overlap => "shells overlapping",
         };
         if !self.total().is_finite() {
             return format!("unbounded (mesh repair: {cause})");
@@ -758,6 +763,58 @@ impl<'a> Ladder<'a> {
         }
     }
 
+    /// On the repaired rungs, the faces that bound the solid when shells overlap (see
+    /// [`super::winding_shells`]): doubly enclosed shells dropped, inside-out ones turned, and what is
+    /// left undecided bounded in `model`. The surfaces integrated as stored pay nothing.
+    fn shells(
+        &mut self,
+        vertices: &[[f64; 3]],
+        faces: Polygons,
+        rung: &Rung,
+        model: &mut Model,
+    ) -> Polygons {
+        if !matches!(
+            rung,
+            Rung::Capped { .. } | Rung::NonManifold { .. } | Rung::Reoriented { .. }
+        ) {
+            return faces;
+        }
+        let s = winding_shells::classify(vertices, &faces);
+        if s.overlap_bound > 0.0 {
+            let others: f64 = model.terms.iter().map(|t| t.0).sum();
+            if s.overlap_bound > others {
+                model.source = ModelError::Overlap;
+            }
+            model.terms.push((s.overlap_bound, Lever::Anywhere));
+            self.warn(HealthKind::Repaired, format!(
+                "{} pair(s) of shells touch or cut each other (or are open) where their boxes overlap: the volume they may count twice, at most {:.2e} m³ (their boxes' intersections), is in the error estimate",
+                s.undecided_pairs, s.overlap_bound
+            ));
+        }
+        if !s.changed {
+            return faces;
+        }
+        self.known = None;
+        let mut done = Vec::new();
+        if s.dropped_shells > 0 {
+            done.push(format!(
+                "{} shell(s) ({} faces) inside the solid on both sides left out (an internal wall or a region enclosed twice would count twice)",
+                s.dropped_shells, s.dropped_faces
+            ));
+        }
+        if s.turned_shells > 0 {
+            done.push(format!(
+                "{} shell(s) turned round (inside-out, or a cavity wound outward), so each counts once",
+                s.turned_shells
+            ));
+        }
+        self.warn(
+            HealthKind::Repaired,
+            format!("overlapping shells: {}", done.join("; ")),
+        );
+        s.faces
+    }
+
     /// Integrates, checks the volume and estimates the error: the last step of every rung. `model`
     /// is the volume (m³) by which the solid can differ from the stored surface, and what it is made
     /// of; `message` turns the relative model error into the rung's warning, if it has one.
@@ -767,8 +824,10 @@ impl<'a> Ladder<'a> {
         faces: Polygons,
         rung: Rung,
         model: impl Into<Model>,
-        message: impl FnOnce(f64) -> Option<String>,
+        message: impl FnOnce(f64, f64) -> Option<String>,
     ) -> Result<Solid, MeshError> {
+        let mut model = model.into();
+        let faces = self.shells(&vertices, faces, &rung, &mut model);
         let unit = match self.known.take() {
             Some(t) => MassProperties::from_integrals(&t, 1.0),
             None => unit_props(&vertices, &faces, None),
@@ -777,11 +836,10 @@ impl<'a> Ladder<'a> {
         let bounds = bbox(&vertices);
         check_volume(&vertices, &faces, bounds, unit.mass, self.path)?;
         let round_off = round_off(&vertices, &faces, bounds.0, &unit);
-        let model = model.into();
         let source = model.source;
         let bound = model.bound(&unit, &vertices);
         let model_error = bound.relative;
-        if let Some(m) = message(model_error) {
+        if let Some(m) = message(model_error, unit.mass) {
             self.warn(HealthKind::Repaired, m);
         }
         let mut rung = rung;
@@ -1051,7 +1109,9 @@ fn consistent_closed(
                 faces_flipped: flipped,
                 components: ncomp,
             };
-            return ladder.finish(vertices, out, rung, (model, ModelError::Cracks), |_| None);
+            return ladder.finish(vertices, out, rung, (model, ModelError::Cracks), |_, _| {
+                None
+            });
         }
     }
     if let Rung::Welded {
@@ -1071,7 +1131,13 @@ fn consistent_closed(
     };
     // The faces are the stored ones, or all of them reversed: their integrals are known.
     ladder.known = Some(if inverted { t.negated() } else { t });
-    ladder.finish(vertices, faces, rung, (model, ModelError::Cracks), |_| None)
+    ladder.finish(
+        vertices,
+        faces,
+        rung,
+        (model, ModelError::Cracks),
+        |_, _| None,
+    )
 }
 
 /// Connected components of faces over manifold edges (union-find): per-face component ids and the
@@ -1155,7 +1221,7 @@ fn reoriented(
     } else {
         ModelError::Cracks
     };
-    ladder.finish(w.vertices, faces, rung, (model, source), |_| None)
+    ladder.finish(w.vertices, faces, rung, (model, source), |_, _| None)
 }
 
 /// Each face's reversal under an orientation that turns every component outward by its own signed
@@ -1360,7 +1426,9 @@ fn non_manifold(
     } else {
         ModelError::Cracks
     };
-    ladder.finish(w.vertices, winding.faces, rung, (model, source), |_| None)
+    ladder.finish(w.vertices, winding.faces, rung, (model, source), |_, _| {
+        None
+    })
 }
 
 /// The model error of caps: their bound near the loops they close, cracks left open and components
@@ -1416,7 +1484,7 @@ fn with_caps(
             w.stored,
             rung,
             (model, ModelError::Cracks),
-            |_| None,
+            |_, _| None,
         );
     }
     ladder.strict(&format!("mesh is {what}"))?;
@@ -1440,8 +1508,7 @@ fn with_caps(
     };
     let done = done.join(", ");
     let flips = winding.flips();
-    let volume = plan.volume;
-    ladder.finish(plan.vertices, plan.faces, rung, model, |m| {
+    ladder.finish(plan.vertices, plan.faces, rung, model, |m, volume| {
         Some(if m > 0.0 {
             format!(
                 "mesh is {what}: {done}{flips}; its volume {volume:.6e} m³ and inertia are uncertain by at most {m:.1e} (relative) because of them"
@@ -1488,7 +1555,7 @@ fn convex_hull(
     } else {
         0.0
     };
-    let message = move |m: f64| {
+    let message = move |m: f64, _| {
         let bound = if m.is_finite() {
             format!("uncertain by at most {m:.1e} (relative)")
         } else {
