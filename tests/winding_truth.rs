@@ -455,3 +455,28 @@ fn interpenetrating_shells_are_bounded_not_assumed_apart() {
         s.warnings
     );
 }
+
+/// Spheres as well as boxes: an icosphere with one face removed (a planar hole, capped exactly) around
+/// a smaller one. Outward, the inner sphere encloses a region twice and drops out; inward, it is a
+/// cavity. Against the rational integrals of the closed polyhedra.
+#[test]
+fn nested_spheres_count_once() {
+    let (v, f) = common::icosphere(3);
+    let inner: Mesh = (
+        v.iter()
+            .map(|p| [p[0] * 0.5 + 0.125, p[1] * 0.5, p[2] * 0.5])
+            .collect(),
+        f.clone(),
+    );
+    let outer: Mesh = (v.clone(), f.clone());
+    let open_outer: Mesh = (v.clone(), f[1..].to_vec());
+    for (name, inward, exact) in [
+        ("double-walled", false, exact_boxes(&[&outer], &[])),
+        ("cavity", true, exact_boxes(&[&outer], &[&inner])),
+    ] {
+        let (mv, mf) = together(&open_outer, &inner, inward);
+        let s = solid(&mv, &mf, OpenMeshModel::default()).expect(name);
+        let (volume_error, _) = within_estimate(name, &s, &exact);
+        assert!(volume_error < 1e-13, "{name}: {volume_error:e}");
+    }
+}

@@ -1198,6 +1198,7 @@ fn reoriented(
         reversed,
         flipped,
         nested,
+        flip_volume,
     } = outward(&w.vertices, &w.kept, o);
     let mut faces = w.kept.clone();
     apply(&mut faces, &reversed);
@@ -1215,8 +1216,8 @@ fn reoriented(
         faces_flipped: flipped,
         components: o.ncomp,
     };
-    let model = open_volume(&w.vertices, &faces) + nested;
-    let source = if nested > 0.0 {
+    let model = open_volume(&w.vertices, &faces) + nested + flip_volume;
+    let source = if nested + flip_volume > 0.0 {
         ModelError::Orientation
     } else {
         ModelError::Cracks
@@ -1227,10 +1228,47 @@ fn reoriented(
 /// Each face's reversal under an orientation that turns every component outward by its own signed
 /// volume, how many faces that flips, and the volume of components lying inside another one's
 /// bounding box (counted twice: a cavity turned outward adds its volume instead of removing it).
+/// `flip_volume` is what the faces flipped against the rest of their component change ([`flip_change`]).
 struct Outward {
     reversed: Vec<bool>,
     flipped: usize,
     nested: f64,
+    flip_volume: f64,
+}
+
+/// The volume that re-orienting faces within components can change, m³: per component, the smaller
+/// of the sets flipped and kept (flipping a whole shell changes nothing the winding number rule does
+/// not already decide) changes the integral by twice its signed volume, which moves with the
+/// reference point by twice its vector area × the diagonal / 6; both are counted.
+fn flip_change(vertices: &[[f64; 3]], faces: &Polygons, o: &Orientation, reversed: &[bool]) -> f64 {
+    let centre = bounding_box_centre(vertices);
+    let (lo, hi) = bbox(vertices);
+    let diag = dist(lo, hi);
+    let mut count = vec![[0usize; 2]; o.ncomp];
+    for (i, r) in reversed.iter().enumerate() {
+        count[o.comp[i] as usize][usize::from(*r)] += 1;
+    }
+    let mut volume6 = vec![0.0f64; o.ncomp];
+    let mut area2 = vec![[0.0f64; 3]; o.ncomp];
+    for (i, face) in faces.iter().enumerate() {
+        let c = o.comp[i] as usize;
+        // The minority side (ties: the flipped side); nothing when the whole component turned.
+        let minority = usize::from(count[c][1] <= count[c][0]);
+        if usize::from(reversed[i]) != minority || count[c][0].min(count[c][1]) == 0 {
+            continue;
+        }
+        let a = sub(vertices[face[0] as usize], centre);
+        for k in 1..face.len() - 1 {
+            let b = sub(vertices[face[k] as usize], centre);
+            let d = sub(vertices[face[k + 1] as usize], centre);
+            volume6[c] += dot(a, cross(b, d));
+            let n = cross(sub(b, a), sub(d, a));
+            (0..3).for_each(|j| area2[c][j] += n[j]);
+        }
+    }
+    (0..o.ncomp)
+        .map(|c| 2.0 * volume6[c].abs() / 6.0 + dot(area2[c], area2[c]).sqrt() * diag / 6.0)
+        .sum()
 }
 
 fn outward(vertices: &[[f64; 3]], faces: &Polygons, o: &Orientation) -> Outward {
@@ -1250,10 +1288,12 @@ fn outward(vertices: &[[f64; 3]], faces: &Polygons, o: &Orientation) -> Outward 
             }
         }
     }
+    let flip_volume = flip_change(vertices, faces, o, &reversed);
     Outward {
         reversed,
         flipped,
         nested,
+        flip_volume,
     }
 }
 
@@ -1278,6 +1318,8 @@ struct Winding {
     flipped: usize,
     /// Volume of components re-oriented inside another's bounding box (m³).
     nested: f64,
+    /// What flipping faces against the rest of their component changes (m³, [`flip_change`]).
+    flip_volume: f64,
 }
 
 impl Winding {
@@ -1313,6 +1355,7 @@ fn windings(w: &Welding, te: &Edges) -> Vec<Winding> {
                 boundary,
                 flipped: turned.flipped,
                 nested: turned.nested,
+                flip_volume: turned.flip_volume,
             });
         }
     }
@@ -1321,6 +1364,7 @@ fn windings(w: &Welding, te: &Edges) -> Vec<Winding> {
         boundary: te.boundary_half_edges.clone(),
         flipped: 0,
         nested: 0.0,
+        flip_volume: 0.0,
     });
     out
 }
@@ -1415,13 +1459,13 @@ fn non_manifold(
     what: &str,
 ) -> Result<Solid, MeshError> {
     ladder.strict(&format!("mesh is {what}"))?;
-    ladder.warn(HealthKind::Repaired, format!("mesh is {what} but has no holes: integrated as it is{} (a region enclosed by two overlapping shells would count twice)", winding.flips()));
-    let model = open_volume(&w.vertices, &winding.faces) + winding.nested;
+    ladder.warn(HealthKind::Repaired, format!("mesh is {what} but has no holes: integrated as it is{} (shells that overlap are classified by the winding number on their sides)", winding.flips()));
+    let model = open_volume(&w.vertices, &winding.faces) + winding.nested + winding.flip_volume;
     let rung = Rung::NonManifold {
         nonmanifold_edges: te.nonmanifold,
         faces_flipped: winding.flipped,
     };
-    let source = if winding.nested > 0.0 {
+    let source = if winding.nested + winding.flip_volume > 0.0 {
         ModelError::Orientation
     } else {
         ModelError::Cracks
@@ -1498,7 +1542,9 @@ fn with_caps(
             caps.cracks
         ));
     }
-    let model = caps_model(caps, plan.cracks, winding.nested);
+    let mut model = caps_model(caps, plan.cracks, winding.nested);
+    // The flips are in the estimate, not in the choice whether caps are trusted (that is about caps).
+    model.terms.push((winding.flip_volume, Lever::Anywhere));
     let rung = Rung::Capped {
         holes: caps.holes,
         boundary_edges: te.boundary,
