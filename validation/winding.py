@@ -41,8 +41,8 @@ KNOWN = {
     "alex_description/meshes/cycloidal_arm/RightGripperYawLink.obj": _BAND,
 }
 
-# Points per mesh (the cells of the stratified grid number half as many): about 2 s per mesh on one core.
-POINTS = 200_000
+# Points per mesh (the cells of the stratified grid number half as many): about 1 s per mesh.
+POINTS = 100_000
 
 
 def triangles(path, scale):

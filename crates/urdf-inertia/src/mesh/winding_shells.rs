@@ -141,7 +141,13 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
         }
     }
     out.changed = out.dropped_shells > 0 || out.turned_shells > 0;
-    out.faces = Polygons::new();
+    out.faces = rebuilt(faces, &keep, &turn);
+    out
+}
+
+/// The faces kept, those marked turned reversed.
+fn rebuilt(faces: &Polygons, keep: &[bool], turn: &[bool]) -> Polygons {
+    let mut out = Polygons::new();
     for (i, face) in faces.iter().enumerate() {
         if !keep[i] {
             continue;
@@ -149,9 +155,9 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
         if turn[i] {
             let mut r = face.to_vec();
             r.reverse();
-            out.faces.push(&r);
+            out.push(&r);
         } else {
-            out.faces.push(face);
+            out.push(face);
         }
     }
     out
