@@ -16,6 +16,7 @@ pub mod obj;
 pub mod open;
 pub mod stl;
 pub mod weld;
+mod winding_shells;
 
 use crate::mass::Polygons;
 use std::borrow::Cow;
