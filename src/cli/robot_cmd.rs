@@ -693,28 +693,9 @@ fn write_robot(
     } else {
         w.target.as_deref()
     };
-    // `--format json` prints its summary (with the errors, `"written": false`) when nothing is
-    // written too.
-    let json_unwritten = || {
-        if w.json && file.is_some() {
-            let mut run = run_diagnostics(robot, report);
-            policy.apply_all(&mut run);
-            let seconds = start.elapsed().as_secs_f64();
-            summary::fill_json(robot, report, &run, w.digits, seconds, false);
-        }
-    };
+    let json_unwritten = || unwritten_summary(robot, report, w, policy, start, false);
     if promoted > 0 {
-        if w.json && file.is_some() {
-            json_unwritten();
-        } else {
-            let run = run_diagnostics(robot, report);
-            let times = summary::Times {
-                seconds: start.elapsed().as_secs_f64(),
-                write: 0.0,
-                written: Some(0),
-            };
-            summary::fill_text(robot, report, &run, policy, times, w.several);
-        }
+        unwritten_summary(robot, report, w, policy, start, true);
         errln!(
             "error: {}: {promoted} warning(s) made errors by --warn-as-error (or warn-as-error in urdf-inertia.toml): nothing written",
             robot.path.display()
@@ -774,6 +755,32 @@ fn write_robot(
         summary::fill_text(robot, report, &run, policy, times, w.several);
     }
     Ok(())
+}
+
+/// The summary when nothing is written: `--format json` prints its JSON (with the errors,
+/// `"written": false`) when the URDF was to go to a file; otherwise, with `text`, the text summary.
+fn unwritten_summary(
+    robot: &Robot,
+    report: &FillReport,
+    w: &WriteConfig,
+    policy: &Policy,
+    start: Instant,
+    text: bool,
+) {
+    let run = run_diagnostics(robot, report);
+    let seconds = start.elapsed().as_secs_f64();
+    if w.json && (w.in_place || w.target.is_some()) {
+        let mut run = run;
+        policy.apply_all(&mut run);
+        summary::fill_json(robot, report, &run, w.digits, seconds, false);
+    } else if text {
+        let times = summary::Times {
+            seconds,
+            write: 0.0,
+            written: Some(0),
+        };
+        summary::fill_text(robot, report, &run, policy, times, w.several);
+    }
 }
 
 /// `fill -i` on a xacro source: each computed `<inertial>` spliced into the file where its link is
