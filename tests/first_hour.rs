@@ -952,3 +952,63 @@ fn the_release_profile_keeps_no_full_debug_info() {
     };
     assert!(debug.is_none_or(allowed), "release debug = {debug:?}");
 }
+
+/// The README's quick start for one's own robot, run as written (each `urdf-inertia` line of the
+/// block, comments cut) in a repository holding `urdf/my_robot.urdf` and `densities.toml`: every
+/// command does its work (none is a placeholder that errors), the fill keeps the weighed mass, and
+/// the final check passes. The robot: a 0.1 × 0.2 × 0.3 m box weighed at 5 kg, without inertia,
+/// and a 0.1 m cube without `<inertial>` (1 kg at 1000 kg/m³).
+#[test]
+fn the_readme_quick_start_runs_as_written() {
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
+    let start = readme
+        .find("### Quick start on your own robot")
+        .expect("quick start section");
+    let block = &readme[start..];
+    let block = &block[block.find("```sh\n").expect("sh block") + 6..];
+    let block = &block[..block.find("```").expect("block end")];
+    let commands: Vec<Vec<&str>> = block
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("urdf-inertia "))
+        .map(|l| l.split(" #").next().unwrap().split_whitespace().collect())
+        .collect();
+    assert!(commands.len() >= 3, "{block}");
+    let tmp = tempfile::tempdir().unwrap();
+    let urdf = write(
+        tmp.path(),
+        "urdf/my_robot.urdf",
+        "<robot name=\"mine\">\n  <link name=\"base\">\n    <inertial><mass value=\"5\"/></inertial>\n    <collision><geometry><box size=\"0.1 0.2 0.3\"/></geometry></collision>\n  </link>\n  <link name=\"head\">\n    <collision><geometry><box size=\"0.1 0.1 0.1\"/></geometry></collision>\n  </link>\n</robot>\n",
+    );
+    write(tmp.path(), "densities.toml", "default = 1000\n");
+    let mut masses = Vec::new();
+    for args in &commands {
+        let out = Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
+            .args(args)
+            .arg("--no-config")
+            .current_dir(tmp.path())
+            .output()
+            .unwrap();
+        // diff and check report what they find (exit 1); nothing may be an error.
+        let expected: &[i32] = if args[0] == "fill" { &[0] } else { &[0, 1] };
+        assert!(
+            out.status.code().is_some_and(|c| expected.contains(&c)),
+            "{args:?}: {}",
+            text(&out)
+        );
+        if args[0] == "fill" {
+            let filled = std::fs::read_to_string(&urdf).unwrap();
+            masses.push((mass_of(&filled, "base"), mass_of(&filled, "head")));
+        }
+        if args[0] == "check" {
+            assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+        }
+    }
+    // --keep-mass kept the weighed 5 kg; the map's fill then computes every link from 1000 kg/m³.
+    assert_eq!(masses.first().map(|m| m.0), Some(5.0), "{masses:?}");
+    assert!(
+        masses.iter().all(|m| (m.1 - 1.0).abs() < 1e-12),
+        "{masses:?}"
+    );
+    assert!((masses.last().unwrap().0 - 6.0).abs() < 1e-12, "{masses:?}");
+}

@@ -13,7 +13,7 @@
 //! | 4 | quadratic weld on integer-grid coordinates | `integer_grid_coordinates_weld` (and the library's `integer_and_millimetre_grids_hash_apart`) |
 //! | 5 | panics: a 400 KB density-map key, a thread pool that cannot start; `RAYON_NUM_THREADS=5000` | `huge_density_map_key_is_an_error`, `density_globs_compiled_once_agree_with_a_plain_scan`, `thread_pool_failures_fall_back_to_one_thread` |
 //! | 6 | no memory budget; later files of a multi-file run never processed; every healed mesh kept | `a_mesh_over_the_memory_budget_fails_its_link_and_the_run_goes_on`, the library's `the_memory_budget_bounds_what_is_held_and_refuses_what_cannot_fit`, `overlap_of_1000_crowded_convex_pieces_keeps_to_the_work_cap`, `overlap_of_a_sliver_cone_and_a_box_has_bounded_memory` |
-//! | 7 | `fill -i` drops extended attributes and ACLs; rewrites unchanged files | `fill_in_place_keeps_extended_attributes`, `unchanged_output_is_not_written_and_long_names_fill_in_place` |
+//! | 7 | `fill -i` drops extended attributes and ACLs; rewrites unchanged files | `fill_in_place_keeps_extended_attributes` (a `user.` attribute and an ACL), `unchanged_output_is_not_written_and_long_names_fill_in_place` |
 //! | 8 | control characters from input printed raw | `control_characters_from_input_are_escaped_in_messages` |
 //! | 9 | `--keep-mass` replaces a `<mass>` it cannot parse | `keep_mass_with_an_unusable_mass_is_an_error` |
 //! | 10 | mesh overflow and underflow reported as "flat" with `NaN` | `mesh_overflow_and_underflow_are_named`, `collada_unit_that_is_no_positive_number_is_an_error` (1e308, 1e-310) |
@@ -2242,6 +2242,21 @@ fn collada_unit_that_is_no_positive_number_is_an_error() {
             &format!("unit.dae:3: with <unit meter=\"{value}\">, the mesh's coordinates, volume or inertia {what} a 64-bit float"),
         );
     }
+    // `fill -i` once wrote the 10⁹-times mass into the URDF: it leaves the file as it was now.
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(
+        tmp.path().join("mm.dae"),
+        dae(&format!(
+            "<asset><unit meter=\"0,001\"/></asset>\n{geometry}"
+        )),
+    )
+    .unwrap();
+    let text = "<robot name=\"r\">\n  <link name=\"a\">\n    <collision><geometry><mesh filename=\"mm.dae\"/></geometry></collision>\n  </link>\n</robot>\n";
+    let urdf = tmp.path().join("r.urdf");
+    std::fs::write(&urdf, text).unwrap();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
     // A well-formed millimetre unit scales: the 1-unit box is 1e-9 m³ (exact: 0.001³ rounds to it).
     let text = dae(&format!(
         "<asset><unit meter=\" 0.001 \"/></asset>\n{geometry}"
@@ -2617,15 +2632,34 @@ fn fill_in_place_on_stdin_is_refused() {
     }
 }
 
-/// `fill -i` keeps the file's extended attributes (POSIX ACLs are some): they are copied to the
-/// temporary file before the rename. Checked with a `user.` attribute where the temp dir's file
-/// system takes one.
+/// `fill -i` keeps the file's extended attributes and its POSIX ACL (stored as the
+/// `system.posix_acl_access` attribute): they are copied to the temporary file before the rename.
+/// Checked with a `user.` attribute and an ACL granting a named user read access, where the temp
+/// dir's file system takes them.
 #[test]
 fn fill_in_place_keeps_extended_attributes() {
     let (_tmp, urdf) = urdf_in_tmp(&one_box());
     if xattr::set(&urdf, "user.urdf_inertia_test", b"kept").is_err() {
         eprintln!("the temp dir's file system takes no user xattrs: not checked here");
         return;
+    }
+    // The kernel's ACL format: version 2, then (tag, permissions, id) for the owner, user 1234,
+    // the group, the mask and others.
+    let mut acl = 2u32.to_le_bytes().to_vec();
+    for (tag, perm, id) in [
+        (0x01u16, 6u16, u32::MAX),
+        (0x02, 4, 1234),
+        (0x04, 4, u32::MAX),
+        (0x10, 4, u32::MAX),
+        (0x20, 4, u32::MAX),
+    ] {
+        acl.extend(tag.to_le_bytes());
+        acl.extend(perm.to_le_bytes());
+        acl.extend(id.to_le_bytes());
+    }
+    let with_acl = xattr::set(&urdf, "system.posix_acl_access", &acl).is_ok();
+    if !with_acl {
+        eprintln!("the temp dir's file system takes no POSIX ACLs: the ACL is not checked here");
     }
     let ino = std::fs::metadata(&urdf).unwrap().ino();
     let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
@@ -2644,6 +2678,15 @@ fn fill_in_place_keeps_extended_attributes() {
             .as_deref(),
         Some(&b"kept"[..])
     );
+    if with_acl {
+        assert_eq!(
+            xattr::get(&urdf, "system.posix_acl_access")
+                .unwrap()
+                .as_deref(),
+            Some(&acl[..]),
+            "the ACL naming user 1234 is kept"
+        );
+    }
 }
 
 /// Control characters from input are shown escaped in every text message: a link name holding
