@@ -1012,3 +1012,91 @@ fn the_readme_quick_start_runs_as_written() {
     );
     assert!((masses.last().unwrap().0 - 6.0).abs() < 1e-12, "{masses:?}");
 }
+
+/// A binary STL (f32 corners) of a regular `n`-gon prism about the vertical axis through `(cx, cy)`,
+/// circumradius `r`, from z = 0 to `h`, wound outward.
+fn prism_stl_f32(n: u32, r: f64, h: f64, cx: f64, cy: f64) -> Vec<u8> {
+    let corner = |i: u32, z: f64| {
+        let t = 2.0 * std::f64::consts::PI * f64::from(i % n) / f64::from(n);
+        [cx + r * t.cos(), cy + r * t.sin(), z]
+    };
+    let mut tris = Vec::new();
+    for i in 0..n {
+        let (a0, b0, a1, b1) = (
+            corner(i, 0.0),
+            corner(i + 1, 0.0),
+            corner(i, h),
+            corner(i + 1, h),
+        );
+        tris.push([[cx, cy, 0.0], b0, a0]);
+        tris.push([[cx, cy, h], a1, b1]);
+        tris.push([a0, b0, b1]);
+        tris.push([a0, b1, a1]);
+    }
+    let mut out = vec![0u8; 80];
+    out.extend_from_slice(&(tris.len() as u32).to_le_bytes());
+    for t in tris {
+        out.extend_from_slice(&[0u8; 12]);
+        for p in t {
+            for x in p {
+                out.extend_from_slice(&(x as f32).to_le_bytes());
+            }
+        }
+        out.extend_from_slice(&[0u8; 2]);
+    }
+    out
+}
+
+/// Products of inertia that are f32 round-off (`ixy="4.28736e-14"` beside `iyy="2.83e-5"` once) are
+/// written as `0`: a regular 64-gon prism has none about its axis, but its f32 corners, away from
+/// the origin, leave one of about 1e-19 (`--digits full` shows it). Its moments are the prism's:
+/// m·R²(1 + 2cos²(π/n))/6 about the axis, half that plus m·h²/12 across it.
+#[test]
+fn f32_noise_in_products_of_inertia_is_written_as_zero() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (n, r, h) = (64u32, 0.021, 0.05);
+    std::fs::write(
+        tmp.path().join("prism.stl"),
+        prism_stl_f32(n, r, h, 0.13, -0.07),
+    )
+    .unwrap();
+    let urdf = write(
+        tmp.path(),
+        "robot.urdf",
+        "<robot name=\"r\"><link name=\"p\"><collision><geometry><mesh filename=\"prism.stl\"/></geometry></collision></link></robot>",
+    );
+    let attr = |filled: &str, name: &str| {
+        let i = filled.find(&format!("{name}=\"")).expect(name) + name.len() + 2;
+        filled[i..i + filled[i..].find('"').unwrap()].to_string()
+    };
+    let out = run(&[
+        "fill",
+        &urdf,
+        "--density",
+        "1000",
+        "--digits",
+        "full",
+        "--no-config",
+    ]);
+    let full = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert_ne!(attr(&full, "ixy"), "0", "the noise is there: {full}");
+    let out = run(&["fill", &urdf, "--density", "1000", "--no-config"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let filled = String::from_utf8_lossy(&out.stdout).into_owned();
+    for product in ["ixy", "ixz", "iyz"] {
+        assert_eq!(attr(&filled, product), "0", "{filled}");
+    }
+    let nf = f64::from(n);
+    let area = nf / 2.0 * r * r * (2.0 * std::f64::consts::PI / nf).sin();
+    let m = 1000.0 * area * h;
+    let polar = m * r * r * (1.0 + 2.0 * (std::f64::consts::PI / nf).cos().powi(2)) / 6.0;
+    for (name, value) in [
+        ("ixx", polar / 2.0 + m * h * h / 12.0),
+        ("iyy", polar / 2.0 + m * h * h / 12.0),
+        ("izz", polar),
+    ] {
+        let got: f64 = attr(&filled, name).parse().unwrap();
+        // The f32 corners are within 6e-8 of 0.15 m, so r within about 5e-7 relative.
+        assert!((got - value).abs() <= 1e-5 * value, "{name} {got} {value}");
+    }
+}
