@@ -53,23 +53,40 @@ pub fn main() -> i32 {
         }
     };
     write::remove_temp_files_on_signal();
-    let max_size = match &args.command {
-        Command::Mesh(m) => m.max_file_size.clone(),
-        Command::Fill(f) => f.source.max_file_size.clone(),
-        Command::Diff(d) => d.source.max_file_size.clone(),
-        Command::Check(c) => c.source.max_file_size.clone(),
-        Command::Xacro(x) => x.max_file_size.clone(),
+    let (max_size, max_total) = match &args.command {
+        Command::Mesh(m) => (&m.max_file_size, &m.max_total_read),
+        Command::Fill(f) => (&f.source.max_file_size, &f.source.max_total_read),
+        Command::Diff(d) => (&d.source.max_file_size, &d.source.max_total_read),
+        Command::Check(c) => (&c.source.max_file_size, &c.source.max_total_read),
+        Command::Xacro(x) => (&x.max_file_size, &x.max_total_read),
     };
-    let from_env = std::env::var(urdf_inertia::input::MAX_FILE_SIZE_ENV).ok();
-    if let Some((what, s)) = max_size
-        .map(|s| ("--max-file-size", s))
-        .or(from_env.map(|s| (urdf_inertia::input::MAX_FILE_SIZE_ENV, s)))
-    {
-        match urdf_inertia::input::parse_size(&s) {
-            Ok(n) => urdf_inertia::input::set_max_file_size(n),
-            Err(e) => {
-                errln!("error: {what}: {e}");
-                return ExitStatus::Error as i32;
+    use urdf_inertia::input;
+    for (flag, value, env, set) in [
+        (
+            "--max-file-size",
+            max_size,
+            input::MAX_FILE_SIZE_ENV,
+            input::set_max_file_size as fn(u64),
+        ),
+        (
+            "--max-total-read",
+            max_total,
+            input::MAX_TOTAL_READ_ENV,
+            input::set_max_total_read,
+        ),
+    ] {
+        let from_env = std::env::var(env).ok();
+        if let Some((what, s)) = value
+            .clone()
+            .map(|s| (flag, s))
+            .or(from_env.map(|s| (env, s)))
+        {
+            match input::parse_size(&s) {
+                Ok(n) => set(n),
+                Err(e) => {
+                    errln!("error: {what}: {e}");
+                    return ExitStatus::Error as i32;
+                }
             }
         }
     }

@@ -1,6 +1,10 @@
 //! Reading input files with two guards: only regular files are read (a FIFO would hang, `/dev/zero`
 //! or `/dev/urandom` never end), and no more than a size limit, 1 GiB by default, set with
-//! `--max-file-size` or the `URDF_INERTIA_MAX_FILE_SIZE` environment variable (the CLI reads both).
+//! `--max-file-size` or the `URDF_INERTIA_MAX_FILE_SIZE` environment variable (the CLI reads both);
+//! and a budget for all the files of one run together, 16 GiB by default (`--max-total-read`,
+//! `URDF_INERTIA_MAX_TOTAL_READ`): a file is charged its length when it is opened, so that a robot
+//! naming thousands of large files (each within the limit) ends with an error naming the file that
+//! would exceed the budget instead of reading for hours.
 //!
 //! This is the one way the library reads a file: URDFs, meshes, glTF buffers, density maps and
 //! `package.xml` all go through [`read_file`] or [`open_file`] (a test in tests/regression.rs puts a
@@ -18,16 +22,70 @@ pub const DEFAULT_MAX_FILE_SIZE: u64 = 1 << 30;
 /// The environment variable that sets the limit when `--max-file-size` is not given.
 pub const MAX_FILE_SIZE_ENV: &str = "URDF_INERTIA_MAX_FILE_SIZE";
 
-static MAX_FILE_SIZE: AtomicU64 = AtomicU64::new(DEFAULT_MAX_FILE_SIZE);
+/// The default budget of bytes read in one run, all files together: 16 GiB, sixteen files at the
+/// one-file limit. No real robot comes near it: the largest of example-robot-data's 40 robots reads
+/// 40 MB of files, all 40 together 411 MB.
+pub const DEFAULT_MAX_TOTAL_READ: u64 = 16 << 30;
+
+/// The environment variable that sets the run's budget when `--max-total-read` is not given.
+pub const MAX_TOTAL_READ_ENV: &str = "URDF_INERTIA_MAX_TOTAL_READ";
+
+/// What the gate lets a run read: the limit on one file, the budget for all files together, and
+/// the bytes charged to that budget so far.
+struct ReadLimits {
+    per_file: AtomicU64,
+    total: AtomicU64,
+    charged: AtomicU64,
+}
+
+impl ReadLimits {
+    /// Charges a file of `len` bytes to the budget, or says why it cannot be read (the budget is left
+    /// as it was).
+    fn charge(&self, len: u64) -> Result<(), String> {
+        let total = self.total.load(Ordering::Relaxed);
+        self.charged
+            .fetch_update(Ordering::Relaxed, Ordering::Relaxed, |c| {
+                c.checked_add(len).filter(|&sum| sum <= total)
+            })
+            .map(drop)
+            .map_err(|charged| {
+                format!(
+                    "is over the budget of {total} bytes read from all files together in this run ({len} bytes, after {charged} bytes read before it); raise it with --max-total-read SIZE or {MAX_TOTAL_READ_ENV}"
+                )
+            })
+    }
+}
+
+// The one process-wide value of the gate (it held the one-file limit alone before the budget).
+static LIMITS: ReadLimits = ReadLimits {
+    per_file: AtomicU64::new(DEFAULT_MAX_FILE_SIZE),
+    total: AtomicU64::new(DEFAULT_MAX_TOTAL_READ),
+    charged: AtomicU64::new(0),
+};
 
 /// Sets the process-wide limit on the size of one input file, in bytes.
 pub fn set_max_file_size(bytes: u64) {
-    MAX_FILE_SIZE.store(bytes, Ordering::Relaxed);
+    LIMITS.per_file.store(bytes, Ordering::Relaxed);
 }
 
 /// The process-wide limit on the size of one input file, in bytes.
 pub fn max_file_size() -> u64 {
-    MAX_FILE_SIZE.load(Ordering::Relaxed)
+    LIMITS.per_file.load(Ordering::Relaxed)
+}
+
+/// Sets the budget of bytes the process may read from all files together.
+pub fn set_max_total_read(bytes: u64) {
+    LIMITS.total.store(bytes, Ordering::Relaxed);
+}
+
+/// The budget of bytes the process may read from all files together.
+pub fn max_total_read() -> u64 {
+    LIMITS.total.load(Ordering::Relaxed)
+}
+
+/// The bytes charged to the budget so far: the lengths of the files opened.
+pub fn total_read() -> u64 {
+    LIMITS.charged.load(Ordering::Relaxed)
 }
 
 /// Parses a size: bytes, or a number with a `K`, `M` or `G` suffix (powers of 1024).
@@ -105,7 +163,8 @@ pub fn open_file(path: &Path) -> Result<(File, u64), String> {
     open_file_within(path, max_file_size())
 }
 
-/// [`open_file`] with the size limit `limit` instead of the process-wide one.
+/// [`open_file`] with the size limit `limit` instead of the process-wide one (the file is charged to
+/// the run's budget all the same).
 pub fn open_file_within(path: &Path, limit: u64) -> Result<(File, u64), String> {
     let regular = |meta: &fs::Metadata| {
         if meta.is_file() {
@@ -125,6 +184,7 @@ pub fn open_file_within(path: &Path, limit: u64) -> Result<(File, u64), String> 
     if meta.len() > limit {
         return Err(too_large(limit));
     }
+    LIMITS.charge(meta.len())?;
     Ok((file, meta.len()))
 }
 
@@ -179,6 +239,26 @@ mod tests {
         assert!(read_file_within(&p, 99)
             .unwrap_err()
             .contains("larger than the limit of 99 bytes"));
+    }
+
+    #[test]
+    fn the_budget_charges_lengths_and_refuses_what_exceeds_it() {
+        let limits = ReadLimits {
+            per_file: AtomicU64::new(DEFAULT_MAX_FILE_SIZE),
+            total: AtomicU64::new(100),
+            charged: AtomicU64::new(0),
+        };
+        assert_eq!(limits.charge(60), Ok(()));
+        assert_eq!(limits.charge(40), Ok(()));
+        let e = limits.charge(1).unwrap_err();
+        assert!(
+            e.contains("is over the budget of 100 bytes read from all files together")
+                && e.contains("(1 bytes, after 100 bytes read before it)")
+                && e.contains("--max-total-read"),
+            "{e}"
+        );
+        assert!(limits.charge(u64::MAX).is_err());
+        assert_eq!(limits.charged.load(Ordering::Relaxed), 100);
     }
 
     #[test]

@@ -268,7 +268,8 @@ fn broken_meshes_take_the_documented_rung() {
     let e = mesh::load_solid(&p, [1.0; 3], HealthOptions::default()).unwrap_err();
     assert!(matches!(e.kind, MeshErrorKind::NoSolid(_)), "{e}");
     assert!(
-        e.to_string().contains("UI108") && e.to_string().contains("--open-mesh hull"),
+        e.to_string().contains("defines no solid to trust")
+            && e.to_string().contains("--open-mesh hull"),
         "{e}"
     );
     let hull = HealthOptions {
