@@ -832,7 +832,7 @@ fn json_summary_names_repairs() {
     let out = run(&["fill", urdf.to_str().unwrap(), "--density", "1000", "-v"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("note[UI101]: inside.stl: inverted: all 12 faces wound inward")
+        stderr.contains("note[UI101]: inside.stl: inside out: all 12 faces wound inward")
             && stderr.contains("(link `box`, collision 1)"),
         "{stderr}"
     );
@@ -846,7 +846,7 @@ fn json_summary_names_repairs() {
     ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("warning[UI101]: inside.stl: inverted: all 12 faces wound inward"),
+        stderr.contains("warning[UI101]: inside.stl: inside out: all 12 faces wound inward"),
         "{stderr}"
     );
 }
@@ -868,7 +868,7 @@ fn millimetre_meshes_without_scale_are_flagged() {
     ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
-    assert!(stderr.contains("warning[UI106]: package://demo_arm_description/meshes/shoulder.STL: exact: the mesh is 229.8 m across: if it was exported in millimetres, give it scale=\"0.001 0.001 0.001\" (link `shoulder_link`, collision 1)"), "{stderr}");
+    assert!(stderr.contains("warning[UI106]: package://demo_arm_description/meshes/shoulder.STL: closed mesh: the mesh is 229.8 m across: if it was exported in millimetres, give it scale=\"0.001 0.001 0.001\" (link `shoulder_link`, collision 1)"), "{stderr}");
     // diff and check show it too (they compute the same meshes), with the same acceptance; without
     // it the link fails there as well (UI710).
     let (_, map) = demo();
@@ -889,7 +889,7 @@ fn millimetre_meshes_without_scale_are_flagged() {
             "--allow-large-parts",
         ]);
         let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(stderr.contains("warning[UI106]: package://demo_arm_description/meshes/shoulder.STL: exact: the mesh is 229.8 m across"), "{command}: {stderr}");
+        assert!(stderr.contains("warning[UI106]: package://demo_arm_description/meshes/shoulder.STL: closed mesh: the mesh is 229.8 m across"), "{command}: {stderr}");
     }
 }
 
@@ -1147,7 +1147,7 @@ fn mesh_warnings_once_per_file_in_fill_diff_and_check() {
     let tmp = tempfile::tempdir().unwrap();
     let urdf = shared_mesh_robot(tmp.path());
     let u = urdf.to_str().unwrap();
-    let once = "warning[UI101]: cube.stl: inverted: all 12 faces wound inward (negative volume); flipped (4 links: `a` collision 1, `b` collision 1, `c` collision 1, `d` collision 1)";
+    let once = "warning[UI101]: cube.stl: inside out: all 12 faces wound inward (negative volume); flipped (4 links: `a` collision 1, `b` collision 1, `c` collision 1, `d` collision 1)";
     for command in ["fill", "diff", "check"] {
         let out = run(&[command, u, "--density", "1000", "--note-below", "0"]);
         let stderr = stderr_of(&out);
@@ -1208,7 +1208,7 @@ fn quiet_ignore_and_warn_as_error() {
     std::fs::remove_file(&out_file).unwrap();
     let out = fill(&["--warn-as-error", "UI101"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr_of(&out));
-    assert!(stderr_of(&out).contains("error[UI101]: cube.stl: inverted"));
+    assert!(stderr_of(&out).contains("error[UI101]: cube.stl: inside out"));
     assert!(stderr_of(&out).contains("nothing written"));
     assert!(!out_file.exists());
     // check on the filled robot: clean, unless the warning is an error.
@@ -1274,9 +1274,8 @@ fn colours_on_request_only_and_never_in_json() {
     ];
     // Through a pipe: plain text with the codes.
     let out = run(&args);
-    assert!(
-        stderr_of(&out).contains("note[UI105]: ../meshes/upper_arm.obj: exact: 2 objects/groups")
-    );
+    assert!(stderr_of(&out)
+        .contains("note[UI105]: ../meshes/upper_arm.obj: closed mesh: 2 objects/groups"));
     assert!(!stderr_of(&out).contains('\x1b'));
     let forced = bin()
         .args(args)

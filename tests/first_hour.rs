@@ -503,3 +503,600 @@ fn f32_corners_write_the_decimals_the_file_means() {
     let want = 0.036 * 0.06 * 0.03 / 36.0;
     assert!((ixy - want).abs() < 1e-6 * want.abs(), "{ixy} {want}");
 }
+
+/// An ASCII STL of the cube of side `a` wound inward (every face reversed): read, it is flipped, a
+/// repair (UI101) whose bound is round-off.
+fn inside_out_cube_stl(a: f64) -> String {
+    let outward = cube_stl(a);
+    let mut out = String::new();
+    let mut corners: Vec<&str> = Vec::new();
+    for line in outward.lines() {
+        if line.trim_start().starts_with("vertex") {
+            corners.push(line);
+            if corners.len() == 3 {
+                for c in [corners[0], corners[2], corners[1]] {
+                    out.push_str(c);
+                    out.push('\n');
+                }
+                corners.clear();
+            }
+        } else {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    out
+}
+
+/// `mesh` takes the diagnostic flags and `urdf-inertia.toml` as the other commands do: a flipped
+/// cube's repair (UI101, bound round-off) is a note by default (below `--note-below`), a warning with
+/// `--note-below 0`, gone with `--ignore` or `--quiet` (the numbers stay), an error with
+/// `--warn-as-error` (exit 2), in text and JSON; a part over 10 m across (UI106) is silenced the same
+/// way. The cube's volume is a³ whatever is printed.
+#[test]
+fn mesh_takes_the_diagnostic_flags_and_the_configuration() {
+    let tmp = tempfile::tempdir().unwrap();
+    let stl = write(tmp.path(), "inv.stl", &inside_out_cube_stl(2.0));
+    let mesh = |extra: &[&str]| {
+        let mut args = vec!["mesh", stl.as_str(), "--no-config"];
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    let out = mesh(&[]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    assert!(text(&out).contains("note[UI101]"), "{}", text(&out));
+    assert!(
+        text(&out).contains("volume            8 m³"),
+        "{}",
+        text(&out)
+    );
+    let out = mesh(&["--note-below", "0"]);
+    assert!(text(&out).contains("warning[UI101]"), "{}", text(&out));
+    for quiet in [
+        &["--note-below", "0", "--quiet"][..],
+        &["--note-below", "0", "--ignore", "UI101"],
+    ] {
+        let out = mesh(quiet);
+        assert_eq!(out.status.code(), Some(0), "{quiet:?}");
+        assert!(!text(&out).contains("UI101"), "{quiet:?}: {}", text(&out));
+        assert!(
+            text(&out).contains("volume            8 m³"),
+            "{}",
+            text(&out)
+        );
+    }
+    let out = mesh(&["--note-below", "0", "--warn-as-error", "UI101"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(text(&out).contains("error[UI101]"), "{}", text(&out));
+    assert!(
+        text(&out).contains("made an error (--warn-as-error)"),
+        "{}",
+        text(&out)
+    );
+    // JSON: the promoted repair under "errors", the exit status 2, the volume all the same.
+    let out = mesh(&[
+        "--note-below",
+        "0",
+        "--warn-as-error",
+        "UI101",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["errors"][0]["code"], "UI101", "{json}");
+    assert_eq!(json["volume"], 8.0);
+    let out = mesh(&["--ignore", "UI101", "--format", "json"]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(!json.to_string().contains("UI101"), "{json}");
+    // The same from urdf-inertia.toml (found in the current directory).
+    write(
+        tmp.path(),
+        "urdf-inertia.toml",
+        "note-below = 0\nwarn-as-error = [\"UI101\"]\n",
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
+        .args(["mesh", "inv.stl"])
+        .current_dir(tmp.path())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(text(&out).contains("error[UI101]"), "{}", text(&out));
+    // A 20 m cube (a millimetre export without scale): UI106, which --ignore silences.
+    let big = write(tmp.path(), "big.stl", &cube_stl(20.0));
+    let out = run(&["mesh", &big, "--no-config"]);
+    assert!(text(&out).contains("warning[UI106]"), "{}", text(&out));
+    let out = run(&["mesh", &big, "--no-config", "--ignore", "UI106"]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(!text(&out).contains("across"), "{}", text(&out));
+}
+
+/// `xacro` takes the diagnostic flags and `urdf-inertia.toml` too: its warning (UI208, here an
+/// unknown attribute) is printed by default, gone with `--quiet` or `--ignore`, and with
+/// `--warn-as-error` nothing is printed on stdout and the exit status is 2.
+#[test]
+fn xacro_takes_the_diagnostic_flags_and_the_configuration() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = write(
+        tmp.path(),
+        "r.urdf.xacro",
+        "<robot name=\"r\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">\n  <xacro:property name=\"w\" value=\"2\" colour=\"red\"/>\n  <link name=\"a\"><collision><geometry><box size=\"${w} 1 1\"/></geometry></collision></link>\n</robot>\n",
+    );
+    let xacro = |extra: &[&str]| {
+        let mut args = vec!["xacro", file.as_str(), "--no-config"];
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    let out = xacro(&[]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(
+        err.contains("warning[UI208]") && err.contains("unknown attribute(s): colour"),
+        "{err}"
+    );
+    let expanded = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(expanded.contains("<box size=\"2 1 1\"/>"), "{expanded}");
+    for quiet in [&["--quiet"][..], &["--ignore", "UI208"]] {
+        let out = xacro(quiet);
+        assert_eq!(out.status.code(), Some(0), "{quiet:?}");
+        assert!(out.stderr.is_empty(), "{quiet:?}: {}", text(&out));
+        assert_eq!(String::from_utf8_lossy(&out.stdout), expanded);
+    }
+    let out = xacro(&["--warn-as-error", "UI208"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(out.stdout.is_empty());
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("error[UI208]"),
+        "{}",
+        text(&out)
+    );
+    write(tmp.path(), "urdf-inertia.toml", "ignore = [\"UI208\"]\n");
+    let out = Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
+        .args(["xacro", "r.urdf.xacro"])
+        .current_dir(tmp.path())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    assert!(out.stderr.is_empty(), "{}", text(&out));
+}
+
+/// `fill --format json` printed no JSON when a link failed without `--keep-going`: it prints its
+/// summary with the errors and `"written": false`, writes nothing and exits 2; with `--keep-going`
+/// `"written"` is true. The same when a warning is made an error.
+#[test]
+fn fill_json_reports_a_failure_and_exits_2() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text_in = "<robot name=\"r\">\n  <link name=\"good\">\n    <collision><geometry><box size=\"1 2 3\"/></geometry></collision>\n  </link>\n  <link name=\"bad\">\n    <collision><geometry><box size=\"1 -2 3\"/></geometry></collision>\n  </link>\n</robot>\n";
+    let urdf = write(tmp.path(), "r.urdf", text_in);
+    let out_file = tmp.path().join("out.urdf");
+    let out_s = out_file.to_str().unwrap();
+    for target in [&["-o", out_s][..], &["-i"]] {
+        let mut args = vec![
+            "fill",
+            urdf.as_str(),
+            "--density",
+            "1000",
+            "--format",
+            "json",
+        ];
+        args.extend_from_slice(target);
+        let out = run(&args);
+        assert_eq!(out.status.code(), Some(2), "{target:?}: {}", text(&out));
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout)
+            .unwrap_or_else(|e| panic!("{target:?}: no JSON ({e}): {}", text(&out)));
+        assert_eq!(json["written"], false, "{json}");
+        let errors = json["errors"].as_array().expect("errors");
+        assert_eq!(errors.len(), 1, "{json}");
+        assert_eq!(errors[0]["link"], "bad");
+        assert_eq!(errors[0]["code"], "UI701");
+        assert!(!out_file.exists());
+        assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text_in);
+    }
+    let out = run(&[
+        "fill",
+        &urdf,
+        "--density",
+        "1000",
+        "--format",
+        "json",
+        "-o",
+        out_s,
+        "--keep-going",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["written"], true, "{json}");
+    assert!(out_file.exists());
+    // A warning made an error: nothing written, the JSON says so.
+    std::fs::remove_file(&out_file).unwrap();
+    let stl = write(tmp.path(), "inv.stl", &inside_out_cube_stl(1.0));
+    let urdf = write(
+        tmp.path(),
+        "m.urdf",
+        "<robot name=\"m\"><link name=\"c\"><collision><geometry><mesh filename=\"inv.stl\"/></geometry></collision></link></robot>",
+    );
+    assert!(std::path::Path::new(&stl).exists());
+    let out = run(&[
+        "fill",
+        &urdf,
+        "--density",
+        "1000",
+        "--format",
+        "json",
+        "-o",
+        out_s,
+        "--note-below",
+        "0",
+        "--warn-as-error",
+        "UI101",
+        "--no-config",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["written"], false, "{json}");
+    assert!(!out_file.exists());
+}
+
+/// The fill hook's default `args: [--density-map, densities.toml]` failed in a repository without
+/// that file. The hooks of both manifests (built from source, and the `language: python` mirror)
+/// pass no density arguments: run as pre-commit runs them (the manifest's `entry` and the changed
+/// file, from the repository's root), the fill hook takes the density map that `urdf-inertia.toml`
+/// names; without one it fails saying how to give one.
+#[test]
+fn the_fill_hook_takes_its_densities_from_the_configuration() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let manifests = [
+        root.join(".pre-commit-hooks.yaml"),
+        root.join("packaging/pre-commit-mirror/.pre-commit-hooks.yaml"),
+    ];
+    for manifest in &manifests {
+        let yaml = std::fs::read_to_string(manifest).unwrap();
+        let fill_hook = yaml
+            .split("- id: ")
+            .find(|h| h.starts_with("urdf-inertia-fill"))
+            .expect("fill hook");
+        assert!(
+            !fill_hook.contains("args:"),
+            "{}: {fill_hook}",
+            manifest.display()
+        );
+        let entry = fill_hook
+            .lines()
+            .find_map(|l| l.trim().strip_prefix("entry: "))
+            .expect("entry");
+        let argv: Vec<&str> = entry.split_whitespace().collect();
+        assert_eq!(argv[..2], ["urdf-inertia", "fill"], "{entry}");
+        for with_config in [true, false] {
+            let tmp = tempfile::tempdir().unwrap();
+            std::fs::create_dir(tmp.path().join(".git")).unwrap();
+            write(tmp.path(), "densities.toml", "default = 1000\n");
+            if with_config {
+                write(
+                    tmp.path(),
+                    "urdf-inertia.toml",
+                    "density-map = \"densities.toml\"\n",
+                );
+            }
+            let urdf = write(
+                tmp.path(),
+                "urdf/r.urdf",
+                "<robot name=\"r\">\n  <link name=\"a\">\n    <collision><geometry><box size=\"0.1 0.2 0.3\"/></geometry></collision>\n  </link>\n</robot>\n",
+            );
+            let out = Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
+                .args(&argv[1..])
+                .arg("urdf/r.urdf")
+                .current_dir(tmp.path())
+                .output()
+                .unwrap();
+            let filled = std::fs::read_to_string(&urdf).unwrap();
+            if with_config {
+                assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+                // 0.1 × 0.2 × 0.3 m of 1000 kg/m³.
+                assert!((mass_of(&filled, "a") - 6.0).abs() < 1e-12, "{filled}");
+            } else {
+                assert_eq!(out.status.code(), Some(2));
+                assert!(
+                    text(&out).contains("fill needs densities")
+                        && text(&out).contains("density-map = \"FILE\"")
+                        && text(&out).contains("urdf-inertia.toml"),
+                    "{}",
+                    text(&out)
+                );
+                assert!(!filled.contains("<inertial>"));
+            }
+        }
+    }
+}
+
+/// Messages speak plain words: none of the repair ladder's terms (`rung`, `ladder`, a bare `exact:`
+/// or `welded:` before a message, `model: cracks`, "by 1 of it") in what `fill`, `diff`, `check`
+/// and `mesh` print about a flipped cube, a cube whose corners need joining and a closed one, with
+/// every note shown; `mesh` names the health in words ("closed mesh", "inside out").
+#[test]
+fn messages_use_plain_words() {
+    let tmp = tempfile::tempdir().unwrap();
+    write(tmp.path(), "inv.stl", &inside_out_cube_stl(0.2));
+    write(tmp.path(), "ok.stl", &cube_stl(0.2));
+    // The same cube with one corner of one face off by 1e-9 m: closed once corners are joined.
+    let cracked =
+        cube_stl(0.2).replacen("vertex -0.1 -0.1 -0.1", "vertex -0.100000001 -0.1 -0.1", 1);
+    assert_ne!(cracked, cube_stl(0.2));
+    write(tmp.path(), "cracked.stl", &cracked);
+    let urdf = write(
+        tmp.path(),
+        "r.urdf",
+        "<robot name=\"r\">\n  <link name=\"a\"><inertial><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"3\"/></inertial><collision><geometry><mesh filename=\"inv.stl\"/></geometry></collision></link>\n  <link name=\"b\"><collision><geometry><mesh filename=\"cracked.stl\"/></geometry></collision></link>\n  <link name=\"c\"><collision><geometry><mesh filename=\"ok.stl\"/></geometry></collision></link>\n</robot>\n",
+    );
+    let mut printed = String::new();
+    for cmd in ["fill", "diff", "check"] {
+        let out = run(&[
+            cmd,
+            &urdf,
+            "--density",
+            "1000",
+            "--note-below",
+            "0",
+            "-v",
+            "--no-config",
+        ]);
+        printed.push_str(&text(&out));
+    }
+    for mesh in ["inv.stl", "ok.stl", "cracked.stl"] {
+        let p = tmp.path().join(mesh);
+        let out = run(&[
+            "mesh",
+            p.to_str().unwrap(),
+            "--note-below",
+            "0",
+            "--no-config",
+        ]);
+        printed.push_str(&text(&out));
+    }
+    assert!(printed.contains("warning[UI101]"), "{printed}");
+    assert!(
+        printed.contains("health            inside out"),
+        "{printed}"
+    );
+    assert!(
+        printed.contains("health            closed mesh"),
+        "{printed}"
+    );
+    for jargon in [
+        "rung",
+        "ladder",
+        ": exact:",
+        ": welded:",
+        "model: cracks",
+        "by 1 of it",
+    ] {
+        assert!(
+            !printed.to_lowercase().contains(jargon),
+            "`{jargon}` in:\n{printed}"
+        );
+    }
+}
+
+/// A density map with an unquoted glob key (the likeliest slip) is an error with the line, the
+/// column, the line itself, a caret and the hint to quote it, through the binary.
+#[test]
+fn a_density_map_error_shows_line_column_and_hint() {
+    let tmp = tempfile::tempdir().unwrap();
+    let urdf = battery_robot(tmp.path());
+    let map = write(
+        tmp.path(),
+        "d.toml",
+        "default = 1000\n[links]\n*battery* = 2000\n",
+    );
+    let out = run(&["fill", &urdf, "--density-map", &map, "--no-config"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(err.contains("d.toml:3:1"), "{err}");
+    assert!(err.contains("*battery* = 2000"), "{err}");
+    assert!(err.contains('^'), "{err}");
+    assert!(
+        err.contains("hint: a key with glob characters must be quoted: \"*battery*\" = …"),
+        "{err}"
+    );
+}
+
+/// A new `<inertial>` follows the style of the file's existing ones (attribute order, ` />`), as the
+/// real binary writes it.
+#[test]
+fn a_new_inertial_follows_the_files_style() {
+    let tmp = tempfile::tempdir().unwrap();
+    let urdf = write(
+        tmp.path(),
+        "r.urdf",
+        "<robot name=\"r\">\n  <link name=\"kept\">\n    <inertial>\n      <origin rpy=\"0 0 0\" xyz=\"0 0 0\" />\n      <mass value=\"6\" />\n      <inertia ixx=\"0.065\" iyy=\"0.05\" izz=\"0.025\" ixy=\"0\" ixz=\"0\" iyz=\"0\" />\n    </inertial>\n    <collision><geometry><box size=\"0.1 0.2 0.3\"/></geometry></collision>\n  </link>\n  <link name=\"new\">\n    <collision><geometry><box size=\"0.1 0.2 0.3\"/></geometry></collision>\n  </link>\n</robot>\n",
+    );
+    let out = run(&[
+        "fill",
+        &urdf,
+        "--density",
+        "1000",
+        "--missing-only",
+        "--no-config",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let filled = String::from_utf8_lossy(&out.stdout).into_owned();
+    let new = &filled[filled.find("<link name=\"new\">").unwrap()..];
+    assert!(new.contains("<origin rpy=\"0 0 0\" xyz=\""), "{new}");
+    assert!(new.contains("<mass value=\"6\" />"), "{new}");
+    assert!(
+        new.contains(
+            "<inertia ixx=\"0.065\" iyy=\"0.05\" izz=\"0.025\" ixy=\"0\" ixz=\"0\" iyz=\"0\" />"
+        ),
+        "{new}"
+    );
+}
+
+/// The release binary was 50 MB with `debug = 1` in the release profile: the profile keeps no debug
+/// information beyond line tables (the profiling profile may).
+#[test]
+fn the_release_profile_keeps_no_full_debug_info() {
+    let manifest =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("Cargo.toml")).unwrap();
+    let doc: toml::Table = manifest.parse().unwrap();
+    let release = doc
+        .get("profile")
+        .and_then(|p| p.get("release"))
+        .and_then(toml::Value::as_table);
+    let debug = release.and_then(|r| r.get("debug"));
+    let allowed = |v: &toml::Value| {
+        matches!(v.as_integer(), Some(0))
+            || matches!(v.as_bool(), Some(false))
+            || matches!(
+                v.as_str(),
+                Some("none" | "line-tables-only" | "line-directives-only")
+            )
+    };
+    assert!(debug.is_none_or(allowed), "release debug = {debug:?}");
+}
+
+/// The README's quick start for one's own robot, run as written (each `urdf-inertia` line of the
+/// block, comments cut) in a repository holding `urdf/my_robot.urdf` and `densities.toml`: every
+/// command does its work (none is a placeholder that errors), the fill keeps the weighed mass, and
+/// the final check passes. The robot: a 0.1 × 0.2 × 0.3 m box weighed at 5 kg, without inertia,
+/// and a 0.1 m cube without `<inertial>` (1 kg at 1000 kg/m³).
+#[test]
+fn the_readme_quick_start_runs_as_written() {
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
+    let start = readme
+        .find("### Quick start on your own robot")
+        .expect("quick start section");
+    let block = &readme[start..];
+    let block = &block[block.find("```sh\n").expect("sh block") + 6..];
+    let block = &block[..block.find("```").expect("block end")];
+    let commands: Vec<Vec<&str>> = block
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("urdf-inertia "))
+        .map(|l| l.split(" #").next().unwrap().split_whitespace().collect())
+        .collect();
+    assert!(commands.len() >= 3, "{block}");
+    let tmp = tempfile::tempdir().unwrap();
+    let urdf = write(
+        tmp.path(),
+        "urdf/my_robot.urdf",
+        "<robot name=\"mine\">\n  <link name=\"base\">\n    <inertial><mass value=\"5\"/></inertial>\n    <collision><geometry><box size=\"0.1 0.2 0.3\"/></geometry></collision>\n  </link>\n  <link name=\"head\">\n    <collision><geometry><box size=\"0.1 0.1 0.1\"/></geometry></collision>\n  </link>\n</robot>\n",
+    );
+    write(tmp.path(), "densities.toml", "default = 1000\n");
+    let mut masses = Vec::new();
+    for args in &commands {
+        let out = Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
+            .args(args)
+            .arg("--no-config")
+            .current_dir(tmp.path())
+            .output()
+            .unwrap();
+        // diff and check report what they find (exit 1); nothing may be an error.
+        let expected: &[i32] = if args[0] == "fill" { &[0] } else { &[0, 1] };
+        assert!(
+            out.status.code().is_some_and(|c| expected.contains(&c)),
+            "{args:?}: {}",
+            text(&out)
+        );
+        if args[0] == "fill" {
+            let filled = std::fs::read_to_string(&urdf).unwrap();
+            masses.push((mass_of(&filled, "base"), mass_of(&filled, "head")));
+        }
+        if args[0] == "check" {
+            assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+        }
+    }
+    // --keep-mass kept the weighed 5 kg; the map's fill then computes every link from 1000 kg/m³.
+    assert_eq!(masses.first().map(|m| m.0), Some(5.0), "{masses:?}");
+    assert!(
+        masses.iter().all(|m| (m.1 - 1.0).abs() < 1e-12),
+        "{masses:?}"
+    );
+    assert!((masses.last().unwrap().0 - 6.0).abs() < 1e-12, "{masses:?}");
+}
+
+/// A binary STL (f32 corners) of a regular `n`-gon prism about the vertical axis through `(cx, cy)`,
+/// circumradius `r`, from z = 0 to `h`, wound outward.
+fn prism_stl_f32(n: u32, r: f64, h: f64, cx: f64, cy: f64) -> Vec<u8> {
+    let corner = |i: u32, z: f64| {
+        let t = 2.0 * std::f64::consts::PI * f64::from(i % n) / f64::from(n);
+        [cx + r * t.cos(), cy + r * t.sin(), z]
+    };
+    let mut tris = Vec::new();
+    for i in 0..n {
+        let (a0, b0, a1, b1) = (
+            corner(i, 0.0),
+            corner(i + 1, 0.0),
+            corner(i, h),
+            corner(i + 1, h),
+        );
+        tris.push([[cx, cy, 0.0], b0, a0]);
+        tris.push([[cx, cy, h], a1, b1]);
+        tris.push([a0, b0, b1]);
+        tris.push([a0, b1, a1]);
+    }
+    let mut out = vec![0u8; 80];
+    out.extend_from_slice(&(tris.len() as u32).to_le_bytes());
+    for t in tris {
+        out.extend_from_slice(&[0u8; 12]);
+        for p in t {
+            for x in p {
+                out.extend_from_slice(&(x as f32).to_le_bytes());
+            }
+        }
+        out.extend_from_slice(&[0u8; 2]);
+    }
+    out
+}
+
+/// Products of inertia that are f32 round-off (`ixy="4.28736e-14"` beside `iyy="2.83e-5"` once) are
+/// written as `0`: a regular 64-gon prism has none about its axis, but its f32 corners, away from
+/// the origin, leave one of about 1e-19 (`--digits full` shows it). Its moments are the prism's:
+/// m·R²(1 + 2cos²(π/n))/6 about the axis, half that plus m·h²/12 across it.
+#[test]
+fn f32_noise_in_products_of_inertia_is_written_as_zero() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (n, r, h) = (64u32, 0.021, 0.05);
+    std::fs::write(
+        tmp.path().join("prism.stl"),
+        prism_stl_f32(n, r, h, 0.13, -0.07),
+    )
+    .unwrap();
+    let urdf = write(
+        tmp.path(),
+        "robot.urdf",
+        "<robot name=\"r\"><link name=\"p\"><collision><geometry><mesh filename=\"prism.stl\"/></geometry></collision></link></robot>",
+    );
+    let attr = |filled: &str, name: &str| {
+        let i = filled.find(&format!("{name}=\"")).expect(name) + name.len() + 2;
+        filled[i..i + filled[i..].find('"').unwrap()].to_string()
+    };
+    let out = run(&[
+        "fill",
+        &urdf,
+        "--density",
+        "1000",
+        "--digits",
+        "full",
+        "--no-config",
+    ]);
+    let full = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert_ne!(attr(&full, "ixy"), "0", "the noise is there: {full}");
+    let out = run(&["fill", &urdf, "--density", "1000", "--no-config"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let filled = String::from_utf8_lossy(&out.stdout).into_owned();
+    for product in ["ixy", "ixz", "iyz"] {
+        assert_eq!(attr(&filled, product), "0", "{filled}");
+    }
+    let nf = f64::from(n);
+    let area = nf / 2.0 * r * r * (2.0 * std::f64::consts::PI / nf).sin();
+    let m = 1000.0 * area * h;
+    let polar = m * r * r * (1.0 + 2.0 * (std::f64::consts::PI / nf).cos().powi(2)) / 6.0;
+    for (name, value) in [
+        ("ixx", polar / 2.0 + m * h * h / 12.0),
+        ("iyy", polar / 2.0 + m * h * h / 12.0),
+        ("izz", polar),
+    ] {
+        let got: f64 = attr(&filled, name).parse().unwrap();
+        // The f32 corners are within 6e-8 of 0.15 m, so r within about 5e-7 relative.
+        assert!((got - value).abs() <= 1e-5 * value, "{name} {got} {value}");
+    }
+}

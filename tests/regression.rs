@@ -1,5 +1,27 @@
 //! Regression tests for issue 13 ("Hardening"), each named after what it covers. The real binary runs in
 //! a temp dir on inputs generated here; nothing depends on timing, and everything holds when run as root.
+//!
+//! The second hardening campaign's findings, item by item, and the tests that reproduce each with a
+//! generated input and show it now holds (all in this file unless named otherwise):
+//!
+//! | item | finding | tests |
+//! | --- | --- | --- |
+//! | 1 | COLLADA `<unit meter>` not a positive number read as 1 m | `collada_unit_that_is_no_positive_number_is_an_error` |
+//! | 2 | `package.xml` (and every other input) outside the input guard | `package_xml_that_is_no_regular_file_is_an_error`, `every_file_the_tool_opens_goes_through_the_input_guard`, `non_regular_inputs_are_refused`, `gltf_buffer_uris_are_relative_references_or_refused` |
+//! | 2, 3 | a total-bytes budget per run over every file read | `total_bytes_read_have_a_budget_per_run` |
+//! | 3 | glTF instancing without a budget, buffers read once each, buffer URIs | `gltf_instance_fan_out_has_a_budget`, `gltf_buffers_are_read_once_and_within_the_size_limit`, `gltf_buffer_uris_are_relative_references_or_refused` |
+//! | 4 | quadratic weld on integer-grid coordinates | `integer_grid_coordinates_weld` (and the library's `integer_and_millimetre_grids_hash_apart`) |
+//! | 5 | panics: a 400 KB density-map key, a thread pool that cannot start; `RAYON_NUM_THREADS=5000` | `huge_density_map_key_is_an_error`, `density_globs_compiled_once_agree_with_a_plain_scan`, `thread_pool_failures_fall_back_to_one_thread` |
+//! | 6 | no memory budget; later files of a multi-file run never processed; every healed mesh kept | `a_mesh_over_the_memory_budget_fails_its_link_and_the_run_goes_on`, the library's `the_memory_budget_bounds_what_is_held_and_refuses_what_cannot_fit`, `overlap_of_1000_crowded_convex_pieces_keeps_to_the_work_cap`, `overlap_of_a_sliver_cone_and_a_box_has_bounded_memory` |
+//! | 7 | `fill -i` drops extended attributes and ACLs; rewrites unchanged files | `fill_in_place_keeps_extended_attributes` (a `user.` attribute and an ACL), `unchanged_output_is_not_written_and_long_names_fill_in_place` |
+//! | 8 | control characters from input printed raw | `control_characters_from_input_are_escaped_in_messages` |
+//! | 9 | `--keep-mass` replaces a `<mass>` it cannot parse | `keep_mass_with_an_unusable_mass_is_an_error` |
+//! | 10 | mesh overflow and underflow reported as "flat" with `NaN` | `mesh_overflow_and_underflow_are_named`, `collada_unit_that_is_no_positive_number_is_an_error` (1e308, 1e-310) |
+//! | 11 | temp files left by catchable signals and SIGXFSZ; 250-byte names; an edit lost during `fill -i`; `-i /dev/stdin` | `every_ending_signal_removes_the_temp_file`, `temp_file_has_the_targets_mode_and_is_removed_on_sigterm`, `file_size_limit_is_a_write_error`, `unchanged_output_is_not_written_and_long_names_fill_in_place`, `edit_during_fill_in_place_is_kept`, `fill_in_place_on_stdin_is_refused` |
+//! | 12 | two `<robot>` roots; CR-only line ends; UTF-32 and mark-less UTF-16; upper-case ASCII STL | `second_robot_root_is_left_alone`, `cr_only_urdf_keeps_its_line_ends_and_lines`, `utf16_without_a_mark_is_read_and_utf32_is_named`, `upper_case_ascii_stl_is_read_as_ascii` |
+//!
+//! Item 12's self-intersecting and nested outward shells are the winding-number work's (its tests are
+//! in tests/winding_truth.rs). docs/reliability.md has a row for each input above.
 
 // The test helpers are the library tests' own (exact integrals, mesh generators).
 #[path = "../crates/urdf-inertia/tests/common/mod.rs"]
@@ -1274,6 +1296,58 @@ fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option
         .collect();
     write("u32.urdf", &utf32);
     add("a UTF-32 URDF", a(&["check", "u32.urdf"]), None);
+    // The xacro robot of every kind of input: its xacro file (read twice: to tell it from a URDF,
+    // then by the expander), the macro file, the YAML and `package.xml` make exactly 1,047 bytes, so
+    // each mesh is a file over the budget.
+    package_of_every_input(&d.join("budget"));
+    add(
+        "all files of a run over `--max-total-read 1047`",
+        a(&[
+            "fill",
+            "budget/pkg/urdf/robot.urdf.xacro",
+            "--density",
+            "1000",
+            "--max-total-read",
+            "1047",
+            "-o",
+            "/dev/null",
+        ]),
+        None,
+    );
+    // Link data is not under the memory budget (meshes are): the peak for many primitive links.
+    let many: Vec<(String, String)> = (0..100_000)
+        .map(|i| (format!("l{i}"), format!("{i} 0 0")))
+        .collect();
+    let many: Vec<(&str, &str, &str)> = many
+        .iter()
+        .map(|(n, xyz)| (n.as_str(), "0.1 0.2 0.3", xyz.as_str()))
+        .collect();
+    write("boxes.urdf", boxes(&many).as_bytes());
+    add(
+        "100,000 box links",
+        a(&["fill", "boxes.urdf", "--density", "1000", "-o", "/dev/null"]),
+        None,
+    );
+    package_of_every_input(&d.join("fifo"));
+    std::fs::remove_file(d.join("fifo/pkg/urdf/arm.xacro")).unwrap();
+    assert!(Command::new("mkfifo")
+        .arg(d.join("fifo/pkg/urdf/arm.xacro"))
+        .status()
+        .unwrap()
+        .success());
+    add(
+        "a xacro include that is a FIFO",
+        a(&["check", "fifo/pkg/urdf/robot.urdf.xacro"]),
+        None,
+    );
+    package_of_every_input(&d.join("zero"));
+    std::fs::remove_file(d.join("zero/pkg/config/sizes.yaml")).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", d.join("zero/pkg/config/sizes.yaml")).unwrap();
+    add(
+        "a xacro `load_yaml` of a symlink to `/dev/zero`",
+        a(&["xacro", "zero/pkg/urdf/robot.urdf.xacro"]),
+        None,
+    );
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -1580,16 +1654,16 @@ fn write_fuzz_seeds() {
 // docs/reliability.md: regenerate with
 //   cargo test --release --test regression -- --ignored write_reliability_table
 
-/// The first `error:` line of stderr (else its first line, else the volume `mesh` printed), then what
-/// was (not) written, with temp paths removed.
+/// The first `error:` line of stderr (else the volume `mesh` printed, else the first line of stderr),
+/// then what was (not) written, with temp paths removed.
 fn what_it_says(out: &Output, tmp: &Path) -> String {
     let err = stderr(out);
     let stdout = String::from_utf8_lossy(&out.stdout);
     let first = err
         .lines()
         .find(|l| l.starts_with("error:") || l.starts_with("error["))
-        .or_else(|| err.lines().next())
         .or_else(|| stdout.lines().find(|l| l.contains("volume")))
+        .or_else(|| err.lines().next())
         .map_or("(nothing)", str::trim);
     let written = err
         .lines()
@@ -2095,11 +2169,11 @@ fn write_reliability_table() {
     ));
     std::fs::set_permissions(d.join("rodir"), std::fs::Permissions::from_mode(0o755)).unwrap();
 
-    let mut md = String::from("# Reliability: hostile input, what urdf-inertia does, exit code, memory and time\n\nGenerated by `cargo test --release --test regression -- --ignored write_reliability_table` (every input is made by the test in a temp dir; file names are relative to it), on purpose: CI does not run it. Exit codes: 0 ok, 1 `check` found problems, 2 error. Each row has a regression test in `tests/regression.rs`. Every catchable signal whose default action ends the process (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU) during a write removes the temporary file and exits 130 (`temp_file_has_the_targets_mode_and_is_removed_on_sigterm`, `every_ending_signal_removes_the_temp_file`); SIGXFSZ is caught, so a file-size limit is a write error (`file_size_limit_is_a_write_error`); an edit made while `fill -i` runs is kept and the run fails (`edit_during_fill_in_place_is_kept`). Only SIGKILL (or a crash) can leave a temporary file. Peak memory (maximum resident set) and wall time are GNU time's (`/usr/bin/time -v`: its maximum resident set size and elapsed wall-clock time) for the whole process, on the machine that generated this file (2 cores shared with other work); input size is the largest file named on the command line (for `fill`, the URDF, not its meshes); the program itself takes a few MB. Every reader is also fuzzed, with the figures of the last run in [fuzz/README.md](../fuzz/README.md).\n\n| hostile input | input size | what the tool does (first error line, or first line of stderr) | exit | peak memory | time |\n| --- | --- | --- | --- | --- | --- |\n");
+    let mut md = String::from("# Reliability: hostile input, what urdf-inertia does, exit code, memory and time\n\nGenerated by `cargo test --release --test regression -- --ignored write_reliability_table` (every input is made by the test in a temp dir; file names are relative to it), on purpose: CI does not run it. Exit codes: 0 ok, 1 `check` found problems, 2 error. Each row has a regression test in `tests/regression.rs`, whose header maps each finding of the hardening campaigns to its tests. Every catchable signal whose default action ends the process (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU) during a write removes the temporary file and exits 130 (`temp_file_has_the_targets_mode_and_is_removed_on_sigterm`, `every_ending_signal_removes_the_temp_file`); SIGXFSZ is caught, so a file-size limit is a write error (`file_size_limit_is_a_write_error`); an edit made while `fill -i` runs is kept and the run fails (`edit_during_fill_in_place_is_kept`). Only SIGKILL (or a crash) can leave a temporary file. Peak memory (maximum resident set) and wall time are GNU time's (`/usr/bin/time -v`: its maximum resident set size and elapsed wall-clock time) for the whole process, on the machine that generated this file (2 cores shared with other work); input size is the largest file named on the command line (for `fill`, the URDF, not its meshes); the program itself takes a few MB. Every reader is also fuzzed, with the figures of the last run in [fuzz/README.md](../fuzz/README.md).\n\n| hostile input | input size | what the tool does (first error line, or first line of stderr) | exit | peak memory | time |\n| --- | --- | --- | --- | --- | --- |\n");
     for row in rows.iter().filter(|r| !r.large) {
         md.push_str(&row.markdown(d));
     }
-    md.push_str("\n## Large inputs: peak memory against file size\n\n`urdf-inertia mesh FILE` on one closed torus of 1,000,000 triangles (500,000 vertices) written in each format by the same generator: read, weld, heal and integrate. Peak memory is about k × the file size, with k in the last column: what stays is the mesh as read (f64 coordinates) and the welded, healed solid, about 140 to 190 MiB per million triangles whatever the format, plus the file's bytes while it is parsed. So k is largest for compact binary files (glTF's f32 positions and shared vertices) and smallest for verbose text (ASCII STL, whose bytes dominate). `URDF_INERTIA_BIN=OTHER_BUILD` runs the same rows with another build, to compare.\n\n| input | input size | what the tool does | exit | peak memory | time | peak / size |\n| --- | --- | --- | --- | --- | --- | --- |\n");
+    md.push_str("\n## Large inputs: peak memory against file size\n\n`urdf-inertia mesh FILE` on one closed torus of 1,000,000 triangles (500,000 vertices) written in each format by the same generator: read, weld, heal and integrate. Peak memory is about k × the file size, with k in the last column: what stays is the mesh as read (f64 coordinates) and the welded, healed solid, about 140 to 190 MiB per million triangles whatever the format, plus the file's bytes while it is parsed. So k is largest for compact binary files (glTF's f32 positions and shared vertices) and smallest for ASCII STL, which is streamed: its verbose bytes are never held whole. `URDF_INERTIA_BIN=OTHER_BUILD` runs the same rows with another build, to compare.\n\n| input | input size | what the tool does | exit | peak memory | time | peak / size |\n| --- | --- | --- | --- | --- | --- | --- |\n");
     for row in rows.iter().filter(|r| r.large) {
         let _ = writeln!(
             md,
@@ -2186,6 +2260,21 @@ fn collada_unit_that_is_no_positive_number_is_an_error() {
             &format!("unit.dae:3: with <unit meter=\"{value}\">, the mesh's coordinates, volume or inertia {what} a 64-bit float"),
         );
     }
+    // `fill -i` once wrote the 10⁹-times mass into the URDF: it leaves the file as it was now.
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(
+        tmp.path().join("mm.dae"),
+        dae(&format!(
+            "<asset><unit meter=\"0,001\"/></asset>\n{geometry}"
+        )),
+    )
+    .unwrap();
+    let text = "<robot name=\"r\">\n  <link name=\"a\">\n    <collision><geometry><mesh filename=\"mm.dae\"/></geometry></collision>\n  </link>\n</robot>\n";
+    let urdf = tmp.path().join("r.urdf");
+    std::fs::write(&urdf, text).unwrap();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert_eq!(std::fs::read_to_string(&urdf).unwrap(), text);
     // A well-formed millimetre unit scales: the 1-unit box is 1e-9 m³ (exact: 0.001³ rounds to it).
     let text = dae(&format!(
         "<asset><unit meter=\" 0.001 \"/></asset>\n{geometry}"
@@ -2561,15 +2650,34 @@ fn fill_in_place_on_stdin_is_refused() {
     }
 }
 
-/// `fill -i` keeps the file's extended attributes (POSIX ACLs are some): they are copied to the
-/// temporary file before the rename. Checked with a `user.` attribute where the temp dir's file
-/// system takes one.
+/// `fill -i` keeps the file's extended attributes and its POSIX ACL (stored as the
+/// `system.posix_acl_access` attribute): they are copied to the temporary file before the rename.
+/// Checked with a `user.` attribute and an ACL granting a named user read access, where the temp
+/// dir's file system takes them.
 #[test]
 fn fill_in_place_keeps_extended_attributes() {
     let (_tmp, urdf) = urdf_in_tmp(&one_box());
     if xattr::set(&urdf, "user.urdf_inertia_test", b"kept").is_err() {
         eprintln!("the temp dir's file system takes no user xattrs: not checked here");
         return;
+    }
+    // The kernel's ACL format: version 2, then (tag, permissions, id) for the owner, user 1234,
+    // the group, the mask and others.
+    let mut acl = 2u32.to_le_bytes().to_vec();
+    for (tag, perm, id) in [
+        (0x01u16, 6u16, u32::MAX),
+        (0x02, 4, 1234),
+        (0x04, 4, u32::MAX),
+        (0x10, 4, u32::MAX),
+        (0x20, 4, u32::MAX),
+    ] {
+        acl.extend(tag.to_le_bytes());
+        acl.extend(perm.to_le_bytes());
+        acl.extend(id.to_le_bytes());
+    }
+    let with_acl = xattr::set(&urdf, "system.posix_acl_access", &acl).is_ok();
+    if !with_acl {
+        eprintln!("the temp dir's file system takes no POSIX ACLs: the ACL is not checked here");
     }
     let ino = std::fs::metadata(&urdf).unwrap().ino();
     let out = run(&["fill", s(&urdf), "--density", "1000", "-i"]);
@@ -2588,6 +2696,15 @@ fn fill_in_place_keeps_extended_attributes() {
             .as_deref(),
         Some(&b"kept"[..])
     );
+    if with_acl {
+        assert_eq!(
+            xattr::get(&urdf, "system.posix_acl_access")
+                .unwrap()
+                .as_deref(),
+            Some(&acl[..]),
+            "the ACL naming user 1234 is kept"
+        );
+    }
 }
 
 /// Control characters from input are shown escaped in every text message: a link name holding
@@ -3038,4 +3155,206 @@ fn a_mesh_over_the_memory_budget_fails_its_link_and_the_run_goes_on() {
     let out = run(&["check", s(&d.join("b.urdf")), "--max-memory", "lots"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("--max-memory"), "{}", stderr(&out));
+}
+
+/// A package of every kind of file a run reads, in `d/pkg`: `package.xml`, a xacro robot that
+/// includes a macro file and loads YAML, two STL meshes found through `package://`, a density map
+/// and the `urdf-inertia.toml` that names it. The files' paths relative to `d/pkg`.
+fn package_of_every_input(d: &Path) -> Vec<&'static str> {
+    let pkg = d.join("pkg");
+    for sub in ["urdf", "meshes", "config"] {
+        std::fs::create_dir_all(pkg.join(sub)).unwrap();
+    }
+    let write = |name: &str, bytes: &[u8]| std::fs::write(pkg.join(name), bytes).unwrap();
+    write(
+        "package.xml",
+        b"<package format=\"3\"><name>pkg</name></package>\n",
+    );
+    write("config/sizes.yaml", b"box: 0.25\n");
+    write("urdf/arm.xacro", b"<robot xmlns:xacro=\"http://www.ros.org/wiki/xacro\">\n  <xacro:macro name=\"part\" params=\"name\">\n    <link name=\"${name}\">\n      <collision><geometry><mesh filename=\"package://pkg/meshes/${name}.stl\"/></geometry></collision>\n    </link>\n  </xacro:macro>\n</robot>\n");
+    write("urdf/robot.urdf.xacro", b"<robot name=\"r\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">\n  <xacro:include filename=\"arm.xacro\"/>\n  <xacro:property name=\"sizes\" value=\"${xacro.load_yaml('../config/sizes.yaml')}\"/>\n  <link name=\"base\">\n    <collision><geometry><box size=\"${sizes['box']} 1 1\"/></geometry></collision>\n  </link>\n  <xacro:part name=\"upper\"/>\n  <xacro:part name=\"lower\"/>\n</robot>\n");
+    for (name, size) in [("upper", [1.0, 2.0, 3.0]), ("lower", [0.5, 0.5, 0.5])] {
+        let (v, f) = common::box_mesh(size);
+        write(
+            &format!("meshes/{name}.stl"),
+            &urdf_inertia::mesh::stl::write_binary(name.as_bytes(), &v, &f),
+        );
+    }
+    write("densities.toml", b"default = 1000\n");
+    write("urdf-inertia.toml", b"density-map = \"densities.toml\"\n");
+    vec![
+        "package.xml",
+        "config/sizes.yaml",
+        "urdf/arm.xacro",
+        "urdf/robot.urdf.xacro",
+        "meshes/upper.stl",
+        "meshes/lower.stl",
+        "densities.toml",
+        "urdf-inertia.toml",
+    ]
+}
+
+/// Every file a run opens (URDF or xacro source, xacro includes and YAML, `package.xml`, meshes,
+/// the density map and the configuration) counts toward one budget of bytes per run,
+/// `--max-total-read` (or URDF_INERTIA_MAX_TOTAL_READ): with a budget of exactly the bytes read the
+/// run succeeds; one byte less, the file that would exceed it is named with the budget and how to raise
+/// it, and nothing is written. (A robot naming thousands of files, each within the one-file limit,
+/// once read without bound.)
+#[test]
+fn total_bytes_read_have_a_budget_per_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let files = package_of_every_input(tmp.path());
+    let pkg = tmp.path().join("pkg");
+    let size = |f: &str| std::fs::metadata(pkg.join(f)).unwrap().len();
+    // The top-level xacro file is read twice (once to tell a xacro from a URDF, then by the
+    // expander), so it counts twice; every other file once (the two meshes are distinct files).
+    let total: u64 = files.iter().map(|f| size(f)).sum::<u64>() + size("urdf/robot.urdf.xacro");
+    let fill = |budget: Option<u64>, env: Option<u64>| {
+        let mut c = bin();
+        c.args(["fill", "urdf/robot.urdf.xacro", "-o", "out.urdf"])
+            .current_dir(&pkg);
+        if let Some(b) = budget {
+            c.args(["--max-total-read", &b.to_string()]);
+        }
+        if let Some(e) = env {
+            c.env("URDF_INERTIA_MAX_TOTAL_READ", e.to_string());
+        }
+        run_or_kill(&mut c, 60)
+    };
+    let out = fill(Some(total), None);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let filled = std::fs::read_to_string(pkg.join("out.urdf")).unwrap();
+    assert_eq!(filled.matches("<inertial>").count(), 3, "{filled}");
+    // The box of 0.25 × 1 × 1 at 1000 kg/m³ (its size from the YAML): 250 kg.
+    assert!(filled.contains("<mass value=\"250\"/>"), "{filled}");
+    std::fs::remove_file(pkg.join("out.urdf")).unwrap();
+    for (flag, env) in [(Some(total - 1), None), (None, Some(total - 1))] {
+        let out = fill(flag, env);
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        let err = stderr(&out);
+        let line = err
+            .lines()
+            .find(|l| l.contains("over the budget of"))
+            .unwrap_or_else(|| panic!("no budget error in {err}"));
+        assert!(
+            line.contains(&format!(
+                "is over the budget of {} bytes read from all files together in this run",
+                total - 1
+            )) && line
+                .contains("raise it with --max-total-read SIZE or URDF_INERTIA_MAX_TOTAL_READ"),
+            "{line}"
+        );
+        assert!(
+            files
+                .iter()
+                .any(|f| line.contains(f.rsplit('/').next().unwrap())),
+            "names no file: {line}"
+        );
+        assert!(!pkg.join("out.urdf").exists(), "nothing written");
+    }
+    // Every command takes the flag, and a budget that is no size is an error.
+    for args in [
+        vec!["check", "urdf/robot.urdf.xacro"],
+        vec!["diff", "urdf/robot.urdf.xacro"],
+        vec!["xacro", "urdf/robot.urdf.xacro"],
+        vec!["mesh", "meshes/upper.stl"],
+    ] {
+        let out = bin()
+            .args(&args)
+            .args(["--max-total-read", "100"])
+            .current_dir(&pkg)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains("over the budget of 100 bytes"),
+            "{args:?}: {}",
+            stderr(&out)
+        );
+        let out = bin()
+            .args(&args)
+            .args(["--max-total-read", "lots"])
+            .current_dir(&pkg)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(
+            stderr(&out).contains("--max-total-read: `lots` is not a size"),
+            "{args:?}: {}",
+            stderr(&out)
+        );
+    }
+}
+
+/// Item 2 of the second campaign asked that *every* file the tool opens go through the regular-file
+/// guard, not only `package.xml`: a xacro include and a YAML file that are FIFOs (which would hang)
+/// or symlinks to `/dev/zero` (which never end), and a configuration or baseline file named on the
+/// command line that is one, are each an error naming the file.
+#[test]
+fn every_file_the_tool_opens_goes_through_the_input_guard() {
+    for (target, special) in [
+        ("urdf/arm.xacro", "fifo"),
+        ("urdf/arm.xacro", "zero"),
+        ("config/sizes.yaml", "fifo"),
+        ("config/sizes.yaml", "zero"),
+        ("densities.toml", "zero"),
+    ] {
+        let tmp = tempfile::tempdir().unwrap();
+        package_of_every_input(tmp.path());
+        let pkg = tmp.path().join("pkg");
+        let path = pkg.join(target);
+        std::fs::remove_file(&path).unwrap();
+        if special == "fifo" {
+            assert!(Command::new("mkfifo")
+                .arg(&path)
+                .status()
+                .unwrap()
+                .success());
+        } else {
+            std::os::unix::fs::symlink("/dev/zero", &path).unwrap();
+        }
+        // `xacro` reads no density map.
+        let commands: &[&str] = if target == "densities.toml" {
+            &["fill", "check"]
+        } else {
+            &["fill", "check", "xacro"]
+        };
+        for cmd in commands {
+            let out = run_or_kill(
+                bin()
+                    .args([*cmd, "urdf/robot.urdf.xacro"])
+                    .current_dir(&pkg),
+                60,
+            );
+            let err = stderr(&out);
+            assert_eq!(
+                out.status.code(),
+                Some(2),
+                "{target} {special} {cmd}: {err}"
+            );
+            let name = target.rsplit('/').next().unwrap();
+            assert!(
+                err.lines()
+                    .any(|l| l.contains(name) && l.contains("is not a regular file")),
+                "{target} {special} {cmd}: {err}"
+            );
+        }
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    package_of_every_input(tmp.path());
+    let pkg = tmp.path().join("pkg");
+    for args in [
+        vec!["check", "urdf/robot.urdf.xacro", "--config", "/dev/zero"],
+        vec!["check", "urdf/robot.urdf.xacro", "--baseline", "/dev/zero"],
+        vec!["mesh", "meshes/upper.stl", "--config", "/dev/zero"],
+        vec!["xacro", "urdf/robot.urdf.xacro", "--config", "/dev/zero"],
+    ] {
+        let out = run_or_kill(bin().args(&args).current_dir(&pkg), 60);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains("/dev/zero") && stderr(&out).contains("is not a regular file"),
+            "{args:?}: {}",
+            stderr(&out)
+        );
+    }
 }

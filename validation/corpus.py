@@ -285,7 +285,7 @@ def classify(pkg, urdf, message, pkgs, dom, mesh=None, link=None):
             axis = "xyz"[ext.index(0.0)]
             return "flat collision mesh (zero volume)", f"its vertices all lie in a plane: extent {ext[0]:.4g} × {ext[1]:.4g} × {ext[2]:.4g} m (zero along {axis})"
         return None, f"extent {ext}"
-    m = re.search(r"(\S+?\.(?:stl|obj|dae|glb|gltf)): UI108: mesh is", message, flags=re.I)
+    m = re.search(r"(\S+?\.(?:stl|obj|dae|glb|gltf)): mesh is .*defines no solid to trust", message, flags=re.I)
     if m:
         boundary, nonmanifold = mesh_edges(mesh or Path(m.group(1)))
         if boundary or nonmanifold:
@@ -482,7 +482,7 @@ def main():
                         r["loose_caps"].append((pkg.rel(path), scale, bound))
                 else:
                     r["rungs"]["error"] += 1
-                    raw = se.strip().removeprefix("error: ")
+                    raw = re.sub(r"^error(\[UI\d+\])?: ", "", se.strip())
                     msg = clean(raw, pkg)
                     defect, evidence = classify(pkg, path, raw, {}, (None, ""), mesh=path)
                     r["mesh_errors"].append({"mesh": pkg.rel(path), "scale": scale, "message": msg, "defect": defect,

@@ -60,7 +60,7 @@ def main():
     errors = []
     for robot, path, scale in meshes:
         proc = subprocess.run([args.binary, "mesh", str(path), "--scale", *map(str, scale), "--format", "json", "--digits", "full"], capture_output=True, text=True)
-        if proc.returncode != 0 and "UI108" in proc.stderr:
+        if proc.returncode != 0 and "error[UI108]" in proc.stderr:
             # An open mesh whose caps cannot be trusted defines no solid: by default an error with
             # its own code (the hull only when asked for), counted here as what it is.
             rungs_by_robot[robot]["no solid (UI108)"] += 1

@@ -100,6 +100,10 @@ isolated git -C "$repo" -c init.defaultBranch=main init --quiet
 cat >"$repo/densities.toml" <<'EOF'
 default = 1000.0
 EOF
+# The fill hook has no density arguments: it takes the density map named here, as the README says.
+cat >"$repo/urdf-inertia.toml" <<'EOF'
+density-map = "densities.toml"
+EOF
 cat >"$repo/urdf/robot.urdf.xacro" <<'EOF'
 <?xml version="1.0"?>
 <robot name="two_arms" xmlns:xacro="http://www.ros.org/wiki/xacro">

@@ -38,6 +38,12 @@ pub struct XacroArgs {
     /// Largest input file read: bytes or K/M/G; default 1G, or URDF_INERTIA_MAX_FILE_SIZE.
     #[arg(long, value_name = "SIZE")]
     pub max_file_size: Option<String>,
+    #[command(flatten)]
+    pub diagnostics: DiagnosticArgs,
+    /// Bytes read from all input files together in this run: bytes or K/M/G; default 16G, or
+    /// URDF_INERTIA_MAX_TOTAL_READ.
+    #[arg(long, value_name = "SIZE")]
+    pub max_total_read: Option<String>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
@@ -105,6 +111,10 @@ pub struct SourceArgs {
     /// URDF_INERTIA_MAX_FILE_SIZE environment variable.
     #[arg(long, value_name = "SIZE")]
     pub max_file_size: Option<String>,
+    /// Bytes read from all input files together in this run: bytes or K/M/G; default 16G, or
+    /// URDF_INERTIA_MAX_TOTAL_READ.
+    #[arg(long, value_name = "SIZE")]
+    pub max_total_read: Option<String>,
     /// Memory the meshes may take: bytes or K/M/G; default the machine's available memory
     /// (MemAvailable in /proc/meminfo). A mesh that would need more fails its links, named.
     #[arg(long, value_name = "SIZE")]
@@ -272,4 +282,10 @@ pub struct MeshArgs {
     /// Largest mesh file read: bytes or K/M/G; default 1G, or URDF_INERTIA_MAX_FILE_SIZE.
     #[arg(long, value_name = "SIZE")]
     pub max_file_size: Option<String>,
+    #[command(flatten)]
+    pub diagnostics: DiagnosticArgs,
+    /// Bytes read from all input files together in this run: bytes or K/M/G; default 16G, or
+    /// URDF_INERTIA_MAX_TOTAL_READ.
+    #[arg(long, value_name = "SIZE")]
+    pub max_total_read: Option<String>,
 }

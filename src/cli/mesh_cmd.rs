@@ -1,9 +1,12 @@
 //! `urdf-inertia mesh FILE`: the mass properties of one mesh, with its health.
 
 use super::args::{Format, MeshArgs};
+use super::policy::Policy;
 use super::ExitStatus;
 use serde_json::json;
+use urdf_inertia::diagnostic::{Code, Diagnostic, Severity};
 use urdf_inertia::text::{round_significant, shortest, within, Digits};
+use urdf_inertia::MeshErrorKind;
 use urdf_inertia::{LoadOptions, Solid};
 use urdf_inertia::{MassProperties, Principal};
 
@@ -15,6 +18,14 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
     if !options_valid(args) {
         return ExitStatus::Error;
     }
+    // The report is the mesh's whole health: its notes print too, unless --quiet.
+    let policy = match Policy::new(&args.diagnostics, true, Some(&args.file)) {
+        Ok((policy, _)) => policy,
+        Err(e) => {
+            errln!("error: {e}");
+            return ExitStatus::Error;
+        }
+    };
     let start = std::time::Instant::now();
     let options = LoadOptions::default()
         .strict(args.strict)
@@ -23,7 +34,11 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
     let solid = match urdf_inertia::load_solid(&args.file, scale, options) {
         Ok(s) => s,
         Err(e) => {
-            errln!("error: {e}");
+            // An open mesh with no solid to trust has a code of its own; reading errors have none.
+            match e.kind {
+                MeshErrorKind::NoSolid(_) => errln!("error[{}]: {e}", Code::MeshNoSolid),
+                _ => errln!("error: {e}"),
+            }
             return ExitStatus::Error;
         }
     };
@@ -38,16 +53,50 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
         errln!("error: {}: {why}", args.file.display());
         return ExitStatus::Error;
     }
-    if let Some(m) = urdf_inertia::millimetre_slip(&solid.vertices, scale) {
-        errln!("warning: {}: {m}", args.file.display());
+    let diagnostics = diagnostics(&solid, scale, &policy);
+    // Text shows what the policy shows (with --quiet, errors only); JSON carries them all.
+    let shown: Vec<Diagnostic> = diagnostics
+        .iter()
+        .filter(|d| policy.shows(d))
+        .cloned()
+        .collect();
+    for d in shown.iter().filter(|d| d.code == Code::MeshTooLarge) {
+        errln!("{}: {}: {}", d.head(), args.file.display(), d.message);
     }
     let out = rounded(args, &solid, volume, density, &mp);
     let elapsed = start.elapsed();
     match args.format {
-        Format::Json => print_json(args, scale, &solid, &out),
-        Format::Text => print_text(args, scale, &solid, &out, elapsed),
+        Format::Json => print_json(args, scale, &solid, &out, &diagnostics),
+        Format::Text => print_text(args, scale, &solid, &out, elapsed, &shown),
+    }
+    if diagnostics.iter().any(|d| d.severity == Severity::Error) {
+        // A warning made an error (--warn-as-error): the numbers are shown, the status says so.
+        errln!(
+            "error: {}: a warning was made an error (--warn-as-error)",
+            args.file.display()
+        );
+        return ExitStatus::Error;
     }
     ExitStatus::Success
+}
+
+/// The mesh's diagnostics as the policy has them, as `fill` has a part's: its health and a part
+/// over 10 m across (UI106), repairs whose bound is below `--note-below` as notes, then `--ignore`
+/// and `--warn-as-error`.
+fn diagnostics(solid: &Solid, scale: [f64; 3], policy: &Policy) -> Vec<Diagnostic> {
+    let mut ds = urdf_inertia::diagnostic::mesh_health(solid);
+    if let Some(m) = urdf_inertia::millimetre_slip(&solid.vertices, scale) {
+        ds.push(Diagnostic::new(Code::MeshTooLarge, m));
+    }
+    if solid.error_estimate < policy.note_below {
+        for d in &mut ds {
+            if matches!(d.code, Code::MeshRepaired | Code::MeshFacesDropped) {
+                d.severity = Severity::Note;
+            }
+        }
+    }
+    policy.apply_all(&mut ds);
+    ds
 }
 
 /// Whether `--density` and `--mass`, if given, are positive numbers (an error is printed if not).
@@ -113,14 +162,25 @@ fn rounded(
 }
 
 /// `--format json`: one object with the results, the solid's health and its diagnostics.
-fn print_json(args: &MeshArgs, scale: [f64; 3], solid: &Solid, out: &Rounded) {
+fn print_json(
+    args: &MeshArgs,
+    scale: [f64; 3],
+    solid: &Solid,
+    out: &Rounded,
+    diagnostics: &[Diagnostic],
+) {
     let Rounded {
         volume,
         density,
         ref mp,
         ref pr,
     } = *out;
-    let diagnostics = urdf_inertia::diagnostic::mesh_health(solid);
+    let of = |s: Severity| {
+        diagnostics
+            .iter()
+            .filter(|d| d.severity == s)
+            .collect::<Vec<_>>()
+    };
     let axes: Vec<Vec<f64>> = (0..3)
         .map(|c| (0..3).map(|r| pr.axes[r][c]).collect())
         .collect();
@@ -143,8 +203,9 @@ fn print_json(args: &MeshArgs, scale: [f64; 3], solid: &Solid, out: &Rounded) {
         "error_model": solid.error.model,
         "error_model_source": solid.error.source.name(),
         "error_center_of_mass": solid.error.com,
-        "warnings": diagnostics.iter().filter(|d| d.is_warning()).collect::<Vec<_>>(),
-        "notes": diagnostics.iter().filter(|d| !d.is_warning()).collect::<Vec<_>>(),
+        "errors": of(Severity::Error),
+        "warnings": of(Severity::Warning),
+        "notes": of(Severity::Note),
     });
     outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
 }
@@ -156,6 +217,7 @@ fn print_text(
     solid: &Solid,
     out: &Rounded,
     elapsed: std::time::Duration,
+    diagnostics: &[Diagnostic],
 ) {
     let Rounded {
         volume,
@@ -172,7 +234,7 @@ fn print_text(
     );
     outln!(
         "  health            {} ({} faces read; the solid has {} faces, {} vertices)",
-        solid.rung.name(),
+        urdf_inertia::diagnostic::Provenance::Mesh(solid.rung.clone()),
         solid.faces_read,
         solid.faces.len(),
         solid.vertices.len()
@@ -214,7 +276,7 @@ fn print_text(
         solid.error.describe()
     );
     outln!("  time              {:.3} ms", elapsed.as_secs_f64() * 1e3);
-    for d in urdf_inertia::diagnostic::mesh_health(solid) {
+    for d in diagnostics.iter().filter(|d| d.code != Code::MeshTooLarge) {
         outln!("  {}: {}", d.head(), d.message);
     }
 }

@@ -40,6 +40,10 @@ pub enum ExitStatus {
 /// The environment variable that sets the limit on one input file when `--max-file-size` is not given.
 const MAX_FILE_SIZE_ENV: &str = "URDF_INERTIA_MAX_FILE_SIZE";
 
+/// The environment variable that sets the run's budget of bytes read from all files together when
+/// `--max-total-read` is not given (default [`urdf_inertia::input::DEFAULT_MAX_TOTAL_READ`]).
+const MAX_TOTAL_READ_ENV: &str = "URDF_INERTIA_MAX_TOTAL_READ";
+
 /// The run's limit on one input file, decided once from the command line and the environment
 /// before any command starts; the library is handed it wherever it reads.
 static MAX_FILE_SIZE: std::sync::OnceLock<u64> = std::sync::OnceLock::new();
@@ -117,25 +121,44 @@ pub fn main() -> i32 {
         }
     };
     write::remove_temp_files_on_signal();
-    let max_size = match &args.command {
-        Command::Mesh(m) => m.max_file_size.clone(),
-        Command::Fill(f) => f.source.max_file_size.clone(),
-        Command::Diff(d) => d.source.max_file_size.clone(),
-        Command::Check(c) => c.source.max_file_size.clone(),
-        Command::Xacro(x) => x.max_file_size.clone(),
+    let (max_size, max_total) = match &args.command {
+        Command::Mesh(m) => (&m.max_file_size, &m.max_total_read),
+        Command::Fill(f) => (&f.source.max_file_size, &f.source.max_total_read),
+        Command::Diff(d) => (&d.source.max_file_size, &d.source.max_total_read),
+        Command::Check(c) => (&c.source.max_file_size, &c.source.max_total_read),
+        Command::Xacro(x) => (&x.max_file_size, &x.max_total_read),
     };
-    let from_env = std::env::var(MAX_FILE_SIZE_ENV).ok();
-    if let Some((what, s)) = max_size
-        .map(|s| ("--max-file-size", s))
-        .or(from_env.map(|s| (MAX_FILE_SIZE_ENV, s)))
-    {
-        match urdf_inertia::input::parse_size(&s) {
-            Ok(n) => {
-                let _ = MAX_FILE_SIZE.set(n);
-            }
-            Err(e) => {
-                errln!("error: {what}: {e}");
-                return ExitStatus::Error as i32;
+    // The library has no budget unless told; a run of the command has one.
+    urdf_inertia::input::set_max_total_read(urdf_inertia::input::DEFAULT_MAX_TOTAL_READ);
+    let set_file_size = |n: u64| {
+        let _ = MAX_FILE_SIZE.set(n);
+    };
+    for (flag, value, env, set) in [
+        (
+            "--max-file-size",
+            max_size,
+            MAX_FILE_SIZE_ENV,
+            &set_file_size as &dyn Fn(u64),
+        ),
+        (
+            "--max-total-read",
+            max_total,
+            MAX_TOTAL_READ_ENV,
+            &urdf_inertia::input::set_max_total_read,
+        ),
+    ] {
+        let from_env = std::env::var(env).ok();
+        if let Some((what, s)) = value
+            .clone()
+            .map(|s| (flag, s))
+            .or(from_env.map(|s| (env, s)))
+        {
+            match urdf_inertia::input::parse_size(&s) {
+                Ok(n) => set(n),
+                Err(e) => {
+                    errln!("error: {what}: {e}");
+                    return ExitStatus::Error as i32;
+                }
             }
         }
     }

@@ -131,7 +131,7 @@ fn sources_with_densities(
 ) -> Result<Sources, String> {
     let src = sources(s, settings)?;
     if src.map.is_none() {
-        return Err(format!("{command} needs densities: pass --density RHO (kg/m³), --density-map FILE, or --keep-mass"));
+        return Err(format!("{command} needs densities: pass --density RHO (kg/m³), --density-map FILE or --keep-mass, or set `density-map = \"FILE\"` in urdf-inertia.toml at the repository's root (the pre-commit hook reads it there)"));
     }
     Ok(src)
 }
@@ -689,29 +689,25 @@ fn write_robot(
 ) -> Result<(), ExitStatus> {
     let robot = &input.robot;
     let t_write = Instant::now();
+    let file = if w.in_place {
+        Some(robot.path.as_path())
+    } else {
+        w.target.as_deref()
+    };
+    let json_unwritten = || unwritten_summary(robot, report, w, policy, start, false);
     if promoted > 0 {
-        let run = run_diagnostics(robot, report);
-        let times = summary::Times {
-            seconds: start.elapsed().as_secs_f64(),
-            write: 0.0,
-            written: Some(0),
-        };
-        summary::fill_text(robot, report, &run, policy, times, w.several);
+        unwritten_summary(robot, report, w, policy, start, true);
         errln!(
             "error: {}: {promoted} warning(s) made errors by --warn-as-error (or warn-as-error in urdf-inertia.toml): nothing written",
             robot.path.display()
         );
         return Err(ExitStatus::Error);
     }
-    let file = if w.in_place {
-        Some(robot.path.as_path())
-    } else {
-        w.target.as_deref()
-    };
     let where_to = file.map_or_else(|| "stdout".to_string(), |p| p.display().to_string());
     let failed = report.error_count();
     let check_failed = || {
         if failed > 0 && !w.keep_going {
+            json_unwritten();
             errln!(
                 "error: {failed} link(s) could not be computed: nothing written to {where_to} (--keep-going writes the links that worked, and still exits 2)"
             );
@@ -755,11 +751,37 @@ fn write_robot(
     let mut run = run_diagnostics(robot, report);
     policy.apply_all(&mut run);
     if w.json && file.is_some() {
-        summary::fill_json(robot, report, &run, w.digits, times.seconds);
+        summary::fill_json(robot, report, &run, w.digits, times.seconds, true);
     } else {
         summary::fill_text(robot, report, &run, policy, times, w.several);
     }
     Ok(())
+}
+
+/// The summary when nothing is written: `--format json` prints its JSON (with the errors,
+/// `"written": false`) when the URDF was to go to a file; otherwise, with `text`, the text summary.
+fn unwritten_summary(
+    robot: &Robot,
+    report: &FillReport,
+    w: &WriteConfig,
+    policy: &Policy,
+    start: Instant,
+    text: bool,
+) {
+    let run = run_diagnostics(robot, report);
+    let seconds = start.elapsed().as_secs_f64();
+    if w.json && (w.in_place || w.target.is_some()) {
+        let mut run = run;
+        policy.apply_all(&mut run);
+        summary::fill_json(robot, report, &run, w.digits, seconds, false);
+    } else if text {
+        let times = summary::Times {
+            seconds,
+            write: 0.0,
+            written: Some(0),
+        };
+        summary::fill_text(robot, report, &run, policy, times, w.several);
+    }
 }
 
 /// `fill -i` on a xacro source: each computed `<inertial>` spliced into the file where its link is

@@ -356,13 +356,15 @@ fn errors_json(report: &FillReport) -> Vec<serde_json::Value> {
     links.chain(robot).collect()
 }
 
-/// The JSON summary of `fill` on stdout (the URDF went to a file).
+/// The JSON summary of `fill` on stdout (the URDF went to a file; `written` false when links failed
+/// without `--keep-going`, or a warning was made an error, so nothing was).
 pub fn fill_json(
     robot: &Robot,
     report: &FillReport,
     run: &[Diagnostic],
     digits: Digits,
     seconds: f64,
+    written: bool,
 ) {
     let mut notes: Vec<&Diagnostic> = robot.notes.iter().collect();
     notes.extend(run);
@@ -370,6 +372,7 @@ pub fn fill_json(
     let v = json!({
         "urdf": robot.path.display().to_string(),
         "robot": robot.name,
+        "written": written,
         "links_filled": report.links.len(),
         "links_without_geometry": report.without_geometry,
         "links_not_selected": report.not_selected,

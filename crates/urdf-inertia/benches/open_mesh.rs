@@ -6,6 +6,10 @@
 //! the raw mesh: welding, edges, caps or the hull, integration and the estimate, on one core. The
 //! hull of a sphere's vertices is the worst case for it: every vertex is a corner.
 //!
+//! The `shells_` rows are two shells in one open mesh: the cost of deciding that one lies inside the
+//! other (exact segment–triangle tests where their boxes overlap, one winding number each way), or
+//! of finding that they cut each other.
+//!
 //! `cargo bench --bench open_mesh`. The figures go to docs/benchmarks.md.
 
 // The allocator of the `urdf-inertia` binary (see the binary's src/main.rs), so that timings are the binary's.
@@ -63,7 +67,43 @@ fn bench(c: &mut Criterion) {
             });
         }
     }
+    // Shells classified by the winding number: a level-6 icosphere (20,480 faces) with one face
+    // removed (a planar hole: exact caps) around a second one at half the radius (doubly enclosed:
+    // dropped), or moved half a radius so that the two cut each other (bounded).
+    for (name, offset, radius) in [("nested", 0.0, 0.5), ("crossing", 0.5, 0.5)] {
+        let mesh = two_spheres(offset, radius);
+        let faces = mesh.faces.len();
+        g.bench_function(format!("shells_{name}_{faces}faces"), |b| {
+            b.iter(|| {
+                let s = health::make_solid(
+                    black_box(&mesh),
+                    Path::new("shells.stl"),
+                    HealthOptions::default(),
+                );
+                black_box(s.map(|s| s.unit.mass).ok())
+            });
+        });
+    }
     g.finish();
+}
+
+/// An icosphere of level 6 without its first face, and a second one scaled by `radius` and moved by
+/// `offset` along x.
+fn two_spheres(offset: f64, radius: f64) -> RawMesh {
+    let (v, f) = common::icosphere(6);
+    let n = v.len() as u32;
+    let mut vertices = v.clone();
+    vertices.extend(
+        v.iter()
+            .map(|p| [p[0] * radius + offset, p[1] * radius, p[2] * radius]),
+    );
+    let mut tris: Vec<[u32; 3]> = f[1..].to_vec();
+    tris.extend(f.iter().map(|t| t.map(|i| i + n)));
+    RawMesh {
+        vertices,
+        faces: Polygons::from_triangles(&tris),
+        ..RawMesh::default()
+    }
 }
 
 criterion_group!(benches, bench);

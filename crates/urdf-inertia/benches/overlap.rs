@@ -1,5 +1,5 @@
 //! The overlap estimate of one link made of N overlapping convex pieces, what a convex decomposition
-//! (V-HACD, CoACD) gives: 1, 10, 100 and 1000 pieces.
+//! (V-HACD, CoACD) gives: 1, 10, 100, 300 and 1000 pieces.
 //!
 //! `cargo bench --bench overlap`. Each piece is a 320-triangle convex mesh (an icosphere of level 3
 //! squashed into an ellipsoid of semi-axes 0.55 to 0.75, turned), placed on a unit lattice filled
@@ -83,10 +83,10 @@ fn estimate(c: &mut Criterion) {
         .expect("a thread pool");
     let mut group = c.benchmark_group("overlap");
     group.sample_size(10);
-    for (name, n) in [1usize, 10, 100, 1000]
+    for (name, n) in [1usize, 10, 100, 300, 1000]
         .map(|n| ("lattice", n))
         .into_iter()
-        .chain([10, 100, 1000].map(|n| ("cluster", n)))
+        .chain([10, 100, 300, 1000].map(|n| ("cluster", n)))
     {
         let parts = pieces(n, name == "cluster");
         // What the estimate says, once: the grid the cap gives and the bound that comes with it.

@@ -1,7 +1,9 @@
 //! ASCII STL against binary STL: the same generated torus (16 Ki to 1 Mi faces; 4 Mi with
 //! `URDF_INERTIA_BENCH_HUGE=1`) as binary records and as ASCII text written as CAD exporters write it
 //! (`%e` with 6 digits, two-space indents), read from a file to a welded mesh by [`stl::read`], on
-//! one thread and on two, reported as faces/s (ns per face = 1e9 / throughput).
+//! one thread and on two, reported as faces/s (ns per face = 1e9 / throughput). The peer:
+//! `mesh-loader` (one thread; it reads the whole file into memory, parses to f32 and does not weld)
+//! on the same two files.
 //!
 //! `cargo bench --bench stl`.
 
@@ -59,6 +61,18 @@ fn read(c: &mut Criterion) {
         std::fs::write(&binary, stl::write_binary(b"bench", &v, &f)).expect("write");
         std::fs::write(&ascii, exporter_ascii(&v, &f)).expect("write");
         group.throughput(Throughput::Elements(n as u64));
+        for (name, path) in [
+            ("mesh-loader binary", &binary),
+            ("mesh-loader ascii", &ascii),
+        ] {
+            let id = BenchmarkId::new(name, n);
+            group.bench_with_input(id, path, |b, path| {
+                b.iter(|| {
+                    let bytes = std::fs::read(black_box(path)).expect("read");
+                    mesh_loader::stl::from_slice(&bytes).map(|s| s.meshes[0].faces.len())
+                })
+            });
+        }
         for (threads, pool) in &pools {
             for (name, path) in [("binary", &binary), ("ascii", &ascii)] {
                 let id = BenchmarkId::new(format!("{name}, {threads} thread(s)"), n);

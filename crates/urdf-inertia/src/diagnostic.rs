@@ -404,9 +404,20 @@ impl Provenance {
     }
 }
 
+/// Plain words for people (messages, the summary, `mesh`'s health line); `name()` stays the short key
+/// for JSON and tables.
 impl fmt::Display for Provenance {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
+        f.write_str(match self {
+            Provenance::Primitive => "primitive shape",
+            Provenance::Mesh(Rung::Exact) => "closed mesh",
+            Provenance::Mesh(Rung::Welded { .. }) => "corners joined",
+            Provenance::Mesh(Rung::Reoriented { .. }) => "faces re-oriented",
+            Provenance::Mesh(Rung::Inverted) => "inside out",
+            Provenance::Mesh(Rung::Capped { .. }) => "holes capped",
+            Provenance::Mesh(Rung::NonManifold { .. }) => "non-manifold",
+            Provenance::Mesh(Rung::ConvexHull { .. }) => "replaced by its convex hull",
+        })
     }
 }
 

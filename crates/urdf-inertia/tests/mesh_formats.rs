@@ -268,7 +268,8 @@ fn broken_meshes_take_the_documented_rung() {
     let e = mesh::load_solid(&p, [1.0; 3], HealthOptions::default()).unwrap_err();
     assert!(matches!(e.kind, MeshErrorKind::NoSolid(_)), "{e}");
     assert!(
-        e.to_string().contains("UI108") && e.to_string().contains("--open-mesh hull"),
+        e.to_string().contains("defines no solid to trust")
+            && e.to_string().contains("--open-mesh hull"),
         "{e}"
     );
     let hull = HealthOptions {
@@ -609,4 +610,42 @@ fn chunked_parallel_weld_is_the_sequential_weld() {
             );
         }
     }
+}
+
+/// ASCII and binary STL of one mesh with f32 corners are one solid, to the bit: the ASCII text is
+/// each corner's shortest f64 decimal (what `write_ascii` writes), which parses back to the f32's
+/// value, and the binary reader widens the same f32. The torus spans more than one streamed piece
+/// and many parse chunks, so the ASCII reader's chunking, its cache of vertex lines and its
+/// cross-chunk weld are all on the path; its vertices are shared by six faces each.
+#[test]
+fn ascii_and_binary_stl_of_one_f32_mesh_give_bit_identical_mass_properties() {
+    let (v, f) = common::wild::torus(1.0, 0.4, 160, 80);
+    #[allow(clippy::cast_possible_truncation)] // The point: corners that are f32 values.
+    let v: Vec<[f64; 3]> = v
+        .iter()
+        .map(|p| p.map(|c| f64::from((0.1 * c + 0.2) as f32)))
+        .collect();
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let d = tmp.path();
+    let ascii = write_ascii(&v, &f);
+    assert!(ascii.len() > 4 << 20, "{} bytes", ascii.len());
+    let load = |p: &Path| {
+        mesh::load_solid(p, [1.0; 3], HealthOptions::default()).unwrap_or_else(|e| panic!("{e}"))
+    };
+    let a = load(&write(d, "torus_ascii.stl", ascii.as_bytes()));
+    let b = load(&write(
+        d,
+        "torus_binary.stl",
+        &write_binary(b"torus", &v, &f),
+    ));
+    let bits = |s: &urdf_inertia::mesh::health::Solid| {
+        let u = s.unit;
+        let mut out = vec![u.mass.to_bits()];
+        out.extend(u.com.map(f64::to_bits));
+        out.extend(u.inertia.iter().flatten().map(|x| x.to_bits()));
+        out
+    };
+    assert_eq!(bits(&a), bits(&b));
+    assert_eq!(a.faces_read, f.len());
+    assert_eq!(a.vertices, b.vertices);
 }

@@ -11,10 +11,12 @@ pub mod collada;
 pub mod gltf;
 pub mod health;
 pub mod hull;
+pub mod inside;
 pub mod obj;
 pub mod open;
 pub mod stl;
 pub mod weld;
+mod winding_shells;
 
 use crate::mass::Polygons;
 use std::borrow::Cow;

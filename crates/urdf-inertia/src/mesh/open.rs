@@ -53,7 +53,7 @@ impl std::fmt::Display for NoSolid {
         };
         write!(
             f,
-            "UI108: mesh is {}: {why}, so it defines no solid to trust; close the mesh, or choose a model for open meshes: `--open-mesh caps` (flat caps, with that bound) or `--open-mesh hull` (its convex hull, an upper bound)",
+            "mesh is {}: {why}, so it defines no solid to trust; close the mesh, or choose a model for open meshes: `--open-mesh caps` (flat caps, with that bound) or `--open-mesh hull` (its convex hull, an upper bound)",
             self.what
         )
     }

@@ -1,0 +1,526 @@
+//! Per-link composition (the paper's Problem 1): each link's collision parts, each with a density or a
+//! mass, as one body in the link frame.
+//!
+//! Work a robot does not need is left out: only links with collision geometry (and selected by
+//! `--only/--skip/--missing-only`) are computed, visual meshes are never read, each mesh file is read
+//! once and each (file, scale) healed and integrated once.
+
+use crate::density::{DensityMap, Spec};
+use crate::diagnostic::{
+    Code, Diagnostic, LinkError, LinkErrorKind, Location, Provenance, RobotError,
+};
+use crate::mass::{validity, MassProperties};
+pub use crate::mesh::cache::MeshCache;
+use crate::mesh::cache::Solids;
+use crate::mesh::health::{ErrorEstimate, HealthOptions, ROUND_OFF_FLOOR};
+use crate::overlap::{self, Overlap, PlacedPart};
+use crate::urdf::resolve::PackageResolver;
+use crate::urdf::{Geometry, Link, Robot};
+use std::path::PathBuf;
+use std::time::Duration;
+
+mod densities;
+mod parts;
+mod select;
+
+use densities::{body, densities, scale_to_total_mass};
+pub use parts::millimetre_slip;
+use parts::{diagonal, geometry_part, part_location, Part};
+use select::is_target;
+pub use select::{existing_props, selected, unresolved_meshes, unused_selection};
+
+/// What to compute.
+#[derive(Debug, Clone, Default)]
+#[non_exhaustive]
+pub struct FillOptions {
+    pub strict: bool,
+    /// What an open mesh whose caps cannot be trusted becomes (`--open-mesh`).
+    pub open_mesh: crate::mesh::open::OpenMeshModel,
+    /// `--only` / `--skip`: links selected by name, compiled once.
+    pub only: Vec<crate::density::Glob>,
+    pub skip: Vec<crate::density::Glob>,
+    /// Only links whose inertial is absent or invalid.
+    pub missing_only: bool,
+    /// Each link's existing `<mass>` is its mass target.
+    pub keep_mass: bool,
+    /// `--allow-large-parts`: a mesh over 10 m across is a warning, not its link's error.
+    pub allow_large_parts: bool,
+}
+
+/// One collision element's contribution.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct PartReport {
+    /// 1-based collision index in the link.
+    pub collision: usize,
+    /// `box 0.1 0.2 0.3`, or the mesh URI.
+    pub what: String,
+    pub file: Option<PathBuf>,
+    /// A primitive, or the mesh rung that produced the solid.
+    pub provenance: Provenance,
+    /// Warnings and notes about this part (mesh health, its reader, its size).
+    pub diagnostics: Vec<Diagnostic>,
+    pub faces: usize,
+    pub volume: f64,
+    pub mass: f64,
+    pub density: f64,
+    /// Where the density came from (`[meshes] "*battery*"`, `[links] base_link`, `default`, …).
+    pub density_source: String,
+    pub error_estimate: f64,
+    /// What the error estimate is made of (round-off, model error and its source).
+    pub error: ErrorEstimate,
+    /// Relative precision of the input's coordinates: 2⁻²⁴ for a mesh stored in f32 (binary STL,
+    /// glTF), 0 for one whose corners are known to every f64 bit (a primitive, most text formats).
+    pub input_precision: f64,
+}
+
+/// A link whose inertial was computed.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct LinkReport {
+    /// Index into `Robot::links`.
+    pub index: usize,
+    pub name: String,
+    pub line: usize,
+    pub computed: MassProperties,
+    pub parts: Vec<PartReport>,
+    /// Estimated volume counted more than once by overlapping parts (m³: their volumes less their
+    /// union's), which parts, and the sampling grid size.
+    pub overlap: Option<(f64, String, usize)>,
+    /// Diagonal of the link's collision geometry's bounding box (link frame), m.
+    pub size: f64,
+    /// Warnings and notes about the link as a whole (overlapping parts, an overridden mass rule).
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl PartReport {
+    /// The warnings (printed always).
+    pub fn warnings(&self) -> impl Iterator<Item = &Diagnostic> {
+        self.diagnostics.iter().filter(|d| d.is_warning())
+    }
+
+    /// The notes (printed with `--verbose`).
+    pub fn notes(&self) -> impl Iterator<Item = &Diagnostic> {
+        self.diagnostics.iter().filter(|d| !d.is_warning())
+    }
+}
+
+impl LinkReport {
+    /// The link's relative error bound: the largest of its parts' (the round-off floor at least).
+    pub fn error_estimate(&self) -> f64 {
+        self.parts
+            .iter()
+            .map(|p| p.error_estimate)
+            .fold(ROUND_OFF_FLOOR, f64::max)
+    }
+
+    /// What the splice writes for this link.
+    pub fn update(&self) -> crate::urdf::write::LinkUpdate {
+        crate::urdf::write::LinkUpdate {
+            index: self.index,
+            props: self.computed,
+            error: self.error_estimate(),
+            input_precision: self
+                .parts
+                .iter()
+                .map(|p| p.input_precision)
+                .fold(0.0, f64::max),
+            size: self.size,
+        }
+    }
+}
+
+/// Wall time per stage.
+#[derive(Debug, Clone, Copy, Default)]
+#[non_exhaustive]
+pub struct Timing {
+    pub load: Duration,
+    pub integrate: Duration,
+}
+
+impl FillReport {
+    /// Links that failed plus robot-wide errors: nonzero means the run failed.
+    pub fn error_count(&self) -> usize {
+        self.failures.len() + self.robot_errors.len()
+    }
+}
+
+/// Everything `fill`, `diff` and `check` need to report.
+#[derive(Debug, Clone, Default)]
+#[non_exhaustive]
+pub struct FillReport {
+    pub links: Vec<LinkReport>,
+    /// Links that could not be computed.
+    pub failures: Vec<LinkError>,
+    /// What stopped the robot as a whole (no density for some links, an unreachable `total_mass`).
+    pub robot_errors: Vec<RobotError>,
+    /// Links with no collision geometry (left as they are).
+    pub without_geometry: usize,
+    /// Links not selected (--only/--skip/--missing-only).
+    pub not_selected: usize,
+    /// Distinct mesh files the selected links use (read by this call, or before it with a shared
+    /// cache).
+    pub mesh_files: usize,
+    pub faces: usize,
+    pub timing: Timing,
+}
+
+/// What every stage of a robot's computation reads.
+struct Context<'a> {
+    robot: &'a Robot,
+    map: &'a DensityMap,
+    resolver: &'a PackageResolver,
+    opts: &'a FillOptions,
+}
+
+/// Computes every selected link with collision geometry.
+pub fn compute(
+    robot: &Robot,
+    map: &DensityMap,
+    resolver: &PackageResolver,
+    opts: &FillOptions,
+) -> FillReport {
+    compute_with(robot, map, resolver, opts, &mut MeshCache::default())
+}
+
+/// [`compute`] with a mesh cache shared across calls (several URDFs of one robot, or a whole corpus).
+/// The report's timings are this call's share (a mesh read before is not read again); its file count is
+/// the distinct mesh files the robot uses.
+///
+/// The stages: preload the meshes → each link's parts → their densities → the link's body → the
+/// overlap estimate → `total_mass` scaling → the overflow backstop.
+pub fn compute_with(
+    robot: &Robot,
+    map: &DensityMap,
+    resolver: &PackageResolver,
+    opts: &FillOptions,
+    cache: &mut MeshCache,
+) -> FillReport {
+    let (load0, integrate0) = (cache.load_time, cache.integrate_time);
+    let ctx = Context {
+        robot,
+        map,
+        resolver,
+        opts,
+    };
+    let mut report = FillReport::default();
+    let (mesh_files, results) = compute_links(&ctx, cache, &mut report);
+    let mut missing_density: Vec<(String, usize)> = Vec::new();
+    // Links whose mass follows from densities (scaled by total_mass), as indices into report.links.
+    let mut density_links: Vec<usize> = Vec::new();
+    for (link, result) in results {
+        match result {
+            Ok(Some((l, density_based))) => {
+                if density_based {
+                    density_links.push(report.links.len());
+                }
+                report.faces += l.faces;
+                report.links.push(l.report);
+            }
+            Ok(None) => missing_density.push((link.name.clone(), link.line)),
+            Err(e) => report.failures.push(e),
+        }
+    }
+    if !missing_density.is_empty() {
+        report.robot_errors.push(RobotError::MissingDensity {
+            links: missing_density,
+        });
+    }
+    if let Some(total) = map.total_mass {
+        scale_to_total_mass(&mut report, &density_links, total);
+    }
+    reject_unrepresentable(&mut report);
+    report.mesh_files = mesh_files;
+    // The cache's clocks only accumulate, so these never saturate.
+    report.timing = Timing {
+        load: cache.load_time.saturating_sub(load0),
+        integrate: cache.integrate_time.saturating_sub(integrate0),
+    };
+    report
+}
+
+/// A link's result: computed (with whether its mass follows from densities alone), without a density
+/// (`None`), or failed.
+type LinkResult = Result<Option<(ComputedLink, bool)>, LinkError>;
+
+/// Every selected link computed, in link order, and the number of distinct mesh files they use (read
+/// now or before); counts the links left alone into `report`. The meshes are read and healed in
+/// parallel, largest first, and each link is computed (its parts, densities, body and overlap
+/// estimate) as soon as its meshes are healed, on the same threads: a link waits only for its own
+/// meshes. A path that does not resolve is the link's error.
+fn compute_links<'r>(
+    ctx: &Context<'r>,
+    cache: &mut MeshCache,
+    report: &mut FillReport,
+) -> (usize, Vec<(&'r Link, LinkResult)>) {
+    let (robot, map, opts) = (ctx.robot, ctx.map, ctx.opts);
+    let mut targets = Vec::new();
+    for (li, link) in robot.links.iter().enumerate() {
+        // Links without collision geometry, or whose only parts are zero-size primitives, are left as
+        // they are (the scan notes the latter).
+        if !link.has_collision_geometry() {
+            report.without_geometry += 1;
+            continue;
+        }
+        if !is_target(link, opts) {
+            report.not_selected += 1;
+            continue;
+        }
+        targets.push((li, link));
+    }
+    let needs: Vec<Vec<(PathBuf, [f64; 3])>> = targets
+        .iter()
+        .map(|(_, link)| {
+            link.collisions
+                .iter()
+                .filter_map(|c| match &c.geometry {
+                    Geometry::Mesh { filename, scale } => ctx
+                        .resolver
+                        .resolve(filename, &robot.path)
+                        .ok()
+                        .map(|p| (p, *scale)),
+                    _ => None,
+                })
+                .collect()
+        })
+        .collect();
+    let files: std::collections::HashSet<&PathBuf> = needs.iter().flatten().map(|n| &n.0).collect();
+    let mesh_files = files.len();
+    let health = HealthOptions {
+        strict: opts.strict,
+        open_mesh: opts.open_mesh,
+    };
+    let results = cache.load_and_run(&needs, health, |t, solids| {
+        let (li, link) = targets[t];
+        link_parts(link, ctx, solids)
+            .and_then(|(parts, flat)| compute_link(li, link, parts, flat, map, opts))
+    });
+    let links = targets.iter().map(|(_, link)| *link).zip(results).collect();
+    (mesh_files, links)
+}
+
+/// A computed link and its face count.
+struct ComputedLink {
+    report: LinkReport,
+    faces: usize,
+}
+
+/// A link's parts (its collisions but the zero-size ones), or the first that fails; with the notes
+/// of the meshes that enclose no volume (a flat plate, a two-sided sheet), which contribute nothing
+/// as a zero-size primitive does (UI203). A link left with no part fails with the first such mesh's
+/// error: it has nothing to compute from.
+fn link_parts(
+    link: &Link,
+    ctx: &Context<'_>,
+    solids: &Solids<'_>,
+) -> Result<(Vec<Part>, Vec<Diagnostic>), LinkError> {
+    let mut parts = Vec::new();
+    let mut flat = Vec::new();
+    let mut first_flat = None;
+    for c in link
+        .collisions
+        .iter()
+        .filter(|c| !c.geometry.is_zero_size())
+    {
+        match geometry_part(link, c, ctx, solids) {
+            Ok(p) => parts.push(p),
+            Err(e) => {
+                let Some((path, volume, bbox)) = is_flat(&e) else {
+                    return Err(e);
+                };
+                let message = format!(
+                    "collision {}: {} encloses no volume ({} m³ against a bounding box of {} m³: a flat plate or a two-sided sheet); it contributes nothing, as a zero-size shape does",
+                    c.index,
+                    crate::text::escape_control(&path),
+                    crate::text::significant(volume, 4),
+                    crate::text::significant(bbox, 4)
+                );
+                let note = Diagnostic::new(Code::UrdfZeroVolume, message);
+                flat.push(note.at(part_location(link, c)));
+                first_flat.get_or_insert(e);
+            }
+        }
+    }
+    match first_flat {
+        Some(e) if parts.is_empty() => Err(e),
+        _ => Ok((parts, flat)),
+    }
+}
+
+/// The mesh (its path, volume and bounding-box volume) when a part failed only because its mesh
+/// encloses no volume (not because it is beyond f64's range: that is another error).
+fn is_flat(e: &LinkError) -> Option<(String, f64, f64)> {
+    match &*e.kind {
+        LinkErrorKind::Mesh(m) => match m.kind {
+            crate::mesh::MeshErrorKind::ZeroVolume {
+                volume,
+                bbox_volume,
+            } => Some((m.path.display().to_string(), volume, bbox_volume)),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// One link: its parts, their densities, the body, the overlap estimate. `Ok(None)` when the link has
+/// no density from anywhere (reported for all such links at once); the flag says whether the link's
+/// mass follows from densities alone (what `total_mass` scales).
+fn compute_link(
+    index: usize,
+    link: &Link,
+    mut parts: Vec<Part>,
+    flat: Vec<Diagnostic>,
+    map: &DensityMap,
+    opts: &FillOptions,
+) -> LinkResult {
+    let Some(densities) = densities(link, &parts, map, opts)? else {
+        return Ok(None);
+    };
+    let (computed, part_reports) = body(&parts, &densities);
+    let size = parts.iter().fold(
+        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+        |(lo, hi), p| {
+            (
+                [0, 1, 2].map(|k| lo[k].min(p.placed.bbox.0[k])),
+                [0, 1, 2].map(|k| hi[k].max(p.placed.bbox.1[k])),
+            )
+        },
+    );
+    let size = diagonal(size.0, size.1);
+    let mut diagnostics = densities.diagnostics;
+    if link.from_visual {
+        diagnostics.push(Diagnostic::new(
+            Code::VisualGeometryUsed,
+            "computed from its visual geometry (it has no collision geometry; --geometry collision,visual)",
+        ));
+    }
+    let (overlap, message) = overlap_estimate(&mut parts);
+    if let Some(message) = message {
+        diagnostics.push(Diagnostic::new(Code::PartsOverlap, message));
+    }
+    for d in &mut diagnostics {
+        d.location = Some(Location {
+            line: Some(link.line),
+            link: Some(link.name.clone()),
+            ..Location::default()
+        });
+    }
+    diagnostics.extend(flat);
+    let density_based = matches!(densities.link_spec, Some((_, Spec::Density(_))))
+        && densities.own.iter().all(Option::is_none);
+    let report = LinkReport {
+        index,
+        name: link.name.clone(),
+        line: link.line,
+        computed,
+        parts: part_reports,
+        overlap,
+        size,
+        diagnostics,
+    };
+    let faces = parts.iter().map(|p| p.faces).sum();
+    Ok(Some((ComputedLink { report, faces }, density_based)))
+}
+
+/// Why computed mass properties cannot be written, if they cannot: every check of
+/// [`validity::check`], plus finite principal axes (what `--principal` writes).
+pub fn unrepresentable(mp: &MassProperties) -> Option<String> {
+    let mut problems: Vec<String> = validity::check(mp, validity::DEFAULT_TOLERANCE)
+        .iter()
+        .map(ToString::to_string)
+        .collect();
+    let largest_moment = (0..3).fold(0.0f64, |a, k| a.max(mp.inertia[k][k].abs()));
+    if problems.is_empty() && (mp.mass < f64::MIN_POSITIVE || largest_moment < f64::MIN_POSITIVE) {
+        // Subnormal: representable, but with most of its digits gone.
+        problems.push(format!(
+            "mass {:e} kg and largest moment {largest_moment:e} kg·m² are below the smallest normal f64 ({:e})",
+            mp.mass,
+            f64::MIN_POSITIVE
+        ));
+    }
+    if problems.is_empty() {
+        let p = mp.principal();
+        if !p
+            .moments
+            .iter()
+            .chain(p.axes.iter().flatten())
+            .all(|x| x.is_finite())
+        {
+            problems.push("its principal axes are not finite".into());
+        }
+    }
+    (!problems.is_empty()).then(|| {
+        format!(
+            "overflow/underflow: the computed inertial is not usable ({}); sizes, positions, scales or densities this large or small are beyond f64",
+            problems.join("; ")
+        )
+    })
+}
+
+/// The backstop after composition: a link whose values overflowed or underflowed (mass `inf`, a NaN,
+/// an all-zero tensor) becomes that link's failure instead of being written.
+fn reject_unrepresentable(report: &mut FillReport) {
+    let links = std::mem::take(&mut report.links);
+    for l in links {
+        match unrepresentable(&l.computed) {
+            None => report.links.push(l),
+            Some(message) => report.failures.push(LinkError {
+                link: l.name,
+                line: l.line,
+                collision: None,
+                kind: Box::new(LinkErrorKind::Unrepresentable(message)),
+            }),
+        }
+    }
+}
+
+/// The volume the link's parts count more than once (their volumes less their union's, estimated by
+/// [`overlap::estimate`]), which parts and the grid, with the warning that says so; or only a warning
+/// when the estimate was skipped.
+fn overlap_estimate(parts: &mut [Part]) -> (Option<(f64, String, usize)>, Option<String>) {
+    let mut placed: Vec<PlacedPart> = parts.iter().map(|p| p.placed.clone()).collect();
+    let e = match crate::threads::install(|| overlap::estimate(&mut placed)) {
+        Overlap::None => return (None, None),
+        Overlap::Skipped(why) => {
+            return (
+                None,
+                Some(format!("the overlap of the parts was not estimated ({why}): any volume they share is counted more than once")),
+            )
+        }
+        Overlap::Estimated(e) => e,
+    };
+    let names: Vec<String> = e
+        .parts
+        .iter()
+        .map(|&i| parts[i].collision.to_string())
+        .collect();
+    let which = match names.len() {
+        0..=6 => match names.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+            _ => names.join(""),
+        },
+        n => format!("{} and {} others", names[..5].join(", "), n - 5),
+    };
+    let total: f64 = parts.iter().map(|p| p.unit.mass).sum();
+    let (v, n) = (e.excess, e.grid);
+    let how = if e.most <= 2 {
+        "is counted twice".to_string()
+    } else {
+        format!("is counted more than once (up to {} times)", e.most)
+    };
+    let capped = if e.capped {
+        format!(
+            " (coarser than {g}³: the work cap for this many overlapping parts; the bound widens with the grid)",
+            g = overlap::GRID
+        )
+    } else {
+        String::new()
+    };
+    let message = format!(
+        "parts {which} overlap: about {} m³ ({:.1}% of the link's volume) {how}; the parts' volumes less their union's, estimated on a {n}³ grid per part{capped}, within ±{} m³",
+        crate::text::significant(v, 4),
+        100.0 * v / total,
+        crate::text::significant(e.bound, 2),
+    );
+    (Some((v, which, n)), Some(message))
+}

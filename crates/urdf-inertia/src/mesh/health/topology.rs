@@ -1,0 +1,316 @@
+//! The edge structure of a welded mesh: boundary, manifold and non-manifold edges, the proof that a
+//! surface is closed and consistently wound, connected components (union-find) and a consistent
+//! orientation of each. Moved out of the ladder ([`super`]) as it is.
+
+use crate::mass::Polygons;
+
+/// Edge structure of a welded mesh.
+#[derive(Debug, Default)]
+pub(super) struct Edges {
+    pub(super) boundary: usize,
+    pub(super) nonmanifold: usize,
+    /// Pairs of faces sharing a manifold edge, and whether they traverse it the same way (inconsistent).
+    pub(super) pairs: Vec<(u32, u32, bool)>,
+    pub(super) inconsistent: usize,
+    /// Boundary edges as directed in their face.
+    pub(super) boundary_half_edges: Vec<(u32, u32)>,
+    /// Per-face component ids and their number, when [`closed_consistent`] proved the surface clean
+    /// (then `pairs` is empty: the components are all a clean surface needs of its topology).
+    pub(super) components: Option<(Vec<u32>, usize)>,
+    /// The face of each boundary edge.
+    pub(super) boundary_faces: Vec<u32>,
+}
+
+impl Edges {
+    /// Per-face component ids over manifold edges and their number.
+    pub(super) fn components(&mut self, nfaces: usize) -> (Vec<u32>, usize) {
+        self.components
+            .take()
+            .unwrap_or_else(|| components(nfaces, &self.pairs))
+    }
+
+    pub(super) fn closed(&self) -> bool {
+        self.boundary == 0 && self.nonmanifold == 0
+    }
+
+    pub(super) fn describe(&self) -> String {
+        if self.boundary > 0 && self.nonmanifold > 0 {
+            format!(
+                "open ({} boundary edges) and non-manifold ({} edges shared by 3+ faces)",
+                self.boundary, self.nonmanifold
+            )
+        } else if self.boundary > 0 {
+            format!("open ({} boundary edges)", self.boundary)
+        } else if self.nonmanifold > 0 {
+            format!(
+                "non-manifold ({} edges shared by 3+ faces)",
+                self.nonmanifold
+            )
+        } else {
+            "closed but not orientable".to_string()
+        }
+    }
+}
+
+/// The edge structure of `faces`. A closed, consistently wound surface (the common case) is proven so
+/// by [`closed_consistent`], which yields only the components; anything else gets the full analysis
+/// below (a sort of every half-edge by its undirected key), whose boundary edges come in key order.
+pub(super) fn edges(faces: &Polygons) -> Edges {
+    if let Some(components) = closed_consistent(faces) {
+        return Edges {
+            components: Some(components),
+            ..Edges::default()
+        };
+    }
+    edge_analysis(faces)
+}
+
+/// [`edges`] without the proof, for faces already known not to be a clean surface.
+pub(super) fn edge_analysis(faces: &Polygons) -> Edges {
+    let mut e = Edges::default();
+    for_each_edge(faces, |half: &[(u32, u32, bool)], lo: u32| match half {
+        [(hi, face, forward)] => {
+            e.boundary += 1;
+            e.boundary_faces.push(*face);
+            e.boundary_half_edges
+                .push(if *forward { (lo, *hi) } else { (*hi, lo) });
+        }
+        [(_, f, a), (_, g, b)] => {
+            let same = a == b;
+            if same {
+                e.inconsistent += 1;
+            }
+            e.pairs.push((*f, *g, same));
+        }
+        _ => e.nonmanifold += 1,
+    });
+    e
+}
+
+/// Calls `visit` for each undirected edge of `faces`, in order of its key (smaller vertex, larger
+/// vertex), with its half-edges as (larger vertex, face, whether the face runs from the smaller to
+/// the larger) and the smaller vertex. Half-edges are bucketed by their smaller vertex (a counting
+/// sort) and each bucket, a handful of entries, sorted by the larger one: linear, where a comparison
+/// sort of all (key, face) records took 24% of healing the 48 k-face borinot base.
+pub(super) fn for_each_edge(faces: &Polygons, mut visit: impl FnMut(&[(u32, u32, bool)], u32)) {
+    let n = faces.indices.iter().max().map_or(0, |&m| m as usize + 1);
+    let (start, mut rec) = grouped(n, |put| {
+        for (fi, face) in faces.iter().enumerate() {
+            for k in 0..face.len() {
+                let (u, v) = (face[k], face[(k + 1) % face.len()]);
+                put(u.min(v) as usize, (u.max(v), fi as u32, u < v));
+            }
+        }
+    });
+    for lo in 0..n {
+        let bucket = &mut rec[start[lo] as usize..start[lo + 1] as usize];
+        // Stable, so the half-edges of an edge keep their face order.
+        bucket.sort_by_key(|r| r.0);
+        for half in bucket.chunk_by(|a, b| a.0 == b.0) {
+            visit(half, lo as u32);
+        }
+    }
+}
+
+/// Items grouped by a key below `groups` (a counting sort), in the order `each` gives them within a
+/// group: key k's items are `items[starts[k]..starts[k + 1]]`. `each` hands every (key, item) to its
+/// argument; it is called twice, to count and then to place.
+pub(super) fn grouped<T: Copy + Default>(
+    groups: usize,
+    each: impl Fn(&mut dyn FnMut(usize, T)),
+) -> (Vec<u32>, Vec<T>) {
+    let mut starts = vec![0u32; groups + 1];
+    each(&mut |k, _| starts[k + 1] += 1);
+    for i in 0..groups {
+        starts[i + 1] += starts[i];
+    }
+    let mut fill = starts[..groups].to_vec();
+    let mut items = vec![T::default(); starts[groups] as usize];
+    each(&mut |k, t| {
+        let s = &mut fill[k];
+        items[*s as usize] = t;
+        *s += 1;
+    });
+    (starts, items)
+}
+
+/// The face components (as [`components`] numbers them) when every directed edge `u → v` of `faces`
+/// has exactly one twin `v → u` (then each undirected edge has one half-edge each way: closed,
+/// edge-manifold, consistently wound); `None` otherwise.
+///
+/// Half-edges are bucketed by their start vertex (a counting sort), each entry holding its end and its
+/// face, so a twin is found by scanning the handful of entries of its start: a few linear passes and
+/// no sort. Faces are joined as twins are found (union-find), so no list of face pairs is built.
+/// Measured on a 1.3 M-face sphere (callgrind): 503 → 329 instructions per face for the proof and the
+/// components together.
+pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
+    let idx = &faces.indices;
+    let n = *idx.iter().max()? as usize + 1;
+    let h = idx.len();
+    // Entries starting at vertex u, after the fill: `out[start[u]..start[u + 1]]`, with start[0] = 0.
+    let mut start = vec![0u32; n + 1];
+    for &u in idx {
+        start[u as usize + 1] += 1;
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    // Filling advances start[u] to where u's entries end, which is where u + 1's begin: after the
+    // fill, u's entries are `start[u - 1]..start[u]` (a shift instead of a second cursor array).
+    let mut out = vec![(0u32, 0u32); h];
+    let mut put = |u: u32, v: u32, f: u32| {
+        let s = &mut start[u as usize];
+        out[*s as usize] = (v, f);
+        *s += 1;
+    };
+    if faces.all_triangles() {
+        for (f, t) in idx.chunks_exact(3).enumerate() {
+            let f = f as u32;
+            put(t[0], t[1], f);
+            put(t[1], t[2], f);
+            put(t[2], t[0], f);
+        }
+    } else {
+        for (f, face) in faces.iter().enumerate() {
+            for k in 0..face.len() {
+                put(face[k], face[(k + 1) % face.len()], f as u32);
+            }
+        }
+    }
+    let bucket = |u: usize| {
+        let lo = if u == 0 { 0 } else { start[u - 1] as usize };
+        &out[lo..start[u] as usize]
+    };
+    let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
+    // Each half-edge u → v with u < v must be alone in u's list and find exactly one v → u; when
+    // those pairs account for every half-edge, no half-edge v → u is left without its twin.
+    let mut paired = 0usize;
+    for u in 0..n {
+        let mine = bucket(u);
+        for (i, &(v, f)) in mine.iter().enumerate() {
+            if v as usize <= u {
+                if v as usize == u {
+                    return None;
+                }
+                continue;
+            }
+            if mine[..i].iter().any(|e| e.0 == v) {
+                return None;
+            }
+            let mut twins = bucket(v as usize).iter().filter(|e| e.0 as usize == u);
+            let &(_, g) = twins.next()?;
+            if twins.next().is_some() {
+                return None;
+            }
+            union(&mut parent, f, g);
+            paired += 1;
+        }
+    }
+    (2 * paired == h).then(|| label(parent))
+}
+
+/// The root of `x` in a union-find forest, halving the path on the way.
+pub(super) fn root(parent: &mut [u32], mut x: u32) -> u32 {
+    while parent[x as usize] != x {
+        let up = parent[parent[x as usize] as usize];
+        parent[x as usize] = up;
+        x = up;
+    }
+    x
+}
+
+/// Joins the sets of `a` and `b`; the smaller root becomes the root.
+pub(super) fn union(parent: &mut [u32], a: u32, b: u32) {
+    let (ra, rb) = (root(parent, a), root(parent, b));
+    if ra != rb {
+        parent[ra.max(rb) as usize] = ra.min(rb);
+    }
+}
+
+/// Per-element set ids numbered by first appearance, and their number.
+pub(super) fn label(mut parent: Vec<u32>) -> (Vec<u32>, usize) {
+    // One set (the common case) needs no root walks: every id is 0.
+    let roots = parent
+        .iter()
+        .enumerate()
+        .filter(|&(i, &p)| p as usize == i)
+        .count();
+    if roots == 1 {
+        parent.fill(0);
+        return (parent, 1);
+    }
+    let mut id = vec![u32::MAX; parent.len()];
+    let mut comp = Vec::with_capacity(parent.len());
+    let mut n = 0u32;
+    for f in 0..parent.len() as u32 {
+        let r = root(&mut parent, f) as usize;
+        if id[r] == u32::MAX {
+            id[r] = n;
+            n += 1;
+        }
+        comp.push(id[r]);
+    }
+    (comp, n as usize)
+}
+
+/// A consistent orientation of each connected component (over manifold edges): per-face flips,
+/// component ids and the number of components; `None` when a component is not orientable.
+pub(super) struct Orientation {
+    pub(super) flip: Vec<bool>,
+    pub(super) comp: Vec<u32>,
+    pub(super) ncomp: usize,
+}
+
+/// The flips are forced within a component once its first face is fixed, and the component ids go
+/// by first face, so neither depends on the order of `pairs` or of the search.
+pub(super) fn orient(nfaces: usize, pairs: &[(u32, u32, bool)]) -> Option<Orientation> {
+    // Neighbours in one flat array (`adj[at[f]..at[f + 1]]`) instead of a Vec per face: the
+    // per-face allocations and frees took half of this function on the 48 k-face borinot base.
+    let (at, adj) = grouped(nfaces, |put| {
+        for &(a, b, same) in pairs {
+            put(a as usize, (b, same));
+            put(b as usize, (a, same));
+        }
+    });
+    let adj = |f: usize| &adj[at[f] as usize..at[f + 1] as usize];
+    let mut flip = vec![false; nfaces];
+    let mut comp = vec![u32::MAX; nfaces];
+    let mut ncomp = 0u32;
+    let mut stack = Vec::new();
+    for start in 0..nfaces {
+        if comp[start] != u32::MAX {
+            continue;
+        }
+        comp[start] = ncomp;
+        stack.push(start);
+        while let Some(f) = stack.pop() {
+            for &(g, same) in adj(f) {
+                // Same traversal direction on the shared edge: exactly one of the two must flip.
+                let want = flip[f] ^ same;
+                if comp[g as usize] == u32::MAX {
+                    comp[g as usize] = ncomp;
+                    flip[g as usize] = want;
+                    stack.push(g as usize);
+                } else if flip[g as usize] != want {
+                    return None;
+                }
+            }
+        }
+        ncomp += 1;
+    }
+    Some(Orientation {
+        flip,
+        comp,
+        ncomp: ncomp as usize,
+    })
+}
+
+/// Connected components of faces over manifold edges (union-find): per-face component ids and the
+/// number of components.
+pub(super) fn components(nfaces: usize, pairs: &[(u32, u32, bool)]) -> (Vec<u32>, usize) {
+    let mut parent: Vec<u32> = (0..nfaces as u32).collect();
+    for &(a, b, _) in pairs {
+        union(&mut parent, a, b);
+    }
+    label(parent)
+}

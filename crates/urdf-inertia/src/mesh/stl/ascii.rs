@@ -1,0 +1,569 @@
+//! ASCII STL, parsed in chunks cut at `facet` lines, in parallel, with the sequential parse's result.
+
+use super::Keyword;
+use crate::mass::Polygons;
+use crate::mesh::weld::VertexTable;
+use crate::mesh::{parse_f64, short_decimal, MeshError, MeshErrorKind, RawMesh};
+use std::io::Read as _;
+use std::path::Path;
+
+/// Parses ASCII STL held in memory; errors carry the line. The same reader as [`ascii_stream`]'s,
+/// fed the whole text at once.
+pub(super) fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
+    let mut reader = Ascii::new(path, ASCII_CHUNK);
+    reader.feed(bytes);
+    reader.finish()
+}
+
+/// Reads ASCII STL from `head` (the bytes already read) and then `source`, in pieces of `piece`
+/// bytes ([`ASCII_PIECE`]; chunks of `chunk`, [`ASCII_CHUNK`]): memory is the mesh and one piece (a
+/// line longer than a piece is held whole), not the file. The result, errors included, is
+/// [`ascii`]'s on the whole text.
+pub(super) fn ascii_stream(
+    head: Vec<u8>,
+    mut source: impl std::io::Read,
+    path: &Path,
+    piece: usize,
+    chunk: usize,
+) -> Result<RawMesh, MeshError> {
+    let mut reader = Ascii::new(path, chunk);
+    let mut buf = head;
+    loop {
+        // Top the piece up to its size (twice what is held when one line is longer).
+        let want = piece.max(2 * buf.len());
+        let before = buf.len();
+        (&mut source)
+            .take((want - before) as u64)
+            .read_to_end(&mut buf)
+            .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e.to_string())))?;
+        let end = buf.len() == before;
+        if end {
+            reader.feed(&buf);
+            return reader.finish();
+        }
+        // Whole lines only; the rest waits for the next piece.
+        let Some(cut) = memchr::memrchr(b'\n', &buf).map(|i| i + 1) else {
+            continue;
+        };
+        reader.feed(&buf[..cut]);
+        if reader.utf8.is_some() {
+            return reader.finish();
+        }
+        buf.drain(..cut);
+    }
+}
+
+/// Bytes of ASCII STL read at a time by [`ascii_stream`].
+pub(super) const ASCII_PIECE: usize = 4 << 20;
+
+/// Bytes of ASCII STL parsed as one chunk (in parallel, each welded on its own, as binary records).
+pub(super) const ASCII_CHUNK: usize = 512 << 10;
+
+/// What a line left for the next: inside `outer loop` … `endloop`, and the corners since `outer`.
+#[derive(Debug, Clone, Default, PartialEq)]
+struct AsciiState {
+    in_loop: bool,
+    current: Vec<u32>,
+}
+
+/// One chunk of whole lines parsed on its own: vertices welded within it in order of first
+/// appearance, faces as indices into them (plus `base`).
+struct AsciiChunk {
+    vertices: Vec<[f64; 3]>,
+    indices: Vec<u32>,
+    /// Corners of each face.
+    sizes: Vec<u32>,
+    /// Lines started in the chunk (its `\n`s, and one for a last line without one).
+    lines: usize,
+    end: AsciiState,
+    /// A `vertex` or `endloop` came before the chunk's first `outer`: the result depends on the
+    /// state the chunk started in.
+    dependent: bool,
+    /// An `outer` began a facet in the chunk.
+    outer: bool,
+    /// The first error: the line within the chunk (from 1) and what.
+    error: Option<(usize, MeshErrorKind)>,
+    /// Not UTF-8 from this byte of the chunk on.
+    utf8: Option<usize>,
+}
+
+/// Parses whole lines of ASCII STL starting in `start`, numbering new vertices from `base`.
+fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
+    let mut out = AsciiChunk {
+        vertices: Vec::new(),
+        indices: Vec::new(),
+        sizes: Vec::new(),
+        lines: 0,
+        end: AsciiState::default(),
+        dependent: false,
+        outer: false,
+        error: None,
+        utf8: None,
+    };
+    if let Err(e) = std::str::from_utf8(text) {
+        out.utf8 = Some(e.valid_up_to());
+        out.end = start;
+        return out;
+    }
+    // About 250 bytes a facet, half a new vertex a facet.
+    out.indices.reserve(text.len() / 80);
+    out.sizes.reserve(text.len() / 240);
+    let mut p = ChunkParse {
+        out,
+        table: VertexTable::with_capacity(text.len() / 400 + 16),
+        seen: SeenLines::with_capacity(text.len() / 400 + 16),
+        in_loop: start.in_loop,
+        current: start.current,
+        base,
+    };
+    let mut rest = text;
+    while !rest.is_empty() {
+        let (line, after) = match memchr::memchr(b'\n', rest) {
+            Some(i) => (&rest[..i], &rest[i + 1..]),
+            None => (rest, &rest[rest.len()..]),
+        };
+        rest = after;
+        p.out.lines += 1;
+        let mut words = AsciiWords { rest: line };
+        let Some(word) = words.next() else { continue };
+        if let Err(kind) = p.line(word, words) {
+            p.out.error = Some((p.out.lines, kind));
+            break;
+        }
+    }
+    let mut out = p.out;
+    out.vertices = p.table.into_vertices();
+    out.end = AsciiState {
+        in_loop: p.in_loop,
+        current: p.current,
+    };
+    out
+}
+
+/// A chunk being parsed: what it has produced, its welds, and the facet it is in.
+struct ChunkParse<'t> {
+    out: AsciiChunk,
+    table: VertexTable,
+    seen: SeenLines<'t>,
+    in_loop: bool,
+    /// The corners since `outer`.
+    current: Vec<u32>,
+    /// The number of the chunk's first new vertex.
+    base: u32,
+}
+
+impl<'t> ChunkParse<'t> {
+    /// One line, whose first word is `word` and the rest `words`.
+    #[inline]
+    fn line(&mut self, word: &[u8], words: AsciiWords<'t>) -> Result<(), MeshErrorKind> {
+        match Keyword::of(word) {
+            Keyword::Vertex => {
+                self.out.dependent |= !self.out.outer;
+                if !self.in_loop {
+                    return Err(MeshErrorKind::Syntax(
+                        "`vertex` outside `outer loop`".into(),
+                    ));
+                }
+                let index = self.vertex(words)?;
+                self.current.push(self.base + index);
+            }
+            Keyword::Outer => {
+                self.out.outer = true;
+                self.in_loop = true;
+                self.current.clear();
+            }
+            Keyword::EndLoop => {
+                self.out.dependent |= !self.out.outer;
+                self.in_loop = false;
+                if self.current.len() < 3 {
+                    return Err(MeshErrorKind::Syntax(format!(
+                        "a facet with {} vertices",
+                        self.current.len()
+                    )));
+                }
+                self.out.indices.extend_from_slice(&self.current);
+                self.out.sizes.push(self.current.len() as u32);
+            }
+            Keyword::Ignored => {}
+            Keyword::Other => {
+                return Err(MeshErrorKind::Syntax(format!(
+                    "unexpected `{}` in ASCII STL",
+                    String::from_utf8_lossy(word)
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The chunk's index of the vertex after `vertex`. The coordinates are a function of the line's
+    /// text after the keyword: a text seen before in the chunk is the vertex it gave then, unparsed
+    /// (each vertex of a closed mesh is written at its six or so corners).
+    #[inline]
+    fn vertex(&mut self, mut words: AsciiWords<'t>) -> Result<u32, MeshErrorKind> {
+        let key = words.rest;
+        if let Some(i) = self.seen.get(key) {
+            return Ok(i);
+        }
+        let i = self.table.insert(words.vertex()?);
+        self.seen.insert(key, i);
+        Ok(i)
+    }
+}
+
+/// The vertex lines of a chunk already parsed, by their text after `vertex`, and the vertex each
+/// gave: an open-addressing table of slices of the chunk's text (the text is the key, so a hit is
+/// exactly the vertex a parse would give, and a miss parses and welds as before).
+struct SeenLines<'t> {
+    lines: Vec<(&'t [u8], u32)>,
+    /// 0: empty; else `tag << 32 | (index into lines + 1)`.
+    slots: Vec<u64>,
+    /// 64 − log2(slots.len()): the slot is the top bits of the hash.
+    shift: u32,
+}
+
+impl<'t> SeenLines<'t> {
+    fn with_capacity(expected: usize) -> Self {
+        let size = (2 * expected).next_power_of_two().max(16);
+        SeenLines {
+            lines: Vec::with_capacity(expected),
+            slots: vec![0; size],
+            shift: 64 - size.trailing_zeros(),
+        }
+    }
+
+    /// Where `key` is (its vertex), or the empty slot where it would go; neither when the probe
+    /// runs past [`MAX_PROBES`] slots.
+    fn find(&self, key: &[u8], h: u64) -> (Option<usize>, Option<u32>) {
+        let tag = h << 32;
+        let mask = self.slots.len() - 1;
+        let mut s = (h >> self.shift) as usize;
+        for _ in 0..MAX_PROBES {
+            let slot = self.slots[s];
+            if slot == 0 {
+                return (Some(s), None);
+            }
+            if slot & 0xffff_ffff_0000_0000 == tag {
+                let (text, vertex) = self.lines[(slot as u32 - 1) as usize];
+                if text == key {
+                    return (Some(s), Some(vertex));
+                }
+            }
+            s = (s + 1) & mask;
+        }
+        (None, None)
+    }
+
+    fn get(&self, key: &[u8]) -> Option<u32> {
+        self.find(key, line_hash(key)).1
+    }
+
+    /// Records that `key` (not yet seen) gave `vertex`, unless its probe is too long: then the line
+    /// is simply parsed again wherever it comes back.
+    fn insert(&mut self, key: &'t [u8], vertex: u32) {
+        let h = line_hash(key);
+        let (Some(s), _) = self.find(key, h) else {
+            return;
+        };
+        self.lines.push((key, vertex));
+        self.slots[s] = (h << 32) | self.lines.len() as u64;
+        if 2 * self.lines.len() > self.slots.len() {
+            let size = 2 * self.slots.len();
+            self.slots = vec![0; size];
+            self.shift = 64 - size.trailing_zeros();
+            for (i, &(text, _)) in self.lines.iter().enumerate() {
+                let h = line_hash(text);
+                if let (Some(s), _) = self.find(text, h) {
+                    self.slots[s] = (h << 32) | (i as u64 + 1);
+                }
+            }
+        }
+    }
+}
+
+/// Slots a lookup in [`SeenLines`] probes at most: the table is at most half full, so an honest
+/// file's probes are a few slots; a file made for its hash to collide gets its lines parsed (as
+/// without the table) instead of a lookup that grows with the chunk.
+const MAX_PROBES: usize = 32;
+
+/// A hash of a line's bytes, eight at a time, every bit mixed into the top (the slot) and the
+/// bottom (the tag).
+fn line_hash(b: &[u8]) -> u64 {
+    const K: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut h = b.len() as u64;
+    let mut words = b.chunks_exact(8);
+    for c in &mut words {
+        let mut w = [0u8; 8];
+        w.copy_from_slice(c);
+        h = (h.rotate_left(23) ^ u64::from_le_bytes(w)).wrapping_mul(K);
+    }
+    let tail = words.remainder();
+    let mut w = [0u8; 8];
+    w[..tail.len()].copy_from_slice(tail);
+    h = (h.rotate_left(23) ^ u64::from_le_bytes(w)).wrapping_mul(K);
+    h ^= h >> 29;
+    h = h.wrapping_mul(K);
+    h ^ (h >> 32)
+}
+
+/// The words of an ASCII STL line: runs of bytes between ASCII whitespace (what
+/// `split_ascii_whitespace` gives).
+struct AsciiWords<'a> {
+    rest: &'a [u8],
+}
+
+impl<'a> Iterator for AsciiWords<'a> {
+    type Item = &'a [u8];
+
+    fn next(&mut self) -> Option<&'a [u8]> {
+        let start = self.rest.iter().position(|b| !b.is_ascii_whitespace())?;
+        let rest = &self.rest[start..];
+        let len = rest
+            .iter()
+            .position(|b| b.is_ascii_whitespace())
+            .unwrap_or(rest.len());
+        let (word, after) = rest.split_at(len);
+        self.rest = after;
+        Some(word)
+    }
+}
+
+impl AsciiWords<'_> {
+    /// The three coordinates after `vertex` (−0.0 folded into 0.0, so that both weld:
+    /// `RawMesh::welded`). A short decimal is scanned in place; any other word is cut out and
+    /// parsed as [`parse_f64`] parses it.
+    fn vertex(&mut self) -> Result<[f64; 3], MeshErrorKind> {
+        let mut p = [0.0; 3];
+        for c in p.iter_mut() {
+            let skip = self
+                .rest
+                .iter()
+                .position(|b| !b.is_ascii_whitespace())
+                .unwrap_or(self.rest.len());
+            self.rest = &self.rest[skip..];
+            let fast = short_decimal(self.rest)
+                .filter(|&(_, n)| self.rest.get(n).is_none_or(|b| b.is_ascii_whitespace()));
+            *c = match fast {
+                Some((x, n)) => {
+                    self.rest = &self.rest[n..];
+                    x
+                }
+                None => {
+                    let w = self.next().ok_or_else(|| {
+                        MeshErrorKind::Syntax("`vertex` needs three coordinates".into())
+                    })?;
+                    // The chunk is UTF-8 and `w` is cut at ASCII bytes, so `from_utf8` succeeds.
+                    let w = std::str::from_utf8(w).unwrap_or_default();
+                    parse_f64(w)
+                        .ok_or_else(|| MeshErrorKind::Syntax(format!("`{w}` is not a number")))?
+                }
+            };
+            if !c.is_finite() {
+                return Err(MeshErrorKind::NotFinite);
+            }
+            *c += 0.0;
+        }
+        Ok(p)
+    }
+}
+
+/// An ASCII STL reader fed whole lines (and at the end the last line, with or without its `\n`).
+///
+/// Each feed is cut into chunks of about [`ASCII_CHUNK`] bytes at lines that begin a `facet`,
+/// parsed and welded on their own in parallel (rayon), as if each began outside a facet; then the
+/// chunks are taken in order, and one whose start did matter (a `vertex` or `endloop` before its
+/// first `outer`, in a file with `facet` inside a loop) and did not hold is parsed again from the
+/// state the one before left. The chunks' vertices are welded across chunks at the end
+/// ([`crate::mesh::weld::join`]): the result is the one sequential parse's, bit for bit, for any thread
+/// count.
+pub(super) struct Ascii<'p> {
+    path: &'p Path,
+    /// Bytes a chunk: [`ASCII_CHUNK`], but for the tests.
+    chunk: usize,
+    vertices: Vec<[f64; 3]>,
+    indices: Vec<u32>,
+    starts: Vec<u32>,
+    state: AsciiState,
+    /// Lines before the next feed.
+    lines: usize,
+    /// Bytes before the next feed.
+    offset: usize,
+    /// The first syntax error: the line and what. Later text is only checked to be UTF-8 (that
+    /// error would be reported instead, as the whole-text reader checks it first).
+    error: Option<(usize, MeshErrorKind)>,
+    /// The first byte that is not UTF-8: reading stops.
+    utf8: Option<usize>,
+}
+
+impl<'p> Ascii<'p> {
+    pub(super) fn new(path: &'p Path, chunk: usize) -> Self {
+        Ascii {
+            path,
+            chunk: chunk.max(1),
+            vertices: Vec::new(),
+            indices: Vec::new(),
+            starts: vec![0],
+            state: AsciiState::default(),
+            lines: 0,
+            offset: 0,
+            error: None,
+            utf8: None,
+        }
+    }
+
+    pub(super) fn feed(&mut self, text: &[u8]) {
+        use rayon::prelude::*;
+        if self.utf8.is_some() {
+            return;
+        }
+        let offset = self.offset;
+        self.offset += text.len();
+        if self.error.is_some() {
+            if let Err(e) = std::str::from_utf8(text) {
+                self.utf8 = Some(offset + e.valid_up_to());
+            }
+            return;
+        }
+        let chunks = facet_chunks(text, self.chunk);
+        let parsed: Vec<AsciiChunk> = chunks
+            .par_iter()
+            .map(|c| ascii_chunk(c, AsciiState::default(), 0))
+            .collect();
+        let mut at = offset;
+        for (text, mut chunk) in chunks.iter().zip(parsed) {
+            let here = at;
+            at += text.len();
+            if self.error.is_none() {
+                if chunk.dependent && self.state != AsciiState::default() {
+                    let start = std::mem::take(&mut self.state);
+                    chunk = ascii_chunk(text, start, self.vertices.len() as u32);
+                } else {
+                    let base = self.vertices.len() as u32;
+                    chunk.indices.iter_mut().for_each(|i| *i += base);
+                    chunk.end.current.iter_mut().for_each(|i| *i += base);
+                }
+            }
+            if let Some(u) = chunk.utf8 {
+                self.utf8 = Some(here + u);
+                return;
+            }
+            if self.error.is_some() {
+                continue;
+            }
+            if let Some((line, kind)) = chunk.error {
+                self.error = Some((self.lines + line, kind));
+                continue;
+            }
+            self.vertices.extend_from_slice(&chunk.vertices);
+            let mut s = *self.starts.last().unwrap_or(&0);
+            for &n in &chunk.sizes {
+                s += n;
+                self.starts.push(s);
+            }
+            self.indices.extend_from_slice(&chunk.indices);
+            // A chunk that neither began a facet nor touched the state leaves it as it was.
+            if chunk.outer || chunk.dependent {
+                self.state = chunk.end;
+            }
+            self.lines += chunk.lines;
+        }
+    }
+
+    pub(super) fn finish(self) -> Result<RawMesh, MeshError> {
+        if let Some(at) = self.utf8 {
+            return Err(MeshError::new(
+                self.path,
+                None,
+                MeshErrorKind::Syntax(format!("ASCII STL is not valid UTF-8 at byte {at}")),
+            ));
+        }
+        if let Some((line, kind)) = self.error {
+            return Err(MeshError::new(self.path, Some(line), kind));
+        }
+        if self.state.in_loop {
+            return Err(MeshError::new(
+                self.path,
+                Some(self.lines),
+                MeshErrorKind::Truncated("ASCII STL ends inside a facet".into()),
+            ));
+        }
+        let mut indices = self.indices;
+        let vertices = crate::mesh::weld::join(self.vertices, &mut indices, None);
+        Ok(RawMesh {
+            vertices,
+            faces: Polygons {
+                indices,
+                starts: self.starts,
+            },
+            notes: Vec::new(),
+            warnings: Vec::new(),
+            welded: true,
+        })
+    }
+}
+
+/// `text` cut into chunks of about `size` bytes, each but the last ending with a `\n` before a line
+/// whose first word is `facet` (outside a facet, in a well-formed file), or (when none comes within
+/// 64 KiB) before any line.
+fn facet_chunks(text: &[u8], size: usize) -> Vec<&[u8]> {
+    let mut out = Vec::new();
+    let mut from = 0;
+    while text.len() - from > size {
+        let target = from + size;
+        let mut cut = None;
+        let mut first = None;
+        let mut at = target;
+        while let Some(i) = memchr::memchr(b'\n', &text[at..]) {
+            let next = at + i + 1;
+            first.get_or_insert(next);
+            let line = &text[next..];
+            let word = line
+                .iter()
+                .position(|&b| !matches!(b, b' ' | b'\t' | b'\r' | b'\x0c'))
+                .map_or(&line[line.len()..], |w| &line[w..]);
+            if word
+                .get(..5)
+                .is_some_and(|w| w.eq_ignore_ascii_case(b"facet"))
+                && word.get(5).is_none_or(|b| b.is_ascii_whitespace())
+            {
+                cut = Some(next);
+                break;
+            }
+            if next - target > 64 << 10 {
+                break;
+            }
+            at = next;
+        }
+        let Some(cut) = cut.or(first).filter(|&c| c < text.len()) else {
+            break;
+        };
+        out.push(&text[from..cut]);
+        from = cut;
+    }
+    out.push(&text[from..]);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every line recorded is found with its vertex through the table's growth, a line never
+    /// recorded is not, and texts that differ only in their last byte or their length are apart.
+    #[test]
+    fn seen_lines_give_back_what_was_recorded() {
+        let texts: Vec<String> = (0..20_000)
+            .map(|i| format!(" {}.000000e-01 2.5e+00 {}", i % 977, i / 977))
+            .collect();
+        let mut seen = SeenLines::with_capacity(4);
+        for (i, t) in texts.iter().enumerate() {
+            assert_eq!(seen.get(t.as_bytes()), None, "{t}");
+            seen.insert(t.as_bytes(), i as u32);
+        }
+        for (i, t) in texts.iter().enumerate() {
+            assert_eq!(seen.get(t.as_bytes()), Some(i as u32), "{t}");
+        }
+        assert_eq!(seen.get(b" 1.000000e-01 2.5e+00 1 "), None);
+        assert_eq!(seen.get(b" 1.000000e-01 2.5e+00 "), None);
+        assert_eq!(seen.get(b""), None);
+    }
+}

@@ -1,0 +1,347 @@
+//! The streaming readers against the whole-text reference reader they replaced.
+
+use super::ascii::Ascii;
+use super::*;
+use crate::mass::Polygons;
+use crate::mesh::parse_f64;
+use crate::mesh::weld::VertexTable;
+
+/// The ASCII reader as it was before it streamed, kept to check the streaming one against it.
+/// Parses ASCII STL; errors carry the line.
+fn ascii_reference(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        MeshError::new(
+            path,
+            None,
+            MeshErrorKind::Syntax(format!(
+                "ASCII STL is not valid UTF-8 at byte {}",
+                e.valid_up_to()
+            )),
+        )
+    })?;
+    let mut vertices = VertexTable::with_capacity(bytes.len() / 512 + 16);
+    let mut faces = Polygons::new();
+    let mut current: Vec<u32> = Vec::new();
+    let mut in_loop = false;
+    for (lineno, line) in text.lines().enumerate() {
+        let lineno = lineno + 1;
+        let mut words = line.split_ascii_whitespace();
+        let Some(word) = words.next() else { continue };
+        match Keyword::of(word.as_bytes()) {
+            Keyword::Vertex => {
+                if !in_loop {
+                    return Err(MeshError::new(
+                        path,
+                        Some(lineno),
+                        MeshErrorKind::Syntax("`vertex` outside `outer loop`".into()),
+                    ));
+                }
+                let p = ascii_vertex(words, lineno, path)?;
+                current.push(vertices.insert(p));
+            }
+            Keyword::Outer => {
+                in_loop = true;
+                current.clear();
+            }
+            Keyword::EndLoop => {
+                in_loop = false;
+                if current.len() < 3 {
+                    return Err(MeshError::new(
+                        path,
+                        Some(lineno),
+                        MeshErrorKind::Syntax(format!("a facet with {} vertices", current.len())),
+                    ));
+                }
+                faces.push(&current);
+            }
+            Keyword::Ignored => {}
+            Keyword::Other => {
+                return Err(MeshError::new(
+                    path,
+                    Some(lineno),
+                    MeshErrorKind::Syntax(format!("unexpected `{word}` in ASCII STL")),
+                ));
+            }
+        }
+    }
+    if in_loop {
+        return Err(MeshError::new(
+            path,
+            Some(text.lines().count()),
+            MeshErrorKind::Truncated("ASCII STL ends inside a facet".into()),
+        ));
+    }
+    Ok(RawMesh {
+        vertices: vertices.into_vertices(),
+        faces,
+        notes: Vec::new(),
+        warnings: Vec::new(),
+        welded: true,
+    })
+}
+
+/// The three coordinates after an ASCII STL `vertex` (for [`ascii_reference`]).
+fn ascii_vertex<'a>(
+    mut words: impl Iterator<Item = &'a str>,
+    lineno: usize,
+    path: &Path,
+) -> Result<[f64; 3], MeshError> {
+    let mut p = [0.0; 3];
+    for c in p.iter_mut() {
+        let w = words.next().ok_or_else(|| {
+            MeshError::new(
+                path,
+                Some(lineno),
+                MeshErrorKind::Syntax("`vertex` needs three coordinates".into()),
+            )
+        })?;
+        *c = parse_f64(w).ok_or_else(|| {
+            MeshError::new(
+                path,
+                Some(lineno),
+                MeshErrorKind::Syntax(format!("`{w}` is not a number")),
+            )
+        })?;
+        if !c.is_finite() {
+            return Err(MeshError::new(path, Some(lineno), MeshErrorKind::NotFinite));
+        }
+        // −0.0 folds into 0.0, so that both weld (`RawMesh::welded`).
+        *c += 0.0;
+    }
+    Ok(p)
+}
+
+/// A closed mesh of quads and triangles on a sphere-like grid, with coordinates of every sign
+/// (−0.0 included) and magnitudes from 1e-7 to 1e5.
+fn mesh() -> (Vec<[f64; 3]>, Vec<Vec<u32>>) {
+    let (n, m) = (9u32, 7u32);
+    let mut v = vec![[0.0, 0.0, 1.0], [-0.0, 0.0, -1.0]];
+    for j in 1..m {
+        for i in 0..n {
+            let (a, b) = (
+                std::f64::consts::TAU * f64::from(i) / f64::from(n),
+                std::f64::consts::PI * f64::from(j) / f64::from(m),
+            );
+            let r = [1e-7, 1.0, 3.5, 1e5][(i % 4) as usize];
+            v.push([r * b.sin() * a.cos(), r * b.sin() * a.sin(), b.cos()]);
+        }
+    }
+    let at = |i: u32, j: u32| 2 + (j - 1) * n + i % n;
+    let mut f = Vec::new();
+    for i in 0..n {
+        f.push(vec![0, at(i, 1), at(i + 1, 1)]);
+        f.push(vec![1, at(i + 1, m - 1), at(i, m - 1)]);
+        for j in 1..m - 1 {
+            if (i + j) % 3 == 0 {
+                f.push(vec![at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)]);
+            } else {
+                f.push(vec![at(i, j), at(i, j + 1), at(i + 1, j + 1)]);
+                f.push(vec![at(i, j), at(i + 1, j + 1), at(i + 1, j)]);
+            }
+        }
+    }
+    (v, f)
+}
+
+/// How a writer spells things: the number format, and the whitespace around lines and words.
+struct Style {
+    number: fn(f64) -> String,
+    indent: &'static str,
+    gap: &'static str,
+    eol: &'static str,
+    solid: &'static str,
+    end: &'static str,
+}
+
+fn write(style: &Style, v: &[[f64; 3]], f: &[Vec<u32>]) -> Vec<u8> {
+    let Style {
+        indent: ind,
+        gap: g,
+        eol,
+        ..
+    } = style;
+    let mut s = format!("{}{eol}", style.solid);
+    for face in f {
+        let _ = write!(
+            s,
+            "{ind}facet{g}normal{g}0{g}0{g}1{eol}{ind}{ind}outer{g}loop{eol}"
+        );
+        for &i in face {
+            let p = v[i as usize].map(style.number);
+            let _ = write!(
+                s,
+                "{ind}{ind}{ind}vertex{g}{}{g}{}{g}{}{eol}",
+                p[0], p[1], p[2]
+            );
+        }
+        let _ = write!(s, "{ind}{ind}endloop{eol}{ind}endfacet{eol}");
+    }
+    s += style.end;
+    s.into_bytes()
+}
+
+fn styles() -> Vec<Style> {
+    vec![
+        Style {
+            number: |x| format!("{x}"),
+            indent: "  ",
+            gap: " ",
+            eol: "\n",
+            solid: "solid fixture",
+            end: "endsolid fixture\n",
+        },
+        Style {
+            number: |x| format!("{x:.6e}"),
+            indent: "\t",
+            gap: "  ",
+            eol: "\r\n",
+            solid: "solid Part 1 (exported) ÄÖ",
+            end: "endsolid\r\n",
+        },
+        Style {
+            // C's %E: an uppercase exponent with a sign and two digits.
+            number: |x| {
+                let t = format!("{x:.8E}");
+                let (m, e) = t.split_once('E').unwrap_or((&t, "0"));
+                let e: i32 = e.parse().unwrap_or(0);
+                format!("{m}E{}{:02}", if e < 0 { '-' } else { '+' }, e.abs())
+            },
+            indent: "",
+            gap: " \t ",
+            eol: " \n\n",
+            solid: "  \n solid",
+            end: "endsolid  name with spaces",
+        },
+        Style {
+            number: |x| format!("{:+.17}", x),
+            indent: "    ",
+            gap: "\x0c ",
+            eol: "\r\n \r\n",
+            solid: "solid",
+            end: "",
+        },
+    ]
+}
+
+fn same(a: &Result<RawMesh, MeshError>, b: &Result<RawMesh, MeshError>, what: &str) {
+    match (a, b) {
+        (Ok(a), Ok(b)) => {
+            let bits = |m: &RawMesh| -> Vec<[u64; 3]> {
+                m.vertices.iter().map(|p| p.map(f64::to_bits)).collect()
+            };
+            assert_eq!(bits(a), bits(b), "{what}: vertices");
+            assert_eq!(a.faces.indices, b.faces.indices, "{what}: corners");
+            assert_eq!(a.faces.starts, b.faces.starts, "{what}: faces");
+            assert_eq!(
+                (&a.notes, &a.warnings, a.welded),
+                (&b.notes, &b.warnings, b.welded),
+                "{what}"
+            );
+        }
+        (Err(a), Err(b)) => assert_eq!(format!("{a:?}"), format!("{b:?}"), "{what}"),
+        (a, b) => panic!(
+            "{what}: {:?} against {:?}",
+            a.as_ref().err(),
+            b.as_ref().err()
+        ),
+    }
+}
+
+/// Every way in: in memory (one chunk, and tiny chunks), streamed in tiny pieces and chunks (lines
+/// longer than a piece, chunk borders everywhere), and through `read_split` as a file is read.
+fn check(bytes: &[u8], what: &str) {
+    let path = Path::new("t.stl");
+    let reference = ascii_reference(bytes, path);
+    same(&reference, &ascii(bytes, path), what);
+    for (piece, chunk) in [(7, 1), (64, 40), (300, 100), (1 << 20, 1000)] {
+        let mut tiny = Ascii::new(path, chunk);
+        tiny.feed(bytes);
+        same(
+            &reference,
+            &tiny.finish(),
+            &format!("{what}, chunks of {chunk}"),
+        );
+        let head = bytes[..bytes.len().min(5)].to_vec();
+        let streamed = ascii_stream(head, &bytes[bytes.len().min(5)..], path, piece, chunk);
+        same(
+            &reference,
+            &streamed,
+            &format!("{what}, pieces of {piece}, chunks of {chunk}"),
+        );
+    }
+    if looks_ascii(bytes) && is_text(&bytes[..bytes.len().min(4096)]) {
+        let read = read_split(bytes, bytes.len() as u64, path, CHUNK, None);
+        same(&reference, &read, &format!("{what}, read"));
+    }
+}
+
+/// The streaming reader gives the whole-text reader's vertices and faces bit for bit, on files
+/// written in several styles (exponents, CRLF, tabs and form feeds, blank lines, `solid` names,
+/// no final newline, quads), and on text spanning many chunks.
+#[test]
+fn streamed_ascii_is_the_whole_text_parse() {
+    let (v, f) = mesh();
+    for (k, style) in styles().iter().enumerate() {
+        let bytes = write(style, &v, &f);
+        check(&bytes, &format!("style {k}"));
+        assert!(ascii(&bytes, Path::new("t")).is_ok_and(|m| m.faces.len() == f.len()));
+    }
+    // Large enough for several default chunks, written as a common exporter writes.
+    let mut big_v = Vec::new();
+    let mut big_f = Vec::new();
+    for copy in 0..400u32 {
+        let base = big_v.len() as u32;
+        big_v.extend(v.iter().map(|p| [p[0] + f64::from(copy % 3), p[1], p[2]]));
+        big_f.extend(f.iter().map(|face| face.iter().map(|i| i + base).collect()));
+    }
+    let bytes = write(&styles()[1], &big_v, &big_f);
+    assert!(bytes.len() > 3 * ASCII_CHUNK, "{}", bytes.len());
+    check(&bytes, "big");
+    let m = ascii(&bytes, Path::new("t")).expect("parses");
+    // Copies 0 and 3 coincide: their corners weld across chunks.
+    assert_eq!(m.vertices.len(), 3 * v.len());
+}
+
+/// Files the reader accepts although they are odd, and files it refuses: the same faces, or the
+/// same error (line, message), as the whole-text reader, however the text is cut.
+#[test]
+fn streamed_ascii_errors_and_oddities_are_the_whole_text_parse() {
+    let facet = "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n";
+    let cases: Vec<(String, &str)> = vec![
+            (format!("solid a\n{facet}{facet}endsolid a\n"), "two facets"),
+            (String::new() + "solid", "no facets"),
+            ("solid x\n".to_string(), "no facets, newline"),
+            (
+                format!("solid a\nfacet\nouter loop\nvertex 0 0 0\nfacet normal 1 2 3\nvertex 1 0 0\nvertex 0 1 0\nendloop\n{facet}"),
+                "`facet` inside a loop",
+            ),
+            (format!("solid a\n{facet}endloop\nendloop\n{facet}"), "endloop repeated"),
+            (format!("solid a\n{facet}vertex 1 2 3 4 extra\n"), "vertex outside a loop"),
+            (format!("solid a\n{facet}outer\nvertex 1 2\n"), "two coordinates"),
+            (format!("solid a\n{facet}outer\nvertex 1 2 x3\n"), "not a number"),
+            (format!("solid a\n{facet}outer\nvertex 1 2 1e999\n"), "not finite"),
+            (format!("solid a\n{facet}outer\nvertex 1 2 3\nendloop\n"), "two vertices"),
+            (format!("solid a\n{facet}bogus line\n{facet}"), "unexpected word"),
+            (format!("solid a\n{facet}outer loop\nvertex 1 2 3\n"), "ends in a facet"),
+            (format!("solid a\n{facet}outer loop\nvertex 1 2 3"), "ends in a facet, no newline"),
+            (
+                format!("solid a\n{facet}outer loop\nvertex .5 5. -0 +1e+2\nvertex 0x1 0 0\n"),
+                "odd numbers",
+            ),
+            (
+                format!("solid a\n{facet}outer\nvertex 1 1 1\nvertex 0 1 1\nvertex 1 0 1\nvertex 0.5 0.5 0.5\nendloop\n"),
+                "a polygon",
+            ),
+        ];
+    for (text, what) in &cases {
+        check(text.as_bytes(), what);
+    }
+    // Not UTF-8: that error wins over a syntax error before it, as the whole text was checked first.
+    let mut bad = format!("solid a\n{facet}bogus\n{facet}").into_bytes();
+    bad.extend_from_slice(b"vertex \xff\n");
+    check(&bad, "syntax error, then not UTF-8");
+    let mut bad = format!("solid a\n{facet}").into_bytes();
+    bad.extend_from_slice(b"outer loop\nvertex 1 \xc3\n");
+    bad.extend_from_slice(facet.repeat(40).as_bytes());
+    check(&bad, "not UTF-8");
+}

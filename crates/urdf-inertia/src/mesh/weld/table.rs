@@ -1,0 +1,352 @@
+//! Bit-identical welding: the vertex table, and chunks welded on their own then joined.
+
+/// Distinct vertices keyed by their bit patterns: an open-addressing table of vertex indices (with a
+/// 32-bit tag of the hash beside each) over the vertex list itself, so a vertex is stored once and a
+/// lookup touches one 8-byte slot and, on a tag match, the vertex. Indices are given in order of first
+/// appearance, which makes the result independent of the table's size and growth.
+///
+/// It replaces a `FxHashMap<[u64; 3], u32>` (32-byte buckets and a second copy of every vertex): on a
+/// 1.3 M-face binary STL that map alone took 128 MiB, and its misses dominated the weld.
+#[derive(Debug, Clone, Default)]
+pub struct VertexTable {
+    pub(super) vertices: Vec<[f64; 3]>,
+    /// 0: empty; else `tag << 32 | (index + 1)`.
+    pub(super) slots: Vec<u64>,
+    /// 64 − log2(slots.len()): the slot is the top bits of the hash.
+    shift: u32,
+}
+
+impl VertexTable {
+    /// A table sized for about `expected` distinct vertices (it grows as needed).
+    pub fn with_capacity(expected: usize) -> Self {
+        let mut t = VertexTable {
+            vertices: Vec::with_capacity(expected),
+            slots: Vec::new(),
+            shift: 64,
+        };
+        t.resize((2 * expected).max(16).next_power_of_two());
+        t
+    }
+
+    fn resize(&mut self, size: usize) {
+        self.slots = vec![0; size];
+        self.shift = 64 - size.trailing_zeros();
+        let mask = size - 1;
+        for (i, v) in self.vertices.iter().enumerate() {
+            let h = hash(&v.map(f64::to_bits));
+            let mut s = (h >> self.shift) as usize;
+            while self.slots[s] != 0 {
+                s = (s + 1) & mask;
+            }
+            self.slots[s] = (h << 32) | (i as u64 + 1);
+        }
+    }
+
+    /// The index of the vertex with exactly the bits of `p`, added if new.
+    #[inline]
+    pub fn insert(&mut self, p: [f64; 3]) -> u32 {
+        let bits = p.map(f64::to_bits);
+        let h = hash(&bits);
+        let tag = h << 32;
+        let mask = self.slots.len() - 1;
+        let mut s = (h >> self.shift) as usize;
+        loop {
+            let slot = self.slots[s];
+            if slot == 0 {
+                break;
+            }
+            if slot & 0xffff_ffff_0000_0000 == tag {
+                let i = (slot as u32 - 1) as usize;
+                if self.vertices[i].map(f64::to_bits) == bits {
+                    return i as u32;
+                }
+            }
+            s = (s + 1) & mask;
+        }
+        let i = self.vertices.len();
+        self.vertices.push(p);
+        self.slots[s] = tag | (i as u64 + 1);
+        if 2 * self.vertices.len() > self.slots.len() {
+            self.resize(2 * self.slots.len());
+        }
+        i as u32
+    }
+
+    /// The distinct vertices, in order of first appearance.
+    pub fn into_vertices(self) -> Vec<[f64; 3]> {
+        self.vertices
+    }
+}
+
+/// Welds vertices that repeat across independently welded chunks: `vertices` are the chunks'
+/// distinct vertices one chunk after the other, `indices` point into them. Returns the distinct
+/// vertices in order of first appearance and rewrites `indices` to them: what one table fed the
+/// vertices in order gives, bit for bit.
+///
+/// One table over all vertices is what this replaces: once table and vertices outgrow the L3 cache
+/// its inserts are DRAM and TLB misses (figures: docs/benchmarks.md, "Figures behind choices in the
+/// code"). Here the vertices are first partitioned by the top bits of their hash into at most 256
+/// runs (8 bytes each: the hash's low half and the position), so each run is welded in its own
+/// small table (in parallel); a run keeps file order, so its first copy of a vertex is the first in
+/// the file. Numbers then follow in one pass in file order.
+///
+/// `runs` forces the number of runs (clamped to 1–256), for tests and the `stl_stream` fuzz target:
+/// the inputs they can afford have a few thousand vertices at most, one run by the choice here.
+pub fn join(vertices: Vec<[f64; 3]>, indices: &mut [u32], runs: Option<usize>) -> Vec<[f64; 3]> {
+    use rayon::prelude::*;
+    let n = vertices.len();
+    // About 2 Ki vertices a run; at most 256 runs, each written as one stream.
+    let runs = runs.map_or_else(
+        || (n / 2048).next_power_of_two().clamp(1, 256),
+        |r| r.clamp(1, 256),
+    );
+    let run_of = |h: u64| ((h >> 32) as usize * runs) >> 32;
+    let hashes: Vec<u64> = crate::threads::install(|| {
+        vertices
+            .par_iter()
+            .map(|v| hash(&v.map(f64::to_bits)))
+            .collect()
+    });
+    let mut starts = vec![0usize; runs + 1];
+    for &h in &hashes {
+        starts[run_of(h) + 1] += 1;
+    }
+    for r in 0..runs {
+        starts[r + 1] += starts[r];
+    }
+    let mut entries = vec![0u64; n];
+    let mut fill = starts.clone();
+    for (p, &h) in hashes.iter().enumerate() {
+        let r = run_of(h);
+        entries[fill[r]] = (h << 32) | p as u64;
+        fill[r] += 1;
+    }
+    drop(hashes);
+    let firsts: Vec<Vec<u32>> = crate::threads::install(|| {
+        (0..runs)
+            .into_par_iter()
+            .map(|r| first_copies(&entries[starts[r]..starts[r + 1]], &vertices))
+            .collect()
+    });
+    // Each vertex's first copy, in file order.
+    let mut first = vec![0u32; n];
+    for (&e, &f) in entries.iter().zip(firsts.iter().flatten()) {
+        first[e as u32 as usize] = f;
+    }
+    drop(entries);
+    // In place: a vertex's first copy comes no later than it, so `first[f]` already holds f's number
+    // and the distinct vertices move only towards the front.
+    let mut vertices = vertices;
+    let mut distinct = 0;
+    for p in 0..n {
+        let f = first[p] as usize;
+        first[p] = if f == p {
+            vertices[distinct] = vertices[p];
+            distinct += 1;
+            distinct as u32 - 1
+        } else {
+            first[f]
+        };
+    }
+    vertices.truncate(distinct);
+    for i in indices.iter_mut() {
+        *i = first[*i as usize];
+    }
+    vertices
+}
+
+/// For each entry of a run (the hash's low half above the position, in file order), the position of
+/// the first entry with the same vertex.
+fn first_copies(entries: &[u64], vertices: &[[f64; 3]]) -> Vec<u32> {
+    let size = (2 * entries.len()).max(16).next_power_of_two();
+    let mask = size - 1;
+    let mut slots = vec![u32::MAX; size];
+    let bits = |e: u64| vertices[e as u32 as usize].map(f64::to_bits);
+    entries
+        .iter()
+        .enumerate()
+        .map(|(i, &e)| {
+            // The hash's low half picks the slot (its top bits picked the run).
+            let mut s = (e >> 32) as usize & mask;
+            loop {
+                match slots[s] {
+                    u32::MAX => {
+                        slots[s] = i as u32;
+                        return e as u32;
+                    }
+                    j => {
+                        let f = entries[j as usize];
+                        if f >> 32 == e >> 32 && bits(f) == bits(e) {
+                            return f as u32;
+                        }
+                    }
+                }
+                s = (s + 1) & mask;
+            }
+        })
+        .collect()
+}
+
+/// Multiplicative hash of three coordinates' bits: the slot is its top bits and the tag its low half,
+/// both depending on every input bit.
+///
+/// A product's low bits depend only on its factors' low bits, and a coordinate's low bits are often
+/// all zero: binary STL's f32 values have 29 zero low bits as f64, an integer or a whole number of
+/// millimetres 40 and more. Each coordinate's high half (sign, exponent, leading mantissa) is
+/// therefore folded onto its low half before it is multiplied (a bijection, so no two keys are made
+/// equal). Without it, the low half (the tag, and `first_copies`' slot) of a 48³ grid of integer
+/// points took 16,266 distinct values for 110,592 points, and the weld turned quadratic (test
+/// `integer_and_millimetre_grids_hash_apart`).
+#[inline(always)]
+fn hash(b: &[u64; 3]) -> u64 {
+    const K: u64 = 0x9e37_79b9_7f4a_7c15;
+    let fold = |x: u64| x ^ (x >> 32);
+    let h = (fold(b[0]).wrapping_mul(K) ^ fold(b[1])).wrapping_mul(K) ^ fold(b[2]);
+    // Folding the high half down before the last product mixes every bit into the high half; a
+    // product's low bits still depend on the low bits alone, so the high half, well mixed, is folded
+    // onto the low half (the tag and `first_copies`' slot) after it.
+    let h = (h ^ (h >> 29)).wrapping_mul(K);
+    h ^ (h >> 32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mass::Polygons;
+    use crate::mesh::weld::exact;
+
+    #[test]
+    fn vertex_table_numbers_by_first_appearance_through_growth() {
+        let mut t = VertexTable::with_capacity(1);
+        let pts: Vec<[f64; 3]> = (0..1000)
+            .map(|i| [f64::from(i % 37), 0.5, -f64::from(i % 37)])
+            .collect();
+        let ids: Vec<u32> = pts.iter().map(|&p| t.insert(p)).collect();
+        assert!(ids.iter().enumerate().all(|(i, &id)| id == (i % 37) as u32));
+        // -0.0 and 0.0 are different bits to the table; `exact` folds them first.
+        assert_ne!(t.insert([-0.0, 0.5, 0.0]), t.insert([0.0, 0.5, 0.0]));
+        // The 37 distinct points and the two of the line above.
+        assert_eq!(t.into_vertices().len(), 39);
+        let w = exact(&[[-0.0, 0.0, 0.0], [0.0, 0.0, 0.0]], &Polygons::new());
+        assert_eq!(w.vertices, vec![[0.0, 0.0, 0.0]]);
+    }
+
+    /// Chunks welded on their own and then joined number every vertex as one weld of all corners in
+    /// order does: corners drawn from a small pool (so most repeat, within and across chunks), in
+    /// chunks of several sizes, from one run of entries to the most, and with run counts forced
+    /// (powers of two or not) on the smaller cases.
+    #[test]
+    fn joined_chunks_are_the_sequential_weld() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let pool: Vec<[f64; 3]> = (0..40_000)
+            .map(|_| [0; 3].map(|_| f64::from(crate::xorshift(&mut state) as u32 as f32) * 1e-6))
+            .collect();
+        let cases: [(usize, usize, &[Option<usize>]); 3] = [
+            (300, 7, &[None, Some(1), Some(3), Some(256)]),
+            (50_000, 1_000, &[None, Some(5), Some(256)]),
+            (1_500_000, 65_536, &[None]),
+        ];
+        for (corners, chunk, runs) in cases {
+            let picks: Vec<[f64; 3]> = (0..corners)
+                .map(|_| pool[(crate::xorshift(&mut state) % pool.len() as u64) as usize])
+                .collect();
+            let mut reference = VertexTable::with_capacity(16);
+            let want: Vec<u32> = picks.iter().map(|&p| reference.insert(p)).collect();
+            let bits = |v: &[[f64; 3]]| v.iter().map(|p| p.map(f64::to_bits)).collect::<Vec<_>>();
+            let reference = bits(&reference.into_vertices());
+            for &runs in runs {
+                let (mut vertices, mut indices) = (Vec::new(), Vec::new());
+                for c in picks.chunks(chunk) {
+                    let mut table = VertexTable::with_capacity(16);
+                    let local: Vec<u32> = c.iter().map(|&p| table.insert(p)).collect();
+                    let base = vertices.len() as u32;
+                    vertices.extend(table.into_vertices());
+                    indices.extend(local.iter().map(|&i| base + i));
+                }
+                let joined = join(vertices, &mut indices, runs);
+                let case = format!("{corners} corners in chunks of {chunk}, runs {runs:?}");
+                assert_eq!(indices, want, "{case}");
+                assert_eq!(bits(&joined), reference, "{case}");
+            }
+        }
+    }
+
+    /// Integer-grid and whole-millimetre coordinates (40 and more zero low bits) spread over the
+    /// slots as random keys do. Both halves of the hash are used: the top bits pick `VertexTable`'s
+    /// slot and `join`'s run, the low half is the tag and picks `first_copies`' slot. n keys thrown
+    /// into n slots fill 1 − 1/e ≈ 63.2% of them; these grids fill between 55% and 72% by either
+    /// half, every key has its own low half, and linear probing takes as few probes as random keys
+    /// (about 1.4 a key at a load of a half). Without the fold, a 48³ integer grid had 16,266
+    /// distinct low halves for its 110,592 points: tags matched falsely and `first_copies` probed
+    /// long runs, the quadratic weld.
+    #[test]
+    fn integer_and_millimetre_grids_hash_apart() {
+        let side = 64usize;
+        let bits = 18; // 2^18 = 64^3 slots
+        type Grid = (&'static str, fn(usize) -> f64);
+        let grids: [Grid; 5] = [
+            ("integers", |n| n as f64),
+            ("integers far out", |n| 1e6 + n as f64),
+            ("half units", |n| n as f64 * 0.5 - 16.0),
+            // Whole millimetres in a binary STL in metres: f32 values, 29 zero low bits as f64.
+            ("f32 millimetres", |n| f64::from(n as f32 * 0.001)),
+            ("f32 whole millimetres", |n| f64::from(n as f32 * 8.0)),
+        ];
+        for (name, c) in grids {
+            let mut points = Vec::with_capacity(side * side * side);
+            for i in 0..side {
+                for j in 0..side {
+                    for k in 0..side {
+                        points.push([c(i), c(j), c(k)]);
+                    }
+                }
+            }
+            let hashes: Vec<u64> = points.iter().map(|p| hash(&p.map(f64::to_bits))).collect();
+            let top = |h: u64, b: u32| (h >> (64 - b)) as usize;
+            let low = |h: u64, b: u32| (h as u32 as usize) & ((1 << b) - 1);
+            for (half, slot) in [("top", &top as &dyn Fn(u64, u32) -> usize), ("low", &low)] {
+                let mut seen = vec![false; 1 << bits];
+                for &h in &hashes {
+                    seen[slot(h, bits)] = true;
+                }
+                let filled = seen.iter().filter(|&&s| s).count() as f64 / points.len() as f64;
+                assert!(
+                    (0.55..0.72).contains(&filled),
+                    "{name}, {half} half: {filled}"
+                );
+                // Every insert's probes into a table at the weld's load (at most a half), against a
+                // generous bound of 4 a key.
+                let mut slots = vec![false; 1 << (bits + 1)];
+                let mask = slots.len() - 1;
+                let mut probes = 0usize;
+                for &h in &hashes {
+                    let mut s = slot(h, bits + 1);
+                    probes += 1;
+                    while slots[s] {
+                        s = (s + 1) & mask;
+                        probes += 1;
+                    }
+                    slots[s] = true;
+                }
+                assert!(
+                    probes < 4 * points.len(),
+                    "{name}, {half} half: {probes} probes"
+                );
+            }
+            let mut tags: Vec<u32> = hashes.iter().map(|&h| h as u32).collect();
+            tags.sort_unstable();
+            tags.dedup();
+            assert!(
+                tags.len() * 1000 >= points.len() * 999,
+                "{name}: {} tags",
+                tags.len()
+            );
+            // The weld's result is the distinct points in order, whatever the hash.
+            let mut table = VertexTable::with_capacity(16);
+            for p in &points {
+                table.insert(*p);
+            }
+            assert_eq!(table.into_vertices(), points, "{name}");
+        }
+    }
+}

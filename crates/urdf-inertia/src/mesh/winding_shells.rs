@@ -1,0 +1,414 @@
+//! Shells that overlap: which faces of a repaired surface bound its solid Ω = {x : |w(x)| ≥ ½}, w the
+//! winding number of the surface.
+//!
+//! Integrating every face gives ∫w, which counts a region enclosed by two shells twice (|w| = 2). A
+//! shell here is a connected component over edges that two faces share with opposite directions. For
+//! two closed shells that do not touch (exact segment–triangle tests with `orient3d`), one lies wholly
+//! inside the other or outside it, and the other's winding number on it is an integer that one point
+//! decides. Then w on the two sides of each shell is known exactly: w_out (the sum over the shells
+//! around it) and w_in = w_out ± 1. A shell bounds Ω only when exactly one side is 0: it counts once,
+//! outward when w_out = 0 (so an inside-out shell counts once) and inward when w_in = 0 (a cavity);
+//! when both sides are inside Ω (an internal wall, a doubly enclosed shell) it drops out.
+//!
+//! Pairs of shells that touch or cut each other, or that are open, are not decided: the region they
+//! can count twice lies in the intersection of their bounding boxes (a closed shell's winding number is
+//! 0 outside its box), whose volume enters the error estimate. A shell that passes through itself is
+//! beyond this module: its own ∫w is taken as its volume.
+
+use crate::geometry::{cross, dot, sub};
+use crate::mass::Polygons;
+use robust::{orient3d, Coord3D};
+use rustc_hash::FxHashMap;
+
+/// Pairs of shells with overlapping boxes beyond this many are not decided one by one: all are bounded.
+const MAX_PAIRS: usize = 20_000;
+
+/// Segment–triangle tests per pair of shells beyond which the pair is bounded, not decided.
+const MAX_TESTS: usize = 4_000_000;
+
+/// A shell with boundary edges (cracks left open) is classified like a closed one when its volume
+/// moves with the reference point by at most this share of itself; the move enters the bound.
+const NEARLY_CLOSED: f64 = 1e-3;
+
+/// A winding number this far from an integer is not trusted to decide nesting (a point too close to
+/// the other shell for f64 solid angles).
+const NOT_INTEGER: f64 = 0.1;
+
+/// What the shells' classification did to a surface.
+#[derive(Debug, Clone, Default)]
+pub struct ShellOutcome {
+    /// The faces that bound Ω, oriented so that their integral is its volume (as far as decided).
+    pub faces: Polygons,
+    /// Shells that dropped out (both sides inside Ω) and their faces.
+    pub dropped_shells: usize,
+    pub dropped_faces: usize,
+    /// Shells turned round (inside-out alone, or a cavity wound outward inside another).
+    pub turned_shells: usize,
+    /// Pairs of shells whose boxes overlap but that touch, cut each other or are open.
+    pub undecided_pairs: usize,
+    /// Bound on the volume those pairs can count twice or cancel, m³: their boxes' intersections.
+    pub overlap_bound: f64,
+    /// Whether anything changed (faces dropped or turned).
+    pub changed: bool,
+}
+
+/// One connected shell.
+struct Shell {
+    faces: Vec<u32>,
+    /// Closed, or so nearly closed (cracks) that its volume moves by at most [`NEARLY_CLOSED`] of
+    /// itself with the reference point; `motion` is then that move, m³.
+    closed: bool,
+    motion: f64,
+    /// Twice the vector area (Σ of the fans' cross products), zero for a closed shell.
+    area2: [f64; 3],
+    /// Six times the signed volume about the surface's box centre.
+    volume6: f64,
+    lo: [f64; 3],
+    hi: [f64; 3],
+}
+
+/// Classifies the shells of `faces` (see the module docs). A surface of one shell comes back as it is.
+pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
+    let shells = shells(vertices, faces);
+    let unchanged = |undecided_pairs, overlap_bound| ShellOutcome {
+        faces: faces.clone(),
+        undecided_pairs,
+        overlap_bound,
+        ..ShellOutcome::default()
+    };
+    if shells.len() < 2 {
+        return unchanged(0, 0.0);
+    }
+    let pairs = overlapping_pairs(&shells);
+    if pairs.len() > MAX_PAIRS {
+        let bound = pairs
+            .iter()
+            .map(|&(a, b)| box_overlap(&shells[a], &shells[b]))
+            .sum();
+        return unchanged(pairs.len(), bound);
+    }
+    let tris: Vec<Vec<[u32; 3]>> = shells.iter().map(|s| fan(faces, &s.faces)).collect();
+    // w_out per shell (the others' winding numbers on it), and whether every pair around it is decided.
+    let mut w_out = vec![0i64; shells.len()];
+    let mut decided = vec![true; shells.len()];
+    let mut undecided = Vec::new();
+    for &(a, b) in &pairs {
+        match nesting(vertices, &shells, &tris, a, b) {
+            Some((wa, wb)) => {
+                w_out[a] += wa;
+                w_out[b] += wb;
+            }
+            None => {
+                decided[a] = false;
+                decided[b] = false;
+                undecided.push((a, b));
+            }
+        }
+    }
+    let mut out = ShellOutcome {
+        undecided_pairs: undecided.len(),
+        ..ShellOutcome::default()
+    };
+    // A pair with an undecided side is bounded whatever the other side's classification.
+    for &(a, b) in &pairs {
+        if !decided[a] || !decided[b] {
+            out.overlap_bound += box_overlap(&shells[a], &shells[b]);
+        }
+    }
+    let mut keep = vec![true; faces.len()];
+    let mut turn = vec![false; faces.len()];
+    for (i, s) in shells.iter().enumerate() {
+        if !decided[i] || !s.closed || s.volume6 == 0.0 {
+            continue;
+        }
+        // A nearly closed shell's classification holds up to the volume its cracks leave undefined.
+        out.overlap_bound += s.motion;
+        let own = if s.volume6 > 0.0 { 1 } else { -1 };
+        let (outside, inside) = (w_out[i], w_out[i] + own);
+        let wanted_outward = match (outside == 0, inside == 0) {
+            (true, false) => true,
+            (false, true) => false,
+            _ => {
+                out.dropped_shells += 1;
+                out.dropped_faces += s.faces.len();
+                s.faces.iter().for_each(|&f| keep[f as usize] = false);
+                continue;
+            }
+        };
+        if wanted_outward != (own > 0) {
+            out.turned_shells += 1;
+            s.faces.iter().for_each(|&f| turn[f as usize] = true);
+        }
+    }
+    out.changed = out.dropped_shells > 0 || out.turned_shells > 0;
+    out.faces = rebuilt(faces, &keep, &turn);
+    out
+}
+
+/// The faces kept, those marked turned reversed.
+fn rebuilt(faces: &Polygons, keep: &[bool], turn: &[bool]) -> Polygons {
+    let mut out = Polygons::new();
+    for (i, face) in faces.iter().enumerate() {
+        if !keep[i] {
+            continue;
+        }
+        if turn[i] {
+            let mut r = face.to_vec();
+            r.reverse();
+            out.push(&r);
+        } else {
+            out.push(face);
+        }
+    }
+    out
+}
+
+/// Shells: components over edges that exactly two faces share with opposite directions; a shell is
+/// closed when every edge of its faces is such an edge.
+fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
+    let mut by_edge: FxHashMap<(u32, u32), Vec<(u32, bool)>> = FxHashMap::default();
+    for (i, face) in faces.iter().enumerate() {
+        for k in 0..face.len() {
+            let (u, v) = (face[k], face[(k + 1) % face.len()]);
+            let key = (u.min(v), u.max(v));
+            by_edge.entry(key).or_default().push((i as u32, u < v));
+        }
+    }
+    let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
+    let mut open_face = vec![false; faces.len()];
+    for users in by_edge.values() {
+        if users.len() == 2 && users[0].1 != users[1].1 {
+            let (a, b) = (root(&mut parent, users[0].0), root(&mut parent, users[1].0));
+            parent[a.max(b) as usize] = a.min(b);
+        } else {
+            users
+                .iter()
+                .for_each(|&(f, _)| open_face[f as usize] = true);
+        }
+    }
+    let centre = crate::mass::integrals::bounding_box_centre(vertices);
+    let mut index: FxHashMap<u32, usize> = FxHashMap::default();
+    let mut out: Vec<Shell> = Vec::new();
+    for (i, face) in faces.iter().enumerate() {
+        let r = root(&mut parent, i as u32);
+        let n = out.len();
+        let at = *index.entry(r).or_insert(n);
+        if at == n {
+            out.push(Shell {
+                faces: Vec::new(),
+                closed: true,
+                motion: 0.0,
+                area2: [0.0; 3],
+                volume6: 0.0,
+                lo: [f64::INFINITY; 3],
+                hi: [f64::NEG_INFINITY; 3],
+            });
+        }
+        let s = &mut out[at];
+        s.faces.push(i as u32);
+        s.closed &= !open_face[i];
+        let a = sub(vertices[face[0] as usize], centre);
+        for k in 1..face.len() - 1 {
+            let b = sub(vertices[face[k] as usize], centre);
+            let c = sub(vertices[face[k + 1] as usize], centre);
+            s.volume6 += dot(a, cross(b, c));
+            let n = cross(sub(b, a), sub(c, a));
+            (0..3).for_each(|j| s.area2[j] += n[j]);
+        }
+        for &v in face {
+            for k in 0..3 {
+                s.lo[k] = s.lo[k].min(vertices[v as usize][k]);
+                s.hi[k] = s.hi[k].max(vertices[v as usize][k]);
+            }
+        }
+    }
+    for s in &mut out {
+        if !s.closed {
+            let diag = dot(sub(s.hi, s.lo), sub(s.hi, s.lo)).sqrt();
+            s.motion = dot(s.area2, s.area2).sqrt() / 2.0 * diag / 6.0;
+            s.closed = s.motion <= NEARLY_CLOSED * s.volume6.abs() / 6.0;
+        }
+    }
+    out
+}
+
+fn root(parent: &mut [u32], mut x: u32) -> u32 {
+    while parent[x as usize] != x {
+        let up = parent[parent[x as usize] as usize];
+        parent[x as usize] = up;
+        x = up;
+    }
+    x
+}
+
+/// Pairs of shells whose boxes overlap in a region of positive volume (sweep along x).
+fn overlapping_pairs(shells: &[Shell]) -> Vec<(usize, usize)> {
+    let mut order: Vec<usize> = (0..shells.len()).collect();
+    order.sort_by(|&a, &b| shells[a].lo[0].total_cmp(&shells[b].lo[0]));
+    let mut pairs = Vec::new();
+    for (i, &a) in order.iter().enumerate() {
+        for &b in &order[i + 1..] {
+            if shells[b].lo[0] >= shells[a].hi[0] {
+                break;
+            }
+            if box_overlap(&shells[a], &shells[b]) > 0.0 {
+                pairs.push((a.min(b), a.max(b)));
+            }
+            if pairs.len() > MAX_PAIRS {
+                return pairs;
+            }
+        }
+    }
+    pairs
+}
+
+/// A bound on the volume two shells can both enclose: the intersection of their boxes, and for closed
+/// shells also the smaller one's volume.
+fn box_overlap(a: &Shell, b: &Shell) -> f64 {
+    let boxes: f64 = (0..3)
+        .map(|k| (a.hi[k].min(b.hi[k]) - a.lo[k].max(b.lo[k])).max(0.0))
+        .product();
+    if a.closed && b.closed {
+        boxes.min(a.volume6.abs().min(b.volume6.abs()) / 6.0)
+    } else {
+        boxes
+    }
+}
+
+/// Triangles of the given faces (fans).
+fn fan(faces: &Polygons, which: &[u32]) -> Vec<[u32; 3]> {
+    let mut out = Vec::new();
+    for &f in which {
+        let face = faces.face(f as usize);
+        for k in 1..face.len() - 1 {
+            out.push([face[0], face[k], face[k + 1]]);
+        }
+    }
+    out
+}
+
+/// For two closed shells that do not touch: the winding number of `b` on `a` and of `a` on `b`.
+/// `None` when either is open, they touch or cut each other, or the test is too large.
+fn nesting(
+    vertices: &[[f64; 3]],
+    shells: &[Shell],
+    tris: &[Vec<[u32; 3]>],
+    a: usize,
+    b: usize,
+) -> Option<(i64, i64)> {
+    let (sa, sb) = (&shells[a], &shells[b]);
+    if !sa.closed || !sb.closed {
+        return None;
+    }
+    let lo: [f64; 3] = std::array::from_fn(|k| sa.lo[k].max(sb.lo[k]));
+    let hi: [f64; 3] = std::array::from_fn(|k| sa.hi[k].min(sb.hi[k]));
+    let near = |t: &[u32; 3]| {
+        (0..3).all(|k| {
+            let (tl, th) = t
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+                    (
+                        l.min(vertices[v as usize][k]),
+                        h.max(vertices[v as usize][k]),
+                    )
+                });
+            tl <= hi[k] && th >= lo[k]
+        })
+    };
+    let ta: Vec<[u32; 3]> = tris[a].iter().filter(|t| near(t)).copied().collect();
+    let tb: Vec<[u32; 3]> = tris[b].iter().filter(|t| near(t)).copied().collect();
+    if ta.len().saturating_mul(tb.len()) > MAX_TESTS {
+        return None;
+    }
+    if ta
+        .iter()
+        .any(|x| tb.iter().any(|y| triangles_touch(vertices, x, y)))
+    {
+        return None;
+    }
+    let wa = integer(winding(
+        vertices,
+        &tris[b],
+        vertices[tris[a][0][0] as usize],
+    ))?;
+    let wb = integer(winding(
+        vertices,
+        &tris[a],
+        vertices[tris[b][0][0] as usize],
+    ))?;
+    Some((wa, wb))
+}
+
+fn integer(w: f64) -> Option<i64> {
+    let r = w.round();
+    ((w - r).abs() <= NOT_INTEGER).then_some(r as i64)
+}
+
+fn c3(p: [f64; 3]) -> Coord3D<f64> {
+    Coord3D {
+        x: p[0],
+        y: p[1],
+        z: p[2],
+    }
+}
+
+/// Whether two triangles may touch: exact, and conservative for coplanar ones (any coplanar pair
+/// whose boxes meet counts as touching). Non-coplanar triangles meet only where an edge of one
+/// crosses the other.
+fn triangles_touch(v: &[[f64; 3]], x: &[u32; 3], y: &[u32; 3]) -> bool {
+    let p = |t: &[u32; 3]| t.map(|i| v[i as usize]);
+    let (px, py) = (p(x), p(y));
+    let boxes_meet = (0..3).all(|k| {
+        let (xl, xh) = px
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
+                (l.min(q[k]), h.max(q[k]))
+            });
+        let (yl, yh) = py
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
+                (l.min(q[k]), h.max(q[k]))
+            });
+        xl <= yh && yl <= xh
+    });
+    if !boxes_meet {
+        return false;
+    }
+    let edges = |t: [[f64; 3]; 3]| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])];
+    edges(px).iter().any(|&(s, e)| segment_meets(s, e, py))
+        || edges(py).iter().any(|&(s, e)| segment_meets(s, e, px))
+}
+
+/// Whether the closed segment `s e` meets the closed triangle `t` (coplanar: yes, conservatively).
+fn segment_meets(s: [f64; 3], e: [f64; 3], t: [[f64; 3]; 3]) -> bool {
+    let (a, b, c) = (c3(t[0]), c3(t[1]), c3(t[2]));
+    let (o1, o2) = (orient3d(a, b, c, c3(s)), orient3d(a, b, c, c3(e)));
+    if (o1 > 0.0 && o2 > 0.0) || (o1 < 0.0 && o2 < 0.0) {
+        return false;
+    }
+    if o1 == 0.0 && o2 == 0.0 {
+        return true;
+    }
+    let (cs, ce) = (c3(s), c3(e));
+    let q = [
+        orient3d(cs, ce, a, b),
+        orient3d(cs, ce, b, c),
+        orient3d(cs, ce, c, a),
+    ];
+    !(q.iter().any(|x| *x > 0.0) && q.iter().any(|x| *x < 0.0))
+}
+
+/// The winding number of triangles at `p`: their solid angles (van Oosterom and Strackee) over 4π.
+fn winding(vertices: &[[f64; 3]], tris: &[[u32; 3]], p: [f64; 3]) -> f64 {
+    let mut total = 0.0;
+    for t in tris {
+        let a = sub(vertices[t[0] as usize], p);
+        let b = sub(vertices[t[1] as usize], p);
+        let c = sub(vertices[t[2] as usize], p);
+        let (la, lb, lc) = (dot(a, a).sqrt(), dot(b, b).sqrt(), dot(c, c).sqrt());
+        let num = dot(a, cross(b, c));
+        let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+        total += 2.0 * num.atan2(den);
+    }
+    total / (4.0 * std::f64::consts::PI)
+}

@@ -1,0 +1,206 @@
+#!/usr/bin/env python3
+"""Every collision mesh of example-robot-data that the health ladder repairs, against libigl's winding number.
+
+The solid a surface defines is Omega = {x : |w(x)| >= 1/2}, w its generalized winding number (Jacobson et al.
+2013), here libigl's fast winding number (Barill et al. 2018) on the triangles coal (assimp) reads, scaled as the
+URDF scales them. Its volume is sampled by stratified sampling in the mesh's bounding box: G^3 cells, two
+uniform points in each; the estimate is the mean over the points times the box volume, and its standard error
+sigma comes from the two points of each cell (an unbiased estimate of each cell's variance), so only cells that
+the surface crosses contribute to sigma.
+
+For each (file, scale) used by a <collision> whose rung is not exact or welded (`urdf-inertia mesh FILE --format
+json`), the report gives our volume, the reference, |difference|, our estimate (relative, times our volume) and
+sigma. A mesh passes when |difference| <= estimate * volume + 3 sigma. Meshes refused by default (UI108: an open
+mesh whose flat caps cannot be trusted) are not a dishonest estimate: they are measured under `--open-mesh caps`
+and reported, not failed. Exits non-zero on any other mesh that does not pass, except the ones listed in KNOWN
+with the reason.
+"""
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import coal
+import igl
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from meshes import collision_meshes  # noqa: E402
+
+# Meshes whose estimate is known to be below the reference's difference, each with the reason (relative to
+# the robots directory). Keep short: every entry is a number printed without an honest bound.
+_BAND = ("two planar holes (the open ends of a band of no thickness) capped flat: each flat cap alone is the "
+         "|w| = 1/2 surface over its loop, but together the caps subtend more than 2 pi from the points between "
+         "them, where w is fractional, so the capped solid is about 6x the winding-number solid; the caps' bound "
+         "measures how flat the loops are, not this (a bound for several holes that see each other is not done)")
+KNOWN = {
+    "alex_description/meshes/cycloidal_arm/LeftGripperYawLink.obj": _BAND,
+    "alex_description/meshes/cycloidal_arm/RightGripperYawLink.obj": _BAND,
+}
+
+# Points per mesh (the cells of the stratified grid number half as many): about 1 s per mesh.
+POINTS = 100_000
+
+
+def triangles(path, scale):
+    """Vertices (float64) and triangles as coal's MeshLoader (assimp) reads them."""
+    model = coal.MeshLoader().load(str(path), np.array(scale, dtype=float))
+    v = np.array(model.vertices(), dtype=np.float64).reshape(-1, 3)
+    f = np.empty((model.num_tris, 3), dtype=np.int64)
+    for i in range(model.num_tris):
+        t = model.tri_indices(i)
+        f[i] = (t[0], t[1], t[2])
+    return v, f
+
+
+def solid_volume(v, f, points, rng):
+    """Volume of {|w| >= 1/2} in the box of `v` and its standard error, by stratified sampling."""
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    size = hi - lo
+    # A margin so that faces on the box's sides are inside it; Omega lies within the box of the surface
+    # up to that (w is below 1/2 in magnitude beyond a plane that has the whole surface on one side).
+    lo = lo - 1e-9 * np.linalg.norm(size)
+    hi = hi + 1e-9 * np.linalg.norm(size)
+    size = hi - lo
+    g = max(8, int(round((points / 2) ** (1 / 3))))
+    cell = size / g
+    idx = np.stack(np.meshgrid(np.arange(g), np.arange(g), np.arange(g), indexing="ij"), axis=-1).reshape(-1, 3)
+    inside = []
+    for _ in range(2):
+        q = lo + (idx + rng.random(idx.shape)) * cell
+        w = igl.fast_winding_number(v, f, q)
+        inside.append((np.abs(w) >= 0.5).astype(np.float64))
+    cell_volume = float(np.prod(cell))
+    a, b = inside
+    volume = cell_volume * float(np.sum(a + b)) / 2.0
+    # Per cell, the mean of two points has variance s^2/2, and (a-b)^2/2 estimates s^2 without bias.
+    sigma = cell_volume * float(np.sqrt(np.sum((a - b) ** 2) / 4.0))
+    return volume, sigma
+
+
+def ours(binary, path, scale, extra=()):
+    proc = subprocess.run(
+        [binary, "mesh", str(path), "--scale", *map(str, scale), "--format", "json", "--digits", "full", *extra],
+        capture_output=True,
+        text=True,
+    )
+    if proc.returncode != 0:
+        return None, proc.stderr.strip()
+    return json.loads(proc.stdout), None
+
+
+def measure(binary, robots, robot, path, scale, rng, points):
+    """One row, or None for a mesh the ladder does not repair."""
+    name = str(path.relative_to(robots)) if path.is_relative_to(robots) else str(path)
+    data, err = ours(binary, path, scale)
+    refused = False
+    if data is None and "UI108" in err:
+        refused = True
+        data, err = ours(binary, path, scale, ("--open-mesh", "caps"))
+    if data is None:
+        return {"name": name, "scale": scale, "error": err}
+    if data["provenance"] in ("exact", "welded"):
+        return None
+    v, f = triangles(path, scale)
+    start = time.perf_counter()
+    ref, sigma = solid_volume(v, f, rng=rng, points=points)
+    seconds = time.perf_counter() - start
+    vol = data["volume"]
+    # An unbounded estimate is JSON null: it claims nothing.
+    est = data["error_estimate"] if data["error_estimate"] is not None else float("inf")
+    diff = abs(vol - ref)
+    allowed = est * vol + 3 * sigma
+    return {
+        "name": name,
+        "scale": scale,
+        "rung": data["provenance"] + (" (caps asked)" if refused else ""),
+        "refused": refused,
+        "ours": vol,
+        "ref": ref,
+        "diff": diff,
+        "estimate": est,
+        "sigma": sigma,
+        "pass": diff <= allowed,
+        "faces": len(f),
+        "seconds": seconds,
+    }
+
+
+def fmt_scale(scale):
+    return "" if all(s == 1.0 for s in scale) else " ×" + ",".join(f"{s:g}" for s in scale)
+
+
+def report(rows, points):
+    measured = [r for r in rows if "error" not in r]
+    by_default = [r for r in measured if not r["refused"]]
+    refused = [r for r in measured if r["refused"]]
+    failed = [r for r in by_default if not r["pass"] and r["name"] not in KNOWN]
+    within = [r for r in by_default if r["diff"] <= 0.01 * r["ref"] + 3 * r["sigma"]]
+    lines = [
+        "# Open and overlapping meshes of example-robot-data: urdf-inertia against libigl's winding number",
+        "",
+        f"Generated by `bash validation/winding.sh`. Every (file, scale) used by a `<collision>` whose rung is not exact "
+        f"or welded; reference: the volume of {{x : |w(x)| >= 1/2}}, w libigl's fast winding number on the triangles "
+        f"coal (assimp) reads, by stratified sampling in the bounding box (about {points:,} points per mesh, two per "
+        "cell; sigma its standard error). Pass: |ours - reference| <= estimate x ours + 3 sigma.",
+        "",
+        f"Repaired by default: {len(by_default)} meshes, {sum(r['pass'] for r in by_default)} pass, "
+        f"{len(by_default) - sum(r['pass'] for r in by_default)} do not ({len(failed)} not listed as known); "
+        f"{len(within)} within 1% (+3 sigma). Refused by default (UI108), measured under `--open-mesh caps`: "
+        f"{len(refused)} meshes, {sum(r['pass'] for r in refused)} of whose estimates bound the difference.",
+        "",
+        "| mesh | rung | faces | ours (m³) | reference (m³) | difference (rel.) | estimate (rel.) | 3 sigma (rel.) | pass |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in sorted(measured, key=lambda r: (r["refused"], r["pass"], r["name"])):
+        rel = r["diff"] / r["ref"] if r["ref"] > 0 else float("inf")
+        mark = "yes" if r["pass"] else ("known" if r["name"] in KNOWN else "NO")
+        lines.append(
+            f"| {r['name']}{fmt_scale(r['scale'])} | {r['rung']} | {r['faces']} | {r['ours']:.4e} | {r['ref']:.4e} | "
+            f"{rel:.1e} | {r['estimate']:.1e} | {3 * r['sigma'] / max(r['ref'], 1e-300):.1e} | {mark} |"
+        )
+    errors = [r for r in rows if "error" in r]
+    if errors:
+        lines += ["", "## Meshes that fail in urdf-inertia", ""]
+        lines += [f"- {r['name']}{fmt_scale(r['scale'])}: {r['error']}" for r in errors]
+    if KNOWN:
+        lines += ["", "## Known and explained", ""] + [f"- {k}: {v}" for k, v in sorted(KNOWN.items())]
+    seconds = sum(r["seconds"] for r in measured)
+    lines += ["", f"Sampling took {seconds:.0f} s in all."]
+    return lines, failed
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--binary", required=True)
+    ap.add_argument("--share", required=True)
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--points", type=int, default=POINTS)
+    ap.add_argument("--only", default="", help="substring of the mesh paths to measure")
+    args = ap.parse_args()
+    share = Path(args.share)
+    robots = share / "example-robot-data" / "robots"
+    rng = np.random.default_rng(20261202)
+    rows = []
+    for robot, path, scale in collision_meshes(robots, share):
+        if args.only and args.only not in str(path):
+            continue
+        row = measure(args.binary, robots, robot, path, scale, rng, args.points)
+        if row is not None:
+            rows.append(row)
+    lines, failed = report(rows, args.points)
+    Path(args.out).write_text("\n".join(lines) + "\n", encoding="utf-8")
+    print("\n".join(lines))
+    if failed:
+        print(f"\nwinding validation FAILED: {len(failed)} estimates below the reference's difference by more than 3 sigma",
+              file=sys.stderr)
+        return 1
+    print(f"\nwinding validation passed: {len(rows)} repaired meshes")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
