@@ -65,7 +65,7 @@ pub enum Code {
     MeshFacesCancelled,
     /// UI108: an open mesh whose flat caps cannot be trusted, or that encloses no volume however its
     /// holes are closed, and no model for open meshes was chosen (`--open-mesh`): the part fails.
-    /// Carried by the link's error ([`LinkError::code`]).
+    /// Carried by the link's error ([`LinkErrorKind::code`]).
     MeshNoSolid,
     /// UI201: an element urdfdom ignores (a second `<origin>`, `<geometry>`, shape, `<inertial>`).
     UrdfIgnoredElement,

@@ -1,7 +1,7 @@
 //! urdf-inertia: correct `<inertial>` elements for URDF robot descriptions, computed from the collision
 //! geometry with Mirtich's polyhedral mass properties (1996).
 //!
-//! Data flows one way: a robot ([`Robot`], from [`scan`] of a URDF's text, or built by the caller from
+//! Data flows one way: a robot ([`Robot`], from [`scan()`] of a URDF's text, or built by the caller from
 //! its own model with [`Link::new`] and [`Collision::new`]) → its collision parts resolved and loaded
 //! ([`PackageResolver`], [`load_solid`]) → the mass core ([`MassProperties`], [`primitives`]) → each
 //! link's parts composed with their densities ([`DensityMap`], [`compute`]) → compared with what the

@@ -423,7 +423,7 @@ fn compute_link(
 }
 
 /// Why computed mass properties cannot be written, if they cannot: every check of
-/// [`validity::check`], plus finite principal axes (what `--principal` writes).
+/// `validity::check`, plus finite principal axes (what `--principal` writes).
 pub fn unrepresentable(mp: &MassProperties) -> Option<String> {
     let mut problems: Vec<String> = validity::check(mp, validity::DEFAULT_TOLERANCE)
         .iter()

@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 /// files only which were read (a file asked for again with a new scale, by a later call sharing the
 /// cache, is read again).
 ///
-/// Between calls it holds at most [`HELD_AT_MOST`] of solids (and half the memory budget), dropping
+/// Between calls it holds at most 256 MiB of solids (and half the memory budget), dropping
 /// those used least recently (a later call that needs one reads it again). With a memory budget
 /// ([`MeshCache::with_memory_budget`]) a file whose reading would need more than what is left of it
 /// fails with an error naming it instead of exhausting the machine.
@@ -90,7 +90,7 @@ impl MeshCache {
     /// healing would need more (its size times the format's measured peak ratio) fails with an
     /// error naming it, and solids held between calls are dropped, least recently used first,
     /// beyond half of it. `u64::MAX` (the default) sets no budget (the cache still holds no more
-    /// than [`HELD_AT_MOST`] between calls).
+    /// than 256 MiB between calls).
     pub fn with_memory_budget(bytes: u64) -> Self {
         Self {
             read: HashSet::new(),

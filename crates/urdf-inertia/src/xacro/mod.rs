@@ -33,7 +33,7 @@
 //! which diagnostics and write-back need. This expander matches xacrodoc on all 26.
 //!
 //! The YAML of `load_yaml` is read with saphyr-parser and resolved as PyYAML resolves it
-//! ([`yaml`]).
+//! (`yaml`).
 
 mod builtins;
 pub mod dom;

@@ -58,7 +58,8 @@ pub fn line_col(text: &str, pos: usize) -> (usize, usize) {
     (line, col)
 }
 
-/// Decodes a URDF file's bytes (see [`super::encoding`]) and scans the text.
+/// Decodes a URDF file's bytes (UTF-8 with or without a byte-order mark, UTF-16 with one or sniffed
+/// from `<?xml`, or an ASCII-compatible encoding the XML declaration names) and scans the text.
 pub fn scan_bytes(bytes: Vec<u8>, path: &Path) -> Result<Robot, UrdfError> {
     let (text, encoding) = match super::encoding::decode(bytes) {
         Ok(d) => d,
