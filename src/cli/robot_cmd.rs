@@ -604,7 +604,7 @@ fn read_input(path: &Path, src: &Sources, policy: &Policy) -> Result<Input, Stri
         return Ok(Input { robot, xacro: None });
     }
     let opts = super::xacro_options(src.xacro_args.clone(), &src.resolver);
-    let x = xacro::expand_file(path, &opts).map_err(|e| e.to_string())?;
+    let x = xacro::expand_source(path, Some(bytes), &opts).map_err(|e| e.to_string())?;
     let mut warnings: Vec<Diagnostic> = x
         .warnings
         .iter()

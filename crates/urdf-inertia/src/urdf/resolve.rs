@@ -368,8 +368,14 @@ fn is_package(dir: &Path, pkg: &str, max_file_size: u64) -> Result<bool, String>
     let xml = dir.join("package.xml");
     if xml.exists() {
         let bytes = crate::input::read_file(&xml, max_file_size).map_err(|e| {
+            // A limit says how to raise it; anything else is the file's fault.
+            let what_to_do = match e {
+                crate::input::InputError::TooLarge { .. }
+                | crate::input::InputError::OverBudget { .. } => "",
+                _ => "; remove or fix it",
+            };
             format!(
-                "{} {e}; remove or fix it (urdf-inertia reads it to find package `{pkg}`)",
+                "{} {e}{what_to_do} (urdf-inertia reads it to find package `{pkg}`)",
                 xml.display()
             )
         })?;

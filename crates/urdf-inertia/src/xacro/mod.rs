@@ -265,7 +265,25 @@ pub fn is_xacro(path: &Path, bytes: &[u8]) -> bool {
 
 /// Expands the xacro file at `path`.
 pub fn expand_file(path: &Path, opts: &Options) -> Result<Expansion, XacroError> {
+    expand_source(path, None, opts)
+}
+
+/// Expands the xacro file at `path` whose bytes the caller has read already (`Some`), or reads it
+/// (`None`); the files it includes are read as [`expand_file`] reads them.
+pub fn expand_source(
+    path: &Path,
+    bytes: Option<Vec<u8>>,
+    opts: &Options,
+) -> Result<Expansion, XacroError> {
     let mut x = expand::Expander::new(opts);
+    if let Some(bytes) = bytes {
+        x.preload(path, bytes).map_err(|message| XacroError {
+            file: path.to_path_buf(),
+            line: 0,
+            message,
+            calls: Vec::new(),
+        })?;
+    }
     let root = x.run(path)?;
     let top = x.files[0].path.display().to_string();
     let banner = [

@@ -250,6 +250,16 @@ impl<'o> Expander<'o> {
         let limit = self.opts.resolver.max_file_size();
         let bytes = crate::input::read_file(&path, limit)
             .map_err(|e| format!("{}: {e}", path.display()))?;
+        self.add_file(path, bytes, kind)
+    }
+
+    /// Takes a file's bytes already read (the top file, which the caller read to tell xacro from
+    /// URDF): read once, and charged once to the run's read budget.
+    pub(super) fn preload(&mut self, path: &Path, bytes: Vec<u8>) -> Result<(), String> {
+        self.add_file(clean(path), bytes, FileKind::Xacro).map(drop)
+    }
+
+    fn add_file(&mut self, path: PathBuf, bytes: Vec<u8>, kind: FileKind) -> Result<usize, String> {
         let (text, encoding) = crate::urdf::encoding::decode(bytes)
             .map_err(|e| format!("{}:{}:{}: {}", path.display(), e.line, e.column, e.message))?;
         self.files.push(SourceFile {
