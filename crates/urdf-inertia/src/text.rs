@@ -27,7 +27,7 @@ pub const MAX_ROUNDING: f64 = 1e-6;
 /// `error`: at least the f64 round-off floor, at most [`MAX_ROUNDING`] (also for an unbounded or NaN
 /// estimate).
 pub fn rounding_tolerance(error: f64) -> f64 {
-    const FLOOR: f64 = 4.0 * f64::EPSILON;
+    const FLOOR: f64 = crate::geometry::ROUND_OFF_FLOOR;
     if error.is_nan() {
         MAX_ROUNDING
     } else {

@@ -1,6 +1,7 @@
 //! Writing `<inertial>` back: splice new text into the original bytes; everything else stays identical.
 
 use super::scan::{Link, Robot};
+use crate::geometry::ROUND_OFF_FLOOR;
 use crate::mass::{matrix_rpy, validity, MassProperties};
 use crate::text::{self, Digits};
 
@@ -51,9 +52,6 @@ pub struct WriteError {
     pub index: usize,
     pub message: String,
 }
-
-/// Relative round-off of one f64 operation chain: the least any error estimate is.
-const ROUND_OFF_FLOOR: f64 = 4.0 * f64::EPSILON;
 
 /// Most nudges of the diagonal `--digits N` tries before it gives up.
 const MAX_NUDGES: usize = 16;

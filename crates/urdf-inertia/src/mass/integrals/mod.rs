@@ -14,7 +14,8 @@
 //! both sum face contributions in blocks whose totals go into compensated (two-sum) accumulators.
 //! [`IntegrationOptions::paper`] reproduces the paper exactly: origin reference, plain summation.
 
-use std::ops::{Index, IndexMut};
+use crate::geometry::sub;
+use std::ops::Index;
 
 mod exact;
 // The paper's polygon kernel: the reference of the tests, benchmarks and accuracy report, not used by
@@ -232,11 +233,6 @@ pub(super) fn finish(
     }
 }
 
-#[inline(always)]
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
 /// The integrals of a polygon mesh with any mix of face sizes, as urdf-inertia computes them.
 ///
 /// Each polygon is integrated as the fan of triangles from its first vertex through the triangle kernel:
@@ -393,18 +389,6 @@ impl Index<usize> for VolumeIntegrals {
             1..=3 => &self.t[i - 1],
             4..=6 => &self.t2[i - 4],
             7..=9 => &self.tp[i - 7],
-            _ => panic!("VolumeIntegrals has ten entries, index {i}"),
-        }
-    }
-}
-
-impl IndexMut<usize> for VolumeIntegrals {
-    fn index_mut(&mut self, i: usize) -> &mut f64 {
-        match i {
-            0 => &mut self.t1,
-            1..=3 => &mut self.t[i - 1],
-            4..=6 => &mut self.t2[i - 4],
-            7..=9 => &mut self.tp[i - 7],
             _ => panic!("VolumeIntegrals has ten entries, index {i}"),
         }
     }
