@@ -388,7 +388,8 @@ struct Findings {
 }
 
 impl Findings {
-    /// The links of `robot` with problems from `from` on, recorded once each.
+    /// The links of `robot` with a problem from `from` on (the problems found in `robot`), each
+    /// recorded once.
     fn record_links(
         &mut self,
         robot: &Robot,
@@ -396,11 +397,9 @@ impl Findings {
         from: usize,
         tolerance: f64,
     ) {
+        let first = self.links.len();
         for p in &self.problems[from..] {
-            let known = |r: &LinkRecord| {
-                r.link == p.problem.link && r.urdf == robot.path.display().to_string()
-            };
-            if self.links.iter().any(known) {
+            if self.links[first..].iter().any(|r| r.link == p.problem.link) {
                 continue;
             }
             let Some(index) = robot.links.iter().position(|l| l.name == p.problem.link) else {

@@ -27,8 +27,8 @@ use serde::Serialize;
 /// removed, renamed or changes its meaning (a new key does not raise it).
 pub const SCHEMA_VERSION: u32 = 1;
 
-/// Mass properties as reported: kg, m, kg·m² about the centre of mass in the link frame (the frame
-/// of `<inertial><origin>` with no rotation), principal moments ascending.
+/// Mass properties as reported: kg, the centre of mass in the link frame (m), the tensor about the
+/// centre of mass in the link frame's axes (kg·m²), the principal moments ascending.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 #[cfg_attr(feature = "json-schema", schemars(deny_unknown_fields))]
@@ -94,6 +94,9 @@ pub struct ComparisonRecord {
 
 /// One problem `check` found in a link's existing `<inertial>`: its code, its message, its kind with
 /// the values that make it a problem (`kind` and the kind's own keys).
+///
+/// Its schema leaves other keys open: the kind's keys come from a flattened enum, which
+/// `additionalProperties: false` beside it would refuse.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct ProblemRecord {
@@ -200,9 +203,8 @@ pub struct LinkRecord {
     pub computed: Option<Props>,
     /// The diagonal of the bounding box of the link's collision geometry, m (with `computed`).
     pub size: Option<f64>,
-    /// The link's relative error bound: the largest of its parts' (with `computed`; `null` inside
-    /// it: unbounded).
-    #[cfg_attr(feature = "json-schema", schemars(with = "Option<Option<f64>>"))]
+    /// The link's relative error bound: the largest of its parts' (with `computed`; also `null`
+    /// when unbounded).
     pub error_estimate: Option<f64>,
     /// The values of the link's existing `<inertial>`, every digit (`null`: none, or not readable).
     pub existing: Option<Props>,
