@@ -525,3 +525,64 @@ pub fn schemas() -> Vec<(&'static str, serde_json::Value)> {
         ("mesh", one::<MeshOutput>("urdf-inertia/mesh.schema.json")),
     ]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::urdf::{Collision, Geometry, Inertial, Link, Pose};
+    use crate::{compute, DensityMap, FillOptions, PackageResolver};
+
+    /// A 0.1 × 0.2 × 0.3 m aluminium box (16.2 kg) whose `<inertial>` says `said` kg.
+    fn record(said: Option<f64>, tolerance: Option<f64>) -> LinkRecord {
+        let part = Collision::new(
+            Geometry::Box {
+                size: [0.1, 0.2, 0.3],
+            },
+            Pose::default(),
+        );
+        let mut link = Link::new("forearm", vec![part]);
+        if let Some(m) = said {
+            let i = [
+                0.1755 * m / 16.2,
+                0.0,
+                0.0,
+                0.135 * m / 16.2,
+                0.0,
+                0.0675 * m / 16.2,
+            ];
+            link = link.with_inertial(Inertial::new(Pose::default(), m, i));
+        }
+        let robot = Robot::new("arm", vec![link]);
+        let report = compute(
+            &robot,
+            &DensityMap::uniform(2700.0),
+            &PackageResolver::new(),
+            &FillOptions::default(),
+        );
+        LinkRecord::new(&robot, 0, report.links.first(), Digits::Auto, tolerance)
+    }
+
+    #[test]
+    fn a_link_record_holds_what_each_command_knows() {
+        // `fill`: computed, existing, comparison; no tolerance, so no verdict.
+        let r = record(Some(1.62), None);
+        assert_eq!(r.computed.as_ref().map(|c| c.mass), Some(16.2));
+        assert_eq!(r.existing.as_ref().map(|e| e.mass), Some(1.62));
+        let ratio = r.comparison.as_ref().map_or(0.0, |c| c.mass_ratio);
+        assert!((ratio - 0.1).abs() < 1e-12, "{ratio}");
+        assert_eq!(r.differs, None);
+        assert!(r.differences.is_empty());
+        assert_eq!(r.parts.len(), 1);
+        // `diff`: the verdict and what differs; the tensor is the same shape, scaled with the mass.
+        let r = record(Some(1.62), Some(0.05));
+        assert_eq!(r.differs, Some(true));
+        assert!(matches!(r.differences[0], Difference::Mass { .. }));
+        // A link without `<inertial>` differs, with nothing to compare.
+        let r = record(None, Some(0.05));
+        assert_eq!(r.differs, Some(true));
+        assert!(r.existing.is_none() && r.comparison.is_none());
+        // The same values: nothing differs.
+        let r = record(Some(16.2), Some(0.05));
+        assert_eq!(r.differs, Some(false), "{r:?}");
+    }
+}
