@@ -458,7 +458,14 @@ fn diff_names_unit_slips() {
         "json",
     ]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
-    assert_eq!(v["links"][0]["mass_ratio"].as_f64(), Some(1000.0));
+    let link = &v["links"][0];
+    assert_eq!(link["comparison"]["mass_ratio"].as_f64(), Some(1000.0));
+    assert_eq!(link["differs"], true);
+    assert_eq!(link["differences"][0]["quantity"], "mass");
+    assert_eq!(link["differences"][0]["ratio"].as_f64(), Some(1000.0));
+    assert!(link["comparison"]["causes"][0]
+        .as_str()
+        .is_some_and(|c| c.contains("mass off by 1e3")));
 }
 
 #[test]
@@ -807,7 +814,7 @@ fn json_summary_names_repairs() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
     assert_eq!(v["links_filled"], 1);
     assert_eq!(v["links"][0]["parts"][0]["provenance"], "inverted");
-    assert_eq!(v["links"][0]["mass"].as_f64(), Some(1000.0));
+    assert_eq!(v["links"][0]["computed"]["mass"].as_f64(), Some(1000.0));
     // Under --strict the same mesh is an error naming link, collision and file.
     let out = run(&[
         "fill",
@@ -1421,31 +1428,56 @@ fn check_format_json_lists_the_problems_of_the_text_output() {
     assert_eq!(json.status.code(), Some(1));
     let v: serde_json::Value = serde_json::from_slice(&json.stdout).expect("JSON on stdout");
     assert_eq!(v["schema_version"], 1);
-    let problems = v["problems"].as_array().expect("problems");
-    let lines: Vec<String> = String::from_utf8_lossy(&text.stdout)
+    // One record per link (the shape `fill` and `diff` use), each with its problems.
+    let links = v["links"].as_array().expect("links");
+    let problems: Vec<&serde_json::Value> = links
+        .iter()
+        .flat_map(|l| {
+            let p = l["problems"].as_array().expect("problems");
+            assert!(!p.is_empty(), "{l}");
+            p.iter().inspect(move |p| {
+                assert!(p["at"]
+                    .as_str()
+                    .unwrap()
+                    .contains(&format!("link `{}`", l["link"].as_str().unwrap())));
+            })
+        })
+        .collect();
+    let mut lines: Vec<String> = String::from_utf8_lossy(&text.stdout)
         .lines()
         .map(str::to_string)
         .collect();
     assert_eq!(problems.len(), lines.len());
     assert_eq!(v["problem_count"], lines.len());
-    for (p, line) in problems.iter().zip(&lines) {
-        let rebuilt = format!(
-            "{}: {} [{}]",
-            p["at"].as_str().unwrap(),
-            p["message"].as_str().unwrap(),
-            p["code"].as_str().unwrap()
-        );
-        assert_eq!(&rebuilt, line);
-        assert!(p["at"]
-            .as_str()
-            .unwrap()
-            .contains(p["link"].as_str().unwrap()));
-    }
+    let mut rebuilt: Vec<String> = problems
+        .iter()
+        .map(|p| {
+            format!(
+                "{}: {} [{}]",
+                p["at"].as_str().unwrap(),
+                p["message"].as_str().unwrap(),
+                p["code"].as_str().unwrap()
+            )
+        })
+        .collect();
+    // JSON groups them by link, text prints them in the order found: compared as sets.
+    rebuilt.sort();
+    lines.sort();
+    assert_eq!(rebuilt, lines);
     // The demo's upper arm carries a tensor that breaks the triangle inequality (0.1, 0.1, 0.3),
     // typed: the kind and the principal moments, on the line of its <inertial>.
-    let upper = problems
+    let upper_link = links
         .iter()
-        .find(|p| p["link"] == "upper_arm_link" && p["code"] == "UI602")
+        .find(|l| l["link"] == "upper_arm_link")
+        .expect("the upper arm");
+    // Without densities nothing is computed; the existing values are there as read.
+    assert!(upper_link["computed"].is_null());
+    assert_eq!(upper_link["existing"]["mass"].as_f64(), Some(1.2));
+    let upper = upper_link["problems"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["code"] == "UI602")
         .expect("the upper arm's problem");
     assert_eq!(upper["kind"], "invalid_tensor");
     let broken = &upper["violation"]["triangle_inequality"];

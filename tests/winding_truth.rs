@@ -306,7 +306,7 @@ fn open_mesh_flag_and_code_through_the_binary() {
         links
             .iter()
             .find(|l| l["link"] == name)
-            .and_then(|l| l["mass"].as_f64())
+            .and_then(|l| l["computed"]["mass"].as_f64())
             .expect("mass")
     };
     let box_volume = 0.3 * 0.2 * 0.1;

@@ -3,61 +3,19 @@
 //! by `--write-baseline FILE`; a later run fails only on problems whose file, link and code are not
 //! in it (the message is for the reader: its numbers may change without making a problem new).
 
-use serde::Serialize;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use urdf_inertia::diagnostic::Code;
 use urdf_inertia::text::escape_control;
 use urdf_inertia::InertialProblem;
 
-/// One problem `check` found, with where to print it.
+/// One problem `check` found, with where to print it (its JSON is `summary::check_json`'s).
 #[derive(Debug, Clone)]
 pub struct Problem {
     /// The problem, typed (file, link, line, code, values).
     pub problem: InertialProblem,
     /// `FILE:LINE: link `NAME`` (the source file and line for xacro).
     pub at: String,
-}
-
-/// `check --format json`: the problems that fail the run and the counts.
-#[derive(Debug, Serialize)]
-struct CheckJson<'a> {
-    schema_version: u32,
-    problems: Vec<ProblemJson<'a>>,
-    problem_count: usize,
-    known_in_baseline: usize,
-    errors: usize,
-}
-
-/// One problem in JSON: the library's typed problem (file, link, line, kind and its values) with
-/// its code, its message and where `check` prints it (`at`: the xacro source's file and line).
-#[derive(Debug, Serialize)]
-struct ProblemJson<'a> {
-    code: Code,
-    message: String,
-    at: &'a str,
-    #[serde(flatten)]
-    problem: &'a InertialProblem,
-}
-
-/// `check --format json` (`schema_version` 1).
-pub fn problems_json(new: &[&Problem], known: usize, errors: usize) -> String {
-    let out = CheckJson {
-        schema_version: 1,
-        problems: new
-            .iter()
-            .map(|p| ProblemJson {
-                code: p.problem.code(),
-                message: p.problem.kind.to_string(),
-                at: &p.at,
-                problem: &p.problem,
-            })
-            .collect(),
-        problem_count: new.len(),
-        known_in_baseline: known,
-        errors,
-    };
-    serde_json::to_string_pretty(&out).unwrap_or_default()
 }
 
 impl Problem {

@@ -3,8 +3,8 @@
 use super::args::{Format, MeshArgs};
 use super::policy::Policy;
 use super::ExitStatus;
-use serde_json::json;
-use urdf_inertia::diagnostic::{Code, Diagnostic, Severity};
+use urdf_inertia::diagnostic::{Code, Diagnostic, Provenance, Severity};
+use urdf_inertia::report::{MeshOutput, SCHEMA_VERSION};
 use urdf_inertia::text::{round_significant, shortest, within, Digits};
 use urdf_inertia::MeshErrorKind;
 use urdf_inertia::{LoadOptions, Solid};
@@ -179,35 +179,37 @@ fn print_json(
         diagnostics
             .iter()
             .filter(|d| d.severity == s)
+            .cloned()
             .collect::<Vec<_>>()
     };
-    let axes: Vec<Vec<f64>> = (0..3)
-        .map(|c| (0..3).map(|r| pr.axes[r][c]).collect())
-        .collect();
-    let v = json!({
-        "file": args.file.display().to_string(),
-        "scale": scale,
-        "volume": volume,
-        "density": density,
-        "mass": mp.mass,
-        "center_of_mass": mp.com,
-        "inertia": mp.inertia,
-        "principal_moments": pr.moments,
-        "principal_axes": axes,
-        "provenance": solid.rung.name(),
-        "faces": solid.faces.len(),
-        "faces_read": solid.faces_read,
-        "vertices": solid.vertices.len(),
-        "error_estimate": solid.error_estimate,
-        "error_round_off": solid.error.round_off,
-        "error_model": solid.error.model,
-        "error_model_source": solid.error.source.name(),
-        "error_center_of_mass": solid.error.com,
-        "errors": of(Severity::Error),
-        "warnings": of(Severity::Warning),
-        "notes": of(Severity::Note),
-    });
-    outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+    let document = MeshOutput {
+        schema_version: SCHEMA_VERSION,
+        file: args.file.display().to_string(),
+        scale,
+        volume,
+        density,
+        mass: mp.mass,
+        center_of_mass: mp.com,
+        inertia: mp.inertia,
+        principal_moments: pr.moments,
+        principal_axes: [0, 1, 2].map(|c| [0, 1, 2].map(|r| pr.axes[r][c])),
+        provenance: Provenance::Mesh(solid.rung.clone()),
+        faces: solid.faces.len(),
+        faces_read: solid.faces_read,
+        vertices: solid.vertices.len(),
+        error_estimate: solid.error_estimate,
+        error_round_off: solid.error.round_off,
+        error_model: solid.error.model,
+        error_model_source: solid.error.source.name().to_string(),
+        error_center_of_mass: solid.error.com,
+        errors: of(Severity::Error),
+        warnings: of(Severity::Warning),
+        notes: of(Severity::Note),
+    };
+    match serde_json::to_string_pretty(&document) {
+        Ok(text) => outln!("{text}"),
+        Err(e) => errln!("error: cannot write the JSON: {e}"),
+    }
 }
 
 /// `--format text`: the results one per line, for people.

@@ -10,16 +10,15 @@ use super::{write, ExitStatus};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use urdf_inertia::diagnostic::{Code, Diagnostic, Location, Severity};
+use urdf_inertia::report::LinkRecord;
 use urdf_inertia::text::Digits;
 use urdf_inertia::write::{splice, LinkUpdate, WriteOptions};
 use urdf_inertia::xacro::{self, Expansion};
-use urdf_inertia::MassProperties;
 use urdf_inertia::PackageResolver;
 use urdf_inertia::ProblemKind;
-use urdf_inertia::{compare, Comparison};
-use urdf_inertia::{existing_props, FillOptions, FillReport};
 use urdf_inertia::{scan_bytes, Geometry, Robot};
 use urdf_inertia::{DensityMap, Glob};
+use urdf_inertia::{FillOptions, FillReport};
 use urdf_inertia::{LinkReport, MeshCache};
 
 /// Validated sources: densities (if any), package paths, link selection.
@@ -357,10 +356,10 @@ fn run(config: &Config) -> Outcome {
             errln!("{}", d.render());
         }
     }
-    let mut problems = Vec::new();
+    let mut found = Findings::default();
     let mut seen = super::noops::Seen::default();
     for path in &config.files {
-        outcome += run_one(config, path, &mut cache, &mut problems, &mut seen);
+        outcome += run_one(config, path, &mut cache, &mut found, &mut seen);
     }
     // One file's --only error stopped it before anything was computed (in `run_one`).
     if config.files.len() > 1 && outcome.errors == 0 {
@@ -375,14 +374,54 @@ fn run(config: &Config) -> Outcome {
         &config.policy,
     );
     if matches!(config.mode, Mode::Check { .. }) {
-        outcome.problems += report_problems(config, &problems, outcome.errors);
+        outcome.problems += report_problems(config, &found, outcome.errors);
     }
     outcome
 }
 
+/// What `check` found over its files: the problems, and each link with one as read (and computed,
+/// with densities), for the JSON.
+#[derive(Default)]
+struct Findings {
+    problems: Vec<Problem>,
+    links: Vec<LinkRecord>,
+}
+
+impl Findings {
+    /// The links of `robot` with a problem from `from` on (the problems found in `robot`), each
+    /// recorded once.
+    fn record_links(
+        &mut self,
+        robot: &Robot,
+        report: Option<&FillReport>,
+        from: usize,
+        tolerance: f64,
+    ) {
+        let first = self.links.len();
+        for p in &self.problems[from..] {
+            if self.links[first..].iter().any(|r| r.link == p.problem.link) {
+                continue;
+            }
+            let Some(index) = robot.links.iter().position(|l| l.name == p.problem.link) else {
+                continue;
+            };
+            let computed = report.and_then(|r| r.links.iter().find(|l| l.index == index));
+            let tolerance = computed.map(|_| tolerance);
+            self.links.push(LinkRecord::new(
+                robot,
+                index,
+                computed,
+                Digits::Auto,
+                tolerance,
+            ));
+        }
+    }
+}
+
 /// `check`'s problems against the baseline (if any): the new ones printed on stdout and counted,
 /// the known ones counted, a baseline to write written; then the closing line on stderr.
-fn report_problems(config: &Config, problems: &[Problem], errors: usize) -> usize {
+fn report_problems(config: &Config, found: &Findings, errors: usize) -> usize {
+    let problems = &found.problems;
     let (new, known): (Vec<&Problem>, Vec<&Problem>) = match &config.baseline {
         Some(BaselineUse::Read(b)) => problems.iter().partition(|p| !b.contains(p)),
         _ => (problems.iter().collect(), Vec::new()),
@@ -412,10 +451,7 @@ fn report_problems(config: &Config, problems: &[Problem], errors: usize) -> usiz
             ..
         }
     ) {
-        outln!(
-            "{}",
-            super::baseline::problems_json(&new, known.len(), errors)
-        );
+        summary::check_json(&new, &found.links, known.len(), errors);
     } else {
         for p in &new {
             outln!("{}", p.line());
@@ -454,7 +490,7 @@ fn run_one(
     config: &Config,
     path: &Path,
     cache: &mut MeshCache,
-    problems: &mut Vec<Problem>,
+    found: &mut Findings,
     seen: &mut super::noops::Seen,
 ) -> Outcome {
     let start = Instant::now();
@@ -479,8 +515,9 @@ fn run_one(
     }
     let robot = &input.robot;
     let mut outcome = Outcome::default();
+    let from = found.problems.len();
     if let Mode::Check { all_links, .. } = config.mode {
-        check_existing(&input, config, all_links, problems);
+        check_existing(&input, config, all_links, &mut found.problems);
     }
     let promoted_notes = promoted(&robot.notes);
     let Some(map) = &config.src.map else {
@@ -495,6 +532,7 @@ fn run_one(
             errln!("error: {}: {f}", input.link_at(f.line, &f.link));
         }
         outcome.errors += missing.len();
+        found.record_links(robot, None, from, config.tolerance);
         return outcome;
     };
     let src = &config.src;
@@ -503,7 +541,6 @@ fn run_one(
     print_failures(&input, &report);
     outcome.errors += report.error_count();
     let promoted = promoted_notes + promoted_in(&report);
-    let rows = compare_all(robot, &report);
     match &config.mode {
         Mode::Write(w) => {
             if write_robot(&input, &report, w, &config.policy, start, promoted).is_err() {
@@ -512,13 +549,15 @@ fn run_one(
         }
         Mode::Diff { format } => {
             summary::computed_diagnostics(&report, &config.policy);
-            summary::diff(&rows, *format, config.tolerance, robot, &report);
-            outcome.problems += rows.iter().filter(|r| r.differs(config.tolerance)).count();
+            let records = summary::diff_records(robot, &report, config.tolerance);
+            outcome.problems += records.iter().filter(|r| r.differs == Some(true)).count();
+            summary::diff(records, *format, config.tolerance, robot, &report);
             outcome.problems += promoted;
         }
         Mode::Check { .. } => {
             summary::computed_diagnostics(&report, &config.policy);
-            check_against_computed(&input, &report, config, problems);
+            check_against_computed(&input, &report, config, &mut found.problems);
+            found.record_links(robot, Some(&report), from, config.tolerance);
             outcome.problems += promoted;
         }
     }
@@ -934,42 +973,6 @@ fn spliced(robot: &Robot, report: &FillReport, w: &WriteConfig) -> Result<Vec<u8
         errln!("error: {}: {e}", robot.path.display());
         ExitStatus::Error
     })
-}
-
-/// One existing `<inertial>` against the computed one.
-pub struct Row<'a> {
-    pub link: &'a LinkReport,
-    pub existing: Option<MassProperties>,
-    pub comparison: Option<Comparison>,
-}
-
-impl Row<'_> {
-    /// Whether `fill` would change this link beyond `tolerance` (or its values are invalid).
-    pub fn differs(&self, tolerance: f64) -> bool {
-        self.comparison
-            .as_ref()
-            .is_none_or(|c| c.differs(tolerance))
-    }
-}
-
-/// Compare once: every computed link against its existing `<inertial>`.
-fn compare_all<'a>(robot: &Robot, report: &'a FillReport) -> Vec<Row<'a>> {
-    report
-        .links
-        .iter()
-        .map(|l| {
-            let existing = robot.links[l.index]
-                .inertial
-                .as_ref()
-                .and_then(|s| existing_props(&s.value));
-            let comparison = existing.as_ref().map(|e| compare(e, &l.computed, l.size));
-            Row {
-                link: l,
-                existing,
-                comparison,
-            }
-        })
-        .collect()
 }
 
 /// Problems of the existing `<inertial>` elements themselves (no computation needed), added to

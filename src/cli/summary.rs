@@ -1,17 +1,20 @@
-//! What `fill` and `diff` print: the fill summary (text on stderr, or JSON), the diff table (or
-//! JSON). Diagnostics print the same way everywhere: warnings always, notes with `--verbose`, both in
-//! JSON as `{"severity", "code", "message", …}` objects.
+//! What `fill`, `diff` and `check` print: the fill summary (text on stderr, or JSON), the diff table
+//! (or JSON), `check`'s JSON. Diagnostics print the same way everywhere: warnings always, notes with
+//! `--verbose`, both in JSON as `{"severity", "code", "message", …}` objects. The JSON documents are
+//! the library's `report` types, one record per link for all three.
 
 use super::args::Format;
+use super::baseline::Problem;
 use super::policy::Policy;
-use super::robot_cmd::Row;
-use serde_json::json;
-use urdf_inertia::diagnostic::{Diagnostic, Provenance, Severity};
-use urdf_inertia::text::{self, significant, Digits};
-use urdf_inertia::write::{tidy, tidy_moments};
-use urdf_inertia::MassProperties;
+use urdf_inertia::diagnostic::{Diagnostic, Provenance};
+use urdf_inertia::report::{
+    CheckOutput, DiffOutput, ErrorRecord, FillOutput, LinkRecord, MeshDiagnostic, MeshUser,
+    ProblemRecord, Totals, SCHEMA_VERSION,
+};
+use urdf_inertia::text::significant;
+use urdf_inertia::text::{self, Digits};
 use urdf_inertia::Robot;
-use urdf_inertia::{existing_props, FillReport, LinkReport, PartReport};
+use urdf_inertia::{existing_props, FillReport, LinkReport};
 
 /// Wall times of a fill, s.
 #[derive(Debug, Clone, Copy)]
@@ -21,11 +24,6 @@ pub struct Times {
     /// How many of the computed links were written, when not all were (a xacro source's macro links,
     /// or nothing at all): the summary then says "computed", not "filled".
     pub written: Option<usize>,
-}
-
-fn by_severity<'a>(ds: impl Iterator<Item = &'a Diagnostic>, warning: bool) -> Vec<&'a Diagnostic> {
-    ds.filter(|d| (d.severity != Severity::Note) == warning)
-        .collect()
 }
 
 /// One diagnostic of a mesh file and every (link, collision) that uses the mesh: a mesh shared by
@@ -136,19 +134,24 @@ pub fn computed_diagnostics(report: &FillReport, policy: &Policy) {
 }
 
 /// The mesh diagnostics as JSON, each mesh once with the links that use it.
-fn mesh_json(report: &FillReport) -> Vec<serde_json::Value> {
+fn mesh_json(report: &FillReport) -> Vec<MeshDiagnostic> {
     mesh_groups(report)
         .into_iter()
-        .map(|g| {
-            json!({
-                "mesh": g.what,
-                "file": g.file.map(|f| f.display().to_string()),
-                "provenance": g.provenance,
-                "severity": g.diagnostic.severity,
-                "code": g.diagnostic.code,
-                "message": g.diagnostic.message,
-                "links": g.users.iter().map(|(l, c)| json!({"link": l, "collision": c})).collect::<Vec<_>>(),
-            })
+        .map(|g| MeshDiagnostic {
+            mesh: g.what.to_string(),
+            file: g.file.map(|f| f.display().to_string()),
+            provenance: g.provenance.clone(),
+            severity: g.diagnostic.severity,
+            code: g.diagnostic.code,
+            message: g.diagnostic.message.clone(),
+            links: g
+                .users
+                .iter()
+                .map(|(l, c)| MeshUser {
+                    link: (*l).to_string(),
+                    collision: *c,
+                })
+                .collect(),
         })
         .collect()
 }
@@ -302,58 +305,23 @@ pub fn fill_text(
     }
 }
 
-fn part_json(p: &PartReport) -> serde_json::Value {
-    json!({
-        "collision": p.collision,
-        "geometry": p.what,
-        "file": p.file.as_ref().map(|f| f.display().to_string()),
-        "provenance": p.provenance,
-        "faces": p.faces,
-        "volume": text::within(p.volume, p.error_estimate * p.volume),
-        "mass": text::within(p.mass, p.error_estimate * p.mass),
-        "density": p.density,
-        "density_source": p.density_source,
-        "error_estimate": p.error_estimate,
-        "error_round_off": p.error.round_off,
-        "error_model": p.error.model,
-        "error_model_source": p.error.source.name(),
-        "error_center_of_mass": p.error.com,
-        "warnings": by_severity(p.diagnostics.iter(), true),
-        "notes": by_severity(p.diagnostics.iter(), false),
-    })
+/// The robot's totals and the run's worst error, as the JSON documents carry them.
+fn totals(robot: &Robot, report: &FillReport) -> Totals {
+    let (total, computed, kept, _) = total_mass(robot, report);
+    Totals {
+        total_mass: total,
+        total_mass_computed: computed,
+        total_mass_as_they_are: kept,
+        worst_error_estimate: worst_error(report).map(|w| w.0),
+    }
 }
 
-fn link_json(l: &LinkReport, digits: Digits) -> serde_json::Value {
-    let written = tidy(&l.update(), digits);
-    json!({
-        "link": l.name,
-        "line": l.line,
-        "mass": written.mass,
-        "center_of_mass": written.com,
-        "inertia": written.inertia,
-        "principal_moments": tidy_moments(l.computed.principal().moments, l.error_estimate(), digits),
-        "size": l.size,
-        "warnings": by_severity(l.diagnostics.iter(), true),
-        "notes": by_severity(l.diagnostics.iter(), false),
-        "parts": l.parts.iter().map(part_json).collect::<Vec<_>>(),
-    })
-}
-
-fn errors_json(report: &FillReport) -> Vec<serde_json::Value> {
-    let links = report.failures.iter().map(|f| {
-        json!({
-            "link": f.link,
-            "line": f.line,
-            "collision": f.collision.map(|c| c.index),
-            "kind": f.kind.name(),
-            "code": f.kind.code(),
-            "message": f.to_string(),
-        })
-    });
-    let robot = report.robot_errors.iter().map(
-        |e| json!({"link": null, "kind": e.name(), "code": e.code(), "message": e.to_string()}),
-    );
-    links.chain(robot).collect()
+/// A JSON document on stdout.
+fn print_json(document: &impl serde::Serialize) {
+    match serde_json::to_string_pretty(document) {
+        Ok(text) => outln!("{text}"),
+        Err(e) => errln!("error: cannot write the JSON: {e}"),
+    }
 }
 
 /// The JSON summary of `fill` on stdout (the URDF went to a file; `written` false when links failed
@@ -366,44 +334,68 @@ pub fn fill_json(
     seconds: f64,
     written: bool,
 ) {
-    let mut notes: Vec<&Diagnostic> = robot.notes.iter().collect();
-    notes.extend(run);
-    let (total, computed, kept, _) = total_mass(robot, report);
-    let v = json!({
-        "urdf": robot.path.display().to_string(),
-        "robot": robot.name,
-        "written": written,
-        "links_filled": report.links.len(),
-        "links_without_geometry": report.without_geometry,
-        "links_not_selected": report.not_selected,
-        "mesh_files": report.mesh_files,
-        "faces": report.faces,
-        "errors": errors_json(report),
-        "notes": notes,
-        "mesh_diagnostics": mesh_json(report),
-        "total_mass": total,
-        "total_mass_computed": computed,
-        "total_mass_as_they_are": kept,
-        "worst_error_estimate": worst_error(report).map(|w| w.0),
-        "seconds": seconds,
-        "seconds_load": report.timing.load.as_secs_f64(),
-        "seconds_integrate": report.timing.integrate.as_secs_f64(),
-        "links": report.links.iter().map(|l| link_json(l, digits)).collect::<Vec<_>>(),
+    let mut notes: Vec<Diagnostic> = robot.notes.clone();
+    notes.extend_from_slice(run);
+    let errors = report.failures.iter().map(ErrorRecord::from);
+    let robot_errors = report.robot_errors.iter().map(ErrorRecord::from);
+    print_json(&FillOutput {
+        schema_version: SCHEMA_VERSION,
+        urdf: robot.path.display().to_string(),
+        robot: robot.name.clone(),
+        written,
+        links_filled: report.links.len(),
+        links_without_geometry: report.without_geometry,
+        links_not_selected: report.not_selected,
+        mesh_files: report.mesh_files,
+        faces: report.faces,
+        errors: errors.chain(robot_errors).collect(),
+        notes,
+        mesh_diagnostics: mesh_json(report),
+        totals: totals(robot, report),
+        seconds,
+        seconds_load: report.timing.load.as_secs_f64(),
+        seconds_integrate: report.timing.integrate.as_secs_f64(),
+        links: report
+            .links
+            .iter()
+            .map(|l| LinkRecord::new(robot, l.index, Some(l), digits, None))
+            .collect(),
     });
-    outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
 }
 
-/// Reported principal moments (rounded like the rest of the output).
-fn moments(mp: &MassProperties, error: f64) -> [f64; 3] {
-    tidy_moments(mp.principal().moments, error, Digits::Auto)
+/// `check --format json`: the links of the new problems (those not in a baseline), each with its
+/// problems, in the order they were found; `records` holds the links as read (and computed).
+pub fn check_json(new: &[&Problem], records: &[LinkRecord], known: usize, errors: usize) {
+    let mut links: Vec<LinkRecord> = Vec::new();
+    let same = |r: &LinkRecord, p: &Problem| {
+        r.link == p.problem.link && r.urdf == p.problem.file.display().to_string()
+    };
+    for p in new {
+        let i = match links.iter().position(|r| same(r, p)) {
+            Some(i) => i,
+            None => {
+                let Some(r) = records.iter().find(|r| same(r, p)) else {
+                    continue;
+                };
+                links.push(r.clone());
+                links.len() - 1
+            }
+        };
+        links[i]
+            .problems
+            .push(ProblemRecord::new(&p.problem, &p.at));
+    }
+    print_json(&CheckOutput {
+        schema_version: SCHEMA_VERSION,
+        problem_count: links.iter().map(|l| l.problems.len()).sum(),
+        links,
+        known_in_baseline: known,
+        errors,
+    });
 }
 
-fn props_json(mp: &MassProperties, error: f64) -> serde_json::Value {
-    json!({"mass": mp.mass, "center_of_mass": mp.com, "inertia": mp.inertia, "principal_moments": moments(mp, error)})
-}
-
-/// The causes and validity problems of a row, as the diff's notes.
-fn row_notes(r: &Row) -> Vec<String> {
+/// The causes and validity problems of a link, as the diff's notes.
+fn diff_notes(r: &LinkRecord) -> Vec<String> {
     r.comparison.as_ref().map_or_else(
         || vec!["no existing <inertial>".to_string()],
         |c| {
@@ -420,55 +412,25 @@ fn row_notes(r: &Row) -> Vec<String> {
     )
 }
 
-/// The diff as JSON: `{"links": [rows], "mesh_diagnostics": [each mesh once], "total_mass"}`.
-fn diff_json(
-    rows: &[Row],
-    tolerance: f64,
-    robot: &Robot,
-    report: &FillReport,
-) -> serde_json::Value {
-    let v: Vec<serde_json::Value> = rows
+/// Every computed link as `diff` reports it: with the comparison against `tolerance`.
+pub fn diff_records(robot: &Robot, report: &FillReport, tolerance: f64) -> Vec<LinkRecord> {
+    report
+        .links
         .iter()
-        .map(|r| {
-            let l = r.link;
-            let c = r.comparison.as_ref();
-            let existing = r.existing.map(|e| tidy(&(l.index, e).into(), Digits::Full));
-            json!({
-                "link": l.name,
-                "line": l.line,
-                "computed": props_json(&tidy(&l.update(), Digits::Auto), l.error_estimate()),
-                "existing": existing.map(|e| props_json(&e, 0.0)),
-                "mass_ratio": c.map(|c| c.mass_ratio),
-                "com_distance_relative": c.map(|c| c.com_distance),
-                "inertia_difference_relative": c.map(|c| c.inertia_difference),
-                "differs": r.differs(tolerance),
-                "notes": row_notes(r),
-                "provenance": l.parts.iter().map(|p| p.provenance.clone()).collect::<Vec<_>>(),
-                "warnings": by_severity(l.diagnostics.iter(), true),
-                "link_notes": by_severity(l.diagnostics.iter(), false),
-            })
-        })
-        .collect();
-    let (total, computed, kept, _) = total_mass(robot, report);
-    json!({
-        "urdf": robot.path.display().to_string(),
-        "robot": robot.name,
-        "links": v,
-        "mesh_diagnostics": mesh_json(report),
-        "total_mass": total,
-        "total_mass_computed": computed,
-        "total_mass_as_they_are": kept,
-        "worst_error_estimate": worst_error(report).map(|w| w.0),
-    })
+        .map(|l| LinkRecord::new(robot, l.index, Some(l), Digits::Auto, Some(tolerance)))
+        .collect()
 }
 
-fn diff_row(r: &Row) {
-    let l = r.link;
-    let computed = tidy(&l.update(), Digits::Auto);
+/// One link of the diff's table: its masses and relative differences, then both sides' principal
+/// moments.
+fn diff_row(r: &LinkRecord) {
+    let Some(computed) = &r.computed else {
+        return;
+    };
     let (Some(e), Some(c)) = (&r.existing, &r.comparison) else {
         outln!(
             "{:<28} {:>12} {:>12} {:>9} {:>10} {:>10}  no existing <inertial>",
-            l.name,
+            r.link,
             "-",
             significant(computed.mass, 6),
             "-",
@@ -477,29 +439,21 @@ fn diff_row(r: &Row) {
         );
         return;
     };
+    let tolerance = text::rounding_tolerance(r.error_estimate.unwrap_or(0.0));
     outln!(
         "{:<28} {:>12} {:>12} {:>9} {:>10} {:>10}  {}",
-        l.name,
+        r.link,
         significant(e.mass, 6),
         significant(computed.mass, 6),
         significant(c.mass_ratio, 4),
-        significant(
-            text::within(c.com_distance, text::rounding_tolerance(l.error_estimate())),
-            4
-        ),
-        significant(
-            text::within(
-                c.inertia_difference,
-                text::rounding_tolerance(l.error_estimate())
-            ),
-            4
-        ),
-        row_notes(r).join("; ")
+        significant(text::within(c.com_distance_relative, tolerance), 4),
+        significant(text::within(c.inertia_difference_relative, tolerance), 4),
+        diff_notes(r).join("; ")
     );
     // Both sides with one formatter, seven significant digits: a table to compare by eye (the JSON
     // and the written file keep every digit the estimate allows).
-    let pe = moments(e, 0.0).map(|x| significant(x, 7));
-    let pc = moments(&l.computed, l.error_estimate()).map(|x| significant(x, 7));
+    let pe = e.principal_moments.map(|x| significant(x, 7));
+    let pc = computed.principal_moments.map(|x| significant(x, 7));
     outln!(
         "{:<28} principal moments existing {} {} {}, computed {} {} {}",
         "",
@@ -512,14 +466,25 @@ fn diff_row(r: &Row) {
     );
 }
 
-/// The diff: a table, or JSON.
-pub fn diff(rows: &[Row], format: Format, tolerance: f64, robot: &Robot, report: &FillReport) {
+/// The diff of `records` ([`diff_records`]): a table, or JSON with each mesh's diagnostics once and
+/// the totals.
+pub fn diff(
+    records: Vec<LinkRecord>,
+    format: Format,
+    tolerance: f64,
+    robot: &Robot,
+    report: &FillReport,
+) {
     match format {
-        Format::Json => outln!(
-            "{}",
-            serde_json::to_string_pretty(&diff_json(rows, tolerance, robot, report))
-                .unwrap_or_default()
-        ),
+        Format::Json => print_json(&DiffOutput {
+            schema_version: SCHEMA_VERSION,
+            urdf: robot.path.display().to_string(),
+            robot: robot.name.clone(),
+            tolerance,
+            links: records,
+            mesh_diagnostics: mesh_json(report),
+            totals: totals(robot, report),
+        }),
         Format::Text => {
             outln!(
                 "{:<28} {:>12} {:>12} {:>9} {:>10} {:>10}  notes",
@@ -530,7 +495,7 @@ pub fn diff(rows: &[Row], format: Format, tolerance: f64, robot: &Robot, report:
                 "COM Δ/size",
                 "inertia Δ"
             );
-            for r in rows {
+            for r in &records {
                 diff_row(r);
             }
         }

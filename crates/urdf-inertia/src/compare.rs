@@ -25,6 +25,7 @@ pub struct Comparison {
 
 /// One way existing mass properties differ from computed ones by more than a tolerance.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 #[serde(tag = "quantity", rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum Difference {

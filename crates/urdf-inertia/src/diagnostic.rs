@@ -44,6 +44,26 @@ impl Serialize for Severity {
     }
 }
 
+/// A string naming its values, for the manual `JsonSchema`s of types serialised as names.
+#[cfg(feature = "json-schema")]
+fn names_schema(description: &str, names: &[&str]) -> schemars::Schema {
+    schemars::json_schema!({"type": "string", "description": description, "enum": names})
+}
+
+#[cfg(feature = "json-schema")]
+impl schemars::JsonSchema for Severity {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "Severity".into()
+    }
+
+    fn json_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        names_schema(
+            "How much a diagnostic matters.",
+            &[Severity::Note, Severity::Warning, Severity::Error].map(Severity::as_str),
+        )
+    }
+}
+
 /// A stable diagnostic code (`UI101`, …); each has one severity.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
@@ -284,8 +304,23 @@ impl Serialize for Code {
     }
 }
 
+#[cfg(feature = "json-schema")]
+impl schemars::JsonSchema for Code {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "Code".into()
+    }
+
+    fn json_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        names_schema(
+            "A stable diagnostic code (the README's table).",
+            &Code::ALL.map(Code::as_str),
+        )
+    }
+}
+
 /// Where a diagnostic points; every part is optional.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 #[non_exhaustive]
 pub struct Location {
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -312,6 +347,7 @@ impl Location {
 
 /// One warning or note.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 #[non_exhaustive]
 pub struct Diagnostic {
     pub severity: Severity,
@@ -424,6 +460,24 @@ impl fmt::Display for Provenance {
 impl Serialize for Provenance {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         s.serialize_str(self.name())
+    }
+}
+
+#[cfg(feature = "json-schema")]
+impl schemars::JsonSchema for Provenance {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "Provenance".into()
+    }
+
+    fn json_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        names_schema(
+            "What a part's numbers were computed from: a primitive, or the rung of the mesh repair ladder.",
+            &crate::mesh::health::Rung::NAMES
+                .iter()
+                .copied()
+                .chain(["primitive"])
+                .collect::<Vec<_>>(),
+        )
     }
 }
 

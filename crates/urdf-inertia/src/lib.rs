@@ -54,6 +54,7 @@ internal!(compare, density, error, fill, mass, mesh, overlap, problem, threads, 
 pub mod diagnostic;
 mod geometry;
 pub mod input;
+pub mod report;
 pub mod text;
 pub mod xacro;
 

@@ -29,6 +29,7 @@ pub struct InertialProblem {
 
 /// What is wrong with an existing `<inertial>`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 #[serde(tag = "kind", rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum ProblemKind {
@@ -41,8 +42,11 @@ pub enum ProblemKind {
         /// The lines of the others.
         ignored_lines: Vec<usize>,
     },
-    /// Its numbers cannot be read.
-    Unreadable { message: String },
+    /// Its numbers cannot be read. (`reason` in JSON, beside the problem's own `message`.)
+    Unreadable {
+        #[serde(rename = "reason")]
+        message: String,
+    },
     /// It has no `<mass>`.
     NoMass,
     /// It has no `<inertia>`.

@@ -8,6 +8,7 @@ use crate::text::significant as sig;
 
 /// One way in which mass properties cannot belong to a physical body.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum Violation {

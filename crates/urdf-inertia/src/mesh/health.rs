@@ -79,6 +79,17 @@ pub enum Rung {
 }
 
 impl Rung {
+    /// Every rung's [`name`](Rung::name), up the ladder.
+    pub const NAMES: [&'static str; 7] = [
+        "exact",
+        "welded",
+        "reoriented",
+        "inverted",
+        "capped",
+        "non-manifold",
+        "convex-hull",
+    ];
+
     /// A short name for tables and JSON.
     pub fn name(&self) -> &'static str {
         match self {

@@ -163,3 +163,54 @@ fn duplicated_faces_are_dropped() {
     assert_eq!(s.rung.name(), "welded", "{:?}", s.warnings);
     assert!((s.unit.mass - 1.0 / 6.0).abs() < 1e-15, "{}", s.unit.mass);
 }
+
+/// `Rung::NAMES` (the JSON Schema's list of provenances) is every rung's name, in ladder order; the
+/// match keeps this list complete when a rung is added.
+#[test]
+fn rung_names_list_every_rung() {
+    let rungs = [
+        Rung::Exact,
+        Rung::Welded {
+            merged_vertices: 0,
+            widest_crack: 0.0,
+            tolerance: 0.0,
+        },
+        Rung::Reoriented {
+            faces_flipped: 0,
+            components: 0,
+        },
+        Rung::Inverted,
+        Rung::Capped {
+            holes: 0,
+            boundary_edges: 0,
+            nonmanifold_edges: 0,
+            faces_flipped: 0,
+            relative_uncertainty: 0.0,
+        },
+        Rung::NonManifold {
+            nonmanifold_edges: 0,
+            faces_flipped: 0,
+        },
+        Rung::ConvexHull {
+            boundary_edges: 0,
+            nonmanifold_edges: 0,
+            mesh_volume: 0.0,
+            hull_volume: 0.0,
+            volume_moves_by: 0.0,
+        },
+    ];
+    for (k, r) in rungs.iter().enumerate() {
+        // A new rung fails to compile here until it is listed above and in `Rung::NAMES`.
+        let position = match r {
+            Rung::Exact => 0,
+            Rung::Welded { .. } => 1,
+            Rung::Reoriented { .. } => 2,
+            Rung::Inverted => 3,
+            Rung::Capped { .. } => 4,
+            Rung::NonManifold { .. } => 5,
+            Rung::ConvexHull { .. } => 6,
+        };
+        assert_eq!(position, k);
+    }
+    assert_eq!(rungs.map(|r| r.name()), Rung::NAMES);
+}
