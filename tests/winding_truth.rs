@@ -172,7 +172,7 @@ fn hull_of_an_open_mesh_with_22k_boundary_vertices() {
 }
 
 /// A flat plate (one-sided or two-sided) has no volume: the mesh is a zero-volume error, which
-/// `fill` turns into a note (UI203) and a part that contributes nothing, as for a zero-size shape.
+/// `fill` turns into a warning (UI109) and a part that contributes nothing, as for a zero-size shape.
 #[test]
 fn flat_plates_have_no_volume() {
     let v = [
@@ -217,8 +217,74 @@ fn run(args: &[&str]) -> std::process::Output {
         .expect("run")
 }
 
-/// A robot of two links in `dir`: `shell`, an open box whose caps are not trusted, and `marker`, a
-/// box beside a flat plate.
+/// The flat parts of [`open_robot`] in a `fill --open-mesh hull` run (`json` its summary, `args` its
+/// arguments, `out` the URDF written).
+fn flat_parts_contribute_nothing(json: &serde_json::Value, hull: &[&str], out: &Path) {
+    let links = json["links"].as_array().expect("links");
+    let mass = |name: &str| {
+        links
+            .iter()
+            .find(|l| l["link"] == name)
+            .and_then(|l| l["mass"].as_f64())
+            .expect("mass")
+    };
+    // The plate (0.5 m off the box: it would move the centre of mass) adds nothing: the marker is its
+    // box alone, m = ρ·abc and I = m/12·(b² + c², a² + c², a² + b²) about the origin.
+    let marker = links
+        .iter()
+        .find(|l| l["link"] == "marker")
+        .expect("marker");
+    let (a, b, c, m) = (0.1, 0.2, 0.3, 1000.0 * 0.1 * 0.2 * 0.3);
+    let want = [
+        [m / 12.0 * (b * b + c * c), 0.0, 0.0],
+        [0.0, m / 12.0 * (a * a + c * c), 0.0],
+        [0.0, 0.0, m / 12.0 * (a * a + b * b)],
+    ];
+    assert!((mass("marker") / m - 1.0).abs() < 1e-12);
+    for i in 0..3 {
+        let com = marker["center_of_mass"][i].as_f64().expect("com");
+        assert!(com.abs() < 1e-15, "{marker}");
+        for j in 0..3 {
+            let got = marker["inertia"][i][j].as_f64().expect("inertia");
+            assert!((got - want[i][j]).abs() <= 1e-12 * want[0][0], "{marker}");
+        }
+    }
+    let warnings = marker["warnings"].to_string();
+    assert!(
+        warnings.contains("UI109") && warnings.contains("plate.obj"),
+        "{warnings}"
+    );
+    // `tag` is left as it is, counted with the links without collision geometry, and said so.
+    assert!(links.iter().all(|l| l["link"] != "tag"), "{json}");
+    assert_eq!(json["links_without_geometry"], 1, "{json}");
+    let notes = json["notes"].to_string();
+    assert!(
+        notes.contains("UI109") && notes.contains("sheet.obj") && notes.contains("left as it is"),
+        "{notes}"
+    );
+    // In text, the warning is printed (JSON has it in "notes" and nothing on stderr).
+    let text: Vec<&str> = hull
+        .iter()
+        .filter(|a| !["--format", "json"].contains(a))
+        .copied()
+        .collect();
+    let t = run(&text);
+    let stderr = String::from_utf8_lossy(&t.stderr);
+    assert!(
+        t.status.success()
+            && stderr.contains("warning[UI109]: link `tag`: its collision geometry has no volume"),
+        "{stderr}"
+    );
+    let written = std::fs::read_to_string(out).expect("written");
+    let tag = &written[written.find("<link name=\"tag\">").expect("tag")..];
+    assert!(
+        !tag[..tag.find("</link>").expect("end")].contains("<inertial>"),
+        "{written}"
+    );
+}
+
+/// A robot of three links in `dir`: `shell`, an open box whose caps are not trusted, `marker`, a
+/// box beside a flat plate, and `tag`, two flat plates (one two-sided) and a zero-size box.
 fn open_robot(dir: &Path) -> std::path::PathBuf {
     let (v, f) = moved_box();
     let open = without_side(&v, &without_side(&v, &f, 2, true), 0, true);
@@ -230,6 +296,11 @@ fn open_robot(dir: &Path) -> std::path::PathBuf {
         [0.0, 0.1, 0.0],
     ];
     write_obj(&dir.join("plate.obj"), &plate_v, &[[0, 1, 2], [0, 2, 3]]);
+    write_obj(
+        &dir.join("sheet.obj"),
+        &plate_v,
+        &[[0, 1, 2], [0, 2, 3], [0, 2, 1], [0, 3, 2]],
+    );
     let urdf = dir.join("robot.urdf");
     std::fs::write(
         &urdf,
@@ -237,9 +308,15 @@ fn open_robot(dir: &Path) -> std::path::PathBuf {
   <link name="shell"><collision><geometry><mesh filename="open.obj"/></geometry></collision></link>
   <link name="marker">
     <collision><geometry><box size="0.1 0.2 0.3"/></geometry></collision>
+    <collision><origin xyz="0.5 0 0"/><geometry><mesh filename="plate.obj"/></geometry></collision>
+  </link>
+  <link name="tag">
     <collision><geometry><mesh filename="plate.obj"/></geometry></collision>
+    <collision><geometry><box size="0 0.1 0.1"/></geometry></collision>
+    <collision><geometry><mesh filename="sheet.obj"/></geometry></collision>
   </link>
   <joint name="j" type="fixed"><parent link="shell"/><child link="marker"/></joint>
+  <joint name="k" type="fixed"><parent link="shell"/><child link="tag"/></joint>
 </robot>
 "#,
     )
@@ -249,7 +326,8 @@ fn open_robot(dir: &Path) -> std::path::PathBuf {
 
 /// The real binary: an open mesh whose caps cannot be trusted fails its link with UI108 (JSON kind
 /// `open-mesh`), `--open-mesh hull` fills it with the hull; a flat plate beside a box contributes
-/// nothing, with a UI203 note.
+/// nothing, with a UI109 warning (the link is the box's analytic values); a link whose parts are all
+/// flat or zero-size is left as it is, with a UI109 warning (issue #22, item 5).
 #[test]
 fn open_mesh_flag_and_code_through_the_binary() {
     let tmp = tempfile::tempdir().expect("tempdir");
@@ -311,17 +389,7 @@ fn open_mesh_flag_and_code_through_the_binary() {
     };
     let box_volume = 0.3 * 0.2 * 0.1;
     assert!((mass("shell") / (1000.0 * box_volume) - 1.0).abs() < 1e-12);
-    // The plate adds nothing: the marker is its box alone.
-    assert!((mass("marker") / (1000.0 * 0.1 * 0.2 * 0.3) - 1.0).abs() < 1e-12);
-    let marker = links
-        .iter()
-        .find(|l| l["link"] == "marker")
-        .expect("marker");
-    let notes = marker["notes"].to_string();
-    assert!(
-        notes.contains("UI203") && notes.contains("plate.obj"),
-        "{notes}"
-    );
+    flat_parts_contribute_nothing(&json, &hull, &out);
 
     // `mesh` takes the flag too.
     let obj = tmp.path().join("open.obj");

@@ -106,18 +106,28 @@ pub fn mesh_lines(report: &FillReport, policy: &Policy) -> Vec<String> {
         .collect()
 }
 
-/// The lines of the links' own diagnostics (overlaps, overridden rules) the policy shows.
+/// The lines of the links' own diagnostics (overlaps, overridden rules, links left as they are for
+/// want of volume) the policy shows.
 pub fn link_lines(report: &FillReport, policy: &Policy) -> Vec<String> {
     report
         .links
         .iter()
-        .flat_map(|l| l.diagnostics.iter().map(move |d| (l, d)))
+        .flat_map(|l| l.diagnostics.iter().map(move |d| (l.name.as_str(), d)))
+        .chain(report.no_volume.iter().map(|d| {
+            (
+                d.location
+                    .as_ref()
+                    .and_then(|l| l.link.as_deref())
+                    .unwrap_or(""),
+                d,
+            )
+        }))
         .filter(|(_, d)| policy.shows(d))
-        .map(|(l, d)| {
+        .map(|(name, d)| {
             format!(
                 "{}: link `{}`: {}",
                 d.head(),
-                text::escape_control(&l.name),
+                text::escape_control(name),
                 d.message
             )
         })
@@ -368,6 +378,7 @@ pub fn fill_json(
 ) {
     let mut notes: Vec<&Diagnostic> = robot.notes.iter().collect();
     notes.extend(run);
+    notes.extend(&report.no_volume);
     let (total, computed, kept, _) = total_mass(robot, report);
     let v = json!({
         "urdf": robot.path.display().to_string(),

@@ -67,6 +67,9 @@ pub enum Code {
     /// holes are closed, and no model for open meshes was chosen (`--open-mesh`): the part fails.
     /// Carried by the link's error ([`LinkError::code`]).
     MeshNoSolid,
+    /// UI109: a collision mesh that encloses no volume however it is closed (a flat plate, a
+    /// two-sided sheet): the part contributes nothing; a link with no other part is left as it is.
+    MeshNoVolume,
     /// UI201: an element urdfdom ignores (a second `<origin>`, `<geometry>`, shape, `<inertial>`).
     UrdfIgnoredElement,
     /// UI202: a `<collision>` without a shape, ignored.
@@ -137,7 +140,7 @@ pub enum Code {
 
 impl Code {
     /// Every code, in table order.
-    pub const ALL: [Code; 40] = [
+    pub const ALL: [Code; 41] = [
         Code::MeshRepaired,
         Code::MeshFacesDropped,
         Code::MeshWelded,
@@ -146,6 +149,7 @@ impl Code {
         Code::MeshTooLarge,
         Code::MeshFacesCancelled,
         Code::MeshNoSolid,
+        Code::MeshNoVolume,
         Code::UrdfIgnoredElement,
         Code::UrdfEmptyCollision,
         Code::UrdfZeroVolume,
@@ -191,6 +195,7 @@ impl Code {
             Code::MeshTooLarge => "UI106",
             Code::MeshFacesCancelled => "UI107",
             Code::MeshNoSolid => "UI108",
+            Code::MeshNoVolume => "UI109",
             Code::UrdfIgnoredElement => "UI201",
             Code::UrdfEmptyCollision => "UI202",
             Code::UrdfZeroVolume => "UI203",
