@@ -121,13 +121,14 @@ pub(super) fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) ->
         }
     }
     // Caps too uncertain to trust: the model the user chose, or no solid (never a silent hull).
-    let no_solid = |caps_bound| {
+    let no_solid = |caps_bound, holes_see_each_other| {
         MeshError::new(
             ladder.path,
             None,
             MeshErrorKind::NoSolid(NoSolid {
                 what: what.clone(),
                 caps_bound,
+                holes_see_each_other,
             }),
         )
     };
@@ -136,7 +137,10 @@ pub(super) fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) ->
         (OpenMeshModel::Caps, Some((_, winding, plan))) => {
             with_caps(ladder, w, te, winding, plan, &what)
         }
-        (OpenMeshModel::Trusted, Some((relative, ..))) => Err(no_solid(Some(relative))),
+        (OpenMeshModel::Trusted, Some((relative, _, plan))) => Err(no_solid(
+            Some(relative),
+            plan.caps.interaction.volume > plan.caps.bound,
+        )),
         // No closing encloses a volume: a flat plate or a two-sided sheet has none to speak of (the
         // part contributes nothing); anything else defines no solid.
         (_, None) if crate::mesh::open::encloses_nothing(&w.vertices, &w.stored) => {
@@ -150,7 +154,7 @@ pub(super) fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) ->
                 },
             ))
         }
-        (_, None) => Err(no_solid(None)),
+        (_, None) => Err(no_solid(None, false)),
     }
 }
 
@@ -181,12 +185,20 @@ pub(super) fn non_manifold(
     })
 }
 
-/// The model error of caps: their bound near the loops they close, cracks left open and components
+/// The model error of caps: their flatness near the loops they close, what the caps of several holes
+/// seeing each other can change near them ([`Caps::interaction`]), cracks left open and components
 /// re-oriented anywhere.
 pub(super) fn caps_model(caps: &Caps, cracks: f64, nested: f64) -> Model {
+    let seen = &caps.interaction;
+    let near = if seen.volume.is_finite() {
+        Lever::Near(seen.points.clone())
+    } else {
+        Lever::Anywhere
+    };
     Model {
         terms: vec![
             (caps.bound, Lever::Near(caps.points.clone())),
+            (seen.volume, near),
             (cracks, Lever::Anywhere),
             (nested, Lever::Anywhere),
         ],
@@ -260,10 +272,20 @@ pub(super) fn with_caps(
     };
     let done = done.join(", ");
     let flips = winding.flips();
+    let seen = caps.interaction.volume > caps.bound;
     ladder.finish(plan.vertices, plan.faces, rung, model, |m, volume| {
-        Some(if m > 0.0 {
+        let seen = if seen {
+            " (mostly because its holes see each other: between their caps the winding number can be fractional)"
+        } else {
+            ""
+        };
+        Some(if !m.is_finite() {
             format!(
-                "mesh is {what}: {done}{flips}; its volume {volume:.6e} m³ and inertia are uncertain by at most {m:.1e} (relative) because of them"
+                "mesh is {what}: {done}{flips}; its volume {volume:.6e} m³ and inertia are not bounded (what the caps and the cracks left open can change is as large as the values)"
+            )
+        } else if m > 0.0 {
+            format!(
+                "mesh is {what}: {done}{flips}; its volume {volume:.6e} m³ and inertia are uncertain by at most {m:.1e} (relative) because of them{seen}"
             )
         } else {
             format!(
