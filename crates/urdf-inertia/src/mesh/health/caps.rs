@@ -46,10 +46,11 @@ struct CapShape {
 }
 
 /// The volume by which capping several holes can differ from the winding number's solid, m³, and
-/// the points whose reach bounds where that volume sits (`INFINITY` and no points when unbounded).
+/// its parts, each with the ball (centre, radius) it lies in (`INFINITY` and no parts when
+/// unbounded).
 pub(super) struct Interaction {
     pub(super) volume: f64,
-    pub(super) points: Vec<[f64; 3]>,
+    pub(super) parts: Vec<(f64, [f64; 3], f64)>,
 }
 
 /// Closes every boundary loop of `faces` with a fan from the loop's centroid, wound against the loop's
@@ -84,7 +85,7 @@ pub(super) fn cap_holes(vertices: &[[f64; 3]], half: &[(u32, u32)]) -> Option<Ca
         loops: Vec::new(),
         interaction: Interaction {
             volume: 0.0,
-            points: Vec::new(),
+            parts: Vec::new(),
         },
     };
     for start in 0..half.len() {
@@ -211,7 +212,7 @@ impl Caps {
         let n = groups.len();
         let mut out = Interaction {
             volume: 0.0,
-            points: Vec::new(),
+            parts: Vec::new(),
         };
         if n < 2 {
             return out;
@@ -265,21 +266,16 @@ impl Caps {
             if volume.is_nan() {
                 return Interaction {
                     volume: f64::INFINITY,
-                    points: Vec::new(),
+                    parts: Vec::new(),
                 };
             }
             if volume == 0.0 {
                 continue;
             }
             out.volume += volume;
-            // The corners of a cube around the ball that holds the cylinder: where the volume sits.
+            // The ball around the cylinder: where this part sits.
             let ball = (disc * disc + half * half).sqrt();
-            for corner in 0..8 {
-                out.points.push([0, 1, 2].map(|i| {
-                    let sign = if corner >> i & 1 == 1 { 1.0 } else { -1.0 };
-                    c.centre[i] + sign * ball
-                }));
-            }
+            out.parts.push((volume, c.centre, ball));
         }
         out
     }

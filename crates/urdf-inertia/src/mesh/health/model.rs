@@ -7,11 +7,12 @@ use crate::mass::{frobenius, MassProperties, Polygons};
 use crate::mesh::{MeshError, MeshErrorKind};
 use std::path::Path;
 
-/// Where the volume of a model error may sit: anywhere in the solid, or near given points (the
-/// loops a cap closes).
+/// Where the volume of a model error may sit: anywhere in the solid, near given points (the loops a
+/// cap closes), or in a ball (centre, radius).
 pub(super) enum Lever {
     Anywhere,
     Near(Vec<[f64; 3]>),
+    Ball([f64; 3], f64),
 }
 
 /// A model error: volumes (m³) by which the solid can differ from the stored surface, each with where
@@ -54,6 +55,7 @@ impl Model {
             let r = match lever {
                 Lever::Anywhere => reach(unit, vertices),
                 Lever::Near(points) => reach(unit, points),
+                Lever::Ball(centre, radius) => dist(*centre, unit.com) + radius,
             };
             volume += delta;
             inertia += 3.0 * delta * r * r;
