@@ -275,6 +275,18 @@ fn flat_parts_contribute_nothing(json: &serde_json::Value, hull: &[&str], out: &
             && stderr.contains("warning[UI109]: link `tag`: its collision geometry has no volume"),
         "{stderr}"
     );
+    // `check` with densities agrees: the link left as it is misses no <inertial> (exit 0, no UI601).
+    let out_text = out.to_str().expect("utf-8");
+    let c = run(&[
+        "check",
+        out_text,
+        "--density",
+        "1000",
+        "--open-mesh",
+        "hull",
+    ]);
+    let said = String::from_utf8_lossy(&c.stdout).to_string() + &String::from_utf8_lossy(&c.stderr);
+    assert!(c.status.success() && !said.contains("UI601"), "{said}");
     let written = std::fs::read_to_string(out).expect("written");
     let tag = &written[written.find("<link name=\"tag\">").expect("tag")..];
     assert!(
