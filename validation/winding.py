@@ -32,14 +32,7 @@ from meshes import collision_meshes  # noqa: E402
 
 # Meshes whose estimate is known to be below the reference's difference, each with the reason (relative to
 # the robots directory). Keep short: every entry is a number printed without an honest bound.
-_BAND = ("two planar holes (the open ends of a band of no thickness) capped flat: each flat cap alone is the "
-         "|w| = 1/2 surface over its loop, but together the caps subtend more than 2 pi from the points between "
-         "them, where w is fractional, so the capped solid is about 6x the winding-number solid; the caps' bound "
-         "measures how flat the loops are, not this (a bound for several holes that see each other is not done)")
-KNOWN = {
-    "alex_description/meshes/cycloidal_arm/LeftGripperYawLink.obj": _BAND,
-    "alex_description/meshes/cycloidal_arm/RightGripperYawLink.obj": _BAND,
-}
+KNOWN = {}
 
 # Points per mesh (the cells of the stratified grid number half as many): about 1 s per mesh.
 POINTS = 100_000

@@ -216,6 +216,7 @@ impl Policy {
             }
             self.apply_all(&mut l.diagnostics);
         }
+        self.apply_all(&mut report.no_volume);
     }
 }
 

@@ -537,6 +537,10 @@ fn run_one(
     };
     let src = &config.src;
     let mut report = urdf_inertia::compute_with(robot, map, &src.resolver, &src.options, cache);
+    // Before the policy, which may drop their UI109 warnings.
+    let flat_links: Vec<String> = (report.no_volume.iter())
+        .filter_map(|d| d.location.as_ref()?.link.clone())
+        .collect();
     config.policy.apply_report(&mut report);
     print_failures(&input, &report);
     outcome.errors += report.error_count();
@@ -556,6 +560,13 @@ fn run_one(
         }
         Mode::Check { .. } => {
             summary::computed_diagnostics(&report, &config.policy);
+            // A link `fill` leaves as it is for want of volume (every part a flat mesh) misses no
+            // <inertial>, as a link whose parts are all zero-size primitives does not.
+            found.problems.retain(|p| {
+                !(p.problem.file == robot.path
+                    && p.problem.kind == ProblemKind::MissingInertial
+                    && flat_links.contains(&p.problem.link))
+            });
             check_against_computed(&input, &report, config, &mut found.problems);
             found.record_links(robot, Some(&report), from, config.tolerance);
             outcome.problems += promoted;

@@ -104,18 +104,28 @@ pub fn mesh_lines(report: &FillReport, policy: &Policy) -> Vec<String> {
         .collect()
 }
 
-/// The lines of the links' own diagnostics (overlaps, overridden rules) the policy shows.
+/// The lines of the links' own diagnostics (overlaps, overridden rules, links left as they are for
+/// want of volume) the policy shows.
 pub fn link_lines(report: &FillReport, policy: &Policy) -> Vec<String> {
     report
         .links
         .iter()
-        .flat_map(|l| l.diagnostics.iter().map(move |d| (l, d)))
+        .flat_map(|l| l.diagnostics.iter().map(move |d| (l.name.as_str(), d)))
+        .chain(report.no_volume.iter().map(|d| {
+            (
+                d.location
+                    .as_ref()
+                    .and_then(|l| l.link.as_deref())
+                    .unwrap_or(""),
+                d,
+            )
+        }))
         .filter(|(_, d)| policy.shows(d))
-        .map(|(l, d)| {
+        .map(|(name, d)| {
             format!(
                 "{}: link `{}`: {}",
                 d.head(),
-                text::escape_control(&l.name),
+                text::escape_control(name),
                 d.message
             )
         })
@@ -336,6 +346,7 @@ pub fn fill_json(
 ) {
     let mut notes: Vec<Diagnostic> = robot.notes.clone();
     notes.extend_from_slice(run);
+    notes.extend_from_slice(&report.no_volume);
     let errors = report.failures.iter().map(ErrorRecord::from);
     let robot_errors = report.robot_errors.iter().map(ErrorRecord::from);
     print_json(&FillOutput {

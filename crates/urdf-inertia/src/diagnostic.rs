@@ -87,6 +87,9 @@ pub enum Code {
     /// holes are closed, and no model for open meshes was chosen (`--open-mesh`): the part fails.
     /// Carried by the link's error ([`LinkErrorKind::code`]).
     MeshNoSolid,
+    /// UI109: a collision mesh that encloses no volume however it is closed (a flat plate, a
+    /// two-sided sheet): the part contributes nothing; a link with no other part is left as it is.
+    MeshNoVolume,
     /// UI201: an element urdfdom ignores (a second `<origin>`, `<geometry>`, shape, `<inertial>`).
     UrdfIgnoredElement,
     /// UI202: a `<collision>` without a shape, ignored.
@@ -157,7 +160,7 @@ pub enum Code {
 
 impl Code {
     /// Every code, in table order.
-    pub const ALL: [Code; 40] = [
+    pub const ALL: [Code; 41] = [
         Code::MeshRepaired,
         Code::MeshFacesDropped,
         Code::MeshWelded,
@@ -166,6 +169,7 @@ impl Code {
         Code::MeshTooLarge,
         Code::MeshFacesCancelled,
         Code::MeshNoSolid,
+        Code::MeshNoVolume,
         Code::UrdfIgnoredElement,
         Code::UrdfEmptyCollision,
         Code::UrdfZeroVolume,
@@ -211,6 +215,7 @@ impl Code {
             Code::MeshTooLarge => "UI106",
             Code::MeshFacesCancelled => "UI107",
             Code::MeshNoSolid => "UI108",
+            Code::MeshNoVolume => "UI109",
             Code::UrdfIgnoredElement => "UI201",
             Code::UrdfEmptyCollision => "UI202",
             Code::UrdfZeroVolume => "UI203",

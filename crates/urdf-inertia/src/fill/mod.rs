@@ -154,8 +154,12 @@ pub struct FillReport {
     pub failures: Vec<LinkError>,
     /// What stopped the robot as a whole (no density for some links, an unreachable `total_mass`).
     pub robot_errors: Vec<RobotError>,
-    /// Links with no collision geometry (left as they are).
+    /// Links with no collision geometry (left as they are), counting those whose every part is a mesh
+    /// that encloses no volume.
     pub without_geometry: usize,
+    /// One warning (UI109) per link left as it is because every part of it is a mesh that encloses
+    /// no volume (a flat plate, a two-sided sheet).
+    pub no_volume: Vec<Diagnostic>,
     /// Links not selected (--only/--skip/--missing-only).
     pub not_selected: usize,
     /// Distinct mesh files the selected links use (read by this call, or before it with a shared
@@ -210,14 +214,18 @@ pub fn compute_with(
     let mut density_links: Vec<usize> = Vec::new();
     for (link, result) in results {
         match result {
-            Ok(Some((l, density_based))) => {
+            Ok(LinkOutcome::Computed(l, density_based)) => {
                 if density_based {
                     density_links.push(report.links.len());
                 }
                 report.faces += l.faces;
                 report.links.push(l.report);
             }
-            Ok(None) => missing_density.push((link.name.clone(), link.line)),
+            Ok(LinkOutcome::NoDensity) => missing_density.push((link.name.clone(), link.line)),
+            Ok(LinkOutcome::NoVolume(d)) => {
+                report.without_geometry += 1;
+                report.no_volume.push(d);
+            }
             Err(e) => report.failures.push(e),
         }
     }
@@ -239,9 +247,20 @@ pub fn compute_with(
     report
 }
 
-/// A link's result: computed (with whether its mass follows from densities alone), without a density
-/// (`None`), or failed.
-type LinkResult = Result<Option<(ComputedLink, bool)>, LinkError>;
+/// A link's result: computed (with whether its mass follows from densities alone), without a density,
+/// left as it is because none of its parts has a volume, or failed.
+type LinkResult = Result<LinkOutcome, LinkError>;
+
+/// What became of a link that did not fail.
+enum LinkOutcome {
+    /// Computed, and whether its mass follows from densities alone (what `total_mass` scales).
+    Computed(ComputedLink, bool),
+    /// No density from anywhere (reported for all such links at once).
+    NoDensity,
+    /// Every part a mesh that encloses no volume: left as it is, like a link whose parts are all
+    /// zero-size primitives, with this warning (UI109).
+    NoVolume(Diagnostic),
+}
 
 /// Every selected link computed, in link order, and the number of distinct mesh files they use (read
 /// now or before); counts the links left alone into `report`. The meshes are read and healed in
@@ -292,8 +311,13 @@ fn compute_links<'r>(
     };
     let results = cache.load_and_run(&needs, health, |t, solids| {
         let (li, link) = targets[t];
-        link_parts(link, ctx, solids)
-            .and_then(|(parts, flat)| compute_link(li, link, parts, flat, map, opts))
+        link_parts(link, ctx, solids).and_then(|(parts, flat)| {
+            if parts.is_empty() {
+                Ok(LinkOutcome::NoVolume(no_volume(link, &flat)))
+            } else {
+                compute_link(li, link, parts, flat, map, opts)
+            }
+        })
     });
     let links = targets.iter().map(|(_, link)| *link).zip(results).collect();
     (mesh_files, links)
@@ -305,10 +329,9 @@ struct ComputedLink {
     faces: usize,
 }
 
-/// A link's parts (its collisions but the zero-size ones), or the first that fails; with the notes
-/// of the meshes that enclose no volume (a flat plate, a two-sided sheet), which contribute nothing
-/// as a zero-size primitive does (UI203). A link left with no part fails with the first such mesh's
-/// error: it has nothing to compute from.
+/// A link's parts (its collisions but the zero-size ones), or the first that fails; with a warning
+/// (UI109) for each mesh that encloses no volume (a flat plate, a two-sided sheet), which contributes
+/// nothing as a zero-size primitive does. The parts are empty when every collision is such a mesh.
 fn link_parts(
     link: &Link,
     ctx: &Context<'_>,
@@ -316,7 +339,6 @@ fn link_parts(
 ) -> Result<(Vec<Part>, Vec<Diagnostic>), LinkError> {
     let mut parts = Vec::new();
     let mut flat = Vec::new();
-    let mut first_flat = None;
     for c in link
         .collisions
         .iter()
@@ -335,16 +357,30 @@ fn link_parts(
                     crate::text::significant(volume, 4),
                     crate::text::significant(bbox, 4)
                 );
-                let note = Diagnostic::new(Code::UrdfZeroVolume, message);
-                flat.push(note.at(part_location(link, c)));
-                first_flat.get_or_insert(e);
+                let warning = Diagnostic::new(Code::MeshNoVolume, message);
+                flat.push(warning.at(part_location(link, c)));
             }
         }
     }
-    match first_flat {
-        Some(e) if parts.is_empty() => Err(e),
-        _ => Ok((parts, flat)),
-    }
+    Ok((parts, flat))
+}
+
+/// The warning of a link whose every part encloses no volume: it is left as it is, as a link whose
+/// parts are all zero-size primitives is (the scan's UI203).
+fn no_volume(link: &Link, flat: &[Diagnostic]) -> Diagnostic {
+    let parts: Vec<&str> = flat.iter().map(|d| d.message.as_str()).collect();
+    Diagnostic::new(
+        Code::MeshNoVolume,
+        format!(
+            "its collision geometry has no volume ({}): the link is left as it is, like a link without collision geometry",
+            parts.join("; ")
+        ),
+    )
+    .at(Location {
+        line: Some(link.line),
+        link: Some(link.name.clone()),
+        ..Location::default()
+    })
 }
 
 /// The mesh (its path, volume and bounding-box volume) when a part failed only because its mesh
@@ -362,7 +398,7 @@ fn is_flat(e: &LinkError) -> Option<(String, f64, f64)> {
     }
 }
 
-/// One link: its parts, their densities, the body, the overlap estimate. `Ok(None)` when the link has
+/// One link: its parts, their densities, the body, the overlap estimate. `NoDensity` when the link has
 /// no density from anywhere (reported for all such links at once); the flag says whether the link's
 /// mass follows from densities alone (what `total_mass` scales).
 fn compute_link(
@@ -374,7 +410,7 @@ fn compute_link(
     opts: &FillOptions,
 ) -> LinkResult {
     let Some(densities) = densities(link, &parts, map, opts)? else {
-        return Ok(None);
+        return Ok(LinkOutcome::NoDensity);
     };
     let (computed, part_reports) = body(&parts, &densities);
     let size = parts.iter().fold(
@@ -419,7 +455,10 @@ fn compute_link(
         diagnostics,
     };
     let faces = parts.iter().map(|p| p.faces).sum();
-    Ok(Some((ComputedLink { report, faces }, density_based)))
+    Ok(LinkOutcome::Computed(
+        ComputedLink { report, faces },
+        density_based,
+    ))
 }
 
 /// Why computed mass properties cannot be written, if they cannot: every check of

@@ -10,7 +10,7 @@
 /// How a mesh whose holes' caps cannot be trusted becomes a solid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum OpenMeshModel {
-    /// Flat caps when their bound is below [`TRUSTED_CAPS`]; otherwise the part fails.
+    /// Flat caps when their bound is below 1e-3; otherwise the part fails.
     #[default]
     Trusted,
     /// Flat caps whatever their bound (which the estimate carries).
@@ -40,15 +40,23 @@ pub struct NoSolid {
     pub what: String,
     /// The caps' relative bound, when caps could be built (infinite: unbounded).
     pub caps_bound: Option<f64>,
+    /// Most of the caps' bound comes from the caps of several holes seeing each other (an open band
+    /// or dish: the winding number between them can be fractional), not from the loops' flatness.
+    pub holes_see_each_other: bool,
 }
 
 impl std::fmt::Display for NoSolid {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let seen = if self.holes_see_each_other {
+            " (mostly because its holes see each other: between their caps the winding number can be fractional, as in an open band or dish)"
+        } else {
+            ""
+        };
         let why = match self.caps_bound {
             Some(b) if b.is_finite() => format!(
-                "flat caps over its holes leave a bound of {b:.1e} on volume and inertia, above the {TRUSTED_CAPS:.0e} they are trusted to"
+                "flat caps over its holes leave a bound of {b:.1e} on volume and inertia{seen}, above the {TRUSTED_CAPS:.0e} they are trusted to"
             ),
-            Some(_) => "flat caps over its holes leave volume and inertia unbounded".to_string(),
+            Some(_) => format!("flat caps over its holes leave volume and inertia unbounded{seen}"),
             None => "no closing of its holes encloses a volume".to_string(),
         };
         write!(

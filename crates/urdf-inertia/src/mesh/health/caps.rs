@@ -1,5 +1,6 @@
-//! Flat caps over the boundary loops of an open surface, with the bound their flatness leaves. Moved
-//! out of the ladder ([`super`]) as it is.
+//! Flat caps over the boundary loops of an open surface, with the bounds they leave: their flatness,
+//! and how much the caps of several holes, seen from near one another, can move the solid that the
+//! winding number defines ([`Caps::interaction`]).
 
 use crate::geometry::{cross, dot, sub};
 use crate::mass::Polygons;
@@ -19,6 +20,37 @@ pub(super) struct Caps {
     pub(super) area: f64,
     /// The vertices of the loops closed and the caps' centres: where the caps' uncertainty sits.
     pub(super) points: Vec<[f64; 3]>,
+    /// Each cap's shape, for [`Caps::interaction`].
+    loops: Vec<CapShape>,
+    /// What the caps seeing each other can change ([`Caps::interaction`]), set once all are closed.
+    pub(super) interaction: Interaction,
+}
+
+/// One cap: a fan from `centre` over a loop, within `deviation` of a plane through `centre`.
+#[derive(Clone)]
+struct CapShape {
+    centre: [f64; 3],
+    /// Unit normal of the plane (zero when the loop has no vector area).
+    normal: [f64; 3],
+    /// The loop's vertices: a range of [`Caps::points`].
+    loop_points: std::ops::Range<usize>,
+    /// Largest distance of a loop vertex from the centre, m.
+    radius: f64,
+    /// Sum of the fan triangles' areas, m² (at least the planar area).
+    area: f64,
+    /// Largest distance of a loop vertex from the plane, m.
+    deviation: f64,
+    /// Bounding box of the loop (the fan lies in it).
+    lo: [f64; 3],
+    hi: [f64; 3],
+}
+
+/// The volume by which capping several holes can differ from the winding number's solid, m³, and
+/// its parts, each with the ball (centre, radius) it lies in (`INFINITY` and no parts when
+/// unbounded).
+pub(super) struct Interaction {
+    pub(super) volume: f64,
+    pub(super) parts: Vec<(f64, [f64; 3], f64)>,
 }
 
 /// Closes every boundary loop of `faces` with a fan from the loop's centroid, wound against the loop's
@@ -50,6 +82,11 @@ pub(super) fn cap_holes(vertices: &[[f64; 3]], half: &[(u32, u32)]) -> Option<Ca
         bound: 0.0,
         area: 0.0,
         points: Vec::new(),
+        loops: Vec::new(),
+        interaction: Interaction {
+            volume: 0.0,
+            parts: Vec::new(),
+        },
     };
     for start in 0..half.len() {
         if used[start] {
@@ -82,6 +119,7 @@ pub(super) fn cap_holes(vertices: &[[f64; 3]], half: &[(u32, u32)]) -> Option<Ca
         caps.close(vertices, base, &steps);
     }
     // What cracks leave open is accounted for by the caller: the capped surface's vector area.
+    caps.interaction = caps.interaction();
     Some(caps)
 }
 
@@ -95,6 +133,7 @@ impl Caps {
         let ci = base + self.centroids.len() as u32;
         self.centroids.push(c);
         self.points.push(c);
+        let first = self.points.len();
         self.points
             .extend(steps.iter().map(|s| vertices[s.0 as usize]));
         let mut area = [0.0f64; 3];
@@ -108,6 +147,26 @@ impl Caps {
         }
         let len = dot(area, area).sqrt();
         self.area += len;
+        let mut shape = CapShape {
+            centre: c,
+            normal: [0.0; 3],
+            loop_points: first..self.points.len(),
+            radius: 0.0,
+            area: 0.0,
+            deviation: 0.0,
+            lo: c,
+            hi: c,
+        };
+        for &(v, a, b) in steps {
+            let p = vertices[v as usize];
+            shape.radius = shape.radius.max(norm(sub(p, c)));
+            let x = cross(sub(vertices[b as usize], c), sub(vertices[a as usize], c));
+            shape.area += 0.5 * norm(x);
+            for k in 0..3 {
+                shape.lo[k] = shape.lo[k].min(p[k]);
+                shape.hi[k] = shape.hi[k].max(p[k]);
+            }
+        }
         if len > 0.0 {
             let nrm = area.map(|x| x / len);
             let dev = steps
@@ -115,6 +174,217 @@ impl Caps {
                 .map(|s| dot(sub(vertices[s.0 as usize], c), nrm).abs())
                 .fold(0.0, f64::max);
             self.bound += 2.0 * dev * len;
+            shape.deviation = dev;
+            shape.normal = nrm;
+        } else {
+            // No plane: the cap may be anywhere within its loop's reach.
+            shape.deviation = shape.radius;
         }
+        self.loops.push(shape);
     }
+
+    /// A bound on the volume by which the capped solid differs from Ω = {x : |w(x)| ≥ ½}, w the
+    /// winding number of the open surface, that comes from the caps seeing each other.
+    ///
+    /// The capped surface has an integer winding number w_c, and w = w_c − Σⱼ wⱼ, wⱼ the winding
+    /// number of cap j; where w_c is 0 or 1 the two solids differ only where Σⱼ |wⱼ| ≥ ½. A flat cap
+    /// alone has |wⱼ| < ½ off its plane (it subtends less than a half-space), so one hole is exact and
+    /// this bound is 0; its non-flatness is the flatness term. With several caps of areas Aⱼ:
+    ///
+    /// * |wⱼ(x)| ≤ Aⱼ / (4π dⱼ²), dⱼ the distance from x to cap j (a surface of area Aⱼ subtends at
+    ///   most Aⱼ/dⱼ²). Where they differ, some cap k has |wₖ| ≥ ½·√Aₖ/Σ√A (the thresholds sum to
+    ///   ½), so x lies within ρₖ = Aₖ^¼·√(Σ√A / 2π) of cap k: in a cylinder about its plane of radius
+    ///   R + ρₖ (R the loop's largest distance from its centre) and half-height ρₖ plus the loop's
+    ///   deviation, and in the loop's box grown by ρₖ.
+    /// * Moreover ½ − |wₖ(x)| ≤ Σ_{j≠k} |wⱼ(x)| ≤ δₖ, the other caps' bound over that neighbourhood
+    ///   (at their boxes' distance from its box). For a flat cap inside a disc of radius R, at height
+    ///   h above its plane and in-plane distance ρ' from its centre, ½ − |wₖ| ≥ ½·h / √(h² +
+    ///   (R + ρ')²) (the plane outside the disc of radius R + ρ' about x's foot), so when δₖ < ½, x
+    ///   lies in a slab of half-thickness 2δₖ(R + ρ') / √(1 − 4δₖ²) (plus the deviation) over a disc
+    ///   of radius R + d, d ≤ ρ the distance |wₖ| ≥ ½ − δₖ allows.
+    ///
+    /// The bound is the sum over the caps (coplanar groups of them: [`Caps::coplanar_groups`]) of
+    /// the smallest of these volumes. It is the caps of an
+    /// open band (a tube open at both ends, whose caps see each other at a large solid angle: the
+    /// winding number is fractional between them) that make it large.
+    pub(super) fn interaction(&self) -> Interaction {
+        let groups = self.coplanar_groups();
+        let n = groups.len();
+        let mut out = Interaction {
+            volume: 0.0,
+            parts: Vec::new(),
+        };
+        if n < 2 {
+            return out;
+        }
+        // Every pair of caps is looked at: beyond this many holes, not bounded (the caps are then
+        // used only if the user asks for them).
+        if n > MAX_INTERACTING {
+            out.volume = f64::INFINITY;
+            return out;
+        }
+        let pi = std::f64::consts::PI;
+        // Thresholds τₖ = ½·√Aₖ / Σ√A (they sum to ½): |wₖ| ≥ τₖ within ρₖ = √(Aₖ / 4πτₖ) of cap k,
+        // so small caps get small neighbourhoods.
+        let roots: f64 = groups.iter().map(|c| c.area.sqrt()).sum();
+        // The other caps' largest winding number anywhere in the box `lo..hi`.
+        let others = |k: usize, lo: [f64; 3], hi: [f64; 3]| -> f64 {
+            (0..n)
+                .filter(|&j| j != k)
+                .map(|j| {
+                    let c = &groups[j];
+                    let d = box_distance(lo, hi, c.lo, c.hi);
+                    if d > 0.0 {
+                        c.area / (4.0 * pi * d * d)
+                    } else {
+                        f64::INFINITY
+                    }
+                })
+                .sum()
+        };
+        let grown = |c: &CapShape, by: f64| (c.lo.map(|x| x - by), c.hi.map(|x| x + by));
+        for (k, c) in groups.iter().enumerate() {
+            let rho = c.area.sqrt().sqrt() * (roots / (2.0 * pi)).sqrt();
+            // The neighbourhood where cap k can be the one that tips the sum.
+            let (disc, half) = (c.radius + rho, c.deviation + rho);
+            let (lo, hi) = grown(c, rho);
+            // The cylinder, or the box grown by ρ (a sliver along an axis).
+            let boxed = (0..3).map(|i| hi[i] - lo[i]).product::<f64>();
+            let mut volume = (2.0 * half * pi * disc * disc).min(boxed);
+            let mut delta = others(k, lo, hi);
+            if delta < 0.5 {
+                // Where |w_k| ≥ ½ − δ: within d ≤ ρ; the other caps seen from there, once more.
+                let mut d = rho.min((c.area / (4.0 * pi * (0.5 - delta))).sqrt());
+                let (lo, hi) = grown(c, d);
+                delta = delta.min(others(k, lo, hi));
+                d = d.min((c.area / (4.0 * pi * (0.5 - delta))).sqrt());
+                let a = 2.0 * c.radius + d;
+                let t = 2.0 * delta * a / (1.0 - 4.0 * delta * delta).sqrt() + c.deviation;
+                let r = c.radius + d;
+                volume = volume.min(2.0 * t * pi * r * r);
+            }
+            if volume.is_nan() {
+                return Interaction {
+                    volume: f64::INFINITY,
+                    parts: Vec::new(),
+                };
+            }
+            if volume == 0.0 {
+                continue;
+            }
+            out.volume += volume;
+            // The ball around the cylinder: where this part sits.
+            let ball = (disc * disc + half * half).sqrt();
+            out.parts.push((volume, c.centre, ball));
+        }
+        out
+    }
+
+    /// The caps gathered into coplanar groups: caps in one plane (within their own deviation from
+    /// it, up to 1e-9 of the group's size) whose loops' boxes in that plane are disjoint. Such a
+    /// group is one flat region (its caps do not overlap), so its winding number is below ½ in
+    /// magnitude off its plane like a single cap's: the caps of one group do not tip each other.
+    /// A hole split at a pinch vertex, or several holes in one flat side, are one group.
+    fn coplanar_groups(&self) -> Vec<CapShape> {
+        let pts = |c: &CapShape| &self.points[c.loop_points.clone()];
+        // An in-plane box of a cap's loop, in the plane's basis (u, v).
+        let flat_box = |c: &CapShape, u: [f64; 3], v: [f64; 3]| {
+            let mut b = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+            for p in pts(c) {
+                let (x, y) = (dot(*p, u), dot(*p, v));
+                b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
+            }
+            b
+        };
+        let mut groups: Vec<(CapShape, Vec<usize>)> = Vec::new();
+        for (k, c) in self.loops.iter().enumerate() {
+            let joined = (c.normal != [0.0; 3])
+                .then(|| {
+                    groups.iter_mut().find(|(g, members)| {
+                        if g.normal == [0.0; 3] || dot(g.normal, c.normal).abs() < 1.0 - 1e-12 {
+                            return false;
+                        }
+                        let n = g.normal;
+                        let size = g.radius + c.radius + norm(sub(g.centre, c.centre));
+                        let off = pts(c)
+                            .iter()
+                            .map(|p| dot(sub(*p, g.centre), n).abs())
+                            .fold(0.0, f64::max);
+                        if off > g.deviation.max(c.deviation) + 1e-9 * size {
+                            return false;
+                        }
+                        let u = any_perpendicular(n);
+                        let v = cross(n, u);
+                        let b = flat_box(c, u, v);
+                        members.iter().all(|&m| {
+                            let o = flat_box(&self.loops[m], u, v);
+                            b[2] < o[0] || o[2] < b[0] || b[3] < o[1] || o[3] < b[1]
+                        })
+                    })
+                })
+                .flatten();
+            match joined {
+                Some((g, members)) => {
+                    members.push(k);
+                    *g = self.merged(g.normal, members);
+                }
+                None => groups.push((c.clone(), vec![k])),
+            }
+        }
+        groups.into_iter().map(|g| g.0).collect()
+    }
+
+    /// One flat region made of the caps `members`, in the plane of unit normal `normal` through the
+    /// centre of their loops' box.
+    fn merged(&self, normal: [f64; 3], members: &[usize]) -> CapShape {
+        let mut g = self.loops[members[0]].clone();
+        for &m in &members[1..] {
+            let c = &self.loops[m];
+            g.area += c.area;
+            for k in 0..3 {
+                g.lo[k] = g.lo[k].min(c.lo[k]);
+                g.hi[k] = g.hi[k].max(c.hi[k]);
+            }
+        }
+        g.normal = normal;
+        g.centre = [0, 1, 2].map(|k| 0.5 * (g.lo[k] + g.hi[k]));
+        let (mut radius, mut deviation) = (0.0f64, 0.0f64);
+        for &m in members {
+            let c = &self.loops[m];
+            for p in self.points[c.loop_points.clone()].iter().chain([&c.centre]) {
+                radius = radius.max(norm(sub(*p, g.centre)));
+                deviation = deviation.max(dot(sub(*p, g.centre), normal).abs());
+            }
+            // A member's own fan is within its deviation of its loop's plane.
+            deviation = deviation.max(c.deviation);
+        }
+        g.radius = radius;
+        g.deviation = deviation;
+        g
+    }
+}
+
+/// Holes beyond which [`Caps::interaction`] (quadratic in them) is not computed but unbounded.
+const MAX_INTERACTING: usize = 4_096;
+
+/// A unit vector perpendicular to the unit vector `n`.
+fn any_perpendicular(n: [f64; 3]) -> [f64; 3] {
+    let axis = if n[0].abs() < 0.6 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let u = cross(n, axis);
+    let l = norm(u);
+    u.map(|x| x / l)
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// The distance between two boxes (0 when they meet).
+fn box_distance(alo: [f64; 3], ahi: [f64; 3], blo: [f64; 3], bhi: [f64; 3]) -> f64 {
+    let gap = [0, 1, 2].map(|k| (blo[k] - ahi[k]).max(alo[k] - bhi[k]).max(0.0));
+    norm(gap)
 }

@@ -1,0 +1,255 @@
+//! The closed rungs: as stored, welded, inverted or re-oriented component by component.
+
+use super::geometry::{
+    bbox, component_boxes, component_volumes, contains, dist, vector_area,
+};
+use super::ladder::Ladder;
+use super::topology::{Edges, Orientation};
+use super::welding::Welding;
+use super::{HealthKind, ModelError, Rung, Solid};
+use crate::geometry::{cross, dot, sub};
+use crate::mass::integrals::{bounding_box_centre, volume_integrals};
+use crate::mass::{IntegrationOptions, Polygons};
+use crate::mesh::MeshError;
+
+/// Closed and consistent (bit-exact or after the tolerant weld): as stored, flipped if inward, or with
+/// the components re-oriented whose winding contradicts their nesting.
+///
+/// `kept` are the faces the topology (the component ids `comp`) numbers, `None` when they are `stored`
+/// themselves.
+pub(super) fn consistent_closed(
+    mut ladder: Ladder<'_>,
+    vertices: Vec<[f64; 3]>,
+    stored: Polygons,
+    kept: Option<Polygons>,
+    (comp, ncomp): (Vec<u32>, usize),
+    rung: Rung,
+) -> Result<Solid, MeshError> {
+    // Closed only once welded within tolerance: the stored surface's vector area is not exactly 0.
+    let welded = kept.is_some();
+    let t = volume_integrals(&vertices, &stored, &IntegrationOptions::accurate());
+    let inverted = t.t1 < 0.0;
+    let mut faces = stored;
+    let mut kept = kept;
+    let mut rung = rung;
+    if inverted {
+        ladder.strict("closed mesh wound inward")?;
+        let all = vec![true; faces.len()];
+        apply(&mut faces, &all);
+        if let Some(k) = kept.as_mut() {
+            let all = vec![true; k.len()];
+            apply(k, &all);
+        }
+        ladder.warn(
+            HealthKind::Repaired,
+            format!(
+                "all {} faces wound inward (negative volume); flipped",
+                faces.len()
+            ),
+        );
+        rung = Rung::Inverted;
+    }
+    let topology_faces = kept.as_ref().unwrap_or(&faces);
+    if ncomp > 1 {
+        let flip = misoriented(&vertices, topology_faces, &comp, ncomp);
+        if flip.iter().any(|f| *f) {
+            ladder.strict("a closed component is wound inward")?;
+            let reversed: Vec<bool> = comp.iter().map(|&c| flip[c as usize]).collect();
+            let mut out = topology_faces.clone();
+            apply(&mut out, &reversed);
+            let flipped = reversed.iter().filter(|r| **r).count();
+            let turned = flip.iter().filter(|f| **f).count();
+            ladder.warn(HealthKind::Repaired, format!(
+                "{turned} of {ncomp} closed components wound inward although no other component encloses them (a cavity must lie inside a solid); {flipped} faces flipped"
+            ));
+            let model = open_volume(&vertices, &out);
+            let rung = Rung::Reoriented {
+                faces_flipped: flipped,
+                components: ncomp,
+            };
+            return ladder.finish(vertices, out, rung, (model, ModelError::Cracks), |_, _| {
+                None
+            });
+        }
+    }
+    if let Rung::Welded {
+        merged_vertices,
+        widest_crack,
+        tolerance,
+    } = rung
+    {
+        ladder.note(HealthKind::Welded, format!(
+            "closed once {merged_vertices} corners stored up to {widest_crack:.1e} m apart are welded (tolerance {tolerance:.1e} m); integrated as stored"
+        ));
+    }
+    let model = if welded {
+        open_volume(&vertices, &faces)
+    } else {
+        0.0
+    };
+    // The faces are the stored ones, or all of them reversed: their integrals are known.
+    ladder.known = Some(if inverted { t.negated() } else { t });
+    ladder.finish(
+        vertices,
+        faces,
+        rung,
+        (model, ModelError::Cracks),
+        |_, _| None,
+    )
+}
+
+/// Components beyond this many are not checked for nesting (quadratic in the components).
+pub(super) const NESTING_CHECK: usize = 2_000;
+
+/// Which components to flip: those wound inward (negative volume) at an even nesting depth, where a
+/// component's depth is the number of larger components whose bounding boxes contain its own. A
+/// component wound inward that nothing encloses cannot be a cavity. An outward component at an odd
+/// depth is kept: bounding boxes cannot tell a cavity wound the wrong way from a part lying in
+/// another's concavity.
+pub(super) fn misoriented(vertices: &[[f64; 3]], faces: &Polygons, comp: &[u32], ncomp: usize) -> Vec<bool> {
+    if ncomp > NESTING_CHECK {
+        return vec![false; ncomp];
+    }
+    let vol = component_volumes(vertices, faces, comp, ncomp);
+    if vol.iter().all(|v| *v >= 0.0) {
+        return vec![false; ncomp];
+    }
+    let boxes = component_boxes(vertices, faces, comp, ncomp);
+    (0..ncomp)
+        .map(|c| {
+            let depth = (0..ncomp)
+                .filter(|&d| {
+                    d != c && vol[d].abs() > vol[c].abs() && contains(&boxes[d], &boxes[c])
+                })
+                .count();
+            vol[c] < 0.0 && depth % 2 == 0
+        })
+        .collect()
+}
+
+/// The volume that moves with the reference point, over reference points in the bounding box, for a
+/// surface that is closed only up to cracks: |vector area| × diagonal / 6 (the signed volume about
+/// r is V(0) − r·A/3). Zero for a closed surface; its round-off for one closed bit for bit.
+pub(super) fn open_volume(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
+    let (lo, hi) = bbox(vertices);
+    vector_area(vertices, faces) * dist(lo, hi) / 6.0
+}
+
+/// Closed after the tolerant weld but wound inconsistently: each component made consistent and outward.
+pub(super) fn reoriented(
+    mut ladder: Ladder<'_>,
+    w: Welding,
+    te: &Edges,
+    o: &Orientation,
+) -> Result<Solid, MeshError> {
+    let Outward {
+        reversed,
+        flipped,
+        nested,
+        flip_volume,
+    } = outward(&w.vertices, &w.kept, o);
+    let mut faces = w.kept.clone();
+    apply(&mut faces, &reversed);
+    ladder.strict(&format!(
+        "{} faces wound against their neighbours",
+        te.inconsistent
+    ))?;
+    ladder.warn(HealthKind::Repaired, format!(
+        "closed, but {flipped} of {} faces were wound against their neighbours ({} edges disagreed); re-oriented each of {} component(s) outward",
+        faces.len(),
+        te.inconsistent,
+        o.ncomp
+    ));
+    let rung = Rung::Reoriented {
+        faces_flipped: flipped,
+        components: o.ncomp,
+    };
+    let model = open_volume(&w.vertices, &faces) + nested + flip_volume;
+    let source = if nested + flip_volume > 0.0 {
+        ModelError::Orientation
+    } else {
+        ModelError::Cracks
+    };
+    ladder.finish(w.vertices, faces, rung, (model, source), |_, _| None)
+}
+
+/// Each face's reversal under an orientation that turns every component outward by its own signed
+/// volume, how many faces that flips, and the volume of components lying inside another one's
+/// bounding box (counted twice: a cavity turned outward adds its volume instead of removing it).
+/// `flip_volume` is what the faces flipped against the rest of their component change ([`flip_change`]).
+pub(super) struct Outward {
+    pub(super) reversed: Vec<bool>,
+    pub(super) flipped: usize,
+    pub(super) nested: f64,
+    pub(super) flip_volume: f64,
+}
+
+/// The volume that re-orienting faces within components can change, m³: per component, the smaller
+/// of the sets flipped and kept (flipping a whole shell changes nothing the winding number rule does
+/// not already decide) changes the integral by twice its signed volume, which moves with the
+/// reference point by twice its vector area × the diagonal / 6; both are counted.
+pub(super) fn flip_change(vertices: &[[f64; 3]], faces: &Polygons, o: &Orientation, reversed: &[bool]) -> f64 {
+    let centre = bounding_box_centre(vertices);
+    let (lo, hi) = bbox(vertices);
+    let diag = dist(lo, hi);
+    let mut count = vec![[0usize; 2]; o.ncomp];
+    for (i, r) in reversed.iter().enumerate() {
+        count[o.comp[i] as usize][usize::from(*r)] += 1;
+    }
+    let mut volume6 = vec![0.0f64; o.ncomp];
+    let mut area2 = vec![[0.0f64; 3]; o.ncomp];
+    for (i, face) in faces.iter().enumerate() {
+        let c = o.comp[i] as usize;
+        // The minority side (ties: the flipped side); nothing when the whole component turned.
+        let minority = usize::from(count[c][1] <= count[c][0]);
+        if usize::from(reversed[i]) != minority || count[c][0].min(count[c][1]) == 0 {
+            continue;
+        }
+        let a = sub(vertices[face[0] as usize], centre);
+        for k in 1..face.len() - 1 {
+            let b = sub(vertices[face[k] as usize], centre);
+            let d = sub(vertices[face[k + 1] as usize], centre);
+            volume6[c] += dot(a, cross(b, d));
+            let n = cross(sub(b, a), sub(d, a));
+            (0..3).for_each(|j| area2[c][j] += n[j]);
+        }
+    }
+    (0..o.ncomp)
+        .map(|c| 2.0 * volume6[c].abs() / 6.0 + dot(area2[c], area2[c]).sqrt() * diag / 6.0)
+        .sum()
+}
+
+pub(super) fn outward(vertices: &[[f64; 3]], faces: &Polygons, o: &Orientation) -> Outward {
+    let mut trial = faces.clone();
+    apply(&mut trial, &o.flip);
+    let vol = component_volumes(vertices, &trial, &o.comp, o.ncomp);
+    let reversed: Vec<bool> = (0..faces.len())
+        .map(|i| o.flip[i] ^ (vol[o.comp[i] as usize] < 0.0))
+        .collect();
+    let flipped = reversed.iter().filter(|r| **r).count();
+    let mut nested = 0.0;
+    if o.ncomp > 1 {
+        let boxes = component_boxes(vertices, faces, &o.comp, o.ncomp);
+        for c in 0..o.ncomp {
+            if (0..o.ncomp).any(|d| d != c && contains(&boxes[d], &boxes[c])) {
+                nested += 2.0 * vol[c].abs() / 6.0;
+            }
+        }
+    }
+    let flip_volume = flip_change(vertices, faces, o, &reversed);
+    Outward {
+        reversed,
+        flipped,
+        nested,
+        flip_volume,
+    }
+}
+
+/// Reverses the faces marked.
+pub(super) fn apply(faces: &mut Polygons, reversed: &[bool]) {
+    for (i, r) in reversed.iter().enumerate() {
+        if *r {
+            faces.reverse_face(i);
+        }
+    }
+}

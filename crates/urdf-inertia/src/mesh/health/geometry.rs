@@ -1,0 +1,119 @@
+//! Small integrals and boxes the rungs share.
+
+use crate::geometry::{cross, dot, sub};
+use crate::mass::integrals::{bounding_box_centre, volume_integrals};
+use crate::mass::{IntegrationOptions, MassProperties, Polygons};
+
+pub(super) fn unit_props(
+    vertices: &[[f64; 3]],
+    faces: &Polygons,
+    reference: Option<[f64; 3]>,
+) -> MassProperties {
+    let opts = IntegrationOptions {
+        reference,
+        ..IntegrationOptions::accurate()
+    };
+    MassProperties::from_integrals(&volume_integrals(vertices, faces, &opts), 1.0)
+}
+
+pub(super) fn signed_volume(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
+    volume_integrals(vertices, faces, &IntegrationOptions::accurate()).t1
+}
+
+pub(super) fn bbox(vertices: &[[f64; 3]]) -> Aabb {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for v in vertices {
+        for k in 0..3 {
+            lo[k] = lo[k].min(v[k]);
+            hi[k] = hi[k].max(v[k]);
+        }
+    }
+    (lo, hi)
+}
+
+
+/// Six times the signed volume of each connected component (about the bounding-box centre).
+pub(super) fn component_volumes(
+    vertices: &[[f64; 3]],
+    faces: &Polygons,
+    comp: &[u32],
+    ncomp: usize,
+) -> Vec<f64> {
+    let centre = bounding_box_centre(vertices);
+    let mut vol = vec![0.0f64; ncomp];
+    for (i, face) in faces.iter().enumerate() {
+        let a = sub(vertices[face[0] as usize], centre);
+        for k in 1..face.len() - 1 {
+            let b = sub(vertices[face[k] as usize], centre);
+            let c = sub(vertices[face[k + 1] as usize], centre);
+            vol[comp[i] as usize] += dot(a, cross(b, c));
+        }
+    }
+    vol
+}
+
+/// A box `(lo, hi)`.
+pub type Aabb = ([f64; 3], [f64; 3]);
+
+pub(super) fn component_boxes(
+    vertices: &[[f64; 3]],
+    faces: &Polygons,
+    comp: &[u32],
+    ncomp: usize,
+) -> Vec<Aabb> {
+    let mut boxes = vec![([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]); ncomp];
+    for (i, face) in faces.iter().enumerate() {
+        let b = &mut boxes[comp[i] as usize];
+        for &v in face {
+            for k in 0..3 {
+                b.0[k] = b.0[k].min(vertices[v as usize][k]);
+                b.1[k] = b.1[k].max(vertices[v as usize][k]);
+            }
+        }
+    }
+    boxes
+}
+
+pub(super) fn contains(outer: &Aabb, inner: &Aabb) -> bool {
+    (0..3).all(|k| outer.0[k] <= inner.0[k] && inner.1[k] <= outer.1[k])
+}
+
+/// The length of the surface's vector area `Σ N/2` (zero for a closed surface).
+pub(super) fn vector_area(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
+    let centre = bounding_box_centre(vertices);
+    let mut a = [0.0f64; 3];
+    for face in faces.iter() {
+        let p = sub(vertices[face[0] as usize], centre);
+        for k in 1..face.len() - 1 {
+            let e1 = sub(sub(vertices[face[k] as usize], centre), p);
+            let e2 = sub(sub(vertices[face[k + 1] as usize], centre), p);
+            let x = cross(e1, e2);
+            for j in 0..3 {
+                a[j] += 0.5 * x[j];
+            }
+        }
+    }
+    dot(a, a).sqrt()
+}
+
+/// Area of a planar polygon (fan from its first vertex).
+pub(super) fn polygon_area(vertices: &[[f64; 3]], face: &[u32]) -> f64 {
+    let p = vertices[face[0] as usize];
+    let mut a = [0.0f64; 3];
+    for k in 1..face.len().saturating_sub(1) {
+        let x = cross(
+            sub(vertices[face[k] as usize], p),
+            sub(vertices[face[k + 1] as usize], p),
+        );
+        for j in 0..3 {
+            a[j] += 0.5 * x[j];
+        }
+    }
+    dot(a, a).sqrt()
+}
+
+pub(super) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let d = sub(a, b);
+    dot(d, d).sqrt()
+}

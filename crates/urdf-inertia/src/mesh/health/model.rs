@@ -1,0 +1,135 @@
+//! The error model: volumes by which a solid can differ from the stored surface, turned into relative
+//! bounds on volume, inertia and centre of mass; the round-off estimate and the empty-solid check.
+
+use super::geometry::{dist, polygon_area, unit_props};
+use super::{ModelError, ROUND_OFF_FLOOR, ZERO_VOLUME_ROUNDOFFS};
+use crate::mass::{frobenius, MassProperties, Polygons};
+use crate::mesh::{MeshError, MeshErrorKind};
+use std::path::Path;
+
+/// Where the volume of a model error may sit: anywhere in the solid, near given points (the loops a
+/// cap closes), or in a ball (centre, radius).
+pub(super) enum Lever {
+    Anywhere,
+    Near(Vec<[f64; 3]>),
+    Ball([f64; 3], f64),
+}
+
+/// A model error: volumes (m³) by which the solid can differ from the stored surface, each with where
+/// it sits, and what the largest is made of.
+pub(super) struct Model {
+    pub(super) terms: Vec<(f64, Lever)>,
+    pub(super) source: ModelError,
+}
+
+impl From<(f64, ModelError)> for Model {
+    fn from((delta, source): (f64, ModelError)) -> Model {
+        Model {
+            terms: vec![(delta, Lever::Anywhere)],
+            source,
+        }
+    }
+}
+
+/// A model error as relative bounds.
+pub(super) struct Bound {
+    /// On volume and central inertia.
+    pub(super) relative: f64,
+    /// On the centre of mass, m.
+    pub(super) com: f64,
+}
+
+impl Model {
+    /// The relative error that volumes δᵢ moved, added or removed at distances up to Rᵢ from the
+    /// centre of mass can cause, against the true value (at least the computed one less the change):
+    /// for the volume Σδ/(V − Σδ); for the central inertia 3·Σδ·R²/(‖I‖ − 3·Σδ·R²) (a point mass δ at
+    /// distance R changes the tensor by at most √2·δ·R², and the centre of mass it moves by as much
+    /// again); for the centre of mass Σδ·R/(V − Σδ). Unbounded when the change could be as large as
+    /// the value itself.
+    pub(super) fn bound(&self, unit: &MassProperties, vertices: &[[f64; 3]]) -> Bound {
+        let (mut volume, mut inertia, mut moment) = (0.0, 0.0, 0.0);
+        for (delta, lever) in &self.terms {
+            if *delta == 0.0 {
+                continue;
+            }
+            let r = match lever {
+                Lever::Anywhere => reach(unit, vertices),
+                Lever::Near(points) => reach(unit, points),
+                Lever::Ball(centre, radius) => dist(*centre, unit.com) + radius,
+            };
+            volume += delta;
+            inertia += 3.0 * delta * r * r;
+            moment += delta * r;
+        }
+        if volume == 0.0 {
+            return Bound {
+                relative: 0.0,
+                com: 0.0,
+            };
+        }
+        let bounded = |change: f64, value: f64| {
+            if change < value {
+                change / (value - change)
+            } else {
+                f64::INFINITY
+            }
+        };
+        Bound {
+            relative: bounded(volume, unit.mass).max(bounded(inertia, frobenius(&unit.inertia))),
+            com: bounded(moment, unit.mass - volume + moment),
+        }
+    }
+}
+
+/// The largest distance of a vertex from the centre of mass.
+pub(super) fn reach(unit: &MassProperties, vertices: &[[f64; 3]]) -> f64 {
+    vertices
+        .iter()
+        .map(|v| dist(*v, unit.com))
+        .fold(0.0, f64::max)
+}
+
+/// The round-off estimate: the relative disagreement of volume and central inertia integrated about
+/// two reference points (bounding-box centre and corner), never below [`ROUND_OFF_FLOOR`].
+pub(super) fn round_off(vertices: &[[f64; 3]], faces: &Polygons, lo: [f64; 3], base: &MassProperties) -> f64 {
+    let other = unit_props(vertices, faces, Some(lo));
+    let mut d = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            d[i][j] = other.inertia[i][j] - base.inertia[i][j];
+        }
+    }
+    let n = frobenius(&base.inertia);
+    let inertia = if n > 0.0 {
+        frobenius(&d) / n
+    } else {
+        f64::INFINITY
+    };
+    let volume = ((other.mass - base.mass) / base.mass).abs();
+    inertia.max(volume).max(ROUND_OFF_FLOOR)
+}
+
+/// A solid is empty when its volume is within a thousand round-offs of its faces' contributions
+/// (Σ face area × diagonal): relative to the surface, so a needle 1e-6 × 1e-6 × 1 (volume 1e-12 of
+/// its diagonal cubed), rotated or not, is a solid, and a flat or doubly covered sheet is not.
+pub(super) fn check_volume(
+    vertices: &[[f64; 3]],
+    faces: &Polygons,
+    (lo, hi): ([f64; 3], [f64; 3]),
+    volume: f64,
+    path: &Path,
+) -> Result<(), MeshError> {
+    let area: f64 = faces.iter().map(|f| polygon_area(vertices, f)).sum();
+    let floor = ZERO_VOLUME_ROUNDOFFS * f64::EPSILON * area * dist(lo, hi);
+    if volume.is_nan() || volume <= floor {
+        return Err(MeshError::new(
+            path,
+            None,
+            MeshErrorKind::ZeroVolume {
+                volume,
+                bbox_volume: (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]),
+            },
+        ));
+    }
+    Ok(())
+}
