@@ -1000,8 +1000,9 @@ fn overlap_of_a_sliver_cone_and_a_box_has_bounded_memory() {
     );
     let grown = peak_rss().saturating_sub(before);
     assert!(report.failures.is_empty(), "{:?}", report.failures);
-    let (excess, which, _) = report.links[0].overlap.clone().expect("an overlap");
-    assert_eq!(which, "1 and 2");
+    let overlap = report.links[0].overlap.clone().expect("an overlap");
+    let excess = overlap.excess;
+    assert_eq!(overlap.parts, "1 and 2");
     assert!((excess / 0.008 - 1.0).abs() < 1e-9, "{excess}");
     // The old bucket grid alone needed 6.7 GB; mesh, healing and buckets now need far less than 1 GiB.
     assert!(grown < 1 << 30, "peak memory grew by {grown} bytes");

@@ -218,9 +218,9 @@ pub fn worst_error(report: &FillReport) -> Option<(f64, String)> {
         .links
         .iter()
         .filter_map(|l| {
-            let (v, which, _) = l.overlap.as_ref()?;
+            let o = l.overlap.as_ref()?;
             let volume: f64 = l.parts.iter().map(|p| p.volume).sum();
-            (volume > 0.0).then(|| (v / volume, l, which))
+            (volume > 0.0).then(|| (o.excess / volume, l, &o.parts))
         })
         .max_by(|a, b| a.0.total_cmp(&b.0));
     match (part, overlap) {

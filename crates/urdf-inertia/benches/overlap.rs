@@ -21,7 +21,7 @@ use std::path::Path;
 use std::sync::Arc;
 use urdf_inertia::mass::{mat_vec, Polygons};
 use urdf_inertia::mesh::{health, RawMesh};
-use urdf_inertia::overlap::{self, PartShape, PlacedPart};
+use urdf_inertia::overlap::{self, Aabb, PartShape, PlacedPart};
 
 /// `n` convex pieces on a lattice (see the module docs), or (`cluster`) at random in a cube of side
 /// 2, where each overlaps most others, placed as the link's parts.
@@ -65,7 +65,7 @@ pub fn pieces(n: usize, cluster: bool) -> Vec<PlacedPart> {
                 shape: PartShape::Mesh(Arc::new(solid)),
                 rotation,
                 translation,
-                bbox: (lo, hi),
+                bbox: Aabb::new(lo, hi),
                 locator: None,
             }
         })

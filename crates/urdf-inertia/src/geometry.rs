@@ -28,3 +28,102 @@ pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
+
+/// An axis-aligned box. [`Aabb::EMPTY`] (lo = +∞, hi = −∞) is the fold's start: adding a point
+/// makes it that point's box. NaN coordinates are skipped, as `f64::min`/`max` skip them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb {
+    pub lo: [f64; 3],
+    pub hi: [f64; 3],
+}
+
+impl Aabb {
+    /// The box of no point.
+    pub const EMPTY: Aabb = Aabb {
+        lo: [f64::INFINITY; 3],
+        hi: [f64::NEG_INFINITY; 3],
+    };
+
+    /// The box from its corners.
+    pub const fn new(lo: [f64; 3], hi: [f64; 3]) -> Aabb {
+        Aabb { lo, hi }
+    }
+
+    /// The box of `points` ([`Aabb::EMPTY`] for none).
+    pub fn of(points: impl IntoIterator<Item = [f64; 3]>) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for p in points {
+            b.add(p);
+        }
+        b
+    }
+
+    /// Grows the box to hold `p`.
+    #[inline]
+    pub fn add(&mut self, p: [f64; 3]) {
+        for k in 0..3 {
+            self.lo[k] = self.lo[k].min(p[k]);
+            self.hi[k] = self.hi[k].max(p[k]);
+        }
+    }
+
+    /// The box of both.
+    pub fn union(self, other: Aabb) -> Aabb {
+        Aabb {
+            lo: [0, 1, 2].map(|k| self.lo[k].min(other.lo[k])),
+            hi: [0, 1, 2].map(|k| self.hi[k].max(other.hi[k])),
+        }
+    }
+
+    /// Where both meet (empty along an axis where they do not: lo > hi).
+    pub fn intersection(self, other: Aabb) -> Aabb {
+        Aabb {
+            lo: [0, 1, 2].map(|k| self.lo[k].max(other.lo[k])),
+            hi: [0, 1, 2].map(|k| self.hi[k].min(other.hi[k])),
+        }
+    }
+
+    /// Whether `inner` lies within the box (faces included).
+    pub fn contains(&self, inner: &Aabb) -> bool {
+        (0..3).all(|k| self.lo[k] <= inner.lo[k] && inner.hi[k] <= self.hi[k])
+    }
+
+    /// The extent along each axis (`hi − lo`).
+    pub fn extent(&self) -> [f64; 3] {
+        sub(self.hi, self.lo)
+    }
+
+    /// The largest extent along an axis (0 for a point, −∞ for the empty box).
+    pub fn largest_extent(&self) -> f64 {
+        let e = self.extent();
+        e[0].max(e[1]).max(e[2])
+    }
+
+    /// The length of the diagonal.
+    pub fn diagonal(&self) -> f64 {
+        let e = self.extent();
+        dot(e, e).sqrt()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Aabb;
+
+    #[test]
+    fn a_box_folds_its_points_and_skips_nan() {
+        let b = Aabb::of([[1.0, -2.0, 3.0], [f64::NAN, 4.0, -1.0], [0.5, 0.0, 0.0]]);
+        assert_eq!(b, Aabb::new([0.5, -2.0, -1.0], [1.0, 4.0, 3.0]));
+        assert_eq!(b.extent(), [0.5, 6.0, 4.0]);
+        assert_eq!(b.largest_extent(), 6.0);
+        assert_eq!(b.diagonal(), (0.25f64 + 36.0 + 16.0).sqrt());
+        let c = Aabb::new([0.0; 3], [2.0; 3]);
+        assert_eq!(
+            b.intersection(c),
+            Aabb::new([0.5, 0.0, 0.0], [1.0, 2.0, 2.0])
+        );
+        assert_eq!(b.union(c), Aabb::new([0.0, -2.0, -1.0], [2.0, 4.0, 3.0]));
+        assert!(b.union(c).contains(&c) && !c.contains(&b));
+        assert_eq!(Aabb::of([]), Aabb::EMPTY);
+    }
+}

@@ -63,8 +63,8 @@ pub use density::{near_miss, DensityMap, Glob, MapError};
 pub use error::Error;
 pub use fill::{
     compute, compute_with, existing_props, millimetre_slip, selected, unrepresentable,
-    unresolved_meshes, unused_selection, FillOptions, FillReport, LinkReport, MeshCache,
-    PartReport, Timing,
+    unresolved_meshes, unused_selection, FillOptions, FillReport, LinkOverlap, LinkReport,
+    MeshCache, PartReport, Timing,
 };
 pub use mass::validity::Violation;
 pub use mass::{primitives, rpy_matrix, MassProperties, Mat3, Principal};

@@ -9,13 +9,15 @@ use crate::density::{DensityMap, Spec};
 use crate::diagnostic::{
     Code, Diagnostic, LinkError, LinkErrorKind, Location, Provenance, RobotError,
 };
+use crate::geometry::Aabb;
 use crate::mass::{validity, MassProperties};
 pub use crate::mesh::cache::MeshCache;
 use crate::mesh::cache::Solids;
 use crate::mesh::health::{ErrorEstimate, HealthOptions, ROUND_OFF_FLOOR};
 use crate::overlap::{self, Overlap, PlacedPart};
-use crate::urdf::resolve::PackageResolver;
+use crate::urdf::resolve::{NotFound, PackageResolver};
 use crate::urdf::{Geometry, Link, Robot};
+use std::collections::HashMap;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -25,7 +27,7 @@ mod select;
 
 use densities::{body, densities, scale_to_total_mass};
 pub use parts::millimetre_slip;
-use parts::{diagonal, geometry_part, part_location, Part};
+use parts::{geometry_part, part_location, Part};
 use select::is_target;
 pub use select::{existing_props, selected, unresolved_meshes, unused_selection};
 
@@ -84,13 +86,24 @@ pub struct LinkReport {
     pub line: usize,
     pub computed: MassProperties,
     pub parts: Vec<PartReport>,
-    /// Estimated volume counted more than once by overlapping parts (m³: their volumes less their
-    /// union's), which parts, and the sampling grid size.
-    pub overlap: Option<(f64, String, usize)>,
+    /// The volume its overlapping parts count more than once, when they overlap.
+    pub overlap: Option<LinkOverlap>,
     /// Diagonal of the link's collision geometry's bounding box (link frame), m.
     pub size: f64,
     /// Warnings and notes about the link as a whole (overlapping parts, an overridden mass rule).
     pub diagnostics: Vec<Diagnostic>,
+}
+
+/// The volume a link's overlapping parts count more than once (UI401).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct LinkOverlap {
+    /// Estimated volume counted more than once (m³: the parts' volumes less their union's).
+    pub excess: f64,
+    /// Which parts, as the warning names them (`1 and 2`, `1, 2, 3, 4, 5 and 195 others`).
+    pub parts: String,
+    /// The sampling grid's cells per side, per part.
+    pub grid: usize,
 }
 
 impl PartReport {
@@ -175,6 +188,26 @@ struct Context<'a> {
     map: &'a DensityMap,
     resolver: &'a PackageResolver,
     opts: &'a FillOptions,
+    /// Each mesh URI of the selected links, resolved once (a URI several links or collisions use is
+    /// looked up once; the stage that loads the meshes and the one that builds the parts share it).
+    resolved: HashMap<&'a str, Result<PathBuf, NotFound>>,
+}
+
+/// [`Context::resolved`]: every mesh URI of the links [`compute_links`] computes, resolved.
+fn resolve_meshes<'a>(
+    robot: &'a Robot,
+    resolver: &PackageResolver,
+    opts: &FillOptions,
+) -> HashMap<&'a str, Result<PathBuf, NotFound>> {
+    let mut resolved = HashMap::new();
+    let targets = (robot.links.iter()).filter(|l| l.has_collision_geometry() && is_target(l, opts));
+    for c in targets.flat_map(|l| &l.collisions) {
+        if let Geometry::Mesh { filename, .. } = &c.geometry {
+            (resolved.entry(filename.as_str()))
+                .or_insert_with(|| resolver.resolve(filename, &robot.path));
+        }
+    }
+    resolved
 }
 
 /// Computes every selected link with collision geometry.
@@ -206,6 +239,7 @@ pub fn compute_with(
         map,
         resolver,
         opts,
+        resolved: resolve_meshes(robot, resolver, opts),
     };
     let mut report = FillReport::default();
     let (mesh_files, results) = compute_links(&ctx, cache, &mut report);
@@ -293,11 +327,10 @@ fn compute_links<'r>(
             link.collisions
                 .iter()
                 .filter_map(|c| match &c.geometry {
-                    Geometry::Mesh { filename, scale } => ctx
-                        .resolver
-                        .resolve(filename, &robot.path)
-                        .ok()
-                        .map(|p| (p, *scale)),
+                    Geometry::Mesh { filename, scale } => match ctx.resolved.get(filename.as_str()) {
+                        Some(Ok(p)) => Some((p.clone(), *scale)),
+                        _ => None,
+                    },
                     _ => None,
                 })
                 .collect()
@@ -413,16 +446,9 @@ fn compute_link(
         return Ok(LinkOutcome::NoDensity);
     };
     let (computed, part_reports) = body(&parts, &densities);
-    let size = parts.iter().fold(
-        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
-        |(lo, hi), p| {
-            (
-                [0, 1, 2].map(|k| lo[k].min(p.placed.bbox.0[k])),
-                [0, 1, 2].map(|k| hi[k].max(p.placed.bbox.1[k])),
-            )
-        },
-    );
-    let size = diagonal(size.0, size.1);
+    let size = (parts.iter())
+        .fold(Aabb::EMPTY, |b, p| b.union(p.placed.bbox))
+        .diagonal();
     let mut diagnostics = densities.diagnostics;
     if link.from_visual {
         diagnostics.push(Diagnostic::new(
@@ -516,7 +542,7 @@ fn reject_unrepresentable(report: &mut FillReport) {
 /// The volume the link's parts count more than once (their volumes less their union's, estimated by
 /// [`overlap::estimate`]), which parts and the grid, with the warning that says so; or only a warning
 /// when the estimate was skipped.
-fn overlap_estimate(parts: &mut [Part]) -> (Option<(f64, String, usize)>, Option<String>) {
+fn overlap_estimate(parts: &mut [Part]) -> (Option<LinkOverlap>, Option<String>) {
     let mut placed: Vec<PlacedPart> = parts.iter().map(|p| p.placed.clone()).collect();
     let e = match crate::threads::install(|| overlap::estimate(&mut placed)) {
         Overlap::None => return (None, None),
@@ -561,5 +587,10 @@ fn overlap_estimate(parts: &mut [Part]) -> (Option<(f64, String, usize)>, Option
         100.0 * v / total,
         crate::text::significant(e.bound, 2),
     );
-    (Some((v, which, n)), Some(message))
+    let overlap = LinkOverlap {
+        excess: v,
+        parts: which,
+        grid: n,
+    };
+    (Some(overlap), Some(message))
 }

@@ -5,6 +5,7 @@ use super::Context;
 use crate::diagnostic::{
     self, Code, CollisionRef, Diagnostic, LinkError, LinkErrorKind, Location, Provenance,
 };
+use crate::geometry::Aabb;
 use crate::mass::{mat_vec, primitives, rpy_matrix, MassProperties};
 use crate::mesh::cache::Solids;
 use crate::mesh::health::{ErrorEstimate, ModelError, ROUND_OFF_FLOOR};
@@ -45,17 +46,11 @@ pub(super) fn transformed_bbox(
     points: impl Iterator<Item = [f64; 3]>,
     r: &crate::mass::Mat3,
     t: [f64; 3],
-) -> ([f64; 3], [f64; 3]) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points {
+) -> Aabb {
+    Aabb::of(points.map(|p| {
         let q = mat_vec(r, p);
-        for k in 0..3 {
-            lo[k] = lo[k].min(q[k] + t[k]);
-            hi[k] = hi[k].max(q[k] + t[k]);
-        }
-    }
-    (lo, hi)
+        [q[0] + t[0], q[1] + t[1], q[2] + t[2]]
+    }))
 }
 
 fn box_corners(h: [f64; 3]) -> impl Iterator<Item = [f64; 3]> {
@@ -66,11 +61,6 @@ fn box_corners(h: [f64; 3]) -> impl Iterator<Item = [f64; 3]> {
             if i & 4 == 0 { -h[2] } else { h[2] },
         ]
     })
-}
-
-/// Diagonal of a bounding box.
-pub(super) fn diagonal(lo: [f64; 3], hi: [f64; 3]) -> f64 {
-    ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
 }
 
 /// Where the link's failures point: the link and one of its collisions.
@@ -134,16 +124,7 @@ fn primitive_part(c: &Collision, what: String, unit: MassProperties, shape: Part
 /// already scaled by `scale`), if it is: a link's error by default, a warning with
 /// `--allow-large-parts`, and `mesh`'s warning.
 pub fn millimetre_slip(vertices: &[[f64; 3]], scale: [f64; 3]) -> Option<String> {
-    let (lo, hi) = vertices.iter().fold(
-        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
-        |(lo, hi), p| {
-            (
-                [0, 1, 2].map(|k| lo[k].min(p[k])),
-                [0, 1, 2].map(|k| hi[k].max(p[k])),
-            )
-        },
-    );
-    let extent = diagonal(lo, hi);
+    let extent = Aabb::of(vertices.iter().copied()).diagonal();
     if extent <= MILLIMETRE_SLIP {
         return None;
     }
@@ -202,10 +183,10 @@ fn mesh_part(
     ctx: &Context<'_>,
     solids: &Solids<'_>,
 ) -> Result<Part, LinkError> {
-    let path = ctx
-        .resolver
-        .resolve(filename, &ctx.robot.path)
-        .map_err(|nf| {
+    // Resolved beforehand with the link's other meshes ([`super::resolve_meshes`]).
+    let resolved = (ctx.resolved.get(filename).cloned())
+        .unwrap_or_else(|| ctx.resolver.resolve(filename, &ctx.robot.path));
+    let path = resolved.map_err(|nf| {
             let kind = LinkErrorKind::MeshNotFound {
                 uri: nf.uri,
                 searched: nf.searched,

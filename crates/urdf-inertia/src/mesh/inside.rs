@@ -60,8 +60,8 @@ pub(crate) struct SurfaceCells {
 impl SurfaceCells {
     fn new<'a>(triangles: impl Iterator<Item = &'a [[f64; 3]; 3]>, region: &Aabb) -> Option<Self> {
         let g = SURFACE_GRID;
-        let lo = region.0;
-        let cell = [0, 1, 2].map(|k| ((region.1[k] - lo[k]) / g as f64).max(f64::MIN_POSITIVE));
+        let lo = region.lo;
+        let cell = [0, 1, 2].map(|k| ((region.hi[k] - lo[k]) / g as f64).max(f64::MIN_POSITIVE));
         let mut out = SurfaceCells {
             lo,
             cell,
@@ -70,7 +70,7 @@ impl SurfaceCells {
         let mut marks = 0usize;
         for t in triangles {
             let b = triangle_box(t);
-            if (0..3).any(|k| b.1[k] < region.0[k] || b.0[k] > region.1[k]) {
+            if (0..3).any(|k| b.hi[k] < region.lo[k] || b.lo[k] > region.hi[k]) {
                 continue;
             }
             let [(a0, a1), (b0, b1), (c0, c1)] = out.range(&b);
@@ -90,7 +90,7 @@ impl SurfaceCells {
 
     /// The cells a box meets along each axis (with [`cells`]' slack; clamped into the grid).
     fn range(&self, b: &Aabb) -> [(usize, usize); 3] {
-        [0, 1, 2].map(|k| cells(b.0[k], b.1[k], self.lo[k], self.cell[k], SURFACE_GRID))
+        [0, 1, 2].map(|k| cells(b.lo[k], b.hi[k], self.lo[k], self.cell[k], SURFACE_GRID))
     }
 
     /// Whether the surface may meet the box `b` (mesh frame).
@@ -223,7 +223,7 @@ fn default_grid(triangles: usize) -> usize {
 fn triangle_box(t: &[[f64; 3]; 3]) -> Aabb {
     let lo = [0, 1, 2].map(|k| t[0][k].min(t[1][k]).min(t[2][k]));
     let hi = [0, 1, 2].map(|k| t[0][k].max(t[1][k]).max(t[2][k]));
-    (lo, hi)
+    Aabb::new(lo, hi)
 }
 
 /// Cell references a grid over the whole mesh holds, bounded above (a triangle's rows of cells lie
@@ -248,8 +248,8 @@ impl WholeMeshBound {
     }
 
     fn add(&mut self, b: &Aabb) {
-        let (a0, a1) = cells(b.0[1], b.1[1], self.lo[0], self.cell[0], self.grid);
-        let (b0, b1) = cells(b.0[2], b.1[2], self.lo[1], self.cell[1], self.grid);
+        let (a0, a1) = cells(b.lo[1], b.hi[1], self.lo[0], self.cell[0], self.grid);
+        let (b0, b1) = cells(b.lo[2], b.hi[2], self.lo[1], self.cell[1], self.grid);
         self.entries += (a1 - a0 + 1) * (b1 - b0 + 1);
     }
 
@@ -325,12 +325,12 @@ impl MeshLocator {
             all += 1;
             let b = triangle_box(&t);
             bound.add(&b);
-            if b.1[0] >= region.0[0]
-                && (1..3).all(|k| b.1[k] >= region.0[k] && b.0[k] <= region.1[k])
+            if b.hi[0] >= region.lo[0]
+                && (1..3).all(|k| b.hi[k] >= region.lo[k] && b.lo[k] <= region.hi[k])
             {
                 for k in 0..2 {
-                    lo[k] = lo[k].min(b.0[k + 1]);
-                    hi[k] = hi[k].max(b.1[k + 1]);
+                    lo[k] = lo[k].min(b.lo[k + 1]);
+                    hi[k] = hi[k].max(b.hi[k + 1]);
                 }
                 triangles.push(t);
             }
@@ -340,8 +340,8 @@ impl MeshLocator {
         }
         // The grid spans where the region and the triangles meet.
         for k in 0..2 {
-            lo[k] = lo[k].max(region.0[k + 1]);
-            hi[k] = hi[k].min(region.1[k + 1]).max(lo[k]);
+            lo[k] = lo[k].max(region.lo[k + 1]);
+            hi[k] = hi[k].min(region.hi[k + 1]).max(lo[k]);
         }
         if triangles.is_empty() {
             (lo, hi) = ([0.0; 2], [0.0; 2]);
@@ -641,7 +641,7 @@ mod tests {
     fn a_region_locator_agrees_with_the_winding_number() {
         let solid = cone(500);
         let whole = MeshLocator::new(&solid);
-        let region = ([0.1, -0.3, 0.05], [0.7, 0.6, 0.5]);
+        let region = Aabb::new([0.1, -0.3, 0.05], [0.7, 0.6, 0.5]);
         let (part, bound) = MeshLocator::within(&solid, &region).expect("fits");
         assert!(part.triangles.len() < whole.triangles.len() / 2);
         let exact = MeshLocator::whole_mesh_cost(&solid);
@@ -650,7 +650,7 @@ mod tests {
         let mut unit = || crate::lcg_unit(&mut seed);
         let mut inside = 0;
         for _ in 0..4000 {
-            let q = [0, 1, 2].map(|k| region.0[k] + (region.1[k] - region.0[k]) * unit());
+            let q = [0, 1, 2].map(|k| region.lo[k] + (region.hi[k] - region.lo[k]) * unit());
             let w = winding_number(&solid, q);
             assert_eq!(part.contains(q), whole.contains(q), "{q:?}");
             if w.abs() > 1e-6 && (w - 1.0).abs() > 1e-6 {

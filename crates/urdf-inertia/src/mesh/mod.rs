@@ -404,17 +404,8 @@ fn solid_from(
 /// volume (see [`out_of_range`]): a closure, so the common case pays nothing.
 fn flat_or_out_of_range(raw: &RawMesh, scale: [f64; 3]) -> impl Fn() -> f64 + '_ {
     move || {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for v in &raw.vertices {
-            for k in 0..3 {
-                lo[k] = lo[k].min(v[k]);
-                hi[k] = hi[k].max(v[k]);
-            }
-        }
-        (0..3)
-            .map(|k| (hi[k] - lo[k]) * scale[k].abs())
-            .fold(0.0, f64::max)
+        let e = crate::geometry::Aabb::of(raw.vertices.iter().copied()).extent();
+        (0..3).map(|k| e[k] * scale[k].abs()).fold(0.0, f64::max)
     }
 }
 

@@ -76,14 +76,7 @@ pub fn encloses_nothing(vertices: &[[f64; 3]], faces: &crate::mass::Polygons) ->
         return true;
     };
     let volume = crate::mass::MassProperties::from_trimesh(&hv, &ht, 1.0).mass;
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for p in &hv {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    let diagonal = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    let diagonal = crate::geometry::Aabb::of(hv.iter().copied()).diagonal();
     let mut area = 0.0;
     for face in faces.iter() {
         let p = vertices[face[0] as usize];

@@ -15,7 +15,7 @@
 //! 0 outside its box), whose volume enters the error estimate. A shell that passes through itself is
 //! beyond this module: its own ∫w is taken as its volume.
 
-use crate::geometry::{cross, dot, sub};
+use crate::geometry::{cross, dot, sub, Aabb};
 use crate::mass::Polygons;
 use robust::{orient3d, Coord3D};
 use rustc_hash::FxHashMap;
@@ -63,8 +63,8 @@ struct Shell {
     area2: [f64; 3],
     /// Six times the signed volume about the surface's box centre.
     volume6: f64,
-    lo: [f64; 3],
-    hi: [f64; 3],
+    /// The shell's box.
+    bounds: Aabb,
 }
 
 /// Classifies the shells of `faces` (see the module docs). A surface of one shell comes back as it is.
@@ -200,8 +200,7 @@ fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
                 motion: 0.0,
                 area2: [0.0; 3],
                 volume6: 0.0,
-                lo: [f64::INFINITY; 3],
-                hi: [f64::NEG_INFINITY; 3],
+                bounds: Aabb::EMPTY,
             });
         }
         let s = &mut out[at];
@@ -216,15 +215,12 @@ fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
             (0..3).for_each(|j| s.area2[j] += n[j]);
         }
         for &v in face {
-            for k in 0..3 {
-                s.lo[k] = s.lo[k].min(vertices[v as usize][k]);
-                s.hi[k] = s.hi[k].max(vertices[v as usize][k]);
-            }
+            s.bounds.add(vertices[v as usize]);
         }
     }
     for s in &mut out {
         if !s.closed {
-            let diag = dot(sub(s.hi, s.lo), sub(s.hi, s.lo)).sqrt();
+            let diag = s.bounds.diagonal();
             s.motion = dot(s.area2, s.area2).sqrt() / 2.0 * diag / 6.0;
             s.closed = s.motion <= NEARLY_CLOSED * s.volume6.abs() / 6.0;
         }
@@ -244,11 +240,11 @@ fn root(parent: &mut [u32], mut x: u32) -> u32 {
 /// Pairs of shells whose boxes overlap in a region of positive volume (sweep along x).
 fn overlapping_pairs(shells: &[Shell]) -> Vec<(usize, usize)> {
     let mut order: Vec<usize> = (0..shells.len()).collect();
-    order.sort_by(|&a, &b| shells[a].lo[0].total_cmp(&shells[b].lo[0]));
+    order.sort_by(|&a, &b| shells[a].bounds.lo[0].total_cmp(&shells[b].bounds.lo[0]));
     let mut pairs = Vec::new();
     for (i, &a) in order.iter().enumerate() {
         for &b in &order[i + 1..] {
-            if shells[b].lo[0] >= shells[a].hi[0] {
+            if shells[b].bounds.lo[0] >= shells[a].bounds.hi[0] {
                 break;
             }
             if box_overlap(&shells[a], &shells[b]) > 0.0 {
@@ -266,7 +262,7 @@ fn overlapping_pairs(shells: &[Shell]) -> Vec<(usize, usize)> {
 /// shells also the smaller one's volume.
 fn box_overlap(a: &Shell, b: &Shell) -> f64 {
     let boxes: f64 = (0..3)
-        .map(|k| (a.hi[k].min(b.hi[k]) - a.lo[k].max(b.lo[k])).max(0.0))
+        .map(|k| (a.bounds.hi[k].min(b.bounds.hi[k]) - a.bounds.lo[k].max(b.bounds.lo[k])).max(0.0))
         .product();
     if a.closed && b.closed {
         boxes.min(a.volume6.abs().min(b.volume6.abs()) / 6.0)
@@ -300,8 +296,7 @@ fn nesting(
     if !sa.closed || !sb.closed {
         return None;
     }
-    let lo: [f64; 3] = std::array::from_fn(|k| sa.lo[k].max(sb.lo[k]));
-    let hi: [f64; 3] = std::array::from_fn(|k| sa.hi[k].min(sb.hi[k]));
+    let Aabb { lo, hi } = sa.bounds.intersection(sb.bounds);
     let near = |t: &[u32; 3]| {
         (0..3).all(|k| {
             let (tl, th) = t

@@ -147,8 +147,8 @@ fn estimate_within(parts: &mut [PlacedPart], budget: usize) -> Overlap {
     let most_excess = involved
         .iter()
         .map(|&i| {
-            let r = regions[i].as_ref().map_or(0.0, |(lo, hi)| {
-                (0..3).map(|k| (hi[k] - lo[k]).max(0.0)).product::<f64>()
+            let r = regions[i].as_ref().map_or(0.0, |r| {
+                (0..3).map(|k| (r.hi[k] - r.lo[k]).max(0.0)).product::<f64>()
             });
             parts[i].volume.min(r)
         })

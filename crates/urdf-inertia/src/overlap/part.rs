@@ -12,7 +12,7 @@ pub struct PlacedPart {
     pub rotation: Mat3,
     pub translation: [f64; 3],
     /// Bounding box in the link frame.
-    pub bbox: ([f64; 3], [f64; 3]),
+    pub bbox: Aabb,
     /// Volume (m³).
     pub volume: f64,
     /// For meshes: the bucketed triangles, built when first needed.
@@ -88,7 +88,7 @@ impl PlacedPart {
             PartShape::Mesh(_) => {
                 let locator = self.locator.as_ref()?;
                 let surface = locator.surface.as_ref()?;
-                let b = (
+                let b = Aabb::new(
                     [0, 1, 2].map(|k| q[k] - e[k]),
                     [0, 1, 2].map(|k| q[k] + e[k]),
                 );
@@ -107,27 +107,21 @@ impl PlacedPart {
             return Some(1);
         };
         let rt = transpose(&self.rotation);
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for c in 0..8 {
+        let Aabb { lo, hi } = Aabb::of((0..8).map(|c| {
             let x = [0, 1, 2].map(|k| {
                 if c >> k & 1 == 0 {
-                    region.0[k]
+                    region.lo[k]
                 } else {
-                    region.1[k]
+                    region.hi[k]
                 }
             });
-            let q = mat_vec(&rt, [0, 1, 2].map(|k| x[k] - self.translation[k]));
-            for k in 0..3 {
-                lo[k] = lo[k].min(q[k]);
-                hi[k] = hi[k].max(q[k]);
-            }
-        }
+            mat_vec(&rt, [0, 1, 2].map(|k| x[k] - self.translation[k]))
+        }));
         // Points are moved into the mesh frame one by one, each with its own rounding (~1e-16 of its
         // coordinates): a margin far above that keeps every triangle that can decide one of them.
         let scale = (0..3).fold(0.0f64, |m, k| m.max(lo[k].abs()).max(hi[k].abs()));
         let pad = 1e-9 * scale;
-        let region = (lo.map(|v| v - pad), hi.map(|v| v + pad));
+        let region = Aabb::new(lo.map(|v| v - pad), hi.map(|v| v + pad));
         let (locator, bound) = MeshLocator::within(solid, &region)?;
         self.locator = Some(Arc::new(locator));
         Some(bound.unwrap_or(usize::MAX / 4))

@@ -5,7 +5,7 @@ use super::{Aabb, PlacedPart, GRID, MAX_PAIRS};
 /// The volume of the intersection of two bounding boxes (0 when they do not meet).
 fn box_overlap(a: &PlacedPart, b: &PlacedPart) -> f64 {
     (0..3)
-        .map(|k| (a.bbox.1[k].min(b.bbox.1[k]) - a.bbox.0[k].max(b.bbox.0[k])).max(0.0))
+        .map(|k| (a.bbox.hi[k].min(b.bbox.hi[k]) - a.bbox.lo[k].max(b.bbox.lo[k])).max(0.0))
         .product()
 }
 
@@ -16,19 +16,19 @@ pub(super) fn neighbours(parts: &[PlacedPart]) -> Option<(Vec<Vec<usize>>, f64)>
     let usable: Vec<usize> = (0..parts.len())
         .filter(|&i| {
             let p = &parts[i];
-            p.volume > 0.0 && (0..3).all(|k| p.bbox.0[k].is_finite() && p.bbox.1[k].is_finite())
+            p.volume > 0.0 && (0..3).all(|k| p.bbox.lo[k].is_finite() && p.bbox.hi[k].is_finite())
         })
         .collect();
     let spread = |k: usize| {
         let (lo, hi) = usable
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| {
-                let c = 0.5 * (parts[i].bbox.0[k] + parts[i].bbox.1[k]);
+                let c = 0.5 * (parts[i].bbox.lo[k] + parts[i].bbox.hi[k]);
                 (lo.min(c), hi.max(c))
             });
         let mean_size: f64 = usable
             .iter()
-            .map(|&i| parts[i].bbox.1[k] - parts[i].bbox.0[k])
+            .map(|&i| parts[i].bbox.hi[k] - parts[i].bbox.lo[k])
             .sum::<f64>()
             / usable.len().max(1) as f64;
         (hi - lo) / mean_size.max(f64::MIN_POSITIVE)
@@ -37,14 +37,14 @@ pub(super) fn neighbours(parts: &[PlacedPart]) -> Option<(Vec<Vec<usize>>, f64)>
         .max_by(|&a, &b| spread(a).total_cmp(&spread(b)))
         .unwrap_or(0);
     let mut order = usable;
-    order.sort_by(|&a, &b| parts[a].bbox.0[axis].total_cmp(&parts[b].bbox.0[axis]));
+    order.sort_by(|&a, &b| parts[a].bbox.lo[axis].total_cmp(&parts[b].bbox.lo[axis]));
     let mut out = vec![Vec::new(); parts.len()];
     let mut active: Vec<usize> = Vec::new();
     let mut pairs = 0usize;
     let mut ignored = 0.0;
     for &i in &order {
-        let start = parts[i].bbox.0[axis];
-        active.retain(|&j| parts[j].bbox.1[axis] > start);
+        let start = parts[i].bbox.lo[axis];
+        active.retain(|&j| parts[j].bbox.hi[axis] > start);
         for &j in &active {
             let (a, b) = (&parts[i], &parts[j]);
             let shared = box_overlap(a, b);
@@ -89,16 +89,7 @@ pub(super) fn grid_size(
 /// point can be covered twice, so the only place the part is sampled or tested.
 pub(super) fn region(parts: &[PlacedPart], nb: &[Vec<usize>], i: usize) -> Aabb {
     let p = &parts[i];
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for &j in &nb[i] {
-        let q = &parts[j];
-        for k in 0..3 {
-            lo[k] = lo[k].min(p.bbox.0[k].max(q.bbox.0[k]));
-            hi[k] = hi[k].max(p.bbox.1[k].min(q.bbox.1[k]));
-        }
-    }
-    (lo, hi)
+    (nb[i].iter()).fold(Aabb::EMPTY, |r, &j| r.union(p.bbox.intersection(parts[j].bbox)))
 }
 
 /// What sampling one part found: the volume it shares (each point covered k times counts 1 − 1/k),
@@ -130,12 +121,12 @@ fn neighbour_masks(
             let b = &parts[j].bbox;
             let points = [0, 1, 2].map(|k| {
                 axes[k].iter().enumerate().fold(0u32, |m, (a, &x)| {
-                    m | (u32::from(x >= b.0[k] && x <= b.1[k]) << a)
+                    m | (u32::from(x >= b.lo[k] && x <= b.hi[k]) << a)
                 })
             });
             let cells = [0, 1, 2].map(|k| {
                 axes[k].iter().enumerate().fold(0u32, |m, (a, &x)| {
-                    m | (u32::from(x + half[k] >= b.0[k] && x - half[k] <= b.1[k]) << a)
+                    m | (u32::from(x + half[k] >= b.lo[k] && x - half[k] <= b.hi[k]) << a)
                 })
             });
             (j, points, cells)
@@ -192,7 +183,7 @@ pub(super) fn sample_part(
     n: usize,
 ) -> PartSample {
     let p = &parts[i];
-    let (lo, hi) = region(parts, nb, i);
+    let Aabb { lo, hi } = region(parts, nb, i);
     let cell_volume = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]) / (n * n * n) as f64;
     let half = [0, 1, 2].map(|k| 0.5 * (hi[k] - lo[k]) / n as f64);
     // The surfaces are tested against each cell's core, the cell shrunk by `SHRINK` of its size: a

@@ -3,6 +3,9 @@ use crate::mass::Mat3;
 use crate::mesh::health::Solid;
 use sample::neighbours;
 
+/// A box as its corners `(lo, hi)`, the shape these tests build boxes in.
+type Corners = ([f64; 3], [f64; 3]);
+
 const ID: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 fn placed(shape: PartShape, t: [f64; 3], half: [f64; 3], volume: f64) -> PlacedPart {
@@ -10,7 +13,7 @@ fn placed(shape: PartShape, t: [f64; 3], half: [f64; 3], volume: f64) -> PlacedP
         shape,
         rotation: ID,
         translation: t,
-        bbox: (
+        bbox: Aabb::new(
             [t[0] - half[0], t[1] - half[1], t[2] - half[2]],
             [t[0] + half[0], t[1] + half[1], t[2] + half[2]],
         ),
@@ -149,7 +152,7 @@ fn box_solid(h: [f64; 3]) -> Solid {
 /// The volume of a union of axis-aligned boxes, exact: on the grid of all their coordinates each
 /// elementary cell is in the union or not, and with coordinates that are multiples of 1/8 below
 /// 2^20 every difference and product here is exact in f64.
-fn union_volume(boxes: &[Aabb]) -> f64 {
+fn union_volume(boxes: &[Corners]) -> f64 {
     let coords = |k: usize| {
         let mut c: Vec<f64> = boxes.iter().flat_map(|b| [b.0[k], b.1[k]]).collect();
         c.sort_by(f64::total_cmp);
@@ -186,7 +189,7 @@ fn the_bound_holds_against_an_exact_union_of_boxes() {
         let u = crate::lcg_unit(&mut seed);
         (8.0 * (lo + (hi - lo) * u)).round() / 8.0
     };
-    let boxes: Vec<(Aabb, bool)> = (0..40)
+    let boxes: Vec<(Corners, bool)> = (0..40)
         .map(|i| {
             let lo = [0, 1, 2].map(|_| eighths(0.0, 3.0));
             let size = [0, 1, 2].map(|_| eighths(0.25, 1.5));
@@ -215,7 +218,7 @@ fn the_bound_holds_against_an_exact_union_of_boxes() {
                     PartShape::Box(h)
                 };
                 let mut p = placed(shape, c, [0.0; 3], 8.0 * h[0] * h[1] * h[2]);
-                p.bbox = (lo, hi);
+                p.bbox = Aabb::new(lo, hi);
                 if turned {
                     p.rotation = quarter;
                 }
@@ -247,7 +250,7 @@ fn the_bound_holds_against_an_exact_union_of_boxes() {
 /// part of it (every box's region is one meeting, crossed by few faces).
 #[test]
 fn the_bound_of_a_chain_of_boxes_is_tight() {
-    let boxes: Vec<Aabb> = (0..10)
+    let boxes: Vec<Corners> = (0..10)
         .map(|i| {
             let lo = [0.75 * f64::from(i), 0.125 * f64::from(i % 3), 0.0];
             (lo, [lo[0] + 1.0, lo[1] + 1.0, lo[2] + 1.0])
@@ -298,7 +301,7 @@ fn a_thousand_overlapping_boxes_stay_within_the_cap_and_the_bound() {
 #[test]
 fn the_bound_covers_exact_pairwise_intersections_under_any_cap() {
     let (d, s) = (0.375, 0.125);
-    let boxes: Vec<Aabb> = (0..12)
+    let boxes: Vec<Corners> = (0..12)
         .map(|i| {
             let lo = [(1.0 - d) * f64::from(i), s * f64::from(i % 2), 0.0];
             (lo, [lo[0] + 1.0, lo[1] + 1.0, lo[2] + 1.0])

@@ -157,15 +157,7 @@ fn unit_extent_loss(vertices: &[[f64; 3]], unit: f64) -> Option<&'static str> {
     if unit == 1.0 || vertices.is_empty() {
         return None;
     }
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for v in vertices {
-        for k in 0..3 {
-            lo[k] = lo[k].min(v[k]);
-            hi[k] = hi[k].max(v[k]);
-        }
-    }
-    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    let size = crate::geometry::Aabb::of(vertices.iter().copied()).largest_extent();
     let authored = size / unit;
     unit_range_loss(authored.powi(5), size.powi(5))
 }

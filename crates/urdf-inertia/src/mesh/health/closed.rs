@@ -8,6 +8,7 @@ use super::topology::{Edges, Orientation};
 use super::welding::Welding;
 use super::{HealthKind, ModelError, Rung, Solid};
 use crate::geometry::{cross, dot, sub};
+use crate::geometry::Aabb;
 use crate::mass::integrals::{bounding_box_centre, volume_integrals};
 use crate::mass::{IntegrationOptions, Polygons};
 use crate::mesh::MeshError;
@@ -131,7 +132,7 @@ pub(super) fn misoriented(vertices: &[[f64; 3]], faces: &Polygons, comp: &[u32],
 /// surface that is closed only up to cracks: |vector area| × diagonal / 6 (the signed volume about
 /// r is V(0) − r·A/3). Zero for a closed surface; its round-off for one closed bit for bit.
 pub(super) fn open_volume(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
-    let (lo, hi) = bbox(vertices);
+    let Aabb { lo, hi } = bbox(vertices);
     vector_area(vertices, faces) * dist(lo, hi) / 6.0
 }
 
@@ -190,7 +191,7 @@ pub(super) struct Outward {
 /// reference point by twice its vector area × the diagonal / 6; both are counted.
 pub(super) fn flip_change(vertices: &[[f64; 3]], faces: &Polygons, o: &Orientation, reversed: &[bool]) -> f64 {
     let centre = bounding_box_centre(vertices);
-    let (lo, hi) = bbox(vertices);
+    let Aabb { lo, hi } = bbox(vertices);
     let diag = dist(lo, hi);
     let mut count = vec![[0usize; 2]; o.ncomp];
     for (i, r) in reversed.iter().enumerate() {

@@ -21,15 +21,7 @@ pub(super) fn signed_volume(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
 }
 
 pub(super) fn bbox(vertices: &[[f64; 3]]) -> Aabb {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for v in vertices {
-        for k in 0..3 {
-            lo[k] = lo[k].min(v[k]);
-            hi[k] = hi[k].max(v[k]);
-        }
-    }
-    (lo, hi)
+    Aabb::of(vertices.iter().copied())
 }
 
 
@@ -53,8 +45,7 @@ pub(super) fn component_volumes(
     vol
 }
 
-/// A box `(lo, hi)`.
-pub type Aabb = ([f64; 3], [f64; 3]);
+pub use crate::geometry::Aabb;
 
 pub(super) fn component_boxes(
     vertices: &[[f64; 3]],
@@ -62,21 +53,18 @@ pub(super) fn component_boxes(
     comp: &[u32],
     ncomp: usize,
 ) -> Vec<Aabb> {
-    let mut boxes = vec![([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]); ncomp];
+    let mut boxes = vec![Aabb::EMPTY; ncomp];
     for (i, face) in faces.iter().enumerate() {
         let b = &mut boxes[comp[i] as usize];
         for &v in face {
-            for k in 0..3 {
-                b.0[k] = b.0[k].min(vertices[v as usize][k]);
-                b.1[k] = b.1[k].max(vertices[v as usize][k]);
-            }
+            b.add(vertices[v as usize]);
         }
     }
     boxes
 }
 
 pub(super) fn contains(outer: &Aabb, inner: &Aabb) -> bool {
-    (0..3).all(|k| outer.0[k] <= inner.0[k] && inner.1[k] <= outer.1[k])
+    outer.contains(inner)
 }
 
 /// The length of the surface's vector area `Σ N/2` (zero for a closed surface).

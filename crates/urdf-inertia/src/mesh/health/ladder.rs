@@ -136,7 +136,7 @@ impl<'a> Ladder<'a> {
         // One pass for the box both checks use.
         let bounds = bbox(&vertices);
         check_volume(&vertices, &faces, bounds, unit.mass, self.path)?;
-        let round_off = round_off(&vertices, &faces, bounds.0, &unit);
+        let round_off = round_off(&vertices, &faces, bounds.lo, &unit);
         let source = model.source;
         let bound = model.bound(&unit, &vertices);
         let model_error = bound.relative;

@@ -3,6 +3,7 @@
 
 use super::geometry::{dist, polygon_area, unit_props};
 use super::{ModelError, ROUND_OFF_FLOOR, ZERO_VOLUME_ROUNDOFFS};
+use crate::geometry::Aabb;
 use crate::mass::{frobenius, MassProperties, Polygons};
 use crate::mesh::{MeshError, MeshErrorKind};
 use std::path::Path;
@@ -115,7 +116,7 @@ pub(super) fn round_off(vertices: &[[f64; 3]], faces: &Polygons, lo: [f64; 3], b
 pub(super) fn check_volume(
     vertices: &[[f64; 3]],
     faces: &Polygons,
-    (lo, hi): ([f64; 3], [f64; 3]),
+    Aabb { lo, hi }: Aabb,
     volume: f64,
     path: &Path,
 ) -> Result<(), MeshError> {

@@ -8,6 +8,7 @@ use super::model::{Lever, Model};
 use super::topology::{orient, Edges};
 use super::welding::Welding;
 use super::{HealthKind, ModelError, Rung, Solid, CAPPED, SLIVERS};
+use crate::geometry::Aabb;
 use crate::mass::Polygons;
 use crate::mesh::open::{NoSolid, OpenMeshModel};
 use crate::mesh::{hull, MeshError, MeshErrorKind};
@@ -144,7 +145,7 @@ pub(super) fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) ->
         // No closing encloses a volume: a flat plate or a two-sided sheet has none to speak of (the
         // part contributes nothing); anything else defines no solid.
         (_, None) if crate::mesh::open::encloses_nothing(&w.vertices, &w.stored) => {
-            let (lo, hi) = bbox(&w.vertices);
+            let Aabb { lo, hi } = bbox(&w.vertices);
             Err(MeshError::new(
                 ladder.path,
                 None,
@@ -230,7 +231,7 @@ pub(super) fn with_caps(
 ) -> Result<Solid, MeshError> {
     let caps = &plan.caps;
     // Whatever surface really spans the loops, its contribution is at most (its area) × diagonal.
-    let (lo, hi) = bbox(&w.vertices);
+    let Aabb { lo, hi } = bbox(&w.vertices);
     let spans = caps.area * dist(lo, hi);
     if (spans + caps.bound + plan.cracks) / plan.volume <= SLIVERS && winding.flipped == 0 {
         ladder.note(HealthKind::Welded, format!(
@@ -304,7 +305,7 @@ pub(super) fn convex_hull(
     te: &Edges,
     what: &str,
 ) -> Result<Solid, MeshError> {
-    let (lo, hi) = bbox(&w.vertices);
+    let Aabb { lo, hi } = bbox(&w.vertices);
     let diag = dist(lo, hi);
     // The stored surface's signed volume, and how much it moves over reference points in the box.
     let own = signed_volume(&w.vertices, &w.stored);

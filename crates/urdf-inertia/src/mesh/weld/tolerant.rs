@@ -141,17 +141,13 @@ impl Tolerance {
 
 /// The tolerance of the second pass for these (scaled) vertices stored with `precision`.
 pub fn tolerance(vertices: &[[f64; 3]], precision: Precision) -> Tolerance {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
+    let mut bounds = crate::geometry::Aabb::EMPTY;
     let mut largest = 0.0f64;
-    for v in vertices {
-        for k in 0..3 {
-            lo[k] = lo[k].min(v[k]);
-            hi[k] = hi[k].max(v[k]);
-            largest = largest.max(v[k].abs());
-        }
+    for &v in vertices {
+        bounds.add(v);
+        largest = largest.max(v[0].abs()).max(v[1].abs()).max(v[2].abs());
     }
-    let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0f64, f64::max);
+    let extent = bounds.largest_extent().max(0.0);
     let base = (RELATIVE_TOLERANCE * extent).max(ULPS * f64::EPSILON * largest);
     let relative_ulp = precision.relative_ulp();
     Tolerance {
