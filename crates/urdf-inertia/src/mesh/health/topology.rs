@@ -314,3 +314,114 @@ pub(super) fn components(nfaces: usize, pairs: &[(u32, u32, bool)]) -> (Vec<u32>
     }
     label(parent)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn polygons(faces: &[&[u32]]) -> Polygons {
+        let mut p = Polygons::new();
+        for f in faces {
+            p.push(f);
+        }
+        p
+    }
+
+    /// A tetrahedron wound outward (every edge traversed once each way), and the same offset by 4.
+    const TET: [[u32; 3]; 4] = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
+
+    fn tets(n: u32) -> Vec<Vec<u32>> {
+        (0..n)
+            .flat_map(|t| TET.iter().map(move |f| f.map(|v| v + 4 * t).to_vec()))
+            .collect()
+    }
+
+    fn faces(v: &[Vec<u32>]) -> Polygons {
+        polygons(&v.iter().map(Vec::as_slice).collect::<Vec<_>>())
+    }
+
+    #[test]
+    fn a_clean_tetrahedron_is_proven_closed_with_one_component() {
+        let f = faces(&tets(1));
+        assert_eq!(closed_consistent(&f), Some((vec![0; 4], 1)));
+        let e = edges(&f);
+        assert!(e.closed() && e.inconsistent == 0 && e.pairs.is_empty());
+        // The full analysis agrees: six manifold edges, each traversed both ways.
+        let full = edge_analysis(&f);
+        assert_eq!((full.boundary, full.nonmanifold, full.inconsistent), (0, 0, 0));
+        assert_eq!(full.pairs.len(), 6);
+    }
+
+    #[test]
+    fn components_are_numbered_by_first_face() {
+        // Two tetrahedra, their faces interleaved: ids follow the first face of each.
+        let mut v = tets(2);
+        v.swap(0, 4);
+        let (comp, n) = closed_consistent(&faces(&v)).expect("clean");
+        assert_eq!(n, 2);
+        assert_eq!(comp, vec![0, 1, 1, 1, 1, 0, 0, 0]);
+    }
+
+    #[test]
+    fn a_reversed_face_is_inconsistent_and_orientation_flips_it_alone() {
+        let mut v = tets(1);
+        v[2].reverse();
+        let f = faces(&v);
+        assert_eq!(closed_consistent(&f), None);
+        let e = edges(&f);
+        // Its three edges are traversed the same way by both faces; the surface is still closed.
+        assert!(e.closed());
+        assert_eq!(e.inconsistent, 3);
+        let o = orient(4, &e.pairs).expect("orientable");
+        assert_eq!(o.ncomp, 1);
+        // The first face is kept; exactly the reversed face is flipped.
+        assert_eq!(o.flip, vec![false, false, true, false]);
+    }
+
+    #[test]
+    fn a_removed_face_leaves_three_boundary_edges_directed_as_their_face() {
+        let v = tets(1)[..3].to_vec();
+        let e = edges(&faces(&v));
+        assert_eq!((e.boundary, e.nonmanifold), (3, 0));
+        assert!(!e.closed());
+        assert_eq!(e.describe(), "open (3 boundary edges)");
+        // The hole is the missing face [0, 3, 2]: its edges, traversed by the other faces the
+        // other way, are (3, 0), (2, 3) and (0, 2), in the sort's key order.
+        let mut half = e.boundary_half_edges.clone();
+        half.sort_unstable();
+        assert_eq!(half, vec![(0, 2), (2, 3), (3, 0)]);
+        assert_eq!(e.boundary_faces.len(), 3);
+    }
+
+    #[test]
+    fn three_faces_on_one_edge_are_non_manifold() {
+        let f = polygons(&[&[0, 1, 2], &[1, 0, 3], &[0, 1, 4]]);
+        let e = edges(&f);
+        assert_eq!(e.nonmanifold, 1);
+        assert!(!e.closed());
+        assert!(e.describe().contains("non-manifold (1 edges shared by 3+ faces)"));
+    }
+
+    #[test]
+    fn a_moebius_band_is_not_orientable() {
+        // Four quads in a ring, the last joined to the first with a half twist: going round once
+        // flips the orientation, so no consistent one exists.
+        let band: [&[u32]; 4] = [&[0, 1, 3, 2], &[2, 3, 5, 4], &[4, 5, 7, 6], &[6, 7, 0, 1]];
+        let e = edges(&polygons(&band));
+        assert!(orient(4, &e.pairs).is_none());
+    }
+
+    #[test]
+    fn union_find_joins_sets_and_labels_them_by_first_element() {
+        let mut parent: Vec<u32> = (0..6).collect();
+        union(&mut parent, 4, 5);
+        union(&mut parent, 1, 4);
+        union(&mut parent, 2, 3);
+        assert_eq!(root(&mut parent, 5), 1);
+        assert_eq!(root(&mut parent, 3), 2);
+        assert_eq!(label(parent), (vec![0, 1, 2, 2, 1, 1], 3));
+        // One set: every id 0, without root walks.
+        assert_eq!(label(vec![0, 0, 1, 2]), (vec![0; 4], 1));
+        assert_eq!(components(3, &[(0, 2, false)]), (vec![0, 1, 0], 2));
+    }
+}
