@@ -753,3 +753,62 @@ fn caps_of_several_holes_bound_the_winding_number_solid() {
         "the difference {diff} is not resolved (σ {sigma})"
     );
 }
+
+/// A link whose only collision is a flat plate, with an `<inertial>` of its own whose tensor is zero
+/// (as exported for an ArUco marker): `fill` leaves it as it is (UI109), and `check --density` reports
+/// the invalid tensor without claiming that `fill` computes correct values for it.
+#[test]
+fn check_does_not_promise_fill_computes_a_flat_link() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = tmp.path();
+    let plate = [
+        [0.0, 0.0, 0.0],
+        [0.06, 0.0, 0.0],
+        [0.06, 0.06, 0.0],
+        [0.0, 0.06, 0.0],
+    ];
+    write_obj(&dir.join("plate.obj"), &plate, &[[0, 1, 2], [0, 2, 3]]);
+    let urdf = dir.join("marker.urdf");
+    std::fs::write(
+        &urdf,
+        r#"<robot name="r">
+  <link name="base">
+    <inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>
+  </link>
+  <link name="aruco">
+    <inertial><mass value="3.6e-06"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>
+    <collision><geometry><mesh filename="plate.obj"/></geometry></collision>
+  </link>
+  <joint name="j" type="fixed"><parent link="base"/><child link="aruco"/></joint>
+</robot>
+"#,
+    )
+    .expect("write");
+    let path = urdf.to_str().expect("utf-8");
+    let filled = dir.join("filled.urdf");
+    let fill = run(&[
+        "fill",
+        path,
+        "--density",
+        "1000",
+        "-o",
+        filled.to_str().expect("utf-8"),
+    ]);
+    let said = String::from_utf8_lossy(&fill.stderr).to_string();
+    assert!(
+        fill.status.success() && said.contains("warning[UI109]: link `aruco`"),
+        "{said}"
+    );
+    let c = run(&["check", path, "--density", "1000"]);
+    let out = String::from_utf8_lossy(&c.stdout).to_string();
+    let err = String::from_utf8_lossy(&c.stderr).to_string();
+    assert_eq!(c.status.code(), Some(1), "{out}{err}");
+    assert!(
+        out.contains("link `aruco`") && out.contains("[UI602]"),
+        "{out}"
+    );
+    assert!(
+        err.contains("which `fill` cannot compute") && !err.contains("computes correct values"),
+        "{err}"
+    );
+}

@@ -385,6 +385,9 @@ fn run(config: &Config) -> Outcome {
 struct Findings {
     problems: Vec<Problem>,
     links: Vec<LinkRecord>,
+    /// Links (file, name) `fill` leaves as they are because their collision geometry has no volume
+    /// (UI109): a problem of their own `<inertial>` is not one `fill` can correct.
+    uncomputable: Vec<(PathBuf, String)>,
 }
 
 impl Findings {
@@ -476,7 +479,20 @@ fn report_problems(config: &Config, found: &Findings, errors: usize) -> usize {
         }
     }
     if errors == 0 && !new.is_empty() {
-        errln!("urdf-inertia check: {} problem(s) found; `urdf-inertia fill -i FILE --density-map …` computes correct values", new.len());
+        let by_hand: Vec<&str> = (new.iter())
+            .filter(|p| {
+                (found.uncomputable.iter())
+                    .any(|(f, l)| *f == p.problem.file && *l == p.problem.link)
+            })
+            .map(|p| p.problem.link.as_str())
+            .collect();
+        if by_hand.len() == new.len() {
+            errln!("urdf-inertia check: {} problem(s) found, on links whose collision geometry has no volume (UI109), which `fill` cannot compute: give them a primitive collision shape or a closed mesh, or correct their <inertial> by hand", new.len());
+        } else if by_hand.is_empty() {
+            errln!("urdf-inertia check: {} problem(s) found; `urdf-inertia fill -i FILE --density-map …` computes correct values", new.len());
+        } else {
+            errln!("urdf-inertia check: {} problem(s) found; `urdf-inertia fill -i FILE --density-map …` computes correct values, except for links whose collision geometry has no volume (UI109: {}): give them a primitive collision shape or a closed mesh, or correct their <inertial> by hand", new.len(), by_hand.join(", "));
+        }
         if config.baseline.is_none() && !config.policy.quiet {
             errln!(
                 "help: problems that were there before your change? record them once with `urdf-inertia check FILES --write-baseline urdf-inertia.baseline` (commit it; `baseline = \"urdf-inertia.baseline\"` in urdf-inertia.toml) and later runs fail only on new ones; or leave a link alone with --skip NAME"
@@ -568,6 +584,7 @@ fn run_one(
                     && flat_links.contains(&p.problem.link))
             });
             check_against_computed(&input, &report, config, &mut found.problems);
+            (found.uncomputable).extend(flat_links.iter().map(|l| (robot.path.clone(), l.clone())));
             found.record_links(robot, Some(&report), from, config.tolerance);
             outcome.problems += promoted;
         }
