@@ -9,8 +9,8 @@
 
 use std::sync::OnceLock;
 
-/// At most this many worker threads a core: `RAYON_NUM_THREADS=5000` once turned a 3 ms run into
-/// 69 s of thread start-up and idle spinning. More threads than cores give no speed; a few more are
+/// At most this many worker threads a core: `RAYON_NUM_THREADS=5000` once turned a run of
+/// milliseconds into a minute of thread start-up and idle spinning (docs/benchmarks.md). More threads than cores give no speed; a few more are
 /// allowed so that a test can run on more threads than the machine has.
 pub const MAX_THREADS_PER_CORE: usize = 4;
 

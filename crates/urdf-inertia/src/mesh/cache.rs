@@ -219,9 +219,8 @@ impl MeshCache {
         };
         // Nothing to share out: all here, without touching rayon, whose first use starts its global
         // pool (a thread per core, idle workers spinning in sched_yield) and hands the scope to a
-        // worker while this thread waits. On URDFs whose collision geometry has no mesh (ur3, a1)
-        // that was 0.35–0.65 ms of a 2–2.8 ms task-clock and 22 page faults per process (perf stat
-        // -r 50, 2 cores); pre-commit and the benchmarks run one process per URDF.
+        // worker while this thread waits: a fifth of a run on a URDF without meshes, which pre-commit
+        // runs one process at a time (measured in docs/benchmarks.md, "Figures behind choices in the code").
         if one_at_a_time || (work.len() <= 1 && needs.len() <= 1) {
             (0..work.len()).for_each(load);
             (0..needs.len()).for_each(run);

@@ -457,7 +457,7 @@ mod tests {
             .unwrap_err()
             .hint
             .contains("xacro"));
-        // file:// percent-decoded, as resource_retriever does (issue 11).
+        // file:// percent-decoded, as resource_retriever does.
         let spaced = tmp.path().join("my robot");
         std::fs::create_dir_all(&spaced).expect("mkdir");
         std::fs::write(spaced.join("part one.stl"), "solid x\nendsolid x\n").expect("write");
