@@ -10,8 +10,9 @@
 use std::sync::OnceLock;
 
 /// At most this many worker threads a core: `RAYON_NUM_THREADS=5000` once turned a run of
-/// milliseconds into a minute of thread start-up and idle spinning (docs/benchmarks.md). More threads than cores give no speed; a few more are
-/// allowed so that a test can run on more threads than the machine has.
+/// milliseconds into a minute of thread start-up and idle spinning (docs/benchmarks.md). More
+/// threads than cores give no speed; a few more are allowed so that a test can run on more threads
+/// than the machine has.
 pub const MAX_THREADS_PER_CORE: usize = 4;
 
 /// The pool, and a note when it is not what was asked for (capped, or the calling thread alone).

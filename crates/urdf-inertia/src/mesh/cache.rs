@@ -219,8 +219,8 @@ impl MeshCache {
         };
         // Nothing to share out: all here, without touching rayon, whose first use starts its global
         // pool (a thread per core, idle workers spinning in sched_yield) and hands the scope to a
-        // worker while this thread waits: a fifth of a run on a URDF without meshes, which pre-commit
-        // runs one process at a time (measured in docs/benchmarks.md, "Figures behind choices in the code").
+        // worker while this thread waits: a fifth of a run on a URDF without meshes, which
+        // pre-commit runs one process at a time (docs/benchmarks.md, figures behind choices).
         if one_at_a_time || (work.len() <= 1 && needs.len() <= 1) {
             (0..work.len()).for_each(load);
             (0..needs.len()).for_each(run);
