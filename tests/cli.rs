@@ -311,7 +311,7 @@ fn only_inertials_change_and_fill_is_idempotent() {
     // No temp files left beside it.
     let leftovers: Vec<_> = std::fs::read_dir(urdf.parent().unwrap())
         .unwrap()
-        .filter_map(|e| e.ok())
+        .filter_map(std::result::Result::ok)
         .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
         .collect();
     assert!(leftovers.is_empty());

@@ -21,7 +21,7 @@
 //! | 12 | two `<robot>` roots; CR-only line ends; UTF-32 and mark-less UTF-16; upper-case ASCII STL | `second_robot_root_is_left_alone`, `cr_only_urdf_keeps_its_line_ends_and_lines`, `utf16_without_a_mark_is_read_and_utf32_is_named`, `upper_case_ascii_stl_is_read_as_ascii` |
 //!
 //! Item 12's self-intersecting and nested outward shells are the winding-number work's (its tests are
-//! in tests/winding_truth.rs). docs/reliability.md has a row for each input above.
+//! in `tests/winding_truth.rs`). docs/reliability.md has a row for each input above.
 
 // The test helpers are the library tests' own (exact integrals, mesh generators).
 #[path = "../crates/urdf-inertia/tests/common/mod.rs"]
@@ -37,6 +37,9 @@ use std::io::{BufRead, BufReader, Read, Write};
 use std::os::unix::fs::{FileTypeExt, MetadataExt, PermissionsExt};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
+use urdf_inertia::mesh::health::HealthOptions;
+use urdf_inertia::write::WriteOptions;
+use urdf_inertia::FillOptions;
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
@@ -476,7 +479,7 @@ fn non_regular_inputs_are_refused() {
     assert!(stderr(&out).contains("is not a regular file"));
 }
 
-/// Issue 13.6: the size read is capped (`--max-file-size`, or URDF_INERTIA_MAX_FILE_SIZE).
+/// Issue 13.6: the size read is capped (`--max-file-size`, or `URDF_INERTIA_MAX_FILE_SIZE`).
 #[test]
 fn input_size_is_capped() {
     let (_tmp, urdf) = urdf_in_tmp(&one_box());
@@ -578,7 +581,7 @@ fn assert_fails_with(name: &str, text: &str, message: &str) {
     }
 }
 
-/// Issue 13.7: an `<accessor offset>` beyond the stride, an `<input offset>` near u64::MAX and a huge
+/// Issue 13.7: an `<accessor offset>` beyond the stride, an `<input offset>` near `u64::MAX` and a huge
 /// `<vcount>` once panicked (exit 101, also inside `check`). Each is an error with its line now.
 #[test]
 fn collada_offsets_and_counts_are_checked() {
@@ -943,7 +946,7 @@ fn overlap_of_1000_crowded_convex_pieces_keeps_to_the_work_cap() {
     assert!(excess > 0.0 && excess < 1000.0 * sphere, "{excess}");
 }
 
-/// Peak resident memory of this process (VmHWM), bytes.
+/// Peak resident memory of this process (`VmHWM`), bytes.
 fn peak_rss() -> u64 {
     let status = std::fs::read_to_string("/proc/self/status").expect("/proc/self/status");
     let kb: u64 = status
@@ -996,7 +999,7 @@ fn overlap_of_a_sliver_cone_and_a_box_has_bounded_memory() {
         &robot,
         &urdf_inertia::density::DensityMap::uniform(1000.0),
         &urdf_inertia::urdf::resolve::PackageResolver::new(),
-        &Default::default(),
+        &FillOptions::default(),
     );
     let grown = peak_rss().saturating_sub(before);
     assert!(report.failures.is_empty(), "{:?}", report.failures);
@@ -1111,10 +1114,14 @@ fn fill_on_threads(
             robot,
             &urdf_inertia::density::DensityMap::uniform(1000.0),
             &urdf_inertia::urdf::resolve::PackageResolver::new(),
-            &Default::default(),
+            &FillOptions::default(),
         );
-        let updates: Vec<_> = r.links.iter().map(|l| l.update()).collect();
-        let written = urdf_inertia::urdf::write::splice(robot, &updates, &Default::default());
+        let updates: Vec<_> = r
+            .links
+            .iter()
+            .map(urdf_inertia::LinkReport::update)
+            .collect();
+        let written = urdf_inertia::urdf::write::splice(robot, &updates, &WriteOptions::default());
         let what = format!(
             "{:?}\n{:?}\n{:?}\n{} {} {} {}",
             r.links,
@@ -1133,7 +1140,11 @@ fn fill_on_threads(
 // A list of table rows, one input each: splitting it would only scatter the list.
 #[allow(clippy::too_many_lines)]
 fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)) {
-    let a = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let a = |v: &[&str]| {
+        v.iter()
+            .map(std::string::ToString::to_string)
+            .collect::<Vec<_>>()
+    };
     let write = |name: &str, bytes: &[u8]| std::fs::write(d.join(name), bytes).unwrap();
     let geometry = format!(
         "<library_geometries>{}</library_geometries>\n",
@@ -1368,7 +1379,7 @@ fn fuzz_one(target: &str, data: &[u8]) -> Result<(), String> {
             return Ok(());
         }
         for scale in [[1.0; 3], [1.0, -1.0, 1.0]] {
-            if let Err(e) = mesh::solid_from_raw(&raw, scale, path, Default::default()) {
+            if let Err(e) = mesh::solid_from_raw(&raw, scale, path, HealthOptions::default()) {
                 if matches!(e.kind, MeshErrorKind::Internal(_)) {
                     return Err(e.to_string());
                 }
@@ -1408,7 +1419,8 @@ fn fuzz_one(target: &str, data: &[u8]) -> Result<(), String> {
                 .map(|i| (i, urdf_inertia::mass::primitives::sphere(0.1, 1000.0)).into())
                 .collect();
             // A text that would not re-encode to the same bytes is refused, not written.
-            let Ok(out) = urdf_inertia::urdf::write::splice(&robot, &updates, &Default::default())
+            let Ok(out) =
+                urdf_inertia::urdf::write::splice(&robot, &updates, &WriteOptions::default())
             else {
                 return Ok(());
             };
@@ -1714,7 +1726,7 @@ impl Row {
         let size = args
             .iter()
             .filter_map(|a| std::fs::metadata(d.join(a)).ok())
-            .filter(|m| m.is_file())
+            .filter(std::fs::Metadata::is_file)
             .map(|m| m.len())
             .max()
             .unwrap_or(0);
@@ -1801,7 +1813,11 @@ fn torus(n: u32, m: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
 #[allow(clippy::too_many_lines)] // a table of large inputs
 fn large_inputs(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)) {
     let (v, f) = torus(1000, 500);
-    let a = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let a = |v: &[&str]| {
+        v.iter()
+            .map(std::string::ToString::to_string)
+            .collect::<Vec<_>>()
+    };
     let mut put = |name: &str, bytes: &[u8], what: &str| {
         std::fs::write(d.join(name), bytes).unwrap();
         add(what, a(&["mesh", name]), None);
@@ -2009,7 +2025,11 @@ fn write_reliability_table() {
         let out = c.output().unwrap();
         rows.push(Row::new(what, &args, out, d));
     };
-    let a = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let a = |v: &[&str]| {
+        v.iter()
+            .map(std::string::ToString::to_string)
+            .collect::<Vec<_>>()
+    };
     add(
         "`fill -o /dev/null`",
         a(&["fill", "r.urdf", "--density", "1000", "-o", "/dev/null"]),
@@ -2639,7 +2659,7 @@ fn edit_during_fill_in_place_is_kept() {
 }
 
 /// A run whose output is the file's bytes already writes nothing (same inode, same modification
-/// time); a 250-byte file name (the temporary name once exceeded NAME_MAX) fills in place.
+/// time); a 250-byte file name (the temporary name once exceeded `NAME_MAX`) fills in place.
 #[test]
 fn unchanged_output_is_not_written_and_long_names_fill_in_place() {
     let tmp = tempfile::tempdir().unwrap();
@@ -3233,7 +3253,7 @@ fn package_of_every_input(d: &Path) -> Vec<&'static str> {
 
 /// Every file a run opens (URDF or xacro source, xacro includes and YAML, `package.xml`, meshes,
 /// the density map and the configuration) counts toward one budget of bytes per run,
-/// `--max-total-read` (or URDF_INERTIA_MAX_TOTAL_READ): with a budget of exactly the bytes read the
+/// `--max-total-read` (or `URDF_INERTIA_MAX_TOTAL_READ)`: with a budget of exactly the bytes read the
 /// run succeeds; one byte less, the file that would exceed it is named with the budget and how to raise
 /// it, and nothing is written. (A robot naming thousands of files, each within the one-file limit,
 /// once read without bound.)

@@ -459,7 +459,7 @@ const XACRO_SEEDS: [(&str, &str); 6] = [
 ];
 
 /// Small YAML files as robot descriptions write them (UR's kinematics, joint limits), and YAML 1.1
-/// scalars PyYAML resolves differently from YAML 1.2.
+/// scalars `PyYAML` resolves differently from YAML 1.2.
 const YAML_SEEDS: [(&str, &str); 4] = [
     (
         "kinematics.yaml",
@@ -493,7 +493,7 @@ fn write_xacro_fuzz_seeds() {
 }
 
 /// The xacro and yaml fuzzing seeds go through the fuzz targets' code (expansion, URDF scan, the
-/// write-back splice; load_yaml and printing): nothing panics. The seeds on disk must be the ones
+/// write-back splice; `load_yaml` and printing): nothing panics. The seeds on disk must be the ones
 /// these constants write.
 #[test]
 fn xacro_fuzz_seeds_replay() {

@@ -20,7 +20,7 @@ pub struct Problem {
 
 impl Problem {
     /// The line `check` prints: `FILE:LINE: link `NAME`: MESSAGE [UI601]` (the code last, as
-    /// ESLint puts its rule: the line reads as before, and the code is there to look up or silence).
+    /// `ESLint` puts its rule: the line reads as before, and the code is there to look up or silence).
     pub fn line(&self) -> String {
         format!(
             "{}: {} [{}]",

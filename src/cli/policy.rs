@@ -172,7 +172,7 @@ impl Policy {
         *ds = ds.iter().filter_map(|d| self.apply(d)).collect();
     }
 
-    /// Whether a problem of `check` (UI6xx) is reported.
+    /// Whether a problem of `check` (`UI6xx`) is reported.
     pub fn reports(&self, code: Code) -> bool {
         !self.ignore.contains(&code)
     }

@@ -36,7 +36,7 @@ struct Sources {
     visual_fallback: bool,
 }
 
-/// `--max-memory`, or by default the memory the kernel reports available (Linux: MemAvailable in
+/// `--max-memory`, or by default the memory the kernel reports available (Linux: `MemAvailable` in
 /// /proc/meminfo); no budget where neither is known.
 fn memory_budget(s: &SourceArgs) -> Result<u64, String> {
     if let Some(v) = &s.max_memory {
@@ -658,7 +658,7 @@ fn read_input(path: &Path, src: &Sources, policy: &Policy) -> Result<Input, Stri
     let mut warnings: Vec<Diagnostic> = x
         .warnings
         .iter()
-        .map(|w| Diagnostic::new(Code::XacroWarning, w.to_string()))
+        .map(|w| Diagnostic::new(Code::XacroWarning, w.clone()))
         .collect();
     policy.apply_all(&mut warnings);
     print_diagnostics(&warnings, policy);
@@ -766,28 +766,25 @@ fn write_robot(
         Ok(())
     };
     let mut written = None;
-    match (&input.xacro, w.in_place) {
-        (Some(x), true) => {
-            check_failed()?;
-            let k = write_into_sources(input, x, report, w, policy)?;
-            written = (k < report.links.len()).then_some(k);
-        }
-        _ => {
-            let text = spliced(robot, report, w)?;
-            check_failed()?;
-            let target = file.unwrap_or(Path::new("-"));
-            let written = if w.in_place {
-                write::write_in_place(target, &text)
-            } else {
-                write::write_output(target, &text)
-            };
-            if let Err(e) = written {
-                // A failing stdout was reported where it failed.
-                if file.is_some() {
-                    errln!("error: {e}");
-                }
-                return Err(ExitStatus::Error);
+    if let (Some(x), true) = (&input.xacro, w.in_place) {
+        check_failed()?;
+        let k = write_into_sources(input, x, report, w, policy)?;
+        written = (k < report.links.len()).then_some(k);
+    } else {
+        let text = spliced(robot, report, w)?;
+        check_failed()?;
+        let target = file.unwrap_or(Path::new("-"));
+        let written = if w.in_place {
+            write::write_in_place(target, &text)
+        } else {
+            write::write_output(target, &text)
+        };
+        if let Err(e) = written {
+            // A failing stdout was reported where it failed.
+            if file.is_some() {
+                errln!("error: {e}");
             }
+            return Err(ExitStatus::Error);
         }
     }
     if file.is_some() {
@@ -850,8 +847,7 @@ fn write_into_sources(
     options.digits = w.digits;
     options.principal = w.principal;
     // Per source file: the links written there (span, update).
-    let mut per_file: std::collections::BTreeMap<usize, Vec<(usize, usize, LinkUpdate)>> =
-        Default::default();
+    let mut per_file = std::collections::BTreeMap::<usize, Vec<(usize, usize, LinkUpdate)>>::new();
     for l in &report.links {
         let link = &robot.links[l.index];
         let Some(o) = x.origin(link.line) else {

@@ -8,7 +8,7 @@
 //! the problems. The JSON Schemas in the repository's docs/schema/ are generated from these types
 //! (feature `json-schema`; the workspace's tests/schema.rs).
 //!
-//! A number that is not finite has no JSON form: serde_json writes it as `null`, and the schema
+//! A number that is not finite has no JSON form: `serde_json` writes it as `null`, and the schema
 //! allows `null` where a value can be one (an error estimate that is unbounded, values an existing
 //! `<inertial>` gives as `nan`).
 

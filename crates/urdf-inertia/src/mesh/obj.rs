@@ -231,7 +231,7 @@ fn vertex(mut words: Words<'_>, lineno: usize, path: &Path) -> Result<[f64; 3], 
     let err =
         |line: usize, msg: String| MeshError::new(path, Some(line), MeshErrorKind::Syntax(msg));
     let mut p = [0.0; 3];
-    for c in p.iter_mut() {
+    for c in &mut p {
         *c = words
             .number()
             .ok_or_else(|| err(lineno, "`v` needs three coordinates".into()))?
@@ -404,7 +404,7 @@ mod number_tests {
 
     /// [`SPELLINGS`], then random short decimals in the form exporters write.
     fn words() -> Vec<String> {
-        let mut words: Vec<String> = SPELLINGS.iter().map(|s| s.to_string()).collect();
+        let mut words: Vec<String> = SPELLINGS.iter().map(std::string::ToString::to_string).collect();
         let mut state = 0x2545_f491_4f6c_dd1du64;
         let mut next = move || crate::xorshift(&mut state);
         for _ in 0..200_000 {

@@ -45,15 +45,12 @@ pub(super) fn read_geometry(
         let (vin, stride, voff) = vertex_input(prim, kind, path)?;
         let src = vin.attr("source").unwrap_or("");
         // Each distinct source is appended once; its indices may only reach its own vertices.
-        let (base, count) = match cache.get(src) {
-            Some(&bc) => bc,
-            None => {
-                let pos = positions_of(mesh, &sources, src, vin.line, bytes, path)?;
-                let bc = (vertices.len() as u32, pos.len());
-                vertices.extend(pos);
-                cache.insert(src.to_string(), bc);
-                bc
-            }
+        let (base, count) = if let Some(&bc) = cache.get(src) { bc } else {
+            let pos = positions_of(mesh, &sources, src, vin.line, bytes, path)?;
+            let bc = (vertices.len() as u32, pos.len());
+            vertices.extend(pos);
+            cache.insert(src.to_string(), bc);
+            bc
         };
         let input = VertexInput {
             stride,

@@ -326,10 +326,10 @@ pub(super) fn convex_hull(
     // The mesh's own volume is the truth up to `moves`; the hull differs from it by this much.
     let model = (own - hull_volume).abs() + moves;
     let nv = hv.len();
-    let share = if hull_volume != 0.0 {
-        100.0 * (own - hull_volume) / hull_volume
-    } else {
+    let share = if hull_volume == 0.0 {
         0.0
+    } else {
+        100.0 * (own - hull_volume) / hull_volume
     };
     let message = move |m: f64, _| {
         let bound = if m.is_finite() {

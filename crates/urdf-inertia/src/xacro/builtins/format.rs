@@ -159,22 +159,21 @@ pub fn percent_format(fmt: &str, args: &Value) -> Result<Value, String> {
             Some(k) => spec.replacen(&format!("({k})"), "", 1),
             None => spec,
         };
-        let v = match &key {
-            Some(k) => match args {
+        let v = if let Some(k) = &key {
+            match args {
                 Value::Dict(d) => d
                     .get(&Value::str(k))
                     .cloned()
                     .ok_or_else(|| format!("KeyError: '{k}'"))?,
                 _ => return Err("format requires a mapping".into()),
-            },
-            None => {
-                let v = list
-                    .get(next)
-                    .cloned()
-                    .ok_or("not enough arguments for format string")?;
-                next += 1;
-                v
             }
+        } else {
+            let v = list
+                .get(next)
+                .cloned()
+                .ok_or("not enough arguments for format string")?;
+            next += 1;
+            v
         };
         out.push_str(&percent_one(&spec, &v)?);
     }

@@ -9,7 +9,7 @@ use crate::xacro::FileKind;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
-impl<'o> Expander<'o> {
+impl Expander<'_> {
     pub(super) fn include(
         &mut self,
         e: &Rc<Element>,
@@ -72,7 +72,7 @@ impl<'o> Expander<'o> {
                 if k.starts_with("xmlns:") {
                     match parent_attrs.iter().find(|(p, _)| p == k) {
                         Some((_, old)) if old != v => {
-                            self.warn(format!("inconsistent namespace redefinitions for {k}"))
+                            self.warn(format!("inconsistent namespace redefinitions for {k}"));
                         }
                         Some(_) => {}
                         None => parent_attrs.push((k.clone(), v.clone())),

@@ -6,7 +6,7 @@ use crate::xacro::value::Value;
 use std::collections::HashMap;
 use std::rc::Rc;
 
-impl<'o> Expander<'o> {
+impl Expander<'_> {
     pub(super) fn property(&mut self, e: &Rc<Element>, table: &Rc<Table>) -> R<()> {
         self.known_attrs(
             e,
@@ -372,17 +372,14 @@ pub(super) fn parse_params(s: &str) -> (Vec<String>, HashMap<String, (bool, Opti
         if rest.is_empty() {
             break;
         }
-        match parse_param(rest) {
-            Some((name, forward, default, after)) => {
-                defaults.insert(name.to_string(), (forward, default.map(str::to_string)));
-                names.push(name.to_string());
-                rest = after;
-            }
-            None => {
-                let end = rest.find(char::is_whitespace).unwrap_or(rest.len());
-                names.push(rest[..end].to_string());
-                rest = &rest[end..];
-            }
+        if let Some((name, forward, default, after)) = parse_param(rest) {
+            defaults.insert(name.to_string(), (forward, default.map(str::to_string)));
+            names.push(name.to_string());
+            rest = after;
+        } else {
+            let end = rest.find(char::is_whitespace).unwrap_or(rest.len());
+            names.push(rest[..end].to_string());
+            rest = &rest[end..];
         }
     }
     (names, defaults)

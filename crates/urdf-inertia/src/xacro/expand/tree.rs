@@ -5,7 +5,7 @@ use crate::xacro::dom::{Element, Node};
 use crate::xacro::value::Value;
 use std::rc::Rc;
 
-impl<'o> Expander<'o> {
+impl Expander<'_> {
     /// xacro's `eval_all` on one ordinary element: its attributes evaluated, its children expanded.
     pub(super) fn expand_element(
         &mut self,

@@ -324,7 +324,7 @@ pub(super) fn compare(op: &str, a: &Value, b: &Value) -> Result<bool, String> {
     })
 }
 
-/// Python's ordering of two values (`None` where Python raises TypeError).
+/// Python's ordering of two values (`None` where Python raises `TypeError`).
 pub fn order(a: &Value, b: &Value) -> Option<std::cmp::Ordering> {
     match (a, b) {
         (Value::Str(x), Value::Str(y)) => Some(x.cmp(y)),
