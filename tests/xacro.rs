@@ -286,6 +286,7 @@ fn expansion_errors_are_file_line_with_exit_2() {
 
 #[test]
 fn a_urdf_is_read_from_stdin() {
+    use std::io::Write;
     let tmp = tempfile::tempdir().expect("tempdir");
     let urdf = "<robot name=\"r\"><link name=\"a\"><inertial><mass value=\"-1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial><collision><geometry><box size=\"1 1 1\"/></geometry></collision></link></robot>\n";
     let run_stdin = |args: &[&str]| {
@@ -297,7 +298,6 @@ fn a_urdf_is_read_from_stdin() {
             .stderr(Stdio::piped())
             .spawn()
             .expect("spawn");
-        use std::io::Write;
         // A command refused before it reads stdin (`fill - -i`) may exit before the write: a
         // closed pipe is its answer, not a failure of the test.
         let written = child

@@ -159,6 +159,8 @@ pub struct DiagnosticArgs {
     pub no_config: bool,
 }
 
+// Each bool is a clap flag (`--strict`, `-i`, ...): independent switches, as the command line has them.
+#[allow(clippy::struct_excessive_bools)]
 #[derive(Debug, Clone, ClapArgs)]
 pub struct FillArgs {
     /// The URDF to fill; several with -i (what a pre-commit hook passes: one process, each mesh read

@@ -14,7 +14,7 @@ use urdf_inertia::InertialProblem;
 pub struct Problem {
     /// The problem, typed (file, link, line, code, values).
     pub problem: InertialProblem,
-    /// `FILE:LINE: link `NAME`` (the source file and line for xacro).
+    /// ``FILE:LINE: link `NAME` `` (the source file and line for xacro).
     pub at: String,
 }
 

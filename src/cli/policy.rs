@@ -181,9 +181,9 @@ impl Policy {
     /// `--quiet`, notes with `--verbose` (and not `--quiet`).
     pub fn shows(&self, d: &Diagnostic) -> bool {
         match d.severity {
-            Severity::Error => true,
             Severity::Warning => !self.quiet,
             Severity::Note => self.verbose && !self.quiet,
+            // Errors, and any severity added later.
             _ => true,
         }
     }

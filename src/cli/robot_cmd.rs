@@ -144,6 +144,8 @@ fn validated_tolerance(tolerance: f64) -> Result<f64, String> {
 }
 
 /// Where and how `fill` writes.
+// Independent yes/no settings of `fill` (`-i`, `--keep-going`, ...), not a state machine.
+#[allow(clippy::struct_excessive_bools)]
 pub struct WriteConfig {
     /// `-o OUT` (`None`: stdout, unless in place).
     target: Option<PathBuf>,
@@ -177,6 +179,8 @@ pub enum BaselineUse {
 }
 
 /// A validated command.
+// `config_file`: the configuration file (urdf-inertia.toml) in effect, named as users call it.
+#[allow(clippy::struct_field_names)]
 pub struct Config {
     mode: Mode,
     files: Vec<PathBuf>,
@@ -603,7 +607,7 @@ pub struct Input {
 }
 
 impl Input {
-    /// `FILE:LINE: link `name`` for an element on `line` of the scanned text; for a xacro source
+    /// ``FILE:LINE: link `name` `` for an element on `line` of the scanned text; for a xacro source
     /// the file and line where it was written, and the macro calls that produced it.
     fn link_at(&self, line: usize, name: &str) -> String {
         let name = urdf_inertia::text::escape_control(name);

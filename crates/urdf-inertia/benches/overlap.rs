@@ -25,8 +25,8 @@ use urdf_inertia::overlap::{self, PartShape, PlacedPart};
 
 /// `n` convex pieces on a lattice (see the module docs), or (`cluster`) at random in a cube of side
 /// 2, where each overlaps most others, placed as the link's parts.
-pub fn pieces(n: usize, cluster: bool) -> Vec<PlacedPart> {
-    let side = (1..).find(|s: &usize| s * s * s >= n).unwrap_or(1);
+fn pieces(n: usize, cluster: bool) -> Vec<PlacedPart> {
+    let side = (1..=n.max(1)).find(|s: &usize| s * s * s >= n).unwrap_or(1);
     let (v, f) = common::icosphere(3);
     let mut rng = common::Rng(25);
     (0..n)

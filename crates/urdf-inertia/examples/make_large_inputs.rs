@@ -159,7 +159,7 @@ fn glb(v: &[[f64; 3]], f: &[[u32; 3]]) -> Vec<u8> {
 
 fn pieces(dir: &Path, n: u32) -> std::io::Result<()> {
     let n = n as usize;
-    let side = (1..).find(|s: &usize| s * s * s >= n).unwrap_or(1);
+    let side = (1..=n.max(1)).find(|s: &usize| s * s * s >= n).unwrap_or(1);
     let (v, f) = common::icosphere(3);
     let mut rng = common::Rng(25);
     let mut urdf = String::from(

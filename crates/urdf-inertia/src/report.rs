@@ -106,6 +106,8 @@ pub struct ProblemRecord {
     /// The 1-based line of the problem in the URDF: the `<inertial>`, or the `<link>` when it has
     /// none.
     pub line: usize,
+    // The doc is the JSON Schema's description (docs/schema/), generated as it is written.
+    #[allow(clippy::doc_markdown)]
     /// Where `check` prints it: `FILE:LINE: link `NAME`` (for a xacro source, the file and line
     /// where the link is written).
     pub at: String,

@@ -53,8 +53,8 @@ fn peak_per_byte(path: &Path) -> f64 {
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("stl" | "obj") => 2.5,
-        Some("dae") => 3.0,
         Some("glb" | "gltf") => 7.5,
+        // COLLADA (`dae`) and anything else.
         _ => 3.0,
     }
 }

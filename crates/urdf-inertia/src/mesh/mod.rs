@@ -138,7 +138,6 @@ impl fmt::Display for MeshError {
                 f,
                 "unsupported mesh format `{ext}`; urdf-inertia reads .stl, .obj, .dae, .gltf and .glb (convert the collision mesh, e.g. with meshlab or blender)"
             ),
-            MeshErrorKind::Syntax(msg) => write!(f, "{msg}"),
             MeshErrorKind::Truncated(msg) => write!(f, "truncated file: {msg}; re-export the mesh"),
             MeshErrorKind::NotFinite => write!(f, "a vertex coordinate is NaN or infinite; fix or re-export the mesh"),
             MeshErrorKind::IndexOutOfRange { index, vertices } => {
@@ -161,7 +160,9 @@ impl fmt::Display for MeshError {
                 f,
                 "internal error while processing the mesh (a bug in urdf-inertia; please report it with the file): {msg}"
             ),
-            MeshErrorKind::Unsupported(msg) | MeshErrorKind::OutOfRange(msg) => write!(f, "{msg}"),
+            MeshErrorKind::Syntax(msg) | MeshErrorKind::Unsupported(msg) | MeshErrorKind::OutOfRange(msg) => {
+                write!(f, "{msg}")
+            }
         }
     }
 }

@@ -165,8 +165,7 @@ impl<'a> Words<'a> {
     /// consumed.
     fn ends_at(&mut self, n: usize) -> bool {
         match self.rest.get(n) {
-            None => self.rest = &[],
-            Some(b'#') => self.rest = &[],
+            None | Some(b'#') => self.rest = &[],
             Some(b) if b.is_ascii_whitespace() => self.rest = &self.rest[n..],
             Some(_) => return false,
         }
@@ -277,12 +276,10 @@ fn face_indices(
             )
         })?;
         let n = vertices as i64;
-        let resolved = if i > 0 {
-            i - 1
-        } else if i < 0 {
-            n + i
-        } else {
-            -1
+        let resolved = match i.cmp(&0) {
+            std::cmp::Ordering::Greater => i - 1,
+            std::cmp::Ordering::Less => n + i,
+            std::cmp::Ordering::Equal => -1,
         };
         if resolved < 0 || resolved >= n {
             return Err(MeshError::new(
@@ -423,7 +420,7 @@ mod number_tests {
                 }
                 s.push(char::from(b'0' + (next() % 10) as u8));
             }
-            if r >> 20 & 3 == 0 {
+            if (r >> 20).trailing_zeros() >= 2 {
                 s.push('e');
                 s.push_str(["", "-", "+"][(r >> 30) as usize % 3]);
                 s.push_str(&((r >> 24) % 40).to_string());

@@ -178,9 +178,9 @@ fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
             let (a, b) = (root(&mut parent, users[0].0), root(&mut parent, users[1].0));
             parent[a.max(b) as usize] = a.min(b);
         } else {
-            users
-                .iter()
-                .for_each(|&(f, _)| open_face[f as usize] = true);
+            for &(f, _) in users {
+                open_face[f as usize] = true;
+            }
         }
     }
     let centre = crate::mass::integrals::bounding_box_centre(vertices);

@@ -231,7 +231,7 @@ impl Expansion {
                 s.end -= shift;
             }
         }
-        robot.text = src.text.clone();
+        robot.text.clone_from(&src.text);
         robot.encoding = src.encoding;
         robot.newline = if src.text.contains("\r\n") {
             "\r\n"

@@ -32,7 +32,6 @@ pub(super) fn read_geometry(
         let kind = prim.name.as_str();
         match kind {
             "triangles" | "polylist" | "polygons" => {}
-            "lines" | "linestrips" | "source" | "vertices" | "extra" => continue,
             "tristrips" | "trifans" => {
                 return Err(syntax_at(
                     path,
@@ -40,6 +39,7 @@ pub(super) fn read_geometry(
                     format!("<{kind}> is not supported; re-export the mesh with triangles"),
                 ));
             }
+            // lines, linestrips, source, vertices, extra, and elements unknown: no faces.
             _ => continue,
         }
         let (vin, stride, voff) = vertex_input(prim, kind, path)?;

@@ -114,7 +114,7 @@ pub(super) fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) ->
             caps,
         };
         if relative <= CAPPED {
-            return with_caps(ladder, w, te, winding, plan, &what);
+            return with_caps(ladder, w, te, &winding, plan, &what);
         }
         if fallback.as_ref().is_none_or(|f| relative < f.0) {
             fallback = Some((relative, winding, plan));
@@ -135,7 +135,7 @@ pub(super) fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) ->
     match (ladder.options.open_mesh, fallback) {
         (OpenMeshModel::Hull, _) => convex_hull(ladder, &w, te, &what),
         (OpenMeshModel::Caps, Some((_, winding, plan))) => {
-            with_caps(ladder, w, te, winding, plan, &what)
+            with_caps(ladder, w, te, &winding, plan, &what)
         }
         (OpenMeshModel::Trusted, Some((relative, _, plan))) => Err(no_solid(
             Some(relative),
@@ -224,7 +224,7 @@ pub(super) fn with_caps(
     mut ladder: Ladder<'_>,
     w: Welding,
     te: &Edges,
-    winding: Winding,
+    winding: &Winding,
     plan: CappedSolid,
     what: &str,
 ) -> Result<Solid, MeshError> {

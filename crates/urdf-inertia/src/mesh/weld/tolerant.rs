@@ -79,6 +79,8 @@ fn digits_up_to_ten(x: f64) -> usize {
 /// parsing the decimal gives. A decimal reading back as `x` lies within half an ulp of it, so its
 /// exponent is within one of the one giving `x` 9 digits, and its mantissa within one of `x`/10^k
 /// rounded.
+// The two `None`s differ (documented above): no 9-digit decimal, or outside the exact fast path.
+#[allow(clippy::option_option)]
 fn nine_digits(x: f64) -> Option<Option<u64>> {
     use crate::mesh::EXACT_POWERS_OF_TEN as POW10;
     let x = x.abs();

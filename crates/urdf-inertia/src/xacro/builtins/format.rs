@@ -254,7 +254,7 @@ fn convert(
         })
     };
     Ok(match conv {
-        's' => (false, v.to_py_str()),
+        's' | 'c' => (false, v.to_py_str()),
         'r' | 'a' => (false, v.repr()),
         'd' | 'i' | 'u' => {
             let x = match v {
@@ -298,7 +298,6 @@ fn convert(
             let s = general(x.abs(), prec.unwrap_or(6), alt);
             (x < 0.0, if conv == 'G' { s.to_uppercase() } else { s })
         }
-        'c' => (false, v.to_py_str()),
         other => return Err(format!("unsupported format character '{other}'")),
     })
 }

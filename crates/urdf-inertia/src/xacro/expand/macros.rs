@@ -48,7 +48,7 @@ impl Expander<'_> {
         let mut value = value;
         if let Some(d) = default {
             if scope.is_some() {
-                self.warn(format!(
+                self.warn(&format!(
                     "{name}: default property value can only be defined on local scope"
                 ));
             }
@@ -97,7 +97,7 @@ impl Expander<'_> {
             }
             Some("parent") => {
                 let Some(mut t) = table.parent.clone() else {
-                    self.warn(format!("{name}: no parent scope at global scope"));
+                    self.warn(&format!("{name}: no parent scope at global scope"));
                     return Ok(None);
                 };
                 *lazy = false;
@@ -132,7 +132,7 @@ impl Expander<'_> {
             )));
         }
         if let Some(n) = name.strip_prefix("xacro:") {
-            self.warn(format!(
+            self.warn(&format!(
                 "macro names must not contain prefix 'xacro:': {name}"
             ));
             name = n.to_string();

@@ -223,7 +223,7 @@ impl Expander<'_> {
             .filter(|k| !known.contains(&k.as_str()) && !k.starts_with("xmlns:"))
             .collect();
         if !extra.is_empty() {
-            self.warn(format!(
+            self.warn(&format!(
                 "{}: unknown attribute(s): {}",
                 e.name,
                 extra.join(", ")
