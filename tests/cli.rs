@@ -1,5 +1,6 @@
 //! The real binary on URDFs made by this project: analytic values, lossless output, exit codes.
 
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -311,7 +312,7 @@ fn only_inertials_change_and_fill_is_idempotent() {
     // No temp files left beside it.
     let leftovers: Vec<_> = std::fs::read_dir(urdf.parent().unwrap())
         .unwrap()
-        .filter_map(|e| e.ok())
+        .filter_map(std::result::Result::ok)
         .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
         .collect();
     assert!(leftovers.is_empty());
@@ -1133,10 +1134,10 @@ fn inside_out_cube(path: &Path) {
 fn shared_mesh_robot(dir: &Path) -> PathBuf {
     std::fs::create_dir_all(dir.join(".git")).unwrap();
     inside_out_cube(&dir.join("cube.stl"));
-    let links: String = ["a", "b", "c", "d"]
-        .iter()
-        .map(|l| format!("  <link name=\"{l}\">\n    <collision><geometry><mesh filename=\"cube.stl\"/></geometry></collision>\n  </link>\n"))
-        .collect();
+    let links = ["a", "b", "c", "d"].iter().fold(String::new(), |mut s, l| {
+        let _ = write!(s, "  <link name=\"{l}\">\n    <collision><geometry><mesh filename=\"cube.stl\"/></geometry></collision>\n  </link>\n");
+        s
+    });
     let text = format!("<robot name=\"r\">\n{links}</robot>\n");
     let urdf = dir.join("r.urdf");
     std::fs::write(&urdf, text).unwrap();

@@ -167,7 +167,7 @@ fn cube_stl(a: f64) -> String {
     s
 }
 
-/// A robot of two links: `base_link` (a 0.1 m box) and `battery` (meshes/big_battery.stl, a 0.1 m
+/// A robot of two links: `base_link` (a 0.1 m box) and `battery` (`meshes/big_battery.stl`, a 0.1 m
 /// cube), in `dir`; returns the URDF's path.
 fn battery_robot(dir: &Path) -> String {
     write(dir, "meshes/big_battery.stl", &cube_stl(0.1));

@@ -282,7 +282,7 @@ fn mirrored_nodes_keep_the_solid_outward() {
     );
 }
 
-/// glTF says +Y is up; like pinocchio (coal's assimp loader) and RViz, positions are read as they are:
+/// glTF says +Y is up; like pinocchio (coal's assimp loader) and `RViz`, positions are read as they are:
 /// a box standing along +Y keeps its long axis on Y (Drake would turn it onto Z).
 #[test]
 fn gltf_y_up_is_not_rotated_into_z() {
@@ -439,8 +439,8 @@ fn broken_files_are_errors_never_panics() {
     let mut rng = Rng(7);
     for valid in [&glb, &text] {
         for _ in 0..3000 {
-            let mut m = valid.to_vec();
-            for _ in 0..1 + rng.next_u64() % 6 {
+            let mut m = valid.clone();
+            for _ in 0..=(rng.next_u64() % 6) {
                 let i = (rng.next_u64() % m.len() as u64) as usize;
                 match rng.next_u64() % 3 {
                     0 => m[i] = rng.next_u64() as u8,

@@ -21,7 +21,7 @@
 //! | 12 | two `<robot>` roots; CR-only line ends; UTF-32 and mark-less UTF-16; upper-case ASCII STL | `second_robot_root_is_left_alone`, `cr_only_urdf_keeps_its_line_ends_and_lines`, `utf16_without_a_mark_is_read_and_utf32_is_named`, `upper_case_ascii_stl_is_read_as_ascii` |
 //!
 //! Item 12's self-intersecting and nested outward shells are the winding-number work's (its tests are
-//! in tests/winding_truth.rs). docs/reliability.md has a row for each input above.
+//! in `tests/winding_truth.rs`). docs/reliability.md has a row for each input above.
 
 // The test helpers are the library tests' own (exact integrals, mesh generators).
 #[path = "../crates/urdf-inertia/tests/common/mod.rs"]
@@ -37,6 +37,9 @@ use std::io::{BufRead, BufReader, Read, Write};
 use std::os::unix::fs::{FileTypeExt, MetadataExt, PermissionsExt};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
+use urdf_inertia::mesh::health::HealthOptions;
+use urdf_inertia::write::WriteOptions;
+use urdf_inertia::FillOptions;
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_urdf-inertia"))
@@ -218,7 +221,8 @@ fn temp_file_has_the_targets_mode_and_is_removed_on_sigterm() {
     };
     let name = temp.file_name().unwrap().to_string_lossy().into_owned();
     assert!(
-        name.starts_with(".r.urdf.urdf-inertia.") && name.ends_with(".tmp"),
+        name.starts_with(".r.urdf.urdf-inertia.")
+            && Path::new(&name).extension().is_some_and(|e| e == "tmp"),
         "{name}"
     );
     assert_eq!(temp.parent(), Some(tmp.path()));
@@ -476,7 +480,7 @@ fn non_regular_inputs_are_refused() {
     assert!(stderr(&out).contains("is not a regular file"));
 }
 
-/// Issue 13.6: the size read is capped (`--max-file-size`, or URDF_INERTIA_MAX_FILE_SIZE).
+/// Issue 13.6: the size read is capped (`--max-file-size`, or `URDF_INERTIA_MAX_FILE_SIZE`).
 #[test]
 fn input_size_is_capped() {
     let (_tmp, urdf) = urdf_in_tmp(&one_box());
@@ -578,7 +582,7 @@ fn assert_fails_with(name: &str, text: &str, message: &str) {
     }
 }
 
-/// Issue 13.7: an `<accessor offset>` beyond the stride, an `<input offset>` near u64::MAX and a huge
+/// Issue 13.7: an `<accessor offset>` beyond the stride, an `<input offset>` near `u64::MAX` and a huge
 /// `<vcount>` once panicked (exit 101, also inside `check`). Each is an error with its line now.
 #[test]
 fn collada_offsets_and_counts_are_checked() {
@@ -662,7 +666,10 @@ fn collada_deep_nesting_is_an_error() {
 /// now; the result is still the box.
 #[test]
 fn collada_many_attributes_are_read() {
-    let attrs: String = (0..80_000).map(|i| format!(" a{i}=\"{i}\"")).collect();
+    let attrs = (0..80_000).fold(String::new(), |mut s, i| {
+        let _ = write!(s, " a{i}=\"{i}\"");
+        s
+    });
     let body = format!(
         "<asset{attrs}/>\n<library_geometries>{}</library_geometries>\n",
         dae_box(Some("g"), 1.0, 0.0)
@@ -943,7 +950,7 @@ fn overlap_of_1000_crowded_convex_pieces_keeps_to_the_work_cap() {
     assert!(excess > 0.0 && excess < 1000.0 * sphere, "{excess}");
 }
 
-/// Peak resident memory of this process (VmHWM), bytes.
+/// Peak resident memory of this process (`VmHWM`), bytes.
 fn peak_rss() -> u64 {
     let status = std::fs::read_to_string("/proc/self/status").expect("/proc/self/status");
     let kb: u64 = status
@@ -996,7 +1003,7 @@ fn overlap_of_a_sliver_cone_and_a_box_has_bounded_memory() {
         &robot,
         &urdf_inertia::density::DensityMap::uniform(1000.0),
         &urdf_inertia::urdf::resolve::PackageResolver::new(),
-        &Default::default(),
+        &FillOptions::default(),
     );
     let grown = peak_rss().saturating_sub(before);
     assert!(report.failures.is_empty(), "{:?}", report.failures);
@@ -1112,10 +1119,14 @@ fn fill_on_threads(
             robot,
             &urdf_inertia::density::DensityMap::uniform(1000.0),
             &urdf_inertia::urdf::resolve::PackageResolver::new(),
-            &Default::default(),
+            &FillOptions::default(),
         );
-        let updates: Vec<_> = r.links.iter().map(|l| l.update()).collect();
-        let written = urdf_inertia::urdf::write::splice(robot, &updates, &Default::default());
+        let updates: Vec<_> = r
+            .links
+            .iter()
+            .map(urdf_inertia::LinkReport::update)
+            .collect();
+        let written = urdf_inertia::urdf::write::splice(robot, &updates, &WriteOptions::default());
         let what = format!(
             "{:?}\n{:?}\n{:?}\n{} {} {} {}",
             r.links,
@@ -1134,7 +1145,11 @@ fn fill_on_threads(
 // A list of table rows, one input each: splitting it would only scatter the list.
 #[allow(clippy::too_many_lines)]
 fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)) {
-    let a = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let a = |v: &[&str]| {
+        v.iter()
+            .map(std::string::ToString::to_string)
+            .collect::<Vec<_>>()
+    };
     let write = |name: &str, bytes: &[u8]| std::fs::write(d.join(name), bytes).unwrap();
     let geometry = format!(
         "<library_geometries>{}</library_geometries>\n",
@@ -1369,7 +1384,7 @@ fn fuzz_one(target: &str, data: &[u8]) -> Result<(), String> {
             return Ok(());
         }
         for scale in [[1.0; 3], [1.0, -1.0, 1.0]] {
-            if let Err(e) = mesh::solid_from_raw(&raw, scale, path, Default::default()) {
+            if let Err(e) = mesh::solid_from_raw(&raw, scale, path, HealthOptions::default()) {
                 if matches!(e.kind, MeshErrorKind::Internal(_)) {
                     return Err(e.to_string());
                 }
@@ -1409,7 +1424,8 @@ fn fuzz_one(target: &str, data: &[u8]) -> Result<(), String> {
                 .map(|i| (i, urdf_inertia::mass::primitives::sphere(0.1, 1000.0)).into())
                 .collect();
             // A text that would not re-encode to the same bytes is refused, not written.
-            let Ok(out) = urdf_inertia::urdf::write::splice(&robot, &updates, &Default::default())
+            let Ok(out) =
+                urdf_inertia::urdf::write::splice(&robot, &updates, &WriteOptions::default())
             else {
                 return Ok(());
             };
@@ -1444,11 +1460,10 @@ fn replay(root: &Path) -> usize {
         };
         for entry in dir.flatten() {
             let data = std::fs::read(entry.path()).unwrap();
-            let outcome = std::panic::catch_unwind(|| fuzz_one(target, &data));
-            match outcome {
-                Ok(Ok(())) => {}
-                Ok(Err(e)) => panic!("{}: {e}", entry.path().display()),
-                Err(_) => panic!("{}: panicked", entry.path().display()),
+            let outcome = std::panic::catch_unwind(|| fuzz_one(target, &data))
+                .unwrap_or_else(|_| panic!("{}: panicked", entry.path().display()));
+            if let Err(e) = outcome {
+                panic!("{}: {e}", entry.path().display());
             }
             n += 1;
         }
@@ -1715,7 +1730,7 @@ impl Row {
         let size = args
             .iter()
             .filter_map(|a| std::fs::metadata(d.join(a)).ok())
-            .filter(|m| m.is_file())
+            .filter(std::fs::Metadata::is_file)
             .map(|m| m.len())
             .max()
             .unwrap_or(0);
@@ -1802,7 +1817,11 @@ fn torus(n: u32, m: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
 #[allow(clippy::too_many_lines)] // a table of large inputs
 fn large_inputs(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)) {
     let (v, f) = torus(1000, 500);
-    let a = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let a = |v: &[&str]| {
+        v.iter()
+            .map(std::string::ToString::to_string)
+            .collect::<Vec<_>>()
+    };
     let mut put = |name: &str, bytes: &[u8], what: &str| {
         std::fs::write(d.join(name), bytes).unwrap();
         add(what, a(&["mesh", name]), None);
@@ -1964,7 +1983,7 @@ fn large_inputs(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option<Stdio>)
     )
     .unwrap();
     for n in [10usize, 100, 1000] {
-        let side = (1..).find(|s: &usize| s * s * s >= n).unwrap_or(1);
+        let side = (1..=n.max(1)).find(|s: &usize| s * s * s >= n).unwrap_or(1);
         link(
             &format!("pieces{n}.urdf"),
             &format!("{n} overlapping convex pieces (320-triangle meshes) in one link"),
@@ -2010,7 +2029,11 @@ fn write_reliability_table() {
         let out = c.output().unwrap();
         rows.push(Row::new(what, &args, out, d));
     };
-    let a = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let a = |v: &[&str]| {
+        v.iter()
+            .map(std::string::ToString::to_string)
+            .collect::<Vec<_>>()
+    };
     add(
         "`fill -o /dev/null`",
         a(&["fill", "r.urdf", "--density", "1000", "-o", "/dev/null"]),
@@ -2136,7 +2159,7 @@ fn write_reliability_table() {
         ("COLLADA huge `<vcount>`", lib(&good.replace("<triangles count=\"12\">", "<polylist count=\"1\">").replace("</triangles>", "</polylist>").replace("<p>", "<vcount>4611686018427387904</vcount><p>"))),
         ("COLLADA `<instance_node>` fan-out (40 levels × 2, < 8 KB)", dae(&format!("<library_geometries>{good}</library_geometries>\n<library_nodes>\n{fan}</library_nodes>\n<library_visual_scenes><visual_scene id=\"s\"><node><instance_node url=\"#n0\"/></node></visual_scene></library_visual_scenes>\n<scene><instance_visual_scene url=\"#s\"/></scene>\n"))),
         ("COLLADA 100k nested elements", dae(&format!("{}{}<library_geometries>{good}</library_geometries>\n", "<extra>".repeat(100_000), "</extra>".repeat(100_000)))),
-        ("COLLADA element with 80k attributes", dae(&format!("<asset{}/>\n<library_geometries>{good}</library_geometries>\n", (0..80_000).map(|i| format!(" a{i}=\"{i}\"")).collect::<String>()))),
+        ("COLLADA element with 80k attributes", dae(&format!("<asset{}/>\n<library_geometries>{good}</library_geometries>\n", (0..80_000).fold(String::new(), |mut s, i| { let _ = write!(s, " a{i}=\"{i}\""); s })))),
         ("COLLADA two `<geometry>` without `id` (volumes add)", lib(&(dae_box(None, 1.0, 0.0) + &dae_box(None, 2.0, 5.0)))),
     ];
     for (i, (what, text)) in dae_cases.iter().enumerate() {
@@ -2640,7 +2663,7 @@ fn edit_during_fill_in_place_is_kept() {
 }
 
 /// A run whose output is the file's bytes already writes nothing (same inode, same modification
-/// time); a 250-byte file name (the temporary name once exceeded NAME_MAX) fills in place.
+/// time); a 250-byte file name (the temporary name once exceeded `NAME_MAX`) fills in place.
 #[test]
 fn unchanged_output_is_not_written_and_long_names_fill_in_place() {
     let tmp = tempfile::tempdir().unwrap();
@@ -3234,7 +3257,7 @@ fn package_of_every_input(d: &Path) -> Vec<&'static str> {
 
 /// Every file a run opens (URDF or xacro source, xacro includes and YAML, `package.xml`, meshes,
 /// the density map and the configuration) counts toward one budget of bytes per run,
-/// `--max-total-read` (or URDF_INERTIA_MAX_TOTAL_READ): with a budget of exactly the bytes read the
+/// `--max-total-read` (or `URDF_INERTIA_MAX_TOTAL_READ)`: with a budget of exactly the bytes read the
 /// run succeeds; one byte less, the file that would exceed it is named with the budget and how to raise
 /// it, and nothing is written. (A robot naming thousands of files, each within the one-file limit,
 /// once read without bound.)

@@ -1,4 +1,4 @@
-//! Issue 11: the real binary reads every URDF the way urdfdom (ROS, Gazebo, MoveIt, pinocchio) reads it,
+//! Issue 11: the real binary reads every URDF the way urdfdom (ROS, Gazebo, `MoveIt`, pinocchio) reads it,
 //! and one bad link does not cost the rest of the robot. Fixtures are written here, in a temp dir.
 
 use std::path::{Path, PathBuf};

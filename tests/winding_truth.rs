@@ -426,7 +426,7 @@ fn box_at(lo: [f64; 3], hi: [f64; 3]) -> Mesh {
     let (v, f) = common::box_mesh([hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]]);
     let v = v
         .iter()
-        .map(|p| std::array::from_fn(|k| p[k] + (lo[k] + hi[k]) / 2.0))
+        .map(|p| std::array::from_fn(|k| p[k] + f64::midpoint(lo[k], hi[k])))
         .collect();
     (v, f)
 }

@@ -286,6 +286,7 @@ fn expansion_errors_are_file_line_with_exit_2() {
 
 #[test]
 fn a_urdf_is_read_from_stdin() {
+    use std::io::Write;
     let tmp = tempfile::tempdir().expect("tempdir");
     let urdf = "<robot name=\"r\"><link name=\"a\"><inertial><mass value=\"-1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial><collision><geometry><box size=\"1 1 1\"/></geometry></collision></link></robot>\n";
     let run_stdin = |args: &[&str]| {
@@ -297,7 +298,6 @@ fn a_urdf_is_read_from_stdin() {
             .stderr(Stdio::piped())
             .spawn()
             .expect("spawn");
-        use std::io::Write;
         // A command refused before it reads stdin (`fill - -i`) may exit before the write: a
         // closed pipe is its answer, not a failure of the test.
         let written = child
@@ -459,7 +459,7 @@ const XACRO_SEEDS: [(&str, &str); 6] = [
 ];
 
 /// Small YAML files as robot descriptions write them (UR's kinematics, joint limits), and YAML 1.1
-/// scalars PyYAML resolves differently from YAML 1.2.
+/// scalars `PyYAML` resolves differently from YAML 1.2.
 const YAML_SEEDS: [(&str, &str); 4] = [
     (
         "kinematics.yaml",
@@ -493,7 +493,7 @@ fn write_xacro_fuzz_seeds() {
 }
 
 /// The xacro and yaml fuzzing seeds go through the fuzz targets' code (expansion, URDF scan, the
-/// write-back splice; load_yaml and printing): nothing panics. The seeds on disk must be the ones
+/// write-back splice; `load_yaml` and printing): nothing panics. The seeds on disk must be the ones
 /// these constants write.
 #[test]
 fn xacro_fuzz_seeds_replay() {

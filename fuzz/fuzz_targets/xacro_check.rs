@@ -7,6 +7,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 use urdf_inertia::urdf::resolve::PackageResolver;
+use urdf_inertia::write::WriteOptions;
 use urdf_inertia::xacro::{self, Options};
 
 /// A xacro source that loads `f.yaml` and prints what it holds, for the `yaml` target.
@@ -54,7 +55,7 @@ pub fn xacro(data: &[u8], dir: &Path) {
         let updates: Vec<_> = (0..source.links.len())
             .map(|i| (i, urdf_inertia::mass::primitives::sphere(0.1, 1000.0)).into())
             .collect();
-        let _ = urdf_inertia::urdf::write::splice(&source, &updates, &Default::default());
+        let _ = urdf_inertia::urdf::write::splice(&source, &updates, &WriteOptions::default());
     }
 }
 

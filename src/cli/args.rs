@@ -35,13 +35,13 @@ pub struct XacroArgs {
     /// Where a ROS package lives, for `$(find NAME)`. Repeatable.
     #[arg(long, value_name = "NAME=DIR")]
     pub package_path: Vec<String>,
-    /// Largest input file read: bytes or K/M/G; default 1G, or URDF_INERTIA_MAX_FILE_SIZE.
+    /// Largest input file read: bytes or K/M/G; default 1G, or `URDF_INERTIA_MAX_FILE_SIZE`.
     #[arg(long, value_name = "SIZE")]
     pub max_file_size: Option<String>,
     #[command(flatten)]
     pub diagnostics: DiagnosticArgs,
     /// Bytes read from all input files together in this run: bytes or K/M/G; default 16G, or
-    /// URDF_INERTIA_MAX_TOTAL_READ.
+    /// `URDF_INERTIA_MAX_TOTAL_READ`.
     #[arg(long, value_name = "SIZE")]
     pub max_total_read: Option<String>,
 }
@@ -77,7 +77,7 @@ impl OpenMesh {
 /// Where densities come from and where meshes are found: shared by fill, diff and check.
 #[derive(Debug, Clone, ClapArgs)]
 pub struct SourceArgs {
-    /// Density map (TOML): default, total_mass, [materials], [links], [meshes].
+    /// Density map (TOML): default, `total_mass`, [materials], [links], [meshes].
     #[arg(long, value_name = "FILE", conflicts_with = "density")]
     pub density_map: Option<PathBuf>,
     /// One uniform density for every part, kg/m³.
@@ -108,15 +108,15 @@ pub struct SourceArgs {
     #[arg(long, value_name = "GLOB")]
     pub skip: Vec<String>,
     /// Largest input file read (URDF, mesh, density map): bytes or K/M/G; default 1G, or the
-    /// URDF_INERTIA_MAX_FILE_SIZE environment variable.
+    /// `URDF_INERTIA_MAX_FILE_SIZE` environment variable.
     #[arg(long, value_name = "SIZE")]
     pub max_file_size: Option<String>,
     /// Bytes read from all input files together in this run: bytes or K/M/G; default 16G, or
-    /// URDF_INERTIA_MAX_TOTAL_READ.
+    /// `URDF_INERTIA_MAX_TOTAL_READ`.
     #[arg(long, value_name = "SIZE")]
     pub max_total_read: Option<String>,
     /// Memory the meshes may take: bytes or K/M/G; default the machine's available memory
-    /// (MemAvailable in /proc/meminfo). A mesh that would need more fails its links, named.
+    /// (`MemAvailable` in /proc/meminfo). A mesh that would need more fails its links, named.
     #[arg(long, value_name = "SIZE")]
     pub max_memory: Option<String>,
     /// Which geometry a link's inertia is computed from, in order: `collision` (default), or
@@ -139,7 +139,7 @@ pub struct DiagnosticArgs {
     #[arg(short, long)]
     pub quiet: bool,
     /// Silence these codes (`UI102`, or a comma list; repeatable): warnings, notes, or check's
-    /// problems (UI6xx).
+    /// problems (`UI6xx`).
     #[arg(long, value_name = "CODE")]
     pub ignore: Vec<String>,
     /// Make these warnings errors (`UI101`, or a comma list; repeatable): `fill` writes nothing
@@ -159,6 +159,8 @@ pub struct DiagnosticArgs {
     pub no_config: bool,
 }
 
+// Each bool is a clap flag (`--strict`, `-i`, ...): independent switches, as the command line has them.
+#[allow(clippy::struct_excessive_bools)]
 #[derive(Debug, Clone, ClapArgs)]
 pub struct FillArgs {
     /// The URDF to fill; several with -i (what a pre-commit hook passes: one process, each mesh read
@@ -279,13 +281,13 @@ pub struct MeshArgs {
     /// significant digits (3 to 17).
     #[arg(long, value_name = "auto|full|N", default_value = "auto")]
     pub digits: urdf_inertia::text::Digits,
-    /// Largest mesh file read: bytes or K/M/G; default 1G, or URDF_INERTIA_MAX_FILE_SIZE.
+    /// Largest mesh file read: bytes or K/M/G; default 1G, or `URDF_INERTIA_MAX_FILE_SIZE`.
     #[arg(long, value_name = "SIZE")]
     pub max_file_size: Option<String>,
     #[command(flatten)]
     pub diagnostics: DiagnosticArgs,
     /// Bytes read from all input files together in this run: bytes or K/M/G; default 16G, or
-    /// URDF_INERTIA_MAX_TOTAL_READ.
+    /// `URDF_INERTIA_MAX_TOTAL_READ`.
     #[arg(long, value_name = "SIZE")]
     pub max_total_read: Option<String>,
 }

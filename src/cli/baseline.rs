@@ -14,13 +14,13 @@ use urdf_inertia::InertialProblem;
 pub struct Problem {
     /// The problem, typed (file, link, line, code, values).
     pub problem: InertialProblem,
-    /// `FILE:LINE: link `NAME`` (the source file and line for xacro).
+    /// ``FILE:LINE: link `NAME` `` (the source file and line for xacro).
     pub at: String,
 }
 
 impl Problem {
     /// The line `check` prints: `FILE:LINE: link `NAME`: MESSAGE [UI601]` (the code last, as
-    /// ESLint puts its rule: the line reads as before, and the code is there to look up or silence).
+    /// `ESLint` puts its rule: the line reads as before, and the code is there to look up or silence).
     pub fn line(&self) -> String {
         format!(
             "{}: {} [{}]",

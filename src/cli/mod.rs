@@ -94,10 +94,10 @@ pub fn parse_xacro_arg(s: &str) -> Result<(String, String), String> {
 
 /// xacro's options for this process: its environment (`$(env)`, `$(optenv)`) and working directory
 /// (`$(cwd)`), which the library does not read itself.
-pub fn xacro_options<'r>(
+pub fn xacro_options(
     args: Vec<(String, String)>,
-    resolver: &'r urdf_inertia::PackageResolver,
-) -> urdf_inertia::xacro::Options<'r> {
+    resolver: &urdf_inertia::PackageResolver,
+) -> urdf_inertia::xacro::Options<'_> {
     urdf_inertia::xacro::Options {
         args,
         resolver,

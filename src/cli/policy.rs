@@ -172,7 +172,7 @@ impl Policy {
         *ds = ds.iter().filter_map(|d| self.apply(d)).collect();
     }
 
-    /// Whether a problem of `check` (UI6xx) is reported.
+    /// Whether a problem of `check` (`UI6xx`) is reported.
     pub fn reports(&self, code: Code) -> bool {
         !self.ignore.contains(&code)
     }
@@ -181,9 +181,9 @@ impl Policy {
     /// `--quiet`, notes with `--verbose` (and not `--quiet`).
     pub fn shows(&self, d: &Diagnostic) -> bool {
         match d.severity {
-            Severity::Error => true,
             Severity::Warning => !self.quiet,
             Severity::Note => self.verbose && !self.quiet,
+            // Errors, and any severity added later.
             _ => true,
         }
     }

@@ -36,7 +36,7 @@ struct Sources {
     visual_fallback: bool,
 }
 
-/// `--max-memory`, or by default the memory the kernel reports available (Linux: MemAvailable in
+/// `--max-memory`, or by default the memory the kernel reports available (Linux: `MemAvailable` in
 /// /proc/meminfo); no budget where neither is known.
 fn memory_budget(s: &SourceArgs) -> Result<u64, String> {
     if let Some(v) = &s.max_memory {
@@ -144,6 +144,8 @@ fn validated_tolerance(tolerance: f64) -> Result<f64, String> {
 }
 
 /// Where and how `fill` writes.
+// Independent yes/no settings of `fill` (`-i`, `--keep-going`, ...), not a state machine.
+#[allow(clippy::struct_excessive_bools)]
 pub struct WriteConfig {
     /// `-o OUT` (`None`: stdout, unless in place).
     target: Option<PathBuf>,
@@ -177,6 +179,8 @@ pub enum BaselineUse {
 }
 
 /// A validated command.
+// `config_file`: the configuration file (urdf-inertia.toml) in effect, named as users call it.
+#[allow(clippy::struct_field_names)]
 pub struct Config {
     mode: Mode,
     files: Vec<PathBuf>,
@@ -620,7 +624,7 @@ pub struct Input {
 }
 
 impl Input {
-    /// `FILE:LINE: link `name`` for an element on `line` of the scanned text; for a xacro source
+    /// ``FILE:LINE: link `name` `` for an element on `line` of the scanned text; for a xacro source
     /// the file and line where it was written, and the macro calls that produced it.
     fn link_at(&self, line: usize, name: &str) -> String {
         let name = urdf_inertia::text::escape_control(name);
@@ -675,7 +679,7 @@ fn read_input(path: &Path, src: &Sources, policy: &Policy) -> Result<Input, Stri
     let mut warnings: Vec<Diagnostic> = x
         .warnings
         .iter()
-        .map(|w| Diagnostic::new(Code::XacroWarning, w.to_string()))
+        .map(|w| Diagnostic::new(Code::XacroWarning, w.clone()))
         .collect();
     policy.apply_all(&mut warnings);
     print_diagnostics(&warnings, policy);
@@ -783,28 +787,25 @@ fn write_robot(
         Ok(())
     };
     let mut written = None;
-    match (&input.xacro, w.in_place) {
-        (Some(x), true) => {
-            check_failed()?;
-            let k = write_into_sources(input, x, report, w, policy)?;
-            written = (k < report.links.len()).then_some(k);
-        }
-        _ => {
-            let text = spliced(robot, report, w)?;
-            check_failed()?;
-            let target = file.unwrap_or(Path::new("-"));
-            let written = if w.in_place {
-                write::write_in_place(target, &text)
-            } else {
-                write::write_output(target, &text)
-            };
-            if let Err(e) = written {
-                // A failing stdout was reported where it failed.
-                if file.is_some() {
-                    errln!("error: {e}");
-                }
-                return Err(ExitStatus::Error);
+    if let (Some(x), true) = (&input.xacro, w.in_place) {
+        check_failed()?;
+        let k = write_into_sources(input, x, report, w, policy)?;
+        written = (k < report.links.len()).then_some(k);
+    } else {
+        let text = spliced(robot, report, w)?;
+        check_failed()?;
+        let target = file.unwrap_or(Path::new("-"));
+        let written = if w.in_place {
+            write::write_in_place(target, &text)
+        } else {
+            write::write_output(target, &text)
+        };
+        if let Err(e) = written {
+            // A failing stdout was reported where it failed.
+            if file.is_some() {
+                errln!("error: {e}");
             }
+            return Err(ExitStatus::Error);
         }
     }
     if file.is_some() {
@@ -867,8 +868,7 @@ fn write_into_sources(
     options.digits = w.digits;
     options.principal = w.principal;
     // Per source file: the links written there (span, update).
-    let mut per_file: std::collections::BTreeMap<usize, Vec<(usize, usize, LinkUpdate)>> =
-        Default::default();
+    let mut per_file = std::collections::BTreeMap::<usize, Vec<(usize, usize, LinkUpdate)>>::new();
     for l in &report.links {
         let link = &robot.links[l.index];
         let Some(o) = x.origin(link.line) else {

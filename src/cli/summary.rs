@@ -73,15 +73,14 @@ pub fn mesh_groups(report: &FillReport) -> Vec<MeshGroup<'_>> {
 fn users_text(users: &[(&str, usize)]) -> String {
     const SHOWN: usize = 8;
     let name = |(l, c): &(&str, usize)| format!("`{}` collision {c}", text::escape_control(l));
-    match users {
-        [(l, c)] => format!("link `{}`, collision {c}", text::escape_control(l)),
-        _ => {
-            let mut names: Vec<String> = users.iter().take(SHOWN).map(name).collect();
-            if users.len() > SHOWN {
-                names.push(format!("and {} more", users.len() - SHOWN));
-            }
-            format!("{} links: {}", users.len(), names.join(", "))
+    if let [(l, c)] = users {
+        format!("link `{}`, collision {c}", text::escape_control(l))
+    } else {
+        let mut names: Vec<String> = users.iter().take(SHOWN).map(name).collect();
+        if users.len() > SHOWN {
+            names.push(format!("and {} more", users.len() - SHOWN));
         }
+        format!("{} links: {}", users.len(), names.join(", "))
     }
 }
 
@@ -382,15 +381,14 @@ pub fn check_json(new: &[&Problem], records: &[LinkRecord], known: usize, errors
         r.link == p.problem.link && r.urdf == p.problem.file.display().to_string()
     };
     for p in new {
-        let i = match links.iter().position(|r| same(r, p)) {
-            Some(i) => i,
-            None => {
-                let Some(r) = records.iter().find(|r| same(r, p)) else {
-                    continue;
-                };
-                links.push(r.clone());
-                links.len() - 1
-            }
+        let i = if let Some(i) = links.iter().position(|r| same(r, p)) {
+            i
+        } else {
+            let Some(r) = records.iter().find(|r| same(r, p)) else {
+                continue;
+            };
+            links.push(r.clone());
+            links.len() - 1
         };
         links[i]
             .problems

@@ -2,7 +2,7 @@
 //!
 //! * A regular file (or a symlink to one, followed to its target, dangling ones included) is replaced
 //!   atomically: a temporary file `.NAME.urdf-inertia.PID.N.tmp` in the target's directory (NAME cut
-//!   to its first 64 bytes, so that a name near NAME_MAX still has room), created with the target's
+//!   to its first 64 bytes, so that a name near `NAME_MAX` still has room), created with the target's
 //!   mode (never wider), given the target's owner and group where the process may, and its extended
 //!   attributes (POSIX ACLs among them) where the file system and the process allow, synced, then
 //!   renamed over the target. It is removed on error and on every catchable signal that would end

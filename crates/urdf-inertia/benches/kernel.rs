@@ -23,21 +23,21 @@ fn kernel(c: &mut Criterion) {
         group.bench_with_input(BenchmarkId::new("ours", f.len()), &f, |b, f| {
             b.iter(|| {
                 triangle_integrals(black_box(&v), black_box(f), &IntegrationOptions::accurate())
-            })
+            });
         });
         let plain = IntegrationOptions {
             summation: urdf_inertia::mass::Summation::Plain,
             ..IntegrationOptions::accurate()
         };
         group.bench_with_input(BenchmarkId::new("ours-plain-sum", f.len()), &f, |b, f| {
-            b.iter(|| triangle_integrals(black_box(&v), black_box(f), &plain))
+            b.iter(|| triangle_integrals(black_box(&v), black_box(f), &plain));
         });
         if level <= 6 {
             let polys = Polygons::from_triangles(&f);
             group.bench_with_input(BenchmarkId::new("paper", f.len()), &polys, |b, p| {
                 b.iter(|| {
                     mirtich_polygons(black_box(&v), black_box(p), &IntegrationOptions::paper())
-                })
+                });
             });
         }
     }
@@ -91,14 +91,14 @@ fn accurate(c: &mut Criterion) {
         group.bench_with_input(BenchmarkId::new("accurate", f.len()), &f, |b, f| {
             b.iter(|| {
                 triangle_integrals(black_box(&v), black_box(f), &IntegrationOptions::accurate())
-            })
+            });
         });
         let fast = IntegrationOptions {
             accurate_faces: false,
             ..IntegrationOptions::accurate()
         };
         group.bench_with_input(BenchmarkId::new("fast", f.len()), &f, |b, f| {
-            b.iter(|| triangle_integrals(black_box(&v), black_box(f), &fast))
+            b.iter(|| triangle_integrals(black_box(&v), black_box(f), &fast));
         });
     }
     group.finish();

@@ -1,5 +1,5 @@
 //! The overlap estimate of one link made of N overlapping convex pieces, what a convex decomposition
-//! (V-HACD, CoACD) gives: 1, 10, 100, 300 and 1000 pieces.
+//! (V-HACD, `CoACD`) gives: 1, 10, 100, 300 and 1000 pieces.
 //!
 //! `cargo bench --bench overlap`. Each piece is a 320-triangle convex mesh (an icosphere of level 3
 //! squashed into an ellipsoid of semi-axes 0.55 to 0.75, turned), placed on a unit lattice filled
@@ -25,8 +25,8 @@ use urdf_inertia::overlap::{self, Aabb, PartShape, PlacedPart};
 
 /// `n` convex pieces on a lattice (see the module docs), or (`cluster`) at random in a cube of side
 /// 2, where each overlaps most others, placed as the link's parts.
-pub fn pieces(n: usize, cluster: bool) -> Vec<PlacedPart> {
-    let side = (1..).find(|s: &usize| s * s * s >= n).unwrap_or(1);
+fn pieces(n: usize, cluster: bool) -> Vec<PlacedPart> {
+    let side = (1..=n.max(1)).find(|s: &usize| s * s * s >= n).unwrap_or(1);
     let (v, f) = common::icosphere(3);
     let mut rng = common::Rng(25);
     (0..n)
@@ -42,8 +42,12 @@ pub fn pieces(n: usize, cluster: bool) -> Vec<PlacedPart> {
                 faces: Polygons::from_triangles(&f),
                 ..RawMesh::default()
             };
-            let solid = health::make_solid(&raw, Path::new("piece.stl"), Default::default())
-                .expect("a closed convex piece");
+            let solid = health::make_solid(
+                &raw,
+                Path::new("piece.stl"),
+                health::HealthOptions::default(),
+            )
+            .expect("a closed convex piece");
             let rotation = common::rotation(rpy);
             let lattice = [i % side, i / side % side, i / (side * side)].map(|c| c as f64);
             let translation = if cluster {
@@ -103,7 +107,7 @@ fn estimate(c: &mut Criterion) {
                 || parts.clone(),
                 |mut parts| pool.install(|| overlap::estimate(black_box(&mut parts))),
                 BatchSize::LargeInput,
-            )
+            );
         });
     }
     group.finish();

@@ -63,17 +63,17 @@ fn pipeline(c: &mut Criterion) {
         };
         group.throughput(Throughput::Elements(n as u64));
         group.bench_with_input(BenchmarkId::new("read", n), &bytes, |b, bytes| {
-            b.iter(|| stl::parse(black_box(bytes), path).map(|m| m.faces.len()))
+            b.iter(|| stl::parse(black_box(bytes), path).map(|m| m.faces.len()));
         });
         group.bench_with_input(BenchmarkId::new("edges", n), &raw, |b, raw| {
-            b.iter(|| health::closed_consistent(black_box(&raw.faces)).map(|c| c.1))
+            b.iter(|| health::closed_consistent(black_box(&raw.faces)).map(|c| c.1));
         });
         group.bench_with_input(BenchmarkId::new("weld-soup", n), &soup, |b, soup| {
             b.iter(|| {
                 weld::exact(black_box(&soup.vertices), &soup.faces)
                     .faces
                     .len()
-            })
+            });
         });
         group.bench_with_input(BenchmarkId::new("integrate", n), &raw, |b, w| {
             b.iter(|| {
@@ -82,7 +82,7 @@ fn pipeline(c: &mut Criterion) {
                     &w.faces,
                     &IntegrationOptions::accurate(),
                 )
-            })
+            });
         });
         // The mesh as the binary hands it over (owned: a welded mesh becomes the solid without a copy);
         // the clone is set-up, not timed.
@@ -90,21 +90,24 @@ fn pipeline(c: &mut Criterion) {
             b.iter_batched(
                 || raw.clone(),
                 |raw| {
-                    health::heal(Cow::Owned(raw), path, Default::default(), |_| {
-                        weld::Precision::F32
-                    })
+                    health::heal(
+                        Cow::Owned(raw),
+                        path,
+                        health::HealthOptions::default(),
+                        |_| weld::Precision::F32,
+                    )
                     .map(|s| s.unit.mass)
                 },
                 BatchSize::LargeInput,
-            )
+            );
         });
         group.bench_with_input(BenchmarkId::new("end-to-end", n), &bytes, |b, bytes| {
             b.iter(|| {
                 stl::parse(black_box(bytes), path).and_then(|raw| {
-                    mesh::solid_from_owned(raw, [1.0; 3], path, Default::default())
+                    mesh::solid_from_owned(raw, [1.0; 3], path, health::HealthOptions::default())
                         .map(|s| s.unit.mass)
                 })
-            })
+            });
         });
     }
     group.finish();

@@ -70,7 +70,7 @@ fn read(c: &mut Criterion) {
                 b.iter(|| {
                     let bytes = std::fs::read(black_box(path)).expect("read");
                     mesh_loader::stl::from_slice(&bytes).map(|s| s.meshes[0].faces.len())
-                })
+                });
             });
         }
         for (threads, pool) in &pools {
@@ -82,7 +82,7 @@ fn read(c: &mut Criterion) {
                             stl::read(black_box(path), urdf_inertia::input::DEFAULT_MAX_FILE_SIZE)
                                 .map(|m| m.faces.len())
                         })
-                    })
+                    });
                 });
             }
         }

@@ -19,7 +19,10 @@ mod common;
 #[path = "report/ladder.rs"]
 mod ladder;
 
-use common::*;
+use common::{
+    box_mesh, com_error, exact_integrals, exact_mass, floor_error, icosphere, inertia_error, rat,
+    rel_error, rotation, rounded, transform, ExactMass, Mesh,
+};
 use num_rational::BigRational;
 use num_traits::ToPrimitive;
 use std::fmt::Write as _;
@@ -28,6 +31,8 @@ use urdf_inertia::mass::integrals::{mirtich_polygons, triangle_integrals, volume
 use urdf_inertia::mass::{
     IntegrationOptions, MassProperties, Polygons, Summation, VolumeIntegrals,
 };
+use urdf_inertia::mesh::health::HealthOptions;
+use urdf_inertia::write::WriteOptions;
 
 /// The kernel variants compared.
 #[derive(Clone, Copy)]
@@ -164,7 +169,7 @@ fn machine() -> String {
                 .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
         })
         .unwrap_or_else(|| "unknown CPU".into());
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
     format!(
         "{cpu}, {cores} cores visible, one core used; {} {}",
         std::env::consts::OS,
@@ -438,14 +443,19 @@ fn main() -> std::io::Result<()> {
                 faces: Polygons::from_triangles(&moved_cube.1),
                 ..Default::default()
             };
-            urdf_inertia::mesh::solid_from_raw(&file, [-1.0, 1.0, 1.0], path, Default::default())
+            urdf_inertia::mesh::solid_from_raw(
+                &file,
+                [-1.0, 1.0, 1.0],
+                path,
+                HealthOptions::default(),
+            )
         } else {
             let mesh = urdf_inertia::mesh::RawMesh {
                 vertices: raw.0.clone(),
                 faces: polys.clone(),
                 ..Default::default()
             };
-            urdf_inertia::mesh::health::make_solid(&mesh, path, Default::default())
+            urdf_inertia::mesh::health::make_solid(&mesh, path, HealthOptions::default())
         }
         .expect("solid");
         let er = errors(&solid.unit, &exact, 1.7, small);
@@ -610,7 +620,7 @@ fn main() -> std::io::Result<()> {
         urdf_inertia::mesh::health::make_solid(
             &raw,
             std::path::Path::new("bench.stl"),
-            Default::default(),
+            HealthOptions::default(),
         )
         .map_or(0, |s| s.faces.len())
     });
@@ -680,8 +690,12 @@ fn corpus(md: &mut String, share: &std::path::Path) {
             let mut cache = MeshCache::default();
             let report = compute_with(&robot, &map, &resolver, &FillOptions::default(), &mut cache);
             let t1 = Instant::now();
-            let updates: Vec<_> = report.links.iter().map(|l| l.update()).collect();
-            let out = urdf_inertia::urdf::write::splice(&robot, &updates, &Default::default())
+            let updates: Vec<_> = report
+                .links
+                .iter()
+                .map(urdf_inertia::LinkReport::update)
+                .collect();
+            let out = urdf_inertia::urdf::write::splice(&robot, &updates, &WriteOptions::default())
                 .unwrap_or_default();
             std::hint::black_box(out.len());
             let write = t1.elapsed().as_secs_f64();
@@ -732,7 +746,7 @@ fn corpus(md: &mut String, share: &std::path::Path) {
 }
 
 /// The whole corpus filled by `urdf-inertia fill`, one process per URDF as a user runs it and one
-/// process for all (`fill -i` of copies, one mesh cache), against validation/trimesh_fill.py (one
+/// process for all (`fill -i` of copies, one mesh cache), against `validation/trimesh_fill.py` (one
 /// Python process for all URDFs, so trimesh's import is paid once; a fresh mesh cache per URDF, and
 /// one shared cache), in the same run; only with `PEERS_PYTHON` set (it needs trimesh, pinned in
 /// validation/trimesh-requirements.txt).
@@ -860,7 +874,7 @@ fn ours_one_process(
     (seconds, usize::try_from(code).unwrap_or(usize::MAX))
 }
 
-/// validation/trimesh_fill.py on the whole corpus: its own seconds, the wall seconds, its failures
+/// `validation/trimesh_fill.py` on the whole corpus: its own seconds, the wall seconds, its failures
 /// and trimesh's version.
 fn trimesh_run(
     python: &str,
@@ -948,8 +962,8 @@ fn svg(points: &[(usize, f64, f64)]) -> String {
     let (w, h, l, b, t, r) = (760.0, 460.0, 70.0, 50.0, 20.0, 250.0);
     let xs: Vec<f64> = points.iter().map(|p| p.1.log10()).collect();
     let (x0, x1) = (
-        xs.iter().cloned().fold(f64::INFINITY, f64::min).floor(),
-        xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max).ceil(),
+        xs.iter().copied().fold(f64::INFINITY, f64::min).floor(),
+        xs.iter().copied().fold(f64::NEG_INFINITY, f64::max).ceil(),
     );
     let (y0, y1) = (-18.0f64, 0.0f64);
     let px = |x: f64| l + (x.log10() - x0) / (x1 - x0) * (w - l - r);
@@ -1055,7 +1069,7 @@ fn pipeline_section(md: &mut String) -> std::io::Result<()> {
         let raw = stl::parse(&bytes, path).expect("parse");
         let e2e_once = || {
             stl::parse(&bytes, path)
-                .and_then(|m| solid_from_owned(m, [1.0; 3], path, Default::default()))
+                .and_then(|m| solid_from_owned(m, [1.0; 3], path, HealthOptions::default()))
                 .map(|s| s.unit.mass)
         };
         let (read, edges, integrate, heal, e2e) = one.install(|| {
@@ -1067,7 +1081,7 @@ fn pipeline_section(md: &mut String) -> std::io::Result<()> {
                 volume_integrals(&raw.vertices, &raw.faces, &IntegrationOptions::accurate())
             });
             let heal = time(budget, || {
-                solid_from_raw(&raw, [1.0; 3], path, Default::default()).map(|s| s.unit.mass)
+                solid_from_raw(&raw, [1.0; 3], path, HealthOptions::default()).map(|s| s.unit.mass)
             });
             (read, edges, integrate, heal, time(budget, e2e_once))
         });

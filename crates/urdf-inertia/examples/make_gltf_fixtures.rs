@@ -1,12 +1,12 @@
 //! Writes the glTF fixtures the coal comparison reads (`validation/gltf_coal.py`): boxes through every
 //! buffer kind and primitive mode, a node tree, a mirrored node and a box standing along +Y.
 //!
-//! Usage: cargo run --release --example make_gltf_fixtures -- OUTDIR
+//! Usage: cargo run --release --example `make_gltf_fixtures` -- OUTDIR
 
 #[path = "../tests/common/gltf_gen.rs"]
 mod gltf_gen;
 
-use gltf_gen::*;
+use gltf_gen::{box_builder, box_strip_fan, box_two_primitives, box_unindexed, GltfBuilder};
 use serde_json::json;
 use std::path::Path;
 

@@ -5,7 +5,7 @@
 //!   the tool reads (binary and ASCII STL, OBJ, COLLADA, glTF binary), as `DIR/torus.{stl,ascii.stl,
 //!   obj,dae,glb}`.
 //! - `make_large_inputs pieces DIR N`: one link made of N overlapping convex pieces, what a convex
-//!   decomposition (V-HACD, CoACD) gives: `DIR/pieces_N.urdf` and its N binary STL files. Each piece
+//!   decomposition (V-HACD, `CoACD`) gives: `DIR/pieces_N.urdf` and its N binary STL files. Each piece
 //!   is the 320-triangle icosphere of `benches/overlap.rs` made an ellipsoid of semi-axes 0.55 to
 //!   0.75 m, turned, and placed on a unit lattice (transform baked into the vertices, as
 //!   decompositions write their hulls), so that each overlaps its lattice neighbours.
@@ -159,7 +159,7 @@ fn glb(v: &[[f64; 3]], f: &[[u32; 3]]) -> Vec<u8> {
 
 fn pieces(dir: &Path, n: u32) -> std::io::Result<()> {
     let n = n as usize;
-    let side = (1..).find(|s: &usize| s * s * s >= n).unwrap_or(1);
+    let side = (1..=n.max(1)).find(|s: &usize| s * s * s >= n).unwrap_or(1);
     let (v, f) = common::icosphere(3);
     let mut rng = common::Rng(25);
     let mut urdf = String::from(

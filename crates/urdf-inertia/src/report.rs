@@ -8,7 +8,7 @@
 //! the problems. The JSON Schemas in the repository's docs/schema/ are generated from these types
 //! (feature `json-schema`; the workspace's tests/schema.rs).
 //!
-//! A number that is not finite has no JSON form: serde_json writes it as `null`, and the schema
+//! A number that is not finite has no JSON form: `serde_json` writes it as `null`, and the schema
 //! allows `null` where a value can be one (an error estimate that is unbounded, values an existing
 //! `<inertial>` gives as `nan`).
 
@@ -106,6 +106,8 @@ pub struct ProblemRecord {
     /// The 1-based line of the problem in the URDF: the `<inertial>`, or the `<link>` when it has
     /// none.
     pub line: usize,
+    // The doc is the JSON Schema's description (docs/schema/), generated as it is written.
+    #[allow(clippy::doc_markdown)]
     /// Where `check` prints it: `FILE:LINE: link `NAME`` (for a xacro source, the file and line
     /// where the link is written).
     pub at: String,

@@ -220,16 +220,13 @@ impl ShortestDigits {
         let mut exponent = self.exponent;
         if cut[0] >= b'5' {
             // Round up, carrying through nines.
-            match kept.iter().rposition(|&d| d != b'9') {
-                Some(i) => {
-                    kept[i] += 1;
-                    kept[i + 1..].fill(b'0');
-                }
-                None => {
-                    kept.fill(b'0');
-                    kept[0] = b'1';
-                    exponent += 1;
-                }
+            if let Some(i) = kept.iter().rposition(|&d| d != b'9') {
+                kept[i] += 1;
+                kept[i + 1..].fill(b'0');
+            } else {
+                kept.fill(b'0');
+                kept[0] = b'1';
+                exponent += 1;
             }
         }
         let mut text = String::with_capacity(p + 8);

@@ -5,7 +5,9 @@ mod common;
 
 use common::{box_mesh, Rng};
 use std::path::Path;
+use urdf_inertia::mesh::health::HealthOptions;
 use urdf_inertia::mesh::{self, collada, obj, stl};
+use urdf_inertia::write::WriteOptions;
 
 fn mutations(valid: &[u8], rng: &mut Rng, count: usize) -> Vec<Vec<u8>> {
     let mut out = Vec::new();
@@ -16,7 +18,7 @@ fn mutations(valid: &[u8], rng: &mut Rng, count: usize) -> Vec<Vec<u8>> {
     }
     for _ in 0..count {
         let mut m = valid.to_vec();
-        for _ in 0..1 + rng.next_u64() % 8 {
+        for _ in 0..=(rng.next_u64() % 8) {
             let i = (rng.next_u64() % m.len() as u64) as usize;
             match rng.next_u64() % 3 {
                 0 => m[i] = rng.next_u64() as u8,
@@ -61,21 +63,21 @@ fn mesh_readers_never_panic() {
     {
         if let Ok(m) = stl::parse(input, p) {
             if mesh::validate(&m, p).is_ok() {
-                let _ = mesh::solid_from_raw(&m, [1.0; 3], p, Default::default());
+                let _ = mesh::solid_from_raw(&m, [1.0; 3], p, HealthOptions::default());
             }
         }
     }
     for input in mutations(&objtext, &mut rng, 5000) {
         if let Ok(m) = obj::parse(&input, p) {
             if mesh::validate(&m, p).is_ok() {
-                let _ = mesh::solid_from_raw(&m, [1.0, -1.0, 1.0], p, Default::default());
+                let _ = mesh::solid_from_raw(&m, [1.0, -1.0, 1.0], p, HealthOptions::default());
             }
         }
     }
     for input in mutations(&dae, &mut rng, 5000) {
         if let Ok(m) = collada::parse(&input, p) {
             if mesh::validate(&m, p).is_ok() {
-                let _ = mesh::solid_from_raw(&m, [1.0; 3], p, Default::default());
+                let _ = mesh::solid_from_raw(&m, [1.0; 3], p, HealthOptions::default());
             }
         }
     }
@@ -97,7 +99,7 @@ fn urdf_scan_and_splice_never_panic() {
             let updates: Vec<_> = (0..robot.links.len())
                 .map(|i| (i, urdf_inertia::mass::primitives::sphere(0.1, 1000.0)).into())
                 .collect();
-            let out = urdf_inertia::urdf::write::splice(&robot, &updates, &Default::default())
+            let out = urdf_inertia::urdf::write::splice(&robot, &updates, &WriteOptions::default())
                 .unwrap_or_default();
             // What was spliced must read back.
             assert!(urdf_inertia::urdf::scan(out, Path::new("fuzz.urdf")).is_ok());

@@ -5,6 +5,7 @@ use super::common::{self, wild};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use urdf_inertia::mesh::health::HealthOptions;
 
 pub fn section(md: &mut String, share: Option<&Path>) {
     writeln!(
@@ -81,7 +82,8 @@ fn corpus(md: &mut String, share: &Path) {
             *rungs.entry("error".into()).or_default() += 1;
             continue;
         };
-        let Ok(solid) = urdf_inertia::mesh::solid_from_raw(&raw, [1.0; 3], f, Default::default())
+        let Ok(solid) =
+            urdf_inertia::mesh::solid_from_raw(&raw, [1.0; 3], f, HealthOptions::default())
         else {
             *rungs.entry("error".into()).or_default() += 1;
             continue;
@@ -151,7 +153,7 @@ fn cost(md: &mut String) {
                 raw,
                 [1.0; 3],
                 Path::new("bench"),
-                Default::default(),
+                HealthOptions::default(),
             ) {
                 rung = s.rung.name().to_string();
             }

@@ -294,9 +294,9 @@ fn spec(
     what: &str,
 ) -> Result<Spec, String> {
     match v {
-        toml::Value::Float(d) => check_positive(*d, what).map(|_| Spec::Density(*d)),
+        toml::Value::Float(d) => check_positive(*d, what).map(|()| Spec::Density(*d)),
         toml::Value::Integer(i) => {
-            check_positive(*i as f64, what).map(|_| Spec::Density(*i as f64))
+            check_positive(*i as f64, what).map(|()| Spec::Density(*i as f64))
         }
         toml::Value::String(s) => material(materials, s, what),
         toml::Value::Table(t) => table_spec(materials, t, allow_mass, what),
@@ -330,11 +330,11 @@ fn table_spec(
     match k.as_str() {
         "density" => {
             let d = num()?;
-            check_positive(d, what).map(|_| Spec::Density(d))
+            check_positive(d, what).map(|()| Spec::Density(d))
         }
         "mass" if allow_mass => {
             let m = num()?;
-            check_positive(m, what).map(|_| Spec::Mass(m))
+            check_positive(m, what).map(|()| Spec::Mass(m))
         }
         "material" => material(
             materials,

@@ -206,6 +206,7 @@ mod tests {
 
     #[test]
     fn rules_that_match_nothing_are_named_with_a_near_name() {
+        type Row<'a> = (&'a str, &'a str, usize, Option<(String, String)>);
         let text = "default = 1000\n[links]\n\"*_link\" = 1.0\nbase_lnk = 2.0\n\"Wrist\" = 3.0\n\"arm_*\" = 4.0\n[meshes]\n\"*batery*\" = 5.0\n\"*motor*\" = 6.0\n\"meshes/x/*.stl\" = 7.0\n";
         let m = DensityMap::parse(text, Path::new("d.toml")).unwrap();
         let links = ["base_link", "wrist", "arm_link"];
@@ -214,7 +215,6 @@ mod tests {
             "package://r/meshes/motor.stl",
         ];
         let unused = m.unused_rules(&links, &uris);
-        type Row<'a> = (&'a str, &'a str, usize, Option<(String, String)>);
         let got: Vec<Row<'_>> = unused
             .iter()
             .map(|u| (u.section, u.pattern.as_str(), u.line, u.suggestion.clone()))

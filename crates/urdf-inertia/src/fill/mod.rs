@@ -32,6 +32,8 @@ use select::is_target;
 pub use select::{existing_props, selected, unresolved_meshes, unused_selection};
 
 /// What to compute.
+// Independent switches, one per command-line flag; no two of them form a state machine.
+#[allow(clippy::struct_excessive_bools)]
 #[derive(Debug, Clone, Default)]
 #[non_exhaustive]
 pub struct FillOptions {

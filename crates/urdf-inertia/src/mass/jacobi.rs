@@ -48,7 +48,7 @@ pub fn symmetric_eigen(m: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
             a[p][r] = a[r][p];
             a[r][q] = arq + s * (arp - tau * arq);
             a[q][r] = a[r][q];
-            for row in v.iter_mut() {
+            for row in &mut v {
                 let vp = row[p];
                 let vq = row[q];
                 row[p] = vp - s * (vq + tau * vp);
@@ -70,7 +70,7 @@ pub fn symmetric_eigen(m: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
         - vecs[0][1] * (vecs[1][0] * vecs[2][2] - vecs[1][2] * vecs[2][0])
         + vecs[0][2] * (vecs[1][0] * vecs[2][1] - vecs[1][1] * vecs[2][0]);
     if det < 0.0 {
-        for row in vecs.iter_mut() {
+        for row in &mut vecs {
             row[2] = -row[2];
         }
     }

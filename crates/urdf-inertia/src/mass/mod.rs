@@ -114,6 +114,7 @@ impl MassProperties {
     }
 
     /// The same body with every density multiplied by `factor` (mass and inertia scale, COM does not).
+    #[must_use]
     pub fn scaled(&self, factor: f64) -> MassProperties {
         MassProperties {
             mass: self.mass * factor,
@@ -123,6 +124,7 @@ impl MassProperties {
     }
 
     /// The body moved by `t`: only the centre of mass changes.
+    #[must_use]
     pub fn translated(&self, t: [f64; 3]) -> MassProperties {
         MassProperties {
             com: [self.com[0] + t[0], self.com[1] + t[1], self.com[2] + t[2]],
@@ -131,6 +133,7 @@ impl MassProperties {
     }
 
     /// The body rotated by `r` about the frame origin, then moved by `t`: `c' = R c + t`, `I' = R I Rᵀ`.
+    #[must_use]
     pub fn transformed(&self, r: &Mat3, t: [f64; 3]) -> MassProperties {
         let c = mat_vec(r, self.com);
         MassProperties {

@@ -52,9 +52,9 @@ fn peak_per_byte(path: &Path) -> f64 {
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
-        Some("stl") | Some("obj") => 2.5,
-        Some("dae") => 3.0,
-        Some("glb") | Some("gltf") => 7.5,
+        Some("stl" | "obj") => 2.5,
+        Some("glb" | "gltf") => 7.5,
+        // COLLADA (`dae`) and anything else.
         _ => 3.0,
     }
 }
@@ -249,7 +249,7 @@ impl MeshCache {
                             s.spawn(move |_| run(t));
                         }
                     }
-                })
+                });
             });
         }
         let loaded: Vec<LoadedFile> = done.into_iter().filter_map(OnceLock::into_inner).collect();

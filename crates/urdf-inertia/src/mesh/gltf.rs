@@ -5,7 +5,7 @@
 //!   once, untransformed, when the file has no scene) counts, moved by the composition of its ancestors'
 //!   node transforms (`matrix`, or translation · rotation · scale), composed in f64;
 //! * positions are taken as written: glTF's +Y up is **not** rotated into +Z. That is what pinocchio
-//!   (coal's assimp loader) and RViz do; Drake rotates Y-up into Z-up for glTF, and the README says so.
+//!   (coal's assimp loader) and `RViz` do; Drake rotates Y-up into Z-up for glTF, and the README says so.
 //!   Coal also skips the transform of a single root node for the nodes below it (the heuristic it uses to
 //!   drop assimp's COLLADA up-axis node); this reader applies every node transform, as the format says;
 //! * triangles, triangle strips and triangle fans, indexed or not; points and lines carry no surface and
@@ -168,24 +168,21 @@ fn load_buffers(
                     ),
                 )
             })?),
-            gltf::buffer::Source::Uri(uri) => match by_uri.get(uri) {
-                Some(data) => Rc::clone(data),
-                None => {
-                    let data = Rc::new(read_uri(uri, path, buffer.index(), max_file_size)?);
-                    total = total.saturating_add(data.len() as u64);
-                    if total > max_file_size {
-                        return Err(MeshError::new(
-                            path,
-                            None,
-                            MeshErrorKind::Io(format!(
-                                "buffer {}: the file's buffers together are larger than the limit of {max_file_size} bytes (raise it with --max-file-size or URDF_INERTIA_MAX_FILE_SIZE)",
-                                buffer.index(),
-                            )),
-                        ));
-                    }
-                    by_uri.insert(uri, Rc::clone(&data));
-                    data
+            gltf::buffer::Source::Uri(uri) => if let Some(data) = by_uri.get(uri) { Rc::clone(data) } else {
+                let data = Rc::new(read_uri(uri, path, buffer.index(), max_file_size)?);
+                total = total.saturating_add(data.len() as u64);
+                if total > max_file_size {
+                    return Err(MeshError::new(
+                        path,
+                        None,
+                        MeshErrorKind::Io(format!(
+                            "buffer {}: the file's buffers together are larger than the limit of {max_file_size} bytes (raise it with --max-file-size or URDF_INERTIA_MAX_FILE_SIZE)",
+                            buffer.index(),
+                        )),
+                    ));
                 }
+                by_uri.insert(uri, Rc::clone(&data));
+                data
             },
         };
         if data.len() < buffer.length() {
@@ -602,18 +599,15 @@ fn parse_checked(bytes: &[u8], path: &Path, max_file_size: u64) -> Result<RawMes
         ..Default::default()
     };
     let scene = doc.default_scene().or_else(|| doc.scenes().next());
-    match scene {
-        Some(scene) => add_scene(&scene, &buffers, path, draco_used, &mut out)?,
-        None => {
-            for mesh in doc.meshes() {
-                for prim in mesh.primitives() {
-                    add_primitive(&prim, &IDENTITY, &buffers, path, draco_used, &mut out)?;
-                }
+    if let Some(scene) = scene { add_scene(&scene, &buffers, path, draco_used, &mut out)? } else {
+        for mesh in doc.meshes() {
+            for prim in mesh.primitives() {
+                add_primitive(&prim, &IDENTITY, &buffers, path, draco_used, &mut out)?;
             }
-            if doc.meshes().len() > 0 {
-                out.notes
-                    .push("no scene: every mesh counted once, untransformed".into());
-            }
+        }
+        if doc.meshes().len() > 0 {
+            out.notes
+                .push("no scene: every mesh counted once, untransformed".into());
         }
     }
     Ok(out)

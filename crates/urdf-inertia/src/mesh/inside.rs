@@ -572,6 +572,7 @@ fn norm(a: [f64; 3]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::health::HealthOptions;
 
     /// A cone along +x (base radius 1 at x = 0, apex at x = 1) of `2 n` sliver triangles seen along x.
     fn cone(n: u32) -> Solid {
@@ -591,7 +592,7 @@ mod tests {
             faces: crate::mass::Polygons::from_triangles(&f),
             ..Default::default()
         };
-        crate::mesh::health::make_solid(&raw, std::path::Path::new("cone"), Default::default())
+        crate::mesh::health::make_solid(&raw, std::path::Path::new("cone"), HealthOptions::default())
             .expect("solid")
     }
 
@@ -691,7 +692,7 @@ mod tests {
             ..Default::default()
         };
         let solid =
-            crate::mesh::health::make_solid(&raw, std::path::Path::new("box"), Default::default())
+            crate::mesh::health::make_solid(&raw, std::path::Path::new("box"), HealthOptions::default())
                 .expect("solid");
         assert!((winding_number(&solid, [0.5, 0.5, 0.5]) - 1.0).abs() < 1e-12);
         assert!(winding_number(&solid, [1.5, 0.5, 0.5]).abs() < 1e-12);

@@ -138,7 +138,6 @@ impl fmt::Display for MeshError {
                 f,
                 "unsupported mesh format `{ext}`; urdf-inertia reads .stl, .obj, .dae, .gltf and .glb (convert the collision mesh, e.g. with meshlab or blender)"
             ),
-            MeshErrorKind::Syntax(msg) => write!(f, "{msg}"),
             MeshErrorKind::Truncated(msg) => write!(f, "truncated file: {msg}; re-export the mesh"),
             MeshErrorKind::NotFinite => write!(f, "a vertex coordinate is NaN or infinite; fix or re-export the mesh"),
             MeshErrorKind::IndexOutOfRange { index, vertices } => {
@@ -161,7 +160,9 @@ impl fmt::Display for MeshError {
                 f,
                 "internal error while processing the mesh (a bug in urdf-inertia; please report it with the file): {msg}"
             ),
-            MeshErrorKind::Unsupported(msg) | MeshErrorKind::OutOfRange(msg) => write!(f, "{msg}"),
+            MeshErrorKind::Syntax(msg) | MeshErrorKind::Unsupported(msg) | MeshErrorKind::OutOfRange(msg) => {
+                write!(f, "{msg}")
+            }
         }
     }
 }
@@ -187,7 +188,7 @@ fn catching_panics<T>(
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
         let msg = payload
             .downcast_ref::<&str>()
-            .map(|s| s.to_string())
+            .map(std::string::ToString::to_string)
             .or_else(|| payload.downcast_ref::<String>().cloned())
             .unwrap_or_else(|| "panic".into());
         Err(MeshError::new(path, None, MeshErrorKind::Internal(msg)))
@@ -261,13 +262,13 @@ pub fn apply_scale(mesh: &RawMesh, scale: [f64; 3], path: &Path) -> Result<RawMe
         // Distinct vertices stay distinct, so the mesh stays welded once −0.0 is folded into 0.0
         // (+ 0.0, as the weld itself does) and is not welded again. Of example-robot-data's mesh
         // references, 137 are mirrored and 82 are millimetre binary STLs at 0.001.
-        for v in out.vertices.iter_mut() {
+        for v in &mut out.vertices {
             *v = [0, 1, 2].map(|k| v[k] * scale[k] + 0.0);
         }
     } else {
         // A product can round two distinct coordinates to one value: weld again.
         out.welded = false;
-        for v in out.vertices.iter_mut() {
+        for v in &mut out.vertices {
             *v = [v[0] * scale[0], v[1] * scale[1], v[2] * scale[2]];
         }
     }
@@ -526,7 +527,7 @@ pub(crate) fn short_decimal(w: &[u8]) -> Option<(f64, usize)> {
 }
 
 /// Appends the leading decimal digits of `w` to `mantissa` (wrapping: a caller refuses more than 19
-/// digits) and returns how many there were. (Four digits at a time by SWAR, as fast_float does eight,
+/// digits) and returns how many there were. (Four digits at a time by SWAR, as `fast_float` does eight,
 /// cost more on ERD's 5- and 6-digit indices: go1's trunk.dae 533 M -> 567 M instructions.)
 fn accumulate_digits(w: &[u8], mantissa: &mut u64) -> usize {
     let mut n = 0;

@@ -165,8 +165,7 @@ impl<'a> Words<'a> {
     /// consumed.
     fn ends_at(&mut self, n: usize) -> bool {
         match self.rest.get(n) {
-            None => self.rest = &[],
-            Some(b'#') => self.rest = &[],
+            None | Some(b'#') => self.rest = &[],
             Some(b) if b.is_ascii_whitespace() => self.rest = &self.rest[n..],
             Some(_) => return false,
         }
@@ -231,7 +230,7 @@ fn vertex(mut words: Words<'_>, lineno: usize, path: &Path) -> Result<[f64; 3], 
     let err =
         |line: usize, msg: String| MeshError::new(path, Some(line), MeshErrorKind::Syntax(msg));
     let mut p = [0.0; 3];
-    for c in p.iter_mut() {
+    for c in &mut p {
         *c = words
             .number()
             .ok_or_else(|| err(lineno, "`v` needs three coordinates".into()))?
@@ -277,12 +276,10 @@ fn face_indices(
             )
         })?;
         let n = vertices as i64;
-        let resolved = if i > 0 {
-            i - 1
-        } else if i < 0 {
-            n + i
-        } else {
-            -1
+        let resolved = match i.cmp(&0) {
+            std::cmp::Ordering::Greater => i - 1,
+            std::cmp::Ordering::Less => n + i,
+            std::cmp::Ordering::Equal => -1,
         };
         if resolved < 0 || resolved >= n {
             return Err(MeshError::new(
@@ -404,7 +401,7 @@ mod number_tests {
 
     /// [`SPELLINGS`], then random short decimals in the form exporters write.
     fn words() -> Vec<String> {
-        let mut words: Vec<String> = SPELLINGS.iter().map(|s| s.to_string()).collect();
+        let mut words: Vec<String> = SPELLINGS.iter().map(std::string::ToString::to_string).collect();
         let mut state = 0x2545_f491_4f6c_dd1du64;
         let mut next = move || crate::xorshift(&mut state);
         for _ in 0..200_000 {
@@ -423,7 +420,7 @@ mod number_tests {
                 }
                 s.push(char::from(b'0' + (next() % 10) as u8));
             }
-            if r >> 20 & 3 == 0 {
+            if (r >> 20).trailing_zeros() >= 2 {
                 s.push('e');
                 s.push_str(["", "-", "+"][(r >> 30) as usize % 3]);
                 s.push_str(&((r >> 24) % 40).to_string());

@@ -5,9 +5,9 @@
 //! shell here is a connected component over edges that two faces share with opposite directions. For
 //! two closed shells that do not touch (exact segment–triangle tests with `orient3d`), one lies wholly
 //! inside the other or outside it, and the other's winding number on it is an integer that one point
-//! decides. Then w on the two sides of each shell is known exactly: w_out (the sum over the shells
-//! around it) and w_in = w_out ± 1. A shell bounds Ω only when exactly one side is 0: it counts once,
-//! outward when w_out = 0 (so an inside-out shell counts once) and inward when w_in = 0 (a cavity);
+//! decides. Then w on the two sides of each shell is known exactly: `w_out` (the sum over the shells
+//! around it) and `w_in` = `w_out` ± 1. A shell bounds Ω only when exactly one side is 0: it counts once,
+//! outward when `w_out` = 0 (so an inside-out shell counts once) and inward when `w_in` = 0 (a cavity);
 //! when both sides are inside Ω (an internal wall, a doubly enclosed shell) it drops out.
 //!
 //! Pairs of shells that touch or cut each other, or that are open, are not decided: the region they
@@ -93,16 +93,13 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
     let mut decided = vec![true; shells.len()];
     let mut undecided = Vec::new();
     for &(a, b) in &pairs {
-        match nesting(vertices, &shells, &tris, a, b) {
-            Some((wa, wb)) => {
-                w_out[a] += wa;
-                w_out[b] += wb;
-            }
-            None => {
-                decided[a] = false;
-                decided[b] = false;
-                undecided.push((a, b));
-            }
+        if let Some((wa, wb)) = nesting(vertices, &shells, &tris, a, b) {
+            w_out[a] += wa;
+            w_out[b] += wb;
+        } else {
+            decided[a] = false;
+            decided[b] = false;
+            undecided.push((a, b));
         }
     }
     let mut out = ShellOutcome {
@@ -181,9 +178,9 @@ fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
             let (a, b) = (root(&mut parent, users[0].0), root(&mut parent, users[1].0));
             parent[a.max(b) as usize] = a.min(b);
         } else {
-            users
-                .iter()
-                .for_each(|&(f, _)| open_face[f as usize] = true);
+            for &(f, _) in users {
+                open_face[f as usize] = true;
+            }
         }
     }
     let centre = crate::mass::integrals::bounding_box_centre(vertices);

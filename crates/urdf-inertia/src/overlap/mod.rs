@@ -23,6 +23,7 @@
 //! reason.
 
 use crate::mesh::health::Solid;
+use rayon::prelude::*;
 use std::sync::Arc;
 
 mod part;
@@ -112,7 +113,6 @@ fn estimate_within(parts: &mut [PlacedPart], budget: usize) -> Overlap {
     if involved.is_empty() {
         return Overlap::None;
     }
-    use rayon::prelude::*;
     let regions: Vec<Option<Aabb>> = (0..parts.len())
         .map(|i| (!nb[i].is_empty()).then(|| region(parts, &nb, i)))
         .collect();

@@ -1,6 +1,6 @@
 use super::*;
 use crate::mass::Mat3;
-use crate::mesh::health::Solid;
+use crate::mesh::health::{HealthOptions, Solid};
 use sample::neighbours;
 
 /// A box as its corners `(lo, hi)`, the shape these tests build boxes in.
@@ -145,7 +145,7 @@ fn box_solid(h: [f64; 3]) -> Solid {
         faces: crate::mass::Polygons::from_triangles(&tris),
         ..Default::default()
     };
-    crate::mesh::health::make_solid(&raw, std::path::Path::new("box"), Default::default())
+    crate::mesh::health::make_solid(&raw, std::path::Path::new("box"), HealthOptions::default())
         .expect("solid")
 }
 

@@ -286,7 +286,7 @@ mod tests {
                 "<?xml version=\"1.0\" encoding=\"UTF-16\"?><robot name=\"\u{e9}\"/>"
                     .encode_utf16(),
             )
-            .flat_map(|u| u.to_le_bytes())
+            .flat_map(u16::to_le_bytes)
             .collect();
         let (text, enc) = decode(utf16.clone()).expect("utf-16");
         assert!(
@@ -317,7 +317,7 @@ mod tests {
         let utf16: Vec<u8> = [0xfeff_u16]
             .into_iter()
             .chain("<?xml version='1.0'?><robot name='\u{e9}\u{1F916}'/>".encode_utf16())
-            .flat_map(|u| u.to_be_bytes())
+            .flat_map(u16::to_be_bytes)
             .collect();
         let latin1 = b"<?xml version='1.0' encoding='latin1'?><robot name='\xe9'/>".to_vec();
         for bytes in [utf16, latin1] {

@@ -251,13 +251,10 @@ impl PackageResolver {
         }
         let key = (pkg.to_string(), base.to_path_buf());
         let found = self.cache.lock().get(&key).cloned();
-        let found = match found {
-            Some(f) => f,
-            None => {
-                let f = walk_up(base, pkg, self.max_file_size);
-                self.cache.lock().insert(key, f.clone());
-                f
-            }
+        let found = if let Some(f) = found { f } else {
+            let f = walk_up(base, pkg, self.max_file_size);
+            self.cache.lock().insert(key, f.clone());
+            f
         };
         match found? {
             Some(d) => out.push(d),

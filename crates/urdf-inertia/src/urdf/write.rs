@@ -66,7 +66,7 @@ struct Written {
 }
 
 /// Whether a written tensor is valid with no tolerance at all: positive definite and the triangle
-/// inequality holding exactly, as MuJoCo and Drake require (`check` allows a round-off tolerance for
+/// inequality holding exactly, as `MuJoCo` and Drake require (`check` allows a round-off tolerance for
 /// existing values; what we write must not need it).
 fn tensor_valid(tensor: &[[f64; 3]; 3]) -> bool {
     let mp = MassProperties {
@@ -252,7 +252,7 @@ impl InertialStyle {
         let tag = |name: &str| {
             let start = body.find(&format!("<{name}"))?;
             let rest = &body[start..];
-            Some(&rest[..rest.find('>')? + 1])
+            Some(&rest[..=rest.find('>')?])
         };
         if let Some(t) = tag("inertia ") {
             if let Some(before) = t.strip_suffix("/>") {

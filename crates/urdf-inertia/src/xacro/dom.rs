@@ -384,7 +384,7 @@ impl<'a> Printer<'a> {
                     match k {
                         Node::Element(c) => self.element(c, depth + 1),
                         Node::Text(t) => {
-                            self.line(&format!("{inner}{}", escape(t.trim(), false)), None)
+                            self.line(&format!("{inner}{}", escape(t.trim(), false)), None);
                         }
                         Node::Comment(c) => self.line(&format!("{inner}<!--{c}-->"), None),
                         Node::CData(c) => self.line(&format!("{inner}<![CDATA[{c}]]>"), None),

@@ -32,7 +32,7 @@
 //! `xmltree` without source positions, so nothing in its output can be traced to a file and line,
 //! which diagnostics and write-back need. This expander matches xacrodoc on all 26.
 //!
-//! The YAML of `load_yaml` is read with saphyr-parser and resolved as PyYAML resolves it
+//! The YAML of `load_yaml` is read with saphyr-parser and resolved as `PyYAML` resolves it
 //! (`yaml`).
 
 mod builtins;
@@ -231,7 +231,7 @@ impl Expansion {
                 s.end -= shift;
             }
         }
-        robot.text = src.text.clone();
+        robot.text.clone_from(&src.text);
         robot.encoding = src.encoding;
         robot.newline = if src.text.contains("\r\n") {
             "\r\n"
@@ -308,10 +308,10 @@ pub fn expand_source(
         .map(|e| {
             e.map(|e| {
                 let calls = e.calls.clone().unwrap_or_else(|| Rc::from(Vec::new()));
-                let literal = if e.name != "link" {
-                    Err("not a link".to_string())
-                } else {
+                let literal = if e.name == "link" {
                     literal(e, &calls, uses.get(&(e.src.file, e.src.start)).copied())
+                } else {
+                    Err("not a link".to_string())
                 };
                 Origin {
                     file: e.src.file,

@@ -1,9 +1,9 @@
-//! `xacro.load_yaml`: a YAML file as the values PyYAML's `safe_load` gives (YAML 1.1 scalars:
+//! `xacro.load_yaml`: a YAML file as the values `PyYAML`'s `safe_load` gives (YAML 1.1 scalars:
 //! `yes`/`on` are booleans, `1.5` a float but `1e-3` a string, `0755` octal), with xacro's unit tags
 //! (`!degrees 90`, `!millimeters 5`, …). Mappings become dotted dicts (`d.key` as well as
 //! `d['key']`). The events come from saphyr-parser (a maintained pure-Rust YAML parser); the
-//! resolution of plain scalars is PyYAML's, which saphyr's YAML 1.2 rules would change.
-//! One difference is deliberate: a timestamp (`2001-12-14`) stays a string, where PyYAML makes a
+//! resolution of plain scalars is `PyYAML`'s, which saphyr's YAML 1.2 rules would change.
+//! One difference is deliberate: a timestamp (`2001-12-14`) stays a string, where `PyYAML` makes a
 //! `datetime.date` (printed `datetime.date(2001, 12, 14)`); description files use none.
 
 use super::value::{Dict, Value};
@@ -183,7 +183,7 @@ fn scalar(
     Ok(resolve_plain(v))
 }
 
-/// PyYAML's implicit resolution of a plain scalar.
+/// `PyYAML`'s implicit resolution of a plain scalar.
 pub fn resolve_plain(v: &str) -> Value {
     if matches!(v, "" | "~" | "null" | "Null" | "NULL") {
         return Value::None;

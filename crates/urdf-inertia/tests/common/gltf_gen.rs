@@ -99,7 +99,7 @@ impl GltfBuilder {
         self.scenes.len() - 1
     }
 
-    fn json(&self, buffer: Value) -> Value {
+    fn json(&self, buffer: &Value) -> Value {
         let mut root = json!({
             "asset": {"version": "2.0", "generator": "urdf-inertia tests"},
             "buffers": [buffer],
@@ -128,7 +128,7 @@ impl GltfBuilder {
     /// Binary glTF: 12-byte header, JSON chunk (space-padded), BIN chunk (zero-padded).
     pub fn glb(&self) -> Vec<u8> {
         let mut js =
-            serde_json::to_vec(&self.json(json!({"byteLength": self.bin.len()}))).expect("json");
+            serde_json::to_vec(&self.json(&json!({"byteLength": self.bin.len()}))).expect("json");
         while js.len() % 4 != 0 {
             js.push(b' ');
         }
@@ -153,14 +153,14 @@ impl GltfBuilder {
     /// JSON glTF with the buffer inline as a base64 data URI.
     pub fn gltf_data_uri(&self) -> String {
         let uri = format!("data:application/octet-stream;base64,{}", base64(&self.bin));
-        serde_json::to_string_pretty(&self.json(json!({"byteLength": self.bin.len(), "uri": uri})))
+        serde_json::to_string_pretty(&self.json(&json!({"byteLength": self.bin.len(), "uri": uri})))
             .expect("json")
     }
 
     /// JSON glTF referring to an external buffer file by `uri` (percent-encoded as written); the caller
     /// writes `self.bin` next to it under the decoded name.
     pub fn gltf_external(&self, uri: &str) -> String {
-        serde_json::to_string_pretty(&self.json(json!({"byteLength": self.bin.len(), "uri": uri})))
+        serde_json::to_string_pretty(&self.json(&json!({"byteLength": self.bin.len(), "uri": uri})))
             .expect("json")
     }
 }

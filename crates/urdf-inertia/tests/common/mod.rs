@@ -92,7 +92,7 @@ fn exact_integrals_with(v: &[[f64; 3]], tris: &[[u32; 3]], centred: bool) -> [Bi
                 .cloned()
                 .unwrap_or_default();
             let c: BigInt = (lo + hi) >> 1usize;
-            for p in ints.iter_mut() {
+            for p in &mut ints {
                 p[k] -= &c;
             }
         }
@@ -226,7 +226,7 @@ pub fn com_error(got: [f64; 3], exact: &[BigRational; 3], size: f64) -> f64 {
 /// The paper's Table 2 series: icosahedron (level 1), each refinement splitting every edge at its midpoint
 /// projected onto the unit sphere. Level n has 20·4^(n−1) faces.
 pub fn icosphere(level: u32) -> Mesh {
-    let p = (1.0 + 5f64.sqrt()) / 2.0;
+    let p = f64::midpoint(1.0, 5f64.sqrt());
     let mut v: Vec<[f64; 3]> = vec![
         [-1.0, p, 0.0],
         [1.0, p, 0.0],
@@ -241,7 +241,7 @@ pub fn icosphere(level: u32) -> Mesh {
         [-p, 0.0, -1.0],
         [-p, 0.0, 1.0],
     ];
-    for x in v.iter_mut() {
+    for x in &mut v {
         let n = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
         *x = x.map(|c| c / n);
     }
@@ -341,7 +341,7 @@ pub fn cylinder_mesh(r: f64, l: f64, n: u32) -> Mesh {
     (v, f)
 }
 
-/// A small deterministic generator (SplitMix64) so tests need no rand crate.
+/// A small deterministic generator (`SplitMix64`) so tests need no rand crate.
 pub struct Rng(pub u64);
 
 impl Rng {
@@ -364,7 +364,7 @@ impl Rng {
 /// A random star-shaped closed mesh: an icosphere with each vertex's radius drawn from [0.5, 1.5].
 pub fn random_blob(rng: &mut Rng, level: u32) -> Mesh {
     let (mut v, f) = icosphere(level);
-    for p in v.iter_mut() {
+    for p in &mut v {
         let r = rng.range(0.5, 1.5);
         *p = p.map(|c| c * r);
     }

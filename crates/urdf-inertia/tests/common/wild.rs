@@ -7,6 +7,7 @@
 //! holes), never from the code under test.
 
 use super::{Mesh, Rng};
+use urdf_inertia::mesh::health::HealthOptions;
 
 /// Each facet with three corners of its own, each computed independently by `corner`.
 pub fn per_facet(mesh: &Mesh, mut corner: impl FnMut([f64; 3]) -> [f64; 3]) -> Mesh {
@@ -379,7 +380,7 @@ pub fn run(case: &Case) -> Result<Outcome, String> {
         ..Default::default()
     };
     let path = std::path::Path::new(&case.name);
-    let solid = urdf_inertia::mesh::solid_from_raw(&raw, [1.0; 3], path, Default::default())
+    let solid = urdf_inertia::mesh::solid_from_raw(&raw, [1.0; 3], path, HealthOptions::default())
         .map_err(|e| e.to_string())?;
     let exact = super::exact_mass(&super::exact_integrals_about_centre(
         &case.truth.0,

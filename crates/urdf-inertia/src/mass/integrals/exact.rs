@@ -116,7 +116,7 @@ pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
 }
 
 /// Exact product: `p + e == a * b` (barring overflow and underflow), with `mul_add` where the build
-/// has FMA and Dekker's TwoProduct otherwise (see [`two_prod_in`]).
+/// has FMA and Dekker's `TwoProduct` otherwise (see [`two_prod_in`]).
 #[inline(always)]
 pub(crate) fn two_prod(a: f64, b: f64) -> (f64, f64) {
     two_prod_in::<{ cfg!(target_feature = "fma") }>(a, b)
@@ -125,7 +125,7 @@ pub(crate) fn two_prod(a: f64, b: f64) -> (f64, f64) {
 /// Exact product: `p + e == a * b` (barring overflow and underflow); `FMA`: the code runs where
 /// hardware FMA is enabled (the build, or the x86-64-v3 kernel of [`run_kernel`]).
 ///
-/// Without FMA, Dekker's TwoProduct with Veltkamp's splitting instead of `mul_add`: on baseline
+/// Without FMA, Dekker's `TwoProduct` with Veltkamp's splitting instead of `mul_add`: on baseline
 /// x86-64 (no `fma` in `rustc --print cfg`) `mul_add` is a call into libm that blocks vectorisation
 /// of the accurate-face path (figures: docs/benchmarks.md, "Figures behind choices in the code").
 /// Both give the same `e`: the product's rounding error is representable and each computes it

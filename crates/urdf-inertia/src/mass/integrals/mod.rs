@@ -337,6 +337,7 @@ impl VolumeIntegrals {
     }
 
     /// The same integrals about another reference point `q` (exact algebra; transfer of axes).
+    #[must_use]
     pub fn about(&self, q: [f64; 3]) -> VolumeIntegrals {
         // Coordinates relative to q are x' = x + δ with δ = c − q.
         let d = sub(self.reference, q);
@@ -361,6 +362,7 @@ impl VolumeIntegrals {
     }
 
     /// The integrals of the same surface wound the other way (every integral changes sign).
+    #[must_use]
     pub fn negated(&self) -> VolumeIntegrals {
         VolumeIntegrals {
             t1: -self.t1,

@@ -32,7 +32,6 @@ pub(super) fn read_geometry(
         let kind = prim.name.as_str();
         match kind {
             "triangles" | "polylist" | "polygons" => {}
-            "lines" | "linestrips" | "source" | "vertices" | "extra" => continue,
             "tristrips" | "trifans" => {
                 return Err(syntax_at(
                     path,
@@ -40,20 +39,18 @@ pub(super) fn read_geometry(
                     format!("<{kind}> is not supported; re-export the mesh with triangles"),
                 ));
             }
+            // lines, linestrips, source, vertices, extra, and elements unknown: no faces.
             _ => continue,
         }
         let (vin, stride, voff) = vertex_input(prim, kind, path)?;
         let src = vin.attr("source").unwrap_or("");
         // Each distinct source is appended once; its indices may only reach its own vertices.
-        let (base, count) = match cache.get(src) {
-            Some(&bc) => bc,
-            None => {
-                let pos = positions_of(mesh, &sources, src, vin.line, bytes, path)?;
-                let bc = (vertices.len() as u32, pos.len());
-                vertices.extend(pos);
-                cache.insert(src.to_string(), bc);
-                bc
-            }
+        let (base, count) = if let Some(&bc) = cache.get(src) { bc } else {
+            let pos = positions_of(mesh, &sources, src, vin.line, bytes, path)?;
+            let bc = (vertices.len() as u32, pos.len());
+            vertices.extend(pos);
+            cache.insert(src.to_string(), bc);
+            bc
         };
         let input = VertexInput {
             stride,

@@ -5,9 +5,9 @@
 //!   by the product of its ancestors' node transforms (`<matrix>`, `<translate>`, `<rotate>`, `<scale>`,
 //!   in document order; `<instance_node>` follows `<library_nodes>`); without a scene, every geometry
 //!   counts once, untransformed;
-//! * `<unit meter="s">` scales all coordinates by `s` (as RViz and Gazebo do);
+//! * `<unit meter="s">` scales all coordinates by `s` (as `RViz` and Gazebo do);
 //! * `<up_axis>` is **not** applied: coordinates are taken as authored in the URDF link frame, which is
-//!   what RViz, Gazebo and pinocchio (coal's assimp loader) show for `Y_UP` files; the mesh validation
+//!   what `RViz`, Gazebo and pinocchio (coal's assimp loader) show for `Y_UP` files; the mesh validation
 //!   on example-robot-data compares this against coal.
 //! * `<triangles>`, `<polylist>` and `<polygons>` are read (polygons stay polygons; holes in `<ph>` are
 //!   not supported and reported); `<lines>` and `<linestrips>` carry no surface and are skipped.
@@ -67,17 +67,14 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         },
         notes: Vec::new(),
     };
-    match visual_scene(root, &by_id) {
-        Some(scene) => add_scene(scene, &by_id, &mut inst)?,
-        None => {
-            if let Some(lib) = root.child("library_geometries") {
-                for g in lib.children_named("geometry") {
-                    inst.add(g, &IDENTITY)?;
-                }
+    if let Some(scene) = visual_scene(root, &by_id) { add_scene(scene, &by_id, &mut inst)? } else {
+        if let Some(lib) = root.child("library_geometries") {
+            for g in lib.children_named("geometry") {
+                inst.add(g, &IDENTITY)?;
             }
-            inst.notes
-                .push("no visual scene: every geometry counted once, untransformed".into());
         }
+        inst.notes
+            .push("no visual scene: every geometry counted once, untransformed".into());
     }
     let Instancer {
         mut out,

@@ -94,7 +94,7 @@ fn element(e: &quick_xml::events::BytesStart<'_>, line: usize) -> El {
     for a in e.attributes().with_checks(false).flatten() {
         let v = a
             .unescape_value()
-            .map(|v| v.into_owned())
+            .map(std::borrow::Cow::into_owned)
             .unwrap_or_default();
         el.attrs.push((local(a.key.as_ref()), v));
     }

@@ -186,8 +186,8 @@ impl Caps {
     /// A bound on the volume by which the capped solid differs from Ω = {x : |w(x)| ≥ ½}, w the
     /// winding number of the open surface, that comes from the caps seeing each other.
     ///
-    /// The capped surface has an integer winding number w_c, and w = w_c − Σⱼ wⱼ, wⱼ the winding
-    /// number of cap j; where w_c is 0 or 1 the two solids differ only where Σⱼ |wⱼ| ≥ ½. A flat cap
+    /// The capped surface has an integer winding number `w_c`, and w = `w_c` − Σⱼ wⱼ, wⱼ the winding
+    /// number of cap j; where `w_c` is 0 or 1 the two solids differ only where Σⱼ |wⱼ| ≥ ½. A flat cap
     /// alone has |wⱼ| < ½ off its plane (it subtends less than a half-space), so one hole is exact and
     /// this bound is 0; its non-flatness is the flatness term. With several caps of areas Aⱼ:
     ///

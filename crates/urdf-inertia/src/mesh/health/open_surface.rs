@@ -115,7 +115,7 @@ pub(super) fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) ->
             caps,
         };
         if relative <= CAPPED {
-            return with_caps(ladder, w, te, winding, plan, &what);
+            return with_caps(ladder, w, te, &winding, plan, &what);
         }
         if fallback.as_ref().is_none_or(|f| relative < f.0) {
             fallback = Some((relative, winding, plan));
@@ -136,7 +136,7 @@ pub(super) fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) ->
     match (ladder.options.open_mesh, fallback) {
         (OpenMeshModel::Hull, _) => convex_hull(ladder, &w, te, &what),
         (OpenMeshModel::Caps, Some((_, winding, plan))) => {
-            with_caps(ladder, w, te, winding, plan, &what)
+            with_caps(ladder, w, te, &winding, plan, &what)
         }
         (OpenMeshModel::Trusted, Some((relative, _, plan))) => Err(no_solid(
             Some(relative),
@@ -225,7 +225,7 @@ pub(super) fn with_caps(
     mut ladder: Ladder<'_>,
     w: Welding,
     te: &Edges,
-    winding: Winding,
+    winding: &Winding,
     plan: CappedSolid,
     what: &str,
 ) -> Result<Solid, MeshError> {
@@ -327,10 +327,10 @@ pub(super) fn convex_hull(
     // The mesh's own volume is the truth up to `moves`; the hull differs from it by this much.
     let model = (own - hull_volume).abs() + moves;
     let nv = hv.len();
-    let share = if hull_volume != 0.0 {
-        100.0 * (own - hull_volume) / hull_volume
-    } else {
+    let share = if hull_volume == 0.0 {
         0.0
+    } else {
+        100.0 * (own - hull_volume) / hull_volume
     };
     let message = move |m: f64, _| {
         let bound = if m.is_finite() {

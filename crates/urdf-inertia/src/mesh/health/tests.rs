@@ -98,7 +98,7 @@ fn shuffled_torus(k: u32, quads: bool, rng: &mut u64) -> Vec<Vec<u32>> {
 
 /// Whether every directed edge appears once and its reverse once: the definition, by a map.
 fn twins_by_map(faces: &[Vec<u32>]) -> bool {
-    let mut count: std::collections::HashMap<(u32, u32), i32> = Default::default();
+    let mut count = std::collections::HashMap::<(u32, u32), i32>::new();
     for f in faces {
         for k in 0..f.len() {
             *count.entry((f[k], f[(k + 1) % f.len()])).or_default() += 1;

@@ -5,6 +5,8 @@
 use crate::mass::Polygons;
 
 /// Edge structure of a welded mesh.
+// `boundary_half_edges`: half-edge is the term of the trade, not a repetition of `Edges`.
+#[allow(clippy::struct_field_names)]
 #[derive(Debug, Default)]
 pub(super) struct Edges {
     pub(super) boundary: usize,

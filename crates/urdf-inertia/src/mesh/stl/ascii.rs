@@ -319,7 +319,7 @@ impl<'a> Iterator for AsciiWords<'a> {
         let rest = &self.rest[start..];
         let len = rest
             .iter()
-            .position(|b| b.is_ascii_whitespace())
+            .position(u8::is_ascii_whitespace)
             .unwrap_or(rest.len());
         let (word, after) = rest.split_at(len);
         self.rest = after;
@@ -333,7 +333,7 @@ impl AsciiWords<'_> {
     /// parsed as [`parse_f64`] parses it.
     fn vertex(&mut self) -> Result<[f64; 3], MeshErrorKind> {
         let mut p = [0.0; 3];
-        for c in p.iter_mut() {
+        for c in &mut p {
             let skip = self
                 .rest
                 .iter()
@@ -341,21 +341,18 @@ impl AsciiWords<'_> {
                 .unwrap_or(self.rest.len());
             self.rest = &self.rest[skip..];
             let fast = short_decimal(self.rest)
-                .filter(|&(_, n)| self.rest.get(n).is_none_or(|b| b.is_ascii_whitespace()));
-            *c = match fast {
-                Some((x, n)) => {
-                    self.rest = &self.rest[n..];
-                    x
-                }
-                None => {
-                    let w = self.next().ok_or_else(|| {
-                        MeshErrorKind::Syntax("`vertex` needs three coordinates".into())
-                    })?;
-                    // The chunk is UTF-8 and `w` is cut at ASCII bytes, so `from_utf8` succeeds.
-                    let w = std::str::from_utf8(w).unwrap_or_default();
-                    parse_f64(w)
-                        .ok_or_else(|| MeshErrorKind::Syntax(format!("`{w}` is not a number")))?
-                }
+                .filter(|&(_, n)| self.rest.get(n).is_none_or(u8::is_ascii_whitespace));
+            *c = if let Some((x, n)) = fast {
+                self.rest = &self.rest[n..];
+                x
+            } else {
+                let w = self.next().ok_or_else(|| {
+                    MeshErrorKind::Syntax("`vertex` needs three coordinates".into())
+                })?;
+                // The chunk is UTF-8 and `w` is cut at ASCII bytes, so `from_utf8` succeeds.
+                let w = std::str::from_utf8(w).unwrap_or_default();
+                parse_f64(w)
+                    .ok_or_else(|| MeshErrorKind::Syntax(format!("`{w}` is not a number")))?
             };
             if !c.is_finite() {
                 return Err(MeshErrorKind::NotFinite);
@@ -523,7 +520,7 @@ fn facet_chunks(text: &[u8], size: usize) -> Vec<&[u8]> {
             if word
                 .get(..5)
                 .is_some_and(|w| w.eq_ignore_ascii_case(b"facet"))
-                && word.get(5).is_none_or(|b| b.is_ascii_whitespace())
+                && word.get(5).is_none_or(u8::is_ascii_whitespace)
             {
                 cut = Some(next);
                 break;

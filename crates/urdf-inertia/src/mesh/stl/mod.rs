@@ -11,9 +11,9 @@
 //! and the result is one sequential parse's, bit for bit (the ASCII reader is tested against the
 //! whole-text reader it replaced, kept in the tests).
 //!
-//! Why not stl_io (the brief's choice): measured on example-robot-data 6.0.0, stl_io 0.8 reads all
+//! Why not `stl_io` (the brief's choice): measured on example-robot-data 6.0.0, `stl_io` 0.8 reads all
 //! 410 STL files with the same face counts as this reader, so it does not fail real files. This
-//! reader is kept because it parses binary files several times faster (stl_io merges vertices while
+//! reader is kept because it parses binary files several times faster (`stl_io` merges vertices while
 //! reading, and the health step welds anyway; figures: docs/benchmarks.md, "Figures behind choices
 //! in the code"), gives ASCII errors a line number, and reports a truncated or miscounted binary
 //! file with the numbers a user needs.

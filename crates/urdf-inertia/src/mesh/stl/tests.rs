@@ -87,7 +87,7 @@ fn ascii_vertex<'a>(
     path: &Path,
 ) -> Result<[f64; 3], MeshError> {
     let mut p = [0.0; 3];
-    for c in p.iter_mut() {
+    for c in &mut p {
         let w = words.next().ok_or_else(|| {
             MeshError::new(
                 path,
@@ -213,7 +213,7 @@ fn styles() -> Vec<Style> {
             end: "endsolid  name with spaces",
         },
         Style {
-            number: |x| format!("{:+.17}", x),
+            number: |x| format!("{x:+.17}"),
             indent: "    ",
             gap: "\x0c ",
             eol: "\r\n \r\n",

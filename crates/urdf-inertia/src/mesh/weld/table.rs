@@ -281,9 +281,9 @@ mod tests {
     /// long runs, the quadratic weld.
     #[test]
     fn integer_and_millimetre_grids_hash_apart() {
+        type Grid = (&'static str, fn(usize) -> f64);
         let side = 64usize;
         let bits = 18; // 2^18 = 64^3 slots
-        type Grid = (&'static str, fn(usize) -> f64);
         let grids: [Grid; 5] = [
             ("integers", |n| n as f64),
             ("integers far out", |n| 1e6 + n as f64),

@@ -2,7 +2,7 @@
 //! hash grid.
 
 use super::{RELATIVE_TOLERANCE, ULPS};
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxBuildHasher, FxHashMap};
 
 /// How a file stored the coordinates. A file that rounds each facet's corners independently stores a
 /// shared corner up to one unit in the last place apart in each coordinate: an f32 ulp (binary STL,
@@ -79,6 +79,8 @@ fn digits_up_to_ten(x: f64) -> usize {
 /// parsing the decimal gives. A decimal reading back as `x` lies within half an ulp of it, so its
 /// exponent is within one of the one giving `x` 9 digits, and its mantissa within one of `x`/10^k
 /// rounded.
+// The two `None`s differ (documented above): no 9-digit decimal, or outside the exact fast path.
+#[allow(clippy::option_option)]
 fn nine_digits(x: f64) -> Option<Option<u64>> {
     use crate::mesh::EXACT_POWERS_OF_TEN as POW10;
     let x = x.abs();
@@ -220,7 +222,7 @@ pub fn tolerant(vertices: &[[f64; 3]], tol: Tolerance) -> TolerantWeld {
     // scan's.
     let block = |c: [i64; 3]| c.map(|x| x.div_euclid(2));
     let mut head: FxHashMap<[i64; 3], u32> =
-        FxHashMap::with_capacity_and_hasher(n, Default::default());
+        FxHashMap::with_capacity_and_hasher(n, FxBuildHasher);
     let mut next: Vec<u32> = vec![u32::MAX; n];
     let mut cells: Vec<[i64; 3]> = vec![[0; 3]; n];
     let mut merged = 0;
@@ -258,18 +260,15 @@ pub fn tolerant(vertices: &[[f64; 3]], tol: Tolerance) -> TolerantWeld {
                 }
             }
         }
-        match found {
-            Some(f) => {
-                representative[i] = f.index;
-                merged += 1;
-                widest = widest.max(f.d);
-            }
-            None => {
-                cells[i] = c;
-                let slot = head.entry(block(c)).or_insert(u32::MAX);
-                next[i] = *slot;
-                *slot = i as u32;
-            }
+        if let Some(f) = found {
+            representative[i] = f.index;
+            merged += 1;
+            widest = widest.max(f.d);
+        } else {
+            cells[i] = c;
+            let slot = head.entry(block(c)).or_insert(u32::MAX);
+            next[i] = *slot;
+            *slot = i as u32;
         }
     }
     TolerantWeld {
@@ -362,13 +361,10 @@ mod tests {
                     r = next[r as usize];
                 }
             }
-            match found {
-                Some((r, _)) => representative[i] = r,
-                None => {
-                    let slot = head.entry(c).or_insert(u32::MAX);
-                    next[i] = *slot;
-                    *slot = i as u32;
-                }
+            if let Some((r, _)) = found { representative[i] = r } else {
+                let slot = head.entry(c).or_insert(u32::MAX);
+                next[i] = *slot;
+                *slot = i as u32;
             }
         }
         representative

@@ -1,7 +1,7 @@
 //! A one-pass scan of a URDF: links, their collisions, their existing `<inertial>` and the byte spans
 //! the writer needs.
 //!
-//! It reads what urdfdom (behind ROS, Gazebo, MoveIt, pinocchio) reads: the first `<inertial>` of a link,
+//! It reads what urdfdom (behind ROS, Gazebo, `MoveIt`, pinocchio) reads: the first `<inertial>` of a link,
 //! the first `<origin>` and `<geometry>` of a collision and the first child element of `<geometry>`;
 //! later ones are ignored with a warning. Zero-size primitives are valid (they have no volume). Anything
 //! wrong inside one collision (an unknown shape, a bad number) is that collision's

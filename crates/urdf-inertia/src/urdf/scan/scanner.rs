@@ -67,11 +67,11 @@ fn diagnostic(code: Code, line: usize, link: Option<&str>, message: String) -> D
 }
 
 /// An element urdfdom ignores, in the link being read.
-fn warning(line: usize, link: &Option<Link>, message: String) -> Diagnostic {
+fn warning(line: usize, link: Option<&Link>, message: String) -> Diagnostic {
     diagnostic(
         Code::UrdfIgnoredElement,
         line,
-        link.as_ref().map(|l| l.name.as_str()),
+        link.map(|l| l.name.as_str()),
         message,
     )
 }
@@ -185,7 +185,7 @@ impl<'t> Scanner<'t> {
                 let message = format!("a second root element <{name}> is ignored, with everything after it (urdfdom reads the first <robot> only); keep one <robot> per file");
                 self.notes.push(warning(
                     lines.at(pos),
-                    &None,
+                    None,
                     crate::text::escape_control(&message).into_owned(),
                 ));
                 break;
@@ -363,7 +363,7 @@ impl<'t> Scanner<'t> {
                 }
             }
             Some(_) if c.visual => {}
-            Some(first) => self.notes.push(warning(line, &self.current, format!("collision {}: a second <origin> is ignored (urdfdom reads the first, on line {first}); remove one", c.index))),
+            Some(first) => self.notes.push(warning(line, self.current.as_ref(), format!("collision {}: a second <origin> is ignored (urdfdom reads the first, on line {first}); remove one", c.index))),
         }
     }
 
@@ -372,7 +372,7 @@ impl<'t> Scanner<'t> {
         if let Some(c) = self.collision.as_mut() {
             c.geometries += 1;
             if c.geometries > 1 && !c.visual {
-                self.notes.push(warning(line, &self.current, format!("collision {}: a second <geometry> is ignored (urdfdom reads the first); give each shape its own <collision>", c.index)));
+                self.notes.push(warning(line, self.current.as_ref(), format!("collision {}: a second <geometry> is ignored (urdfdom reads the first); give each shape its own <collision>", c.index)));
             }
         }
     }
@@ -402,7 +402,7 @@ impl<'t> Scanner<'t> {
                 } else {
                     format!("collision {}: a second shape <{g}> in <geometry> is ignored (urdfdom reads only the first, <{first}> on line {first_line}); give each shape its own <collision>", c.index)
                 };
-                self.notes.push(warning(line, &self.current, message));
+                self.notes.push(warning(line, self.current.as_ref(), message));
             }
         }
     }
@@ -414,7 +414,7 @@ impl<'t> Scanner<'t> {
             return;
         };
         if let Some(first) = i.seen.get(child) {
-            self.notes.push(warning(line, &self.current, format!("a second <{child}> in <inertial> is ignored (urdfdom reads the first, on line {first})")));
+            self.notes.push(warning(line, self.current.as_ref(), format!("a second <{child}> in <inertial> is ignored (urdfdom reads the first, on line {first})")));
             return;
         }
         i.seen.insert(child.to_string(), line);

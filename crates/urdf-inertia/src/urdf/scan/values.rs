@@ -9,7 +9,7 @@ use quick_xml::events::BytesStart;
 use std::collections::HashMap;
 
 /// The attributes of a start tag. A duplicate or malformed attribute is malformed XML (urdfdom's
-/// TinyXML refuses the file): its offset in the tag (after `<`) and the message.
+/// `TinyXML` refuses the file): its offset in the tag (after `<`) and the message.
 pub(super) fn attrs(e: &BytesStart<'_>) -> Result<HashMap<String, String>, (usize, String)> {
     let mut m = HashMap::new();
     for a in e.attributes().with_checks(true) {
@@ -29,7 +29,7 @@ pub(super) fn attrs(e: &BytesStart<'_>) -> Result<HashMap<String, String>, (usiz
         let key = String::from_utf8_lossy(a.key.as_ref()).into_owned();
         let v = a.unescape_value().map_or_else(
             |_| String::from_utf8_lossy(&a.value).into_owned(),
-            |v| v.into_owned(),
+            std::borrow::Cow::into_owned,
         );
         m.insert(key, v);
     }

@@ -159,22 +159,21 @@ pub fn percent_format(fmt: &str, args: &Value) -> Result<Value, String> {
             Some(k) => spec.replacen(&format!("({k})"), "", 1),
             None => spec,
         };
-        let v = match &key {
-            Some(k) => match args {
+        let v = if let Some(k) = &key {
+            match args {
                 Value::Dict(d) => d
                     .get(&Value::str(k))
                     .cloned()
                     .ok_or_else(|| format!("KeyError: '{k}'"))?,
                 _ => return Err("format requires a mapping".into()),
-            },
-            None => {
-                let v = list
-                    .get(next)
-                    .cloned()
-                    .ok_or("not enough arguments for format string")?;
-                next += 1;
-                v
             }
+        } else {
+            let v = list
+                .get(next)
+                .cloned()
+                .ok_or("not enough arguments for format string")?;
+            next += 1;
+            v
         };
         out.push_str(&percent_one(&spec, &v)?);
     }
@@ -255,7 +254,7 @@ fn convert(
         })
     };
     Ok(match conv {
-        's' => (false, v.to_py_str()),
+        's' | 'c' => (false, v.to_py_str()),
         'r' | 'a' => (false, v.repr()),
         'd' | 'i' | 'u' => {
             let x = match v {
@@ -299,7 +298,6 @@ fn convert(
             let s = general(x.abs(), prec.unwrap_or(6), alt);
             (x < 0.0, if conv == 'G' { s.to_uppercase() } else { s })
         }
-        'c' => (false, v.to_py_str()),
         other => return Err(format!("unsupported format character '{other}'")),
     })
 }

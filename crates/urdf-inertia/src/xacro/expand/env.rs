@@ -56,7 +56,7 @@ impl Env for ExprEnv<'_, '_> {
             }),
             "xacro.message" | "xacro.warning" | "xacro.error" => {
                 let text: Vec<String> = args.iter().map(Value::to_py_str).collect();
-                self.x.warn(text.join(" "));
+                self.x.warn(&text.join(" "));
                 Ok(Value::str(""))
             }
             "xacro.print_location" => Ok(Value::str("")),

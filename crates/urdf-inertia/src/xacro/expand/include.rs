@@ -9,7 +9,7 @@ use crate::xacro::FileKind;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
-impl<'o> Expander<'o> {
+impl Expander<'_> {
     pub(super) fn include(
         &mut self,
         e: &Rc<Element>,
@@ -42,7 +42,7 @@ impl<'o> Expander<'o> {
             None => false,
         };
         if e.elements().next().is_some() {
-            self.warn("Child elements of a <xacro:include> tag are ignored".into());
+            self.warn("Child elements of a <xacro:include> tag are ignored");
         }
         let name = self.eval_text(&spec, symbols)?.to_py_str();
         let path = self.relative_to_current(&name);
@@ -72,7 +72,7 @@ impl<'o> Expander<'o> {
                 if k.starts_with("xmlns:") {
                     match parent_attrs.iter().find(|(p, _)| p == k) {
                         Some((_, old)) if old != v => {
-                            self.warn(format!("inconsistent namespace redefinitions for {k}"))
+                            self.warn(&format!("inconsistent namespace redefinitions for {k}"));
                         }
                         Some(_) => {}
                         None => parent_attrs.push((k.clone(), v.clone())),
@@ -115,7 +115,7 @@ impl<'o> Expander<'o> {
             .unwrap_or_default();
         found.sort();
         if found.is_empty() {
-            self.warn(format!(
+            self.warn(&format!(
                 "Include tag's filename spec \"{}\" matched no files.",
                 pattern.display()
             ));

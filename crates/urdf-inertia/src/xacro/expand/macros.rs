@@ -6,7 +6,7 @@ use crate::xacro::value::Value;
 use std::collections::HashMap;
 use std::rc::Rc;
 
-impl<'o> Expander<'o> {
+impl Expander<'_> {
     pub(super) fn property(&mut self, e: &Rc<Element>, table: &Rc<Table>) -> R<()> {
         self.known_attrs(
             e,
@@ -48,7 +48,7 @@ impl<'o> Expander<'o> {
         let mut value = value;
         if let Some(d) = default {
             if scope.is_some() {
-                self.warn(format!(
+                self.warn(&format!(
                     "{name}: default property value can only be defined on local scope"
                 ));
             }
@@ -97,7 +97,7 @@ impl<'o> Expander<'o> {
             }
             Some("parent") => {
                 let Some(mut t) = table.parent.clone() else {
-                    self.warn(format!("{name}: no parent scope at global scope"));
+                    self.warn(&format!("{name}: no parent scope at global scope"));
                     return Ok(None);
                 };
                 *lazy = false;
@@ -132,7 +132,7 @@ impl<'o> Expander<'o> {
             )));
         }
         if let Some(n) = name.strip_prefix("xacro:") {
-            self.warn(format!(
+            self.warn(&format!(
                 "macro names must not contain prefix 'xacro:': {name}"
             ));
             name = n.to_string();
@@ -372,17 +372,14 @@ pub(super) fn parse_params(s: &str) -> (Vec<String>, HashMap<String, (bool, Opti
         if rest.is_empty() {
             break;
         }
-        match parse_param(rest) {
-            Some((name, forward, default, after)) => {
-                defaults.insert(name.to_string(), (forward, default.map(str::to_string)));
-                names.push(name.to_string());
-                rest = after;
-            }
-            None => {
-                let end = rest.find(char::is_whitespace).unwrap_or(rest.len());
-                names.push(rest[..end].to_string());
-                rest = &rest[end..];
-            }
+        if let Some((name, forward, default, after)) = parse_param(rest) {
+            defaults.insert(name.to_string(), (forward, default.map(str::to_string)));
+            names.push(name.to_string());
+            rest = after;
+        } else {
+            let end = rest.find(char::is_whitespace).unwrap_or(rest.len());
+            names.push(rest[..end].to_string());
+            rest = &rest[end..];
         }
     }
     (names, defaults)

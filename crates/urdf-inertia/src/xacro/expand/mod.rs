@@ -232,7 +232,7 @@ impl<'o> Expander<'o> {
         }
     }
 
-    fn warn(&mut self, message: String) {
+    fn warn(&mut self, message: &str) {
         let (file, line) = self.here;
         let path = self
             .files
@@ -485,7 +485,7 @@ impl<'o> Expander<'o> {
     /// A property (or block) by name, evaluating a lazy one in the table that holds it.
     fn resolve(&mut self, table: &Rc<Table>, key: &str) -> R<Option<Value>> {
         let mut t = Some(table.clone());
-        while let Some(tb) = t {
+        while let Some(tb) = t.take() {
             let slot = tb.vars.borrow().get(key).cloned();
             match slot {
                 Some(Slot::Val(v)) => return Ok(Some(v)),
@@ -505,7 +505,7 @@ impl<'o> Expander<'o> {
                         .insert(key.to_string(), Slot::Val(v.clone()));
                     return Ok(Some(v));
                 }
-                None => t = tb.parent.clone(),
+                None => t.clone_from(&tb.parent),
             }
         }
         Ok(None)

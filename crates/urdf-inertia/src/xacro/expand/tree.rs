@@ -5,7 +5,7 @@ use crate::xacro::dom::{Element, Node};
 use crate::xacro::value::Value;
 use std::rc::Rc;
 
-impl<'o> Expander<'o> {
+impl Expander<'_> {
     /// xacro's `eval_all` on one ordinary element: its attributes evaluated, its children expanded.
     pub(super) fn expand_element(
         &mut self,
@@ -223,7 +223,7 @@ impl<'o> Expander<'o> {
             .filter(|k| !known.contains(&k.as_str()) && !k.starts_with("xmlns:"))
             .collect();
         if !extra.is_empty() {
-            self.warn(format!(
+            self.warn(&format!(
                 "{}: unknown attribute(s): {}",
                 e.name,
                 extra.join(", ")

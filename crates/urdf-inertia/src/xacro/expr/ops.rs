@@ -60,14 +60,6 @@ fn builtin_name(name: &str) -> Option<&'static str> {
 }
 
 fn math_name(name: &str) -> Option<Value> {
-    match name {
-        "pi" => return Some(Value::Float(std::f64::consts::PI)),
-        "e" => return Some(Value::Float(std::f64::consts::E)),
-        "tau" => return Some(Value::Float(std::f64::consts::TAU)),
-        "inf" => return Some(Value::Float(f64::INFINITY)),
-        "nan" => return Some(Value::Float(f64::NAN)),
-        _ => {}
-    }
     const FNS: [&str; 32] = [
         "math.sin",
         "math.cos",
@@ -102,6 +94,14 @@ fn math_name(name: &str) -> Option<Value> {
         "math.isnan",
         "math.isinf",
     ];
+    match name {
+        "pi" => return Some(Value::Float(std::f64::consts::PI)),
+        "e" => return Some(Value::Float(std::f64::consts::E)),
+        "tau" => return Some(Value::Float(std::f64::consts::TAU)),
+        "inf" => return Some(Value::Float(f64::INFINITY)),
+        "nan" => return Some(Value::Float(f64::NAN)),
+        _ => {}
+    }
     FNS.into_iter()
         .find(|f| &f[5..] == name)
         .map(Value::Builtin)
@@ -324,7 +324,7 @@ pub(super) fn compare(op: &str, a: &Value, b: &Value) -> Result<bool, String> {
     })
 }
 
-/// Python's ordering of two values (`None` where Python raises TypeError).
+/// Python's ordering of two values (`None` where Python raises `TypeError`).
 pub fn order(a: &Value, b: &Value) -> Option<std::cmp::Ordering> {
     match (a, b) {
         (Value::Str(x), Value::Str(y)) => Some(x.cmp(y)),

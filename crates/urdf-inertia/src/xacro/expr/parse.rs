@@ -365,7 +365,7 @@ impl Parser {
             }
             Tok::Op("[") => self.list_display()?,
             Tok::Op("{") => self.dict_display()?,
-            other => return Err(format!("unexpected {}", describe(&other))),
+            other @ Tok::Op(_) => return Err(format!("unexpected {}", describe(&other))),
         })
     }
 
