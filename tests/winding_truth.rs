@@ -755,7 +755,7 @@ fn caps_of_several_holes_bound_the_winding_number_solid() {
 }
 
 /// A link whose only collision is a flat plate, with an `<inertial>` of its own whose tensor is zero
-/// (as exported for an ArUco marker): `fill` leaves it as it is (UI109), and `check --density` reports
+/// (as exported for a fiducial marker): `fill` leaves it as it is (UI109), and `check --density` reports
 /// the invalid tensor without claiming that `fill` computes correct values for it.
 #[test]
 fn check_does_not_promise_fill_computes_a_flat_link() {

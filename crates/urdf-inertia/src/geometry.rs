@@ -68,6 +68,7 @@ impl Aabb {
     }
 
     /// The box of both.
+    #[must_use]
     pub fn union(self, other: Aabb) -> Aabb {
         Aabb {
             lo: [0, 1, 2].map(|k| self.lo[k].min(other.lo[k])),
@@ -76,6 +77,7 @@ impl Aabb {
     }
 
     /// Where both meet (empty along an axis where they do not: lo > hi).
+    #[must_use]
     pub fn intersection(self, other: Aabb) -> Aabb {
         Aabb {
             lo: [0, 1, 2].map(|k| self.lo[k].max(other.lo[k])),
