@@ -4,6 +4,10 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+// The test helpers are the library tests' own (mesh generators).
+#[path = "../crates/urdf-inertia/tests/common/mod.rs"]
+mod common;
+
 const PI: f64 = std::f64::consts::PI;
 
 fn bin() -> Command {
@@ -798,7 +802,7 @@ fn keep_mass_and_total_mass() {
 fn json_summary_names_repairs() {
     let tmp = tempfile::tempdir().unwrap();
     // An inside-out box mesh: the summary must say it was flipped.
-    inside_out_cube(&tmp.path().join("inside.stl"));
+    common::inside_out_cube_stl(&tmp.path().join("inside.stl"));
     let urdf = tmp.path().join("r.urdf");
     std::fs::write(&urdf, "<robot name=\"r\">\n  <link name=\"box\">\n    <collision><geometry><mesh filename=\"inside.stl\"/></geometry></collision>\n  </link>\n</robot>\n").unwrap();
     let out = run(&[
@@ -1098,42 +1102,11 @@ fn overlapping_parts_are_reported_with_the_doubly_counted_volume() {
     assert!(!stderr.contains("link `ball`: parts"), "{stderr}");
 }
 
-/// An inside-out unit cube (every face wound inward) as a binary STL at `path`: turned outside out
-/// exactly, so its repair (UI101) has a round-off bound.
-fn inside_out_cube(path: &Path) {
-    let v: Vec<[f64; 3]> = (0..8)
-        .map(|i| {
-            [
-                f64::from(i & 1),
-                f64::from((i >> 1) & 1),
-                f64::from((i >> 2) & 1),
-            ]
-        })
-        .collect();
-    let quads = [
-        [0u32, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let tris: Vec<[u32; 3]> = quads
-        .iter()
-        .flat_map(|q| [[q[0], q[2], q[1]], [q[0], q[3], q[2]]])
-        .collect();
-    std::fs::write(
-        path,
-        urdf_inertia::mesh::stl::write_binary(b"in", &v, &tris),
-    )
-    .unwrap();
-}
-
 /// A robot of four links sharing one inside-out cube mesh, in `dir` (a `.git` there makes it a
 /// repository root for the configuration file's search).
 fn shared_mesh_robot(dir: &Path) -> PathBuf {
     std::fs::create_dir_all(dir.join(".git")).unwrap();
-    inside_out_cube(&dir.join("cube.stl"));
+    common::inside_out_cube_stl(&dir.join("cube.stl"));
     let links = ["a", "b", "c", "d"].iter().fold(String::new(), |mut s, l| {
         let _ = write!(s, "  <link name=\"{l}\">\n    <collision><geometry><mesh filename=\"cube.stl\"/></geometry></collision>\n  </link>\n");
         s

@@ -10,6 +10,10 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+// The test helpers are the library tests' own (mesh generators).
+#[path = "../crates/urdf-inertia/tests/common/mod.rs"]
+mod common;
+
 const REGENERATE: &str = "UPDATE_SCHEMA=1 cargo test --release --test schema";
 
 fn schema_path(command: &str) -> PathBuf {
@@ -94,36 +98,6 @@ fn s(p: &Path) -> &str {
     p.to_str().expect("UTF-8 path")
 }
 
-/// A unit cube whose faces are all wound inward (binary STL): healed, with a warning.
-fn inside_out_cube(path: &Path) {
-    let v: Vec<[f64; 3]> = (0..8)
-        .map(|i| {
-            [
-                f64::from(i & 1),
-                f64::from((i >> 1) & 1),
-                f64::from((i >> 2) & 1),
-            ]
-        })
-        .collect();
-    let quads = [
-        [0u32, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let tris: Vec<[u32; 3]> = quads
-        .iter()
-        .flat_map(|q| [[q[0], q[2], q[1]], [q[0], q[3], q[2]]])
-        .collect();
-    std::fs::write(
-        path,
-        urdf_inertia::mesh::stl::write_binary(b"in", &v, &tris),
-    )
-    .expect("write the cube");
-}
-
 /// A robot with a bit of everything a report can say: two overlapping boxes (a link warning) with
 /// a unit slip in their `<inertial>` and a second `<inertial>`, an inside-out mesh (a repaired
 /// part), an `<inertial>` whose mass is `nan`, a link without an `<inertial>`, a frame.
@@ -148,7 +122,7 @@ const MIXED: &str = r#"<robot name="mixed">
 /// `text` as mixed.urdf beside the inside-out cube.stl it uses, in a temp dir.
 fn mixed_robot(text: &str) -> (tempfile::TempDir, PathBuf) {
     let tmp = tempfile::tempdir().expect("tempdir");
-    inside_out_cube(&tmp.path().join("cube.stl"));
+    common::inside_out_cube_stl(&tmp.path().join("cube.stl"));
     let urdf = tmp.path().join("mixed.urdf");
     std::fs::write(&urdf, text).expect("write");
     (tmp, urdf)
