@@ -172,6 +172,14 @@ fn the_demo_robots_json_validates() {
         let v = json_of(&["mesh", s(&p), "--density", "1000", "--format", "json"], 0);
         assert_valid("mesh", &v, mesh);
     }
+    // A mesh that gives no solid is a document too (exit 2): the file and why, with a code.
+    let empty = tmp.path().join("empty.stl");
+    std::fs::write(&empty, "solid x\nendsolid x\n").expect("write");
+    let v = json_of(&["mesh", s(&empty), "--format", "json"], 2);
+    assert_valid("mesh", &v, "mesh without faces");
+    assert_eq!(v["error"]["code"], "UI703");
+    assert_eq!(v["error"]["kind"], "mesh");
+    assert!(v.get("volume").is_none(), "{v:#}");
 }
 
 /// A robot with repairs, warnings, a unit slip, a `nan` and duplicates: `fill`, `diff`, `check`

@@ -4,7 +4,7 @@ use super::args::{Format, MeshArgs};
 use super::policy::Policy;
 use super::ExitStatus;
 use urdf_inertia::diagnostic::{Code, Diagnostic, Provenance, Severity};
-use urdf_inertia::report::{MeshOutput, SCHEMA_VERSION};
+use urdf_inertia::report::{MeshErrorRecord, MeshFailure, MeshOutput, SCHEMA_VERSION};
 use urdf_inertia::text::{round_significant, shortest, within, Digits};
 use urdf_inertia::MeshErrorKind;
 use urdf_inertia::{LoadOptions, Solid};
@@ -39,6 +39,7 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
                 MeshErrorKind::NoSolid(_) => errln!("error[{}]: {e}", Code::MeshNoSolid),
                 _ => errln!("error: {e}"),
             }
+            print_failure(args, scale, MeshErrorRecord::from_mesh_error(&e));
             return ExitStatus::Error;
         }
     };
@@ -51,6 +52,7 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
     let mp = solid.unit.scaled(density);
     if let Some(why) = urdf_inertia::unrepresentable(&mp) {
         errln!("error: {}: {why}", args.file.display());
+        print_failure(args, scale, MeshErrorRecord::unrepresentable(&why));
         return ExitStatus::Error;
     }
     let diagnostics = diagnostics(&solid, scale, &policy);
@@ -162,6 +164,23 @@ fn rounded(
 }
 
 /// `--format json`: one object with the results, the solid's health and its diagnostics.
+/// With `--format json`, the document of a mesh that gave no solid (the error is on stderr too).
+fn print_failure(args: &MeshArgs, scale: [f64; 3], error: MeshErrorRecord) {
+    if !matches!(args.format, Format::Json) {
+        return;
+    }
+    let document = MeshFailure {
+        schema_version: SCHEMA_VERSION,
+        file: args.file.display().to_string(),
+        scale,
+        error,
+    };
+    match serde_json::to_string_pretty(&document) {
+        Ok(text) => outln!("{text}"),
+        Err(e) => errln!("error: cannot write the JSON: {e}"),
+    }
+}
+
 fn print_json(
     args: &MeshArgs,
     scale: [f64; 3],

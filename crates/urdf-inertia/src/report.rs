@@ -505,6 +505,67 @@ pub struct MeshOutput {
     pub notes: Vec<Diagnostic>,
 }
 
+/// `urdf-inertia mesh --format json` when the file gives no solid (unreadable, malformed, an open
+/// mesh whose caps cannot be trusted, a mass past f64): the file and why, so that a program reading
+/// the output always gets a document (the command exits 2).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "json-schema", schemars(deny_unknown_fields))]
+pub struct MeshFailure {
+    /// [`SCHEMA_VERSION`].
+    pub schema_version: u32,
+    pub file: String,
+    pub scale: [f64; 3],
+    pub error: MeshErrorRecord,
+}
+
+/// Why a mesh gave no solid.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "json-schema", schemars(deny_unknown_fields))]
+pub struct MeshErrorRecord {
+    /// `mesh` (unreadable or no solid), `open-mesh` (an open mesh whose caps cannot be trusted:
+    /// `--open-mesh caps|hull` chooses a model), `unrepresentable` (a mass or inertia past f64).
+    pub kind: String,
+    pub code: Code,
+    pub message: String,
+}
+
+impl MeshErrorRecord {
+    /// The record of a mesh that did not load.
+    pub fn from_mesh_error(e: &crate::mesh::MeshError) -> MeshErrorRecord {
+        let open = matches!(e.kind, crate::mesh::MeshErrorKind::NoSolid(_));
+        MeshErrorRecord {
+            kind: if open { "open-mesh" } else { "mesh" }.to_string(),
+            code: if open {
+                Code::MeshNoSolid
+            } else {
+                Code::ErrorMesh
+            },
+            message: e.to_string(),
+        }
+    }
+
+    /// The record of mass properties past f64 (`why`, from [`crate::unrepresentable`]).
+    pub fn unrepresentable(why: &str) -> MeshErrorRecord {
+        MeshErrorRecord {
+            kind: "unrepresentable".to_string(),
+            code: Code::ErrorUnrepresentable,
+            message: why.to_string(),
+        }
+    }
+}
+
+/// What `mesh --format json` prints: the solid's mass properties, or why there is none.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+#[serde(untagged)]
+#[allow(clippy::large_enum_variant)] // Printed once per run.
+pub enum MeshDocument {
+    Solid(MeshOutput),
+    Failure(MeshFailure),
+}
+
 /// The JSON Schemas of the four documents, by command (`fill`, `diff`, `check`, `mesh`), as
 /// docs/schema/COMMAND.schema.json holds them.
 #[cfg(feature = "json-schema")]
@@ -524,7 +585,7 @@ pub fn schemas() -> Vec<(&'static str, serde_json::Value)> {
             "check",
             one::<CheckOutput>("urdf-inertia/check.schema.json"),
         ),
-        ("mesh", one::<MeshOutput>("urdf-inertia/mesh.schema.json")),
+        ("mesh", one::<MeshDocument>("urdf-inertia/mesh.schema.json")),
     ]
 }
 
