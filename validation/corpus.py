@@ -319,39 +319,6 @@ def mesh_edges(path):
     return int((counts == 1).sum()), int((counts > 2).sum())
 
 
-def invalid_inertial(urdf, link):
-    """Why `link`'s own <inertial> in the original `urdf` is no valid rigid body, read with
-    ElementTree and numpy (not the tool), or None when it is valid: what `check` may report on a link
-    `fill` left as it is (UI109: its collision geometry has no volume)."""
-    import xml.etree.ElementTree as ET
-
-    import numpy as np
-
-    try:
-        root = ET.parse(urdf).getroot()
-    except (ET.ParseError, OSError):
-        return None
-    el = next((l for l in root.iter("link") if l.get("name") == link), None)
-    inertial = el.find("inertial") if el is not None else None
-    if inertial is None:
-        return "it has no <inertial>"
-    try:
-        mass = float(inertial.find("mass").get("value"))
-        i = {k: float(inertial.find("inertia").get(k)) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
-    except (AttributeError, TypeError, ValueError):
-        return "its <inertial> does not parse"
-    t = np.array([[i["ixx"], i["ixy"], i["ixz"]], [i["ixy"], i["iyy"], i["iyz"]], [i["ixz"], i["iyz"], i["izz"]]])
-    m = np.linalg.eigvalsh(t)
-    why = []
-    if not mass > 0:
-        why.append(f"mass {mass:g}")
-    if not m[0] > 0:
-        why.append("principal moments " + ", ".join(f"{x:.3g}" for x in m) + " (numpy), not positive")
-    elif m[0] + m[1] < m[2] * (1 - 1e-12):
-        why.append("principal moments " + ", ".join(f"{x:.3g}" for x in m) + " (numpy) break the triangle inequality")
-    return "its own <inertial> has " + "; ".join(why) if why else None
-
-
 def known_bug(rel, message):
     """Failures listed as suspected urdf-inertia bugs in the report (so CI stays green while the owners fix
     them); returns the report's name for it, or None."""
@@ -479,36 +446,21 @@ def main():
                                            f"but urdfdom 6.0.0 (pinocchio 4.1.0) loads this file: {evidence.split(' loads the robot but ')[-1] if ' loads the robot but ' in evidence else 'it builds the model'}")
                     if bug == "UNEXPLAINED":
                         unexplained.append(f"{rel}: {link}: {cm}")
-            # Links fill left as they are because their collision geometry has no volume (UI109): check
-            # may report their own <inertial>, when the original's is invalid (verified independently).
-            left_alone = {n.get("link") for n in (summary or {}).get("notes", []) if n.get("code") == "UI109"}
-            verified_alone = {}
-            for link in sorted(l for l in left_alone if l):
-                why = invalid_inertial(urdf, link)
-                if why:
-                    verified_alone[link] = why
-                    r["failures"].append({"urdf": rel, "link": link,
-                                          "message": "collision geometry without volume (UI109): the link is left as it is, and `check` reports its own <inertial>",
-                                          "defect": "flat collision mesh, link left as it is with an invalid <inertial> of its own",
-                                          "evidence": f"verified: {why} (ElementTree and numpy on the original file)", "bug": None,
-                                          "urdfdom": "refuses" if dom[0] else "accepts"})
             if "check" in res:
                 crc, ctext = res["check"]
-                failed_links = {link for link, _ in errors if link} | set(verified_alone)
+                failed_links = {link for link, _ in errors if link}
                 r["check"][f"exit {crc}"] += 1
                 if crc != 0:
                     # Only links fill could not compute may be reported; anything else contradicts fill.
                     bad = [ln for ln in ctext.splitlines() if ln.strip() and not any(f"`{l}`" in ln for l in failed_links)
                            and not ln.startswith(("note", "help:", "  ", "urdf-inertia check:", "error: 1 link"))]
-                    if bad or (res["rc"] == 0 and not verified_alone):
+                    if res["rc"] == 0 or bad:
                         r["check_problems"].append(f"{rel}: `check` exit {crc}: {clean(' / '.join(bad or ctext.splitlines())[:400], pkg)}")
                         unexplained.append(f"{rel}: check exit {crc}")
             if "check_density" in res:
                 crc, cso, cse = res["check_density"]
                 r["check"][f"with --density: exit {crc}"] += 1
-                bad = [ln for ln in (cso + cse).splitlines() if ln.strip() and not any(f"`{l}`" in ln for l in verified_alone)
-                       and not ln.startswith(("note", "help:", "  ", "urdf-inertia check:", "error: 1 link"))]
-                if crc != 0 and (bad or not verified_alone):
+                if crc != 0:
                     r["check_problems"].append(f"{rel}: `check --density 1000` exit {crc}: {clean((cso + cse)[:400], pkg)}")
                     unexplained.append(f"{rel}: check --density exit {crc}")
             if dom[0]:

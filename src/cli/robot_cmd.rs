@@ -552,6 +552,10 @@ fn run_one(
             errln!("error: {}: {f}", input.link_at(f.line, &f.link));
         }
         outcome.errors += missing.len();
+        if found.problems.len() > from {
+            let flat = flat_links_without_densities(robot, &config.src, cache);
+            set_aside_flat_links(&input, config, &flat, found, from);
+        }
         found.record_links(robot, None, from, config.tolerance);
         return outcome;
     };
@@ -580,15 +584,8 @@ fn run_one(
         }
         Mode::Check { .. } => {
             summary::computed_diagnostics(&report, &config.policy);
-            // A link `fill` leaves as it is for want of volume (every part a flat mesh) misses no
-            // <inertial>, as a link whose parts are all zero-size primitives does not.
-            found.problems.retain(|p| {
-                !(p.problem.file == robot.path
-                    && p.problem.kind == ProblemKind::MissingInertial
-                    && flat_links.contains(&p.problem.link))
-            });
+            set_aside_flat_links(&input, config, &flat_links, found, from);
             check_against_computed(&input, &report, config, &mut found.problems);
-            (found.uncomputable).extend(flat_links.iter().map(|l| (robot.path.clone(), l.clone())));
             found.record_links(robot, Some(&report), from, config.tolerance);
             outcome.problems += promoted;
         }
@@ -1005,6 +1002,71 @@ fn spliced(robot: &Robot, report: &FillReport, w: &WriteConfig) -> Result<Vec<u8
 
 /// Problems of the existing `<inertial>` elements themselves (no computation needed), added to
 /// `problems`; those of frames (links without collision geometry) are notes unless `--all-links`.
+/// The links `fill` leaves as they are because every part is a mesh without volume (UI109), found
+/// without densities: only the links `check` reports (`missing_only`) are computed, so their meshes
+/// alone are read, and only when there is something to report.
+fn flat_links_without_densities(
+    robot: &Robot,
+    src: &Sources,
+    cache: &mut MeshCache,
+) -> Vec<String> {
+    let mut options = src.options.clone();
+    options.missing_only = true;
+    let report = urdf_inertia::compute_with(
+        robot,
+        &DensityMap::uniform(1.0),
+        &src.resolver,
+        &options,
+        cache,
+    );
+    (report.no_volume.iter())
+        .filter_map(|d| d.location.as_ref()?.link.clone())
+        .collect()
+}
+
+/// A link `fill` leaves as it is for want of volume (`flat`: every part a flat mesh, UI109) is
+/// checked as a link without collision geometry is: it misses no `<inertial>`, and a problem of its
+/// own `<inertial>` is a note (UI207, fill cannot compute it) unless `--all-links`, when it stays a
+/// problem that the closing line says `fill` cannot correct. `from`: this robot's first problem.
+fn set_aside_flat_links(
+    input: &Input,
+    config: &Config,
+    flat: &[String],
+    found: &mut Findings,
+    from: usize,
+) {
+    let all_links = matches!(
+        config.mode,
+        Mode::Check {
+            all_links: true,
+            ..
+        }
+    );
+    let robot = &input.robot;
+    let ours = |p: &Problem| p.problem.file == robot.path && flat.contains(&p.problem.link);
+    let (aside, kept): (Vec<Problem>, Vec<Problem>) = (found.problems.drain(from..))
+        .partition(|p| ours(p) && !matches!(p.problem.kind, ProblemKind::Duplicates { .. }));
+    found.problems.extend(kept);
+    for p in aside {
+        if p.problem.kind == ProblemKind::MissingInertial {
+            continue;
+        }
+        if all_links {
+            found.problems.push(p);
+        } else {
+            let note = Diagnostic::new(
+                Code::UrdfFrameInertial,
+                format!(
+                    "{} (its collision geometry has no volume, so fill cannot compute it): {}",
+                    p.at, p.problem.kind
+                ),
+            );
+            print_one(&config.policy, &note);
+        }
+    }
+    (found.uncomputable).extend(flat.iter().map(|l| (robot.path.clone(), l.clone())));
+}
+
 fn check_existing(input: &Input, config: &Config, all_links: bool, problems: &mut Vec<Problem>) {
     let robot = &input.robot;
     for p in urdf_inertia::check(robot, &config.src.options) {

@@ -102,7 +102,8 @@ pub enum Code {
     UrdfXacroNamespace,
     /// UI206: `<robot>` has no name attribute.
     UrdfNoRobotName,
-    /// UI207: an invalid `<inertial>` on a link without collision geometry (`check`).
+    /// UI207: an invalid `<inertial>` on a link `fill` cannot compute: without collision geometry, or
+    /// whose collision geometry has no volume (`check`).
     UrdfFrameInertial,
     /// UI301: a link's mass target is overridden by its parts' own `[meshes]` rules.
     DensityRuleOverridden,
