@@ -101,35 +101,6 @@ pub(super) fn polygon_area(vertices: &[[f64; 3]], face: &[u32]) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// [`polygon_area`] of a triangle, with the same operations in the same order (so the same bits):
-/// for a mesh of triangles, without the per-face slice and loop of the general fan.
-#[inline]
-pub(super) fn triangle_area(vertices: &[[f64; 3]], [i, j, k]: [u32; 3]) -> f64 {
-    let p = vertices[i as usize];
-    let x = cross(
-        sub(vertices[j as usize], p),
-        sub(vertices[k as usize], p),
-    );
-    let mut a = [0.0f64; 3];
-    for j in 0..3 {
-        a[j] += 0.5 * x[j];
-    }
-    dot(a, a).sqrt()
-}
-
-/// The faces' total area, summed in face order.
-pub(super) fn total_area(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
-    if faces.all_triangles() {
-        faces
-            .indices
-            .chunks_exact(3)
-            .map(|t| triangle_area(vertices, [t[0], t[1], t[2]]))
-            .sum()
-    } else {
-        faces.iter().map(|f| polygon_area(vertices, f)).sum()
-    }
-}
-
 pub(super) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     let d = sub(a, b);
     dot(d, d).sqrt()

@@ -1,7 +1,7 @@
 //! The error model: volumes by which a solid can differ from the stored surface, turned into relative
 //! bounds on volume, inertia and centre of mass; the round-off estimate and the empty-solid check.
 
-use super::geometry::{dist, total_area, unit_props};
+use super::geometry::{dist, polygon_area, unit_props};
 use super::{ModelError, ROUND_OFF_FLOOR, ZERO_VOLUME_ROUNDOFFS};
 use crate::geometry::Aabb;
 use crate::mass::{frobenius, MassProperties, Polygons};
@@ -120,7 +120,7 @@ pub(super) fn check_volume(
     volume: f64,
     path: &Path,
 ) -> Result<(), MeshError> {
-    let area = total_area(vertices, faces);
+    let area: f64 = faces.iter().map(|f| polygon_area(vertices, f)).sum();
     let floor = ZERO_VOLUME_ROUNDOFFS * f64::EPSILON * area * dist(lo, hi);
     if volume.is_nan() || volume <= floor {
         return Err(MeshError::new(

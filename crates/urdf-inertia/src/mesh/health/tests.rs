@@ -214,27 +214,3 @@ fn rung_names_list_every_rung() {
     }
     assert_eq!(rungs.map(|r| r.name()), Rung::NAMES);
 }
-
-/// The triangle fast path of the area sum gives the general fan's bits: odd coordinates, a −0.0, a
-/// collapsed triangle, and a quad that sends the sum down the general path.
-#[test]
-fn triangle_area_sum_is_the_fan_sum_bit_for_bit() {
-    use super::geometry::{polygon_area, total_area};
-    let v: Vec<[f64; 3]> = (0..40u32)
-        .map(|i| {
-            let t = f64::from(i);
-            [(0.37 * t).sin() * 1e3, -0.0 * t, (t * 1.1).cos() / 3.0 + t]
-        })
-        .collect();
-    let mut faces = crate::mass::Polygons::new();
-    for i in 0..37u32 {
-        faces.push(&[i, (i * 7 + 3) % 40, (i * 11 + 5) % 40]);
-    }
-    faces.push(&[4, 4, 9]);
-    let fan: f64 = faces.iter().map(|f| polygon_area(&v, f)).sum();
-    assert!(faces.all_triangles());
-    assert_eq!(total_area(&v, &faces).to_bits(), fan.to_bits());
-    faces.push(&[1, 2, 3, 5]);
-    let fan: f64 = faces.iter().map(|f| polygon_area(&v, f)).sum();
-    assert_eq!(total_area(&v, &faces).to_bits(), fan.to_bits());
-}

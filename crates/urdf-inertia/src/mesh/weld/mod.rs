@@ -81,16 +81,7 @@ pub fn already_welded(vertices: Vec<[f64; 3]>, faces: Polygons) -> ExactWeld {
         // Polygons fold runs of a repeated corner: `remap_faces` decides.
         _ => true,
     };
-    // Triangles (every binary STL) are checked three indices at a time, without a slice per face.
-    let any_collapsed = if faces.all_triangles() {
-        faces
-            .indices
-            .chunks_exact(3)
-            .any(|t| t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
-    } else {
-        faces.iter().any(collapsed)
-    };
-    if !any_collapsed {
+    if !faces.iter().any(collapsed) {
         return ExactWeld {
             vertices,
             faces,
