@@ -299,18 +299,18 @@ fn flat_parts_contribute_nothing(json: &serde_json::Value, hull: &[&str], out: &
     );
 }
 
+/// The corners of a square of side `a` in the plane z = 0, one at the origin, counter-clockwise.
+fn square(a: f64) -> [[f64; 3]; 4] {
+    [[0.0, 0.0, 0.0], [a, 0.0, 0.0], [a, a, 0.0], [0.0, a, 0.0]]
+}
+
 /// A robot of three links in `dir`: `shell`, an open box whose caps are not trusted, `marker`, a
 /// box beside a flat plate, and `tag`, two flat plates (one two-sided) and a zero-size box.
 fn open_robot(dir: &Path) -> std::path::PathBuf {
     let (v, f) = moved_box();
     let open = without_side(&v, &without_side(&v, &f, 2, true), 0, true);
     write_obj(&dir.join("open.obj"), &v, &open);
-    let plate_v = [
-        [0.0, 0.0, 0.0],
-        [0.1, 0.0, 0.0],
-        [0.1, 0.1, 0.0],
-        [0.0, 0.1, 0.0],
-    ];
+    let plate_v = square(0.1);
     write_obj(&dir.join("plate.obj"), &plate_v, &[[0, 1, 2], [0, 2, 3]]);
     write_obj(
         &dir.join("sheet.obj"),
@@ -763,13 +763,11 @@ fn caps_of_several_holes_bound_the_winding_number_solid() {
 fn check_treats_a_flat_link_as_fill_does() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let dir = tmp.path();
-    let plate = [
-        [0.0, 0.0, 0.0],
-        [0.06, 0.0, 0.0],
-        [0.06, 0.06, 0.0],
-        [0.0, 0.06, 0.0],
-    ];
-    write_obj(&dir.join("plate.obj"), &plate, &[[0, 1, 2], [0, 2, 3]]);
+    write_obj(
+        &dir.join("plate.obj"),
+        &square(0.06),
+        &[[0, 1, 2], [0, 2, 3]],
+    );
     let urdf = dir.join("marker.urdf");
     std::fs::write(
         &urdf,

@@ -175,10 +175,7 @@ fn print_failure(args: &MeshArgs, scale: [f64; 3], error: MeshErrorRecord) {
         scale,
         error,
     };
-    match serde_json::to_string_pretty(&document) {
-        Ok(text) => outln!("{text}"),
-        Err(e) => errln!("error: cannot write the JSON: {e}"),
-    }
+    super::summary::print_json(&document);
 }
 
 fn print_json(
@@ -225,10 +222,7 @@ fn print_json(
         warnings: of(Severity::Warning),
         notes: of(Severity::Note),
     };
-    match serde_json::to_string_pretty(&document) {
-        Ok(text) => outln!("{text}"),
-        Err(e) => errln!("error: cannot write the JSON: {e}"),
-    }
+    super::summary::print_json(&document);
 }
 
 /// `--format text`: the results one per line, for people.

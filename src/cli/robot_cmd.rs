@@ -483,20 +483,10 @@ fn report_problems(config: &Config, found: &Findings, errors: usize) -> usize {
         }
     }
     if errors == 0 && !new.is_empty() {
-        let by_hand: Vec<&str> = (new.iter())
-            .filter(|p| {
-                (found.uncomputable.iter())
-                    .any(|(f, l)| *f == p.problem.file && *l == p.problem.link)
-            })
-            .map(|p| p.problem.link.as_str())
-            .collect();
-        if by_hand.len() == new.len() {
-            errln!("urdf-inertia check: {} problem(s) found, on links whose collision geometry has no volume (UI109), which `fill` cannot compute: give them a primitive collision shape or a closed mesh, or correct their <inertial> by hand", new.len());
-        } else if by_hand.is_empty() {
-            errln!("urdf-inertia check: {} problem(s) found; `urdf-inertia fill -i FILE --density-map …` computes correct values", new.len());
-        } else {
-            errln!("urdf-inertia check: {} problem(s) found; `urdf-inertia fill -i FILE --density-map …` computes correct values, except for links whose collision geometry has no volume (UI109: {}): give them a primitive collision shape or a closed mesh, or correct their <inertial> by hand", new.len(), by_hand.join(", "));
-        }
+        errln!(
+            "urdf-inertia check: {}",
+            closing_line(&new, &found.uncomputable)
+        );
         if config.baseline.is_none() && !config.policy.quiet {
             errln!(
                 "help: problems that were there before your change? record them once with `urdf-inertia check FILES --write-baseline urdf-inertia.baseline` (commit it; `baseline = \"urdf-inertia.baseline\"` in urdf-inertia.toml) and later runs fail only on new ones; or leave a link alone with --skip NAME"
@@ -504,6 +494,32 @@ fn report_problems(config: &Config, found: &Findings, errors: usize) -> usize {
         }
     }
     new.len()
+}
+
+/// `check`'s closing line for the `new` problems. Problems on links `fill` cannot compute
+/// (`uncomputable`: their collision geometry has no volume, UI109) are not promised to `fill`.
+fn closing_line(new: &[&Problem], uncomputable: &[(PathBuf, String)]) -> String {
+    let on_flat: Vec<&str> = (new.iter())
+        .filter(|p| {
+            uncomputable
+                .iter()
+                .any(|(f, l)| *f == p.problem.file && *l == p.problem.link)
+        })
+        .map(|p| p.problem.link.as_str())
+        .collect();
+    let n = new.len();
+    let fill = "`urdf-inertia fill -i FILE --density-map …` computes correct values";
+    let by_hand = "give them a primitive collision shape or a closed mesh, or correct their <inertial> by hand";
+    if on_flat.is_empty() {
+        format!("{n} problem(s) found; {fill}")
+    } else if on_flat.len() == n {
+        format!("{n} problem(s) found, on links whose collision geometry has no volume (UI109), which `fill` cannot compute: {by_hand}")
+    } else {
+        let mut links = on_flat;
+        links.sort_unstable();
+        links.dedup();
+        format!("{n} problem(s) found; {fill}, except for links whose collision geometry has no volume (UI109: {}): {by_hand}", links.join(", "))
+    }
 }
 
 fn run_one(

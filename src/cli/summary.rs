@@ -325,8 +325,8 @@ fn totals(robot: &Robot, report: &FillReport) -> Totals {
     }
 }
 
-/// A JSON document on stdout.
-fn print_json(document: &impl serde::Serialize) {
+/// A JSON document on stdout, pretty-printed.
+pub fn print_json(document: &impl serde::Serialize) {
     match serde_json::to_string_pretty(document) {
         Ok(text) => outln!("{text}"),
         Err(e) => errln!("error: cannot write the JSON: {e}"),

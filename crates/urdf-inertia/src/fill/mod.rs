@@ -195,21 +195,37 @@ struct Context<'a> {
     resolved: HashMap<&'a str, Result<PathBuf, NotFound>>,
 }
 
-/// [`Context::resolved`]: every mesh URI of the links [`compute_links`] computes, resolved.
+/// [`Context::resolved`]: every mesh URI of `targets` (the links to compute), resolved.
 fn resolve_meshes<'a>(
-    robot: &'a Robot,
+    robot: &Robot,
     resolver: &PackageResolver,
-    opts: &FillOptions,
+    targets: &[(usize, &'a Link)],
 ) -> HashMap<&'a str, Result<PathBuf, NotFound>> {
     let mut resolved = HashMap::new();
-    let targets = (robot.links.iter()).filter(|l| l.has_collision_geometry() && is_target(l, opts));
-    for c in targets.flat_map(|l| &l.collisions) {
+    for c in targets.iter().flat_map(|(_, l)| &l.collisions) {
         if let Geometry::Mesh { filename, .. } = &c.geometry {
             (resolved.entry(filename.as_str()))
                 .or_insert_with(|| resolver.resolve(filename, &robot.path));
         }
     }
     resolved
+}
+
+/// The links to compute, with their indices; counts the links left alone into `report`: those
+/// without collision geometry, or whose only parts are zero-size primitives (the scan notes the
+/// latter), and those not selected.
+fn targets<'r>(robot: &'r Robot, opts: &FillOptions, report: &mut FillReport) -> Vec<(usize, &'r Link)> {
+    let mut targets = Vec::new();
+    for (li, link) in robot.links.iter().enumerate() {
+        if !link.has_collision_geometry() {
+            report.without_geometry += 1;
+        } else if !is_target(link, opts) {
+            report.not_selected += 1;
+        } else {
+            targets.push((li, link));
+        }
+    }
+    targets
 }
 
 /// Computes every selected link with collision geometry.
@@ -236,15 +252,16 @@ pub fn compute_with(
     cache: &mut MeshCache,
 ) -> FillReport {
     let (load0, integrate0) = (cache.load_time, cache.integrate_time);
+    let mut report = FillReport::default();
+    let targets = targets(robot, opts, &mut report);
     let ctx = Context {
         robot,
         map,
         resolver,
         opts,
-        resolved: resolve_meshes(robot, resolver, opts),
+        resolved: resolve_meshes(robot, resolver, &targets),
     };
-    let mut report = FillReport::default();
-    let (mesh_files, results) = compute_links(&ctx, cache, &mut report);
+    let (mesh_files, results) = compute_links(&ctx, &targets, cache);
     let mut missing_density: Vec<(String, usize)> = Vec::new();
     // Links whose mass follows from densities (scaled by total_mass), as indices into report.links.
     let mut density_links: Vec<usize> = Vec::new();
@@ -298,31 +315,17 @@ enum LinkOutcome {
     NoVolume(Diagnostic),
 }
 
-/// Every selected link computed, in link order, and the number of distinct mesh files they use (read
-/// now or before); counts the links left alone into `report`. The meshes are read and healed in
+/// Every link of `targets` computed, in link order, and the number of distinct mesh files they use
+/// (read now or before). The meshes are read and healed in
 /// parallel, largest first, and each link is computed (its parts, densities, body and overlap
 /// estimate) as soon as its meshes are healed, on the same threads: a link waits only for its own
 /// meshes. A path that does not resolve is the link's error.
 fn compute_links<'r>(
     ctx: &Context<'r>,
+    targets: &[(usize, &'r Link)],
     cache: &mut MeshCache,
-    report: &mut FillReport,
 ) -> (usize, Vec<(&'r Link, LinkResult)>) {
-    let (robot, map, opts) = (ctx.robot, ctx.map, ctx.opts);
-    let mut targets = Vec::new();
-    for (li, link) in robot.links.iter().enumerate() {
-        // Links without collision geometry, or whose only parts are zero-size primitives, are left as
-        // they are (the scan notes the latter).
-        if !link.has_collision_geometry() {
-            report.without_geometry += 1;
-            continue;
-        }
-        if !is_target(link, opts) {
-            report.not_selected += 1;
-            continue;
-        }
-        targets.push((li, link));
-    }
+    let (map, opts) = (ctx.map, ctx.opts);
     let needs: Vec<Vec<(PathBuf, [f64; 3])>> = targets
         .iter()
         .map(|(_, link)| {

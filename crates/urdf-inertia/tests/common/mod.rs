@@ -390,33 +390,15 @@ pub fn transform(mesh: &Mesh, scale: f64, r: &[[f64; 3]; 3], t: [f64; 3]) -> Mes
     (v, mesh.1.clone())
 }
 
-/// A unit cube whose faces are all wound inward, as a binary STL at `path`: turned outside out
-/// exactly by the repair (UI101), so its bound is round-off.
+/// A unit cube (corners 0 and 1) whose faces are all wound inward, as a binary STL at `path`:
+/// turned outside out exactly by the repair (UI101), so its bound is round-off.
 pub fn inside_out_cube_stl(path: &std::path::Path) {
-    let v: Vec<[f64; 3]> = (0..8)
-        .map(|i| {
-            [
-                f64::from(i & 1),
-                f64::from((i >> 1) & 1),
-                f64::from((i >> 2) & 1),
-            ]
-        })
-        .collect();
-    let quads = [
-        [0u32, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let tris: Vec<[u32; 3]> = quads
-        .iter()
-        .flat_map(|q| [[q[0], q[2], q[1]], [q[0], q[3], q[2]]])
-        .collect();
+    let (v, f) = box_mesh([1.0; 3]);
+    let v: Vec<[f64; 3]> = v.iter().map(|p| p.map(|x| x + 0.5)).collect();
+    let inward: Vec<[u32; 3]> = f.iter().map(|t| [t[0], t[2], t[1]]).collect();
     std::fs::write(
         path,
-        urdf_inertia::mesh::stl::write_binary(b"in", &v, &tris),
+        urdf_inertia::mesh::stl::write_binary(b"in", &v, &inward),
     )
     .expect("write the cube");
 }

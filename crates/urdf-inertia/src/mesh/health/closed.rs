@@ -1,14 +1,13 @@
 //! The closed rungs: as stored, welded, inverted or re-oriented component by component.
 
 use super::geometry::{
-    bbox, component_boxes, component_volumes, contains, dist, vector_area,
+    bbox, component_boxes, component_volumes, vector_area,
 };
 use super::ladder::Ladder;
 use super::topology::{Edges, Orientation};
 use super::welding::Welding;
 use super::{HealthKind, ModelError, Rung, Solid};
 use crate::geometry::{cross, dot, sub};
-use crate::geometry::Aabb;
 use crate::mass::integrals::{bounding_box_centre, volume_integrals};
 use crate::mass::{IntegrationOptions, Polygons};
 use crate::mesh::MeshError;
@@ -120,7 +119,7 @@ pub(super) fn misoriented(vertices: &[[f64; 3]], faces: &Polygons, comp: &[u32],
         .map(|c| {
             let depth = (0..ncomp)
                 .filter(|&d| {
-                    d != c && vol[d].abs() > vol[c].abs() && contains(&boxes[d], &boxes[c])
+                    d != c && vol[d].abs() > vol[c].abs() && boxes[d].contains(&boxes[c])
                 })
                 .count();
             vol[c] < 0.0 && depth % 2 == 0
@@ -132,8 +131,7 @@ pub(super) fn misoriented(vertices: &[[f64; 3]], faces: &Polygons, comp: &[u32],
 /// surface that is closed only up to cracks: |vector area| × diagonal / 6 (the signed volume about
 /// r is V(0) − r·A/3). Zero for a closed surface; its round-off for one closed bit for bit.
 pub(super) fn open_volume(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
-    let Aabb { lo, hi } = bbox(vertices);
-    vector_area(vertices, faces) * dist(lo, hi) / 6.0
+    vector_area(vertices, faces) * bbox(vertices).diagonal() / 6.0
 }
 
 /// Closed after the tolerant weld but wound inconsistently: each component made consistent and outward.
@@ -191,8 +189,7 @@ pub(super) struct Outward {
 /// reference point by twice its vector area × the diagonal / 6; both are counted.
 pub(super) fn flip_change(vertices: &[[f64; 3]], faces: &Polygons, o: &Orientation, reversed: &[bool]) -> f64 {
     let centre = bounding_box_centre(vertices);
-    let Aabb { lo, hi } = bbox(vertices);
-    let diag = dist(lo, hi);
+    let diag = bbox(vertices).diagonal();
     let mut count = vec![[0usize; 2]; o.ncomp];
     for (i, r) in reversed.iter().enumerate() {
         count[o.comp[i] as usize][usize::from(*r)] += 1;
@@ -232,7 +229,7 @@ pub(super) fn outward(vertices: &[[f64; 3]], faces: &Polygons, o: &Orientation) 
     if o.ncomp > 1 {
         let boxes = component_boxes(vertices, faces, &o.comp, o.ncomp);
         for c in 0..o.ncomp {
-            if (0..o.ncomp).any(|d| d != c && contains(&boxes[d], &boxes[c])) {
+            if (0..o.ncomp).any(|d| d != c && boxes[d].contains(&boxes[c])) {
                 nested += 2.0 * vol[c].abs() / 6.0;
             }
         }

@@ -63,9 +63,6 @@ pub(super) fn component_boxes(
     boxes
 }
 
-pub(super) fn contains(outer: &Aabb, inner: &Aabb) -> bool {
-    outer.contains(inner)
-}
 
 /// The length of the surface's vector area `Σ N/2` (zero for a closed surface).
 pub(super) fn vector_area(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {

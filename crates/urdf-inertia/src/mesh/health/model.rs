@@ -116,19 +116,19 @@ pub(super) fn round_off(vertices: &[[f64; 3]], faces: &Polygons, lo: [f64; 3], b
 pub(super) fn check_volume(
     vertices: &[[f64; 3]],
     faces: &Polygons,
-    Aabb { lo, hi }: Aabb,
+    bounds: Aabb,
     volume: f64,
     path: &Path,
 ) -> Result<(), MeshError> {
     let area: f64 = faces.iter().map(|f| polygon_area(vertices, f)).sum();
-    let floor = ZERO_VOLUME_ROUNDOFFS * f64::EPSILON * area * dist(lo, hi);
+    let floor = ZERO_VOLUME_ROUNDOFFS * f64::EPSILON * area * bounds.diagonal();
     if volume.is_nan() || volume <= floor {
         return Err(MeshError::new(
             path,
             None,
             MeshErrorKind::ZeroVolume {
                 volume,
-                bbox_volume: (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]),
+                bbox_volume: bounds.extent().iter().product(),
             },
         ));
     }

@@ -2,13 +2,12 @@
 
 use super::caps::{cap_holes, Caps};
 use super::closed::{apply, open_volume, outward};
-use super::geometry::{bbox, dist, signed_volume, unit_props, vector_area};
+use super::geometry::{bbox, signed_volume, unit_props, vector_area};
 use super::ladder::Ladder;
 use super::model::{Lever, Model};
 use super::topology::{orient, Edges};
 use super::welding::Welding;
 use super::{HealthKind, ModelError, Rung, Solid, CAPPED, SLIVERS};
-use crate::geometry::Aabb;
 use crate::mass::Polygons;
 use crate::mesh::open::{NoSolid, OpenMeshModel};
 use crate::mesh::{hull, MeshError, MeshErrorKind};
@@ -145,13 +144,12 @@ pub(super) fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) ->
         // No closing encloses a volume: a flat plate or a two-sided sheet has none to speak of (the
         // part contributes nothing); anything else defines no solid.
         (_, None) if crate::mesh::open::encloses_nothing(&w.vertices, &w.stored) => {
-            let Aabb { lo, hi } = bbox(&w.vertices);
             Err(MeshError::new(
                 ladder.path,
                 None,
                 MeshErrorKind::ZeroVolume {
                     volume: signed_volume(&w.vertices, &w.stored),
-                    bbox_volume: (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]),
+                    bbox_volume: bbox(&w.vertices).extent().iter().product(),
                 },
             ))
         }
@@ -231,8 +229,7 @@ pub(super) fn with_caps(
 ) -> Result<Solid, MeshError> {
     let caps = &plan.caps;
     // Whatever surface really spans the loops, its contribution is at most (its area) × diagonal.
-    let Aabb { lo, hi } = bbox(&w.vertices);
-    let spans = caps.area * dist(lo, hi);
+    let spans = caps.area * bbox(&w.vertices).diagonal();
     if (spans + caps.bound + plan.cracks) / plan.volume <= SLIVERS && winding.flipped == 0 {
         ladder.note(HealthKind::Welded, format!(
             "closed up to slivers once corners within {:.1e} m are welded ({} boundary edges bound {:.1e} m² in all); integrated as stored",
@@ -305,8 +302,8 @@ pub(super) fn convex_hull(
     te: &Edges,
     what: &str,
 ) -> Result<Solid, MeshError> {
-    let Aabb { lo, hi } = bbox(&w.vertices);
-    let diag = dist(lo, hi);
+    let bounds = bbox(&w.vertices);
+    let diag = bounds.diagonal();
     // The stored surface's signed volume, and how much it moves over reference points in the box.
     let own = signed_volume(&w.vertices, &w.stored);
     let moves = vector_area(&w.vertices, &w.stored) * diag / 6.0;
@@ -317,7 +314,7 @@ pub(super) fn convex_hull(
             None,
             MeshErrorKind::ZeroVolume {
                 volume: own,
-                bbox_volume: (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]),
+                bbox_volume: bounds.extent().iter().product(),
             },
         ),
     })?;
