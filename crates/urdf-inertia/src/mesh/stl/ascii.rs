@@ -3,7 +3,9 @@
 use super::Keyword;
 use crate::mass::Polygons;
 use crate::mesh::weld::VertexTable;
-use crate::mesh::{parse_f64, short_decimal, MeshError, MeshErrorKind, RawMesh};
+use crate::mesh::{
+    parse_f64, short_decimal, MeshError, MeshErrorKind, RawMesh, EXACT_POWERS_OF_TEN,
+};
 use std::io::Read as _;
 use std::path::Path;
 
@@ -41,11 +43,17 @@ pub(super) fn ascii_stream(
             reader.feed(&buf);
             return reader.finish();
         }
-        // Whole lines only; the rest waits for the next piece.
-        let Some(cut) = memchr::memrchr(b'\n', &buf).map(|i| i + 1) else {
+        // Whole chunks only, the last one cut at a `facet` line; the rest waits for the next piece,
+        // so that no chunk begins inside a facet (to be parsed again from the state before it).
+        let Some(lines) = memchr::memrchr(b'\n', &buf).map(|i| i + 1) else {
             continue;
         };
-        reader.feed(&buf[..cut]);
+        let mut chunks = facet_chunks(&buf[..lines], reader.chunk);
+        let Some(rest) = chunks.pop().filter(|_| !chunks.is_empty()) else {
+            continue;
+        };
+        let cut = lines - rest.len();
+        reader.feed_chunks(&chunks);
         if reader.utf8.is_some() {
             return reader.finish();
         }
@@ -116,14 +124,19 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
         current: start.current,
         base,
     };
-    let mut rest = text;
-    while !rest.is_empty() {
-        let (line, after) = match memchr::memchr(b'\n', rest) {
-            Some(i) => (&rest[..i], &rest[i + 1..]),
-            None => (rest, &rest[rest.len()..]),
-        };
-        rest = after;
+    let mut at = 0;
+    while at < text.len() {
         p.out.lines += 1;
+        if let Some(next) = p.fast_line(text, at) {
+            at = next;
+            continue;
+        }
+        // Anything the fast path does not take (an error included) goes through the general one.
+        let (line, next) = match memchr::memchr(b'\n', &text[at..]) {
+            Some(i) => (&text[at..at + i], at + i + 1),
+            None => (&text[at..], text.len()),
+        };
+        at = next;
         let mut words = AsciiWords { rest: line };
         let Some(word) = words.next() else { continue };
         if let Err(kind) = p.line(word, words) {
@@ -201,13 +214,259 @@ impl<'t> ChunkParse<'t> {
     #[inline]
     fn vertex(&mut self, mut words: AsciiWords<'t>) -> Result<u32, MeshErrorKind> {
         let key = words.rest;
-        if let Some(i) = self.seen.get(key) {
+        let h = line_hash(key);
+        let (slot, seen) = self.seen.find(key, h);
+        if let Some(i) = seen {
             return Ok(i);
         }
         let i = self.table.insert(words.vertex()?);
-        self.seen.insert(key, i);
+        self.seen.insert(slot, key, h, i);
         Ok(i)
     }
+
+    /// The line that starts at `at` when it is a well-formed line of the common shapes (a keyword
+    /// in any case after blanks, a vertex whose text was seen or parses), done as [`Self::line`] does
+    /// it, and where the next line starts; `None`, with nothing changed, for anything else (errors
+    /// included), which [`Self::line`] then decides. Each byte is read about once, eight at a time:
+    /// the blanks, the keyword (one load, its case folded), and the rest of the line up to its `\n`,
+    /// hashed on the way when it is a vertex's text.
+    #[inline]
+    fn fast_line(&mut self, text: &'t [u8], mut at: usize) -> Option<usize> {
+        loop {
+            let blanks = load(text, at) ^ SPACES;
+            if blanks == 0 {
+                at += 8;
+                continue;
+            }
+            at += blanks.trailing_zeros() as usize / 8;
+            match *text.get(at)? {
+                b'\t' | b'\r' | b'\x0c' => at += 1,
+                b'\n' => return Some(at + 1),
+                _ => break,
+            }
+        }
+        let w = load(text, at);
+        match w as u8 | 0x20 {
+            b'v' if is_word(text, at, w, b"vertex") => {
+                if !self.in_loop {
+                    return None;
+                }
+                let from = at + 6;
+                let (end, h) = text_to_newline(text, from)?;
+                let key = &text[from..end];
+                let (slot, seen) = self.seen.find(key, h);
+                let i = match seen {
+                    Some(i) => i,
+                    None => {
+                        let p = coordinates(text, from)?;
+                        let i = self.table.insert(p);
+                        self.seen.insert(slot, key, h, i);
+                        i
+                    }
+                };
+                self.out.dependent |= !self.out.outer;
+                self.current.push(self.base + i);
+                return Some(end + 1);
+            }
+            b'o' if is_word(text, at, w, b"outer") => {
+                self.out.outer = true;
+                self.in_loop = true;
+                self.current.clear();
+                at += 5;
+            }
+            b'e' if is_word(text, at, w, b"endloop") => {
+                if self.current.len() < 3 {
+                    return None;
+                }
+                self.out.dependent |= !self.out.outer;
+                self.in_loop = false;
+                self.out.indices.extend_from_slice(&self.current);
+                self.out.sizes.push(self.current.len() as u32);
+                at += 7;
+            }
+            b'f' if is_word(text, at, w, b"facet") => at += 5,
+            b'e' if is_word(text, at, w, b"endfacet") || is_word(text, at, w, b"endsolid") => {
+                at += 8;
+            }
+            b's' if is_word(text, at, w, b"solid") => at += 5,
+            _ => return None,
+        }
+        // The rest of a line other than `vertex` is not read (as `Keyword::of` decides on the
+        // first word alone).
+        Some(newline(text, at).map_or(text.len(), |i| i + 1))
+    }
+}
+
+const ONES: u64 = 0x0101_0101_0101_0101;
+const HIGHS: u64 = 0x8080_8080_8080_8080;
+const SPACES: u64 = 0x2020_2020_2020_2020;
+const NEWLINES: u64 = 0x0a0a_0a0a_0a0a_0a0a;
+
+/// The eight bytes of `text` from `at` (little-endian: the first byte lowest), zeros past its end.
+#[inline(always)]
+fn load(text: &[u8], at: usize) -> u64 {
+    if let Some(&b) = text.get(at..at + 8).and_then(|b| b.first_chunk::<8>()) {
+        u64::from_le_bytes(b)
+    } else {
+        let mut w = [0u8; 8];
+        let tail = text.get(at..).unwrap_or_default();
+        w[..tail.len()].copy_from_slice(tail);
+        u64::from_le_bytes(w)
+    }
+}
+
+/// The bit of the first zero byte of `x` and above it (0 when none): exact for the first one.
+#[inline(always)]
+fn zero_bytes(x: u64) -> u64 {
+    x.wrapping_sub(ONES) & !x & HIGHS
+}
+
+/// Whether the word at `at` (whose first eight bytes are `w`) is the keyword `k` (lowercase letters,
+/// 5 to 8 of them) in any case, followed by ASCII whitespace. A letter `b` is `k`'s in either
+/// case exactly when `b | 0x20` is.
+#[inline(always)]
+fn is_word(text: &[u8], at: usize, w: u64, k: &[u8]) -> bool {
+    let n = k.len();
+    let mask = if n >= 8 { u64::MAX } else { (1 << (8 * n)) - 1 };
+    let mut pattern = [0u8; 8];
+    pattern[..n].copy_from_slice(k);
+    (w | SPACES) & mask == u64::from_le_bytes(pattern)
+        && text.get(at + n).is_some_and(u8::is_ascii_whitespace)
+}
+
+/// The three coordinates of the vertex line whose text after `vertex` starts at `from` (and ends
+/// at a `\n`), when each is a decimal [`decimal`] reads (−0.0 folded into 0.0): what
+/// [`AsciiWords::vertex`] gives then; `None` for anything else, which it decides.
+#[inline]
+fn coordinates(text: &[u8], mut from: usize) -> Option<[f64; 3]> {
+    let mut p = [0.0; 3];
+    for c in &mut p {
+        while let Some(b' ' | b'\t' | b'\r' | b'\x0c') = text.get(from) {
+            from += 1;
+        }
+        let (x, n) = decimal(text.get(from..)?)?;
+        from += n;
+        if !text.get(from)?.is_ascii_whitespace() {
+            return None;
+        }
+        *c = x + 0.0;
+    }
+    Some(p)
+}
+
+/// [`short_decimal`], with the digits before and after the point read eight bytes at a time (fewer
+/// than eight of each; longer runs, and anything it does not take, go to [`short_decimal`]). The
+/// value is m·10^e with m < 10^14 and |e| ≤ 22, rounded once, so it is `short_decimal`'s to the bit.
+#[inline]
+fn decimal(w: &[u8]) -> Option<(f64, usize)> {
+    let (negative, mut i) = match w.first() {
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        _ => (false, 0),
+    };
+    let v = load(w, i);
+    let whole = leading_digits(v);
+    if whole == 8 {
+        return short_decimal(w);
+    }
+    let mut mantissa = digits_value(v, whole);
+    i += whole;
+    let mut fraction = 0;
+    if w.get(i) == Some(&b'.') {
+        i += 1;
+        let v = load(w, i);
+        fraction = leading_digits(v);
+        if fraction == 8 {
+            return short_decimal(w);
+        }
+        mantissa = mantissa * POWERS_OF_TEN[fraction] + digits_value(v, fraction);
+        i += fraction;
+    }
+    if whole + fraction == 0 {
+        return short_decimal(w);
+    }
+    let mut exponent = -(fraction as i32);
+    if let Some(b'e' | b'E') = w.get(i) {
+        i += 1;
+        let negative = w.get(i) == Some(&b'-');
+        if let Some(b'-' | b'+') = w.get(i) {
+            i += 1;
+        }
+        let digits = leading_digits(load(w, i));
+        if digits == 0 || digits > 3 {
+            return short_decimal(w);
+        }
+        let e = digits_value(load(w, i), digits) as i32;
+        i += digits;
+        exponent += if negative { -e } else { e };
+    }
+    let Some(&power) = EXACT_POWERS_OF_TEN.get(exponent.unsigned_abs() as usize) else {
+        return short_decimal(w);
+    };
+    let x = mantissa as f64;
+    let x = if exponent < 0 { x / power } else { x * power };
+    Some((if negative { -x } else { x }, i))
+}
+
+const POWERS_OF_TEN: [u64; 8] = [1, 10, 100, 1000, 10_000, 100_000, 1_000_000, 10_000_000];
+
+/// How many of the eight bytes `v` (the first lowest) are ASCII digits before the first that is
+/// not. A byte is a digit when its high nibble is 3 and stays 3 when 6 is added (a carry out of a
+/// byte only reaches the bytes after it, past the first non-digit).
+#[inline(always)]
+fn leading_digits(v: u64) -> usize {
+    const HIGH_NIBBLES: u64 = 0xf0f0_f0f0_f0f0_f0f0;
+    let x = (v & HIGH_NIBBLES) | ((v.wrapping_add(0x0606_0606_0606_0606) & HIGH_NIBBLES) >> 4);
+    let not_digits = x ^ 0x3333_3333_3333_3333;
+    not_digits.trailing_zeros() as usize / 8
+}
+
+/// The value of the first `n` (fewer than 8) bytes of `v`, decimal digits: the digits moved up to
+/// the top bytes (zeros ahead of them), then combined in pairs, fours and eights (SWAR, as
+/// `fast_float` parses eight digits).
+#[inline(always)]
+fn digits_value(v: u64, n: usize) -> u64 {
+    if n == 0 {
+        return 0;
+    }
+    let d = (v & 0x0f0f_0f0f_0f0f_0f0f) << (8 * (8 - n));
+    let d = d.wrapping_mul(10).wrapping_add(d >> 8);
+    let d = ((d & 0x00ff_00ff_00ff_00ff).wrapping_mul((100 << 16) + 1)) >> 16;
+    ((d & 0x0000_ffff_0000_ffff).wrapping_mul((10_000 << 32) + 1)) >> 32
+}
+
+/// The first `\n` at or after `from`.
+#[inline]
+fn newline(text: &[u8], mut from: usize) -> Option<usize> {
+    while from + 8 <= text.len() {
+        let z = zero_bytes(load(text, from) ^ NEWLINES);
+        if z != 0 {
+            return Some(from + z.trailing_zeros() as usize / 8);
+        }
+        from += 8;
+    }
+    memchr::memchr(b'\n', &text[from..]).map(|i| from + i)
+}
+
+/// The first `\n` at or after `from` and the [`line_hash`] of the text before it, read once; `None`
+/// when no `\n` comes before the last eight bytes of `text` (the caller takes the general path).
+#[inline]
+fn text_to_newline(text: &[u8], from: usize) -> Option<(usize, u64)> {
+    let mut h = HASH_SEED;
+    let mut at = from;
+    while at + 8 <= text.len() {
+        let w = load(text, at);
+        let z = zero_bytes(w ^ NEWLINES);
+        if z != 0 {
+            let j = z.trailing_zeros() as usize / 8;
+            let tail = w & ((1u64 << (8 * j)) - 1);
+            let end = at + j;
+            return Some((end, hash_finish(hash_word(h, tail), end - from)));
+        }
+        h = hash_word(h, w);
+        at += 8;
+    }
+    None
 }
 
 /// The vertex lines of a chunk already parsed, by their text after `vertex`, and the vertex each
@@ -233,6 +492,7 @@ impl<'t> SeenLines<'t> {
 
     /// Where `key` is (its vertex), or the empty slot where it would go; neither when the probe
     /// runs past [`MAX_PROBES`] slots.
+    #[inline]
     fn find(&self, key: &[u8], h: u64) -> (Option<usize>, Option<u32>) {
         let tag = h << 32;
         let mask = self.slots.len() - 1;
@@ -253,15 +513,15 @@ impl<'t> SeenLines<'t> {
         (None, None)
     }
 
+    #[cfg(test)]
     fn get(&self, key: &[u8]) -> Option<u32> {
         self.find(key, line_hash(key)).1
     }
 
-    /// Records that `key` (not yet seen) gave `vertex`, unless its probe is too long: then the line
-    /// is simply parsed again wherever it comes back.
-    fn insert(&mut self, key: &'t [u8], vertex: u32) {
-        let h = line_hash(key);
-        let (Some(s), _) = self.find(key, h) else {
+    /// Records that `key` (not yet seen) gave `vertex`, in the `slot` [`Self::find`] gave, unless
+    /// its probe was too long (no slot): then the line is simply parsed again wherever it comes back.
+    fn insert(&mut self, slot: Option<usize>, key: &'t [u8], h: u64, vertex: u32) {
+        let Some(s) = slot else {
             return;
         };
         self.lines.push((key, vertex));
@@ -288,21 +548,36 @@ const MAX_PROBES: usize = 32;
 /// A hash of a line's bytes, eight at a time, every bit mixed into the top (the slot) and the
 /// bottom (the tag).
 fn line_hash(b: &[u8]) -> u64 {
-    const K: u64 = 0x9e37_79b9_7f4a_7c15;
-    let mut h = b.len() as u64;
+    let mut h = HASH_SEED;
     let mut words = b.chunks_exact(8);
     for c in &mut words {
         let mut w = [0u8; 8];
         w.copy_from_slice(c);
-        h = (h.rotate_left(23) ^ u64::from_le_bytes(w)).wrapping_mul(K);
+        h = hash_word(h, u64::from_le_bytes(w));
     }
     let tail = words.remainder();
     let mut w = [0u8; 8];
     w[..tail.len()].copy_from_slice(tail);
-    h = (h.rotate_left(23) ^ u64::from_le_bytes(w)).wrapping_mul(K);
-    h ^= h >> 29;
-    h = h.wrapping_mul(K);
-    h ^ (h >> 32)
+    hash_finish(hash_word(h, u64::from_le_bytes(w)), b.len())
+}
+
+const HASH_K: u64 = 0x9e37_79b9_7f4a_7c15;
+const HASH_SEED: u64 = 0x2545_f491_4f6c_dd1d;
+
+#[inline(always)]
+fn hash_word(h: u64, w: u64) -> u64 {
+    (h.rotate_left(23) ^ w).wrapping_mul(HASH_K)
+}
+
+#[inline(always)]
+fn hash_finish(h: u64, len: usize) -> u64 {
+    // murmur3's finaliser, the length folded in first.
+    let mut h = h ^ len as u64;
+    h ^= h >> 33;
+    h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+    h ^= h >> 33;
+    h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+    h ^ (h >> 33)
 }
 
 /// The words of an ASCII STL line: runs of bytes between ASCII whitespace (what
@@ -408,19 +683,28 @@ impl<'p> Ascii<'p> {
     }
 
     pub(super) fn feed(&mut self, text: &[u8]) {
+        self.feed_chunks(&facet_chunks(text, self.chunk));
+    }
+
+    /// [`Self::feed`] of the text `chunks` cut ([`facet_chunks`]).
+    fn feed_chunks(&mut self, chunks: &[&[u8]]) {
         use rayon::prelude::*;
         if self.utf8.is_some() {
             return;
         }
         let offset = self.offset;
-        self.offset += text.len();
+        self.offset += chunks.iter().map(|c| c.len()).sum::<usize>();
         if self.error.is_some() {
-            if let Err(e) = std::str::from_utf8(text) {
-                self.utf8 = Some(offset + e.valid_up_to());
+            let mut at = offset;
+            for c in chunks {
+                if let Err(e) = std::str::from_utf8(c) {
+                    self.utf8 = Some(at + e.valid_up_to());
+                    return;
+                }
+                at += c.len();
             }
             return;
         }
-        let chunks = facet_chunks(text, self.chunk);
         let parsed: Vec<AsciiChunk> = chunks
             .par_iter()
             .map(|c| ascii_chunk(c, AsciiState::default(), 0))
@@ -544,6 +828,34 @@ fn facet_chunks(text: &[u8], size: usize) -> Vec<&[u8]> {
 mod tests {
     use super::*;
 
+    /// The eight-at-a-time decimal reader gives `short_decimal`'s value and length, bit for bit, on
+    /// every shape of number around its limits (digit runs of 0 to 9 before and after the point,
+    /// exponents of 0 to 4 digits, signs, cases, what follows), and `str::parse`'s where it takes one.
+    #[test]
+    fn decimal_is_short_decimal() {
+        let runs = ["", "0", "7", "10", "123", "9999", "12345", "999999", "1234567", "09876543", "123456789"];
+        let exps = ["", "e", "E+", "e-", "e0", "e+00", "e-01", "E07", "e-22", "e+22", "e23", "e-23", "e-307", "e0001", "e12345"];
+        let mut n = 0;
+        for sign in ["", "-", "+"] {
+            for whole in runs {
+                for (point, fraction) in [("", ""), (".", "")].into_iter().chain(runs.iter().map(|f| (".", *f))) {
+                    for e in exps {
+                        for end in ["", " ", "\n", "x", " 1"] {
+                            let w = format!("{sign}{whole}{point}{fraction}{e}{end}");
+                            let (a, b) = (decimal(w.as_bytes()), short_decimal(w.as_bytes()));
+                            assert_eq!(a.map(|(x, n)| (x.to_bits(), n)), b.map(|(x, n)| (x.to_bits(), n)), "{w:?}");
+                            if let Some((x, len)) = a {
+                                assert_eq!(w[..len].parse::<f64>().map(f64::to_bits), Ok(x.to_bits()), "{w:?}");
+                                n += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(n > 10_000, "{n}");
+    }
+
     /// Every line recorded is found with its vertex through the table's growth, a line never
     /// recorded is not, and texts that differ only in their last byte or their length are apart.
     #[test]
@@ -554,7 +866,8 @@ mod tests {
         let mut seen = SeenLines::with_capacity(4);
         for (i, t) in texts.iter().enumerate() {
             assert_eq!(seen.get(t.as_bytes()), None, "{t}");
-            seen.insert(t.as_bytes(), i as u32);
+            let h = line_hash(t.as_bytes());
+            seen.insert(seen.find(t.as_bytes(), h).0, t.as_bytes(), h, i as u32);
         }
         for (i, t) in texts.iter().enumerate() {
             assert_eq!(seen.get(t.as_bytes()), Some(i as u32), "{t}");
