@@ -97,22 +97,18 @@ struct AsciiChunk {
 
 /// Parses whole lines of ASCII STL starting in `start`, numbering new vertices from `base`.
 fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
-    let mut out = AsciiChunk {
+    let empty = |end: AsciiState| AsciiChunk {
         vertices: Vec::new(),
         indices: Vec::new(),
         sizes: Vec::new(),
         lines: 0,
-        end: AsciiState::default(),
+        end,
         dependent: false,
         outer: false,
         error: None,
         utf8: None,
     };
-    if let Err(e) = std::str::from_utf8(text) {
-        out.utf8 = Some(e.valid_up_to());
-        out.end = start;
-        return out;
-    }
+    let mut out = empty(AsciiState::default());
     // About 250 bytes a facet, half a new vertex a facet.
     out.indices.reserve(text.len() / 80);
     out.sizes.reserve(text.len() / 240);
@@ -121,8 +117,9 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
         table: VertexTable::with_capacity(text.len() / 400 + 16),
         seen: SeenLines::with_capacity(text.len() / 400 + 16),
         in_loop: start.in_loop,
-        current: start.current,
+        current: start.current.clone(),
         base,
+        bytes: 0,
     };
     let mut at = 0;
     while at < text.len() {
@@ -137,11 +134,22 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
             None => (&text[at..], text.len()),
         };
         at = next;
+        p.bytes |= HIGHS;
         let mut words = AsciiWords { rest: line };
         let Some(word) = words.next() else { continue };
         if let Err(kind) = p.line(word, words) {
             p.out.error = Some((p.out.lines, kind));
             break;
+        }
+    }
+    // Every byte the fast path took was in a word it loaded: when none had its top bit set, the
+    // text is ASCII, so UTF-8; else (and after a line of the general path, or an error) the whole
+    // chunk is checked, and text that is not UTF-8 gives nothing but where it stops being so.
+    if p.bytes & HIGHS != 0 {
+        if let Err(e) = std::str::from_utf8(text) {
+            let mut out = empty(start);
+            out.utf8 = Some(e.valid_up_to());
+            return out;
         }
     }
     let mut out = p.out;
@@ -163,6 +171,8 @@ struct ChunkParse<'t> {
     current: Vec<u32>,
     /// The number of the chunk's first new vertex.
     base: u32,
+    /// The bitwise or of the words the fast path loaded ([`HIGHS`] after a line of the general path).
+    bytes: u64,
 }
 
 impl<'t> ChunkParse<'t> {
@@ -233,7 +243,9 @@ impl<'t> ChunkParse<'t> {
     #[inline]
     fn fast_line(&mut self, text: &'t [u8], mut at: usize) -> Option<usize> {
         loop {
-            let blanks = load(text, at) ^ SPACES;
+            let v = load(text, at);
+            self.bytes |= v;
+            let blanks = v ^ SPACES;
             if blanks == 0 {
                 at += 8;
                 continue;
@@ -246,13 +258,14 @@ impl<'t> ChunkParse<'t> {
             }
         }
         let w = load(text, at);
+        self.bytes |= w;
         match w as u8 | 0x20 {
             b'v' if is_word(text, at, w, b"vertex") => {
                 if !self.in_loop {
                     return None;
                 }
                 let from = at + 6;
-                let (end, h) = text_to_newline(text, from)?;
+                let (end, h) = text_to_newline(text, from, &mut self.bytes)?;
                 let key = &text[from..end];
                 let (slot, seen) = self.seen.find(key, h);
                 let i = match seen {
@@ -293,7 +306,7 @@ impl<'t> ChunkParse<'t> {
         }
         // The rest of a line other than `vertex` is not read (as `Keyword::of` decides on the
         // first word alone).
-        Some(newline(text, at).map_or(text.len(), |i| i + 1))
+        Some(newline(text, at, &mut self.bytes).map_or(text.len(), |i| i + 1))
     }
 }
 
@@ -354,9 +367,11 @@ fn coordinates(text: &[u8], mut from: usize) -> Option<[f64; 3]> {
     Some(p)
 }
 
-/// [`short_decimal`], with the digits before and after the point read eight bytes at a time (fewer
-/// than eight of each; longer runs, and anything it does not take, go to [`short_decimal`]). The
-/// value is m·10^e with m < 10^14 and |e| ≤ 22, rounded once, so it is `short_decimal`'s to the bit.
+/// [`short_decimal`], with the digits before and after the point read eight bytes at a time: in
+/// one step when they fit in eight bytes with the point (`-1.234567e+00`, `0.125`), else in two
+/// runs of fewer than eight (longer runs, and anything it does not take, go to [`short_decimal`]).
+/// The value is m·10^e with m < 10^15 and |e| ≤ 22, rounded once, so it is `short_decimal`'s to the
+/// bit.
 #[inline]
 fn decimal(w: &[u8]) -> Option<(f64, usize)> {
     let (negative, mut i) = match w.first() {
@@ -365,26 +380,26 @@ fn decimal(w: &[u8]) -> Option<(f64, usize)> {
         _ => (false, 0),
     };
     let v = load(w, i);
-    let whole = leading_digits(v);
-    if whole == 8 {
-        return short_decimal(w);
-    }
-    let mut mantissa = digits_value(v, whole);
-    i += whole;
-    let mut fraction = 0;
-    if w.get(i) == Some(&b'.') {
-        i += 1;
-        let v = load(w, i);
-        fraction = leading_digits(v);
-        if fraction == 8 {
+    let not_digits = not_digit_bytes(v);
+    let whole = not_digits.trailing_zeros() as usize / 8;
+    let (mantissa, fraction) = if whole < 7 && (v >> (8 * whole)) as u8 == b'.' {
+        // The digits after the point: up to the first non-digit after it.
+        let end = (not_digits & !(0xff << (8 * whole))).trailing_zeros() as usize / 8;
+        if end == 1 || (end == 8 && w.get(i + 8).is_some_and(u8::is_ascii_digit)) {
             return short_decimal(w);
         }
-        mantissa = mantissa * POWERS_OF_TEN[fraction] + digits_value(v, fraction);
-        i += fraction;
-    }
-    if whole + fraction == 0 {
-        return short_decimal(w);
-    }
+        // The point dropped: the whole digits moved up one byte over it, a zero digit ahead.
+        let low = v & ((1 << (8 * whole)) - 1);
+        let digits = (v & !((1 << (8 * (whole + 1))) - 1)) | (low << 8);
+        i += end;
+        (digits_value(digits, end), end - whole - 1)
+    } else {
+        if whole == 8 || whole == 0 || (v >> (8 * whole)) as u8 == b'.' {
+            return short_decimal(w);
+        }
+        i += whole;
+        (digits_value(v, whole), 0)
+    };
     let mut exponent = -(fraction as i32);
     if let Some(b'e' | b'E') = w.get(i) {
         i += 1;
@@ -392,36 +407,40 @@ fn decimal(w: &[u8]) -> Option<(f64, usize)> {
         if let Some(b'-' | b'+') = w.get(i) {
             i += 1;
         }
-        let digits = leading_digits(load(w, i));
-        if digits == 0 || digits > 3 {
+        let from = i;
+        let mut e = 0;
+        while let Some(&d @ b'0'..=b'9') = w.get(i) {
+            if i - from == 3 {
+                return short_decimal(w);
+            }
+            e = 10 * e + i32::from(d - b'0');
+            i += 1;
+        }
+        if i == from {
             return short_decimal(w);
         }
-        let e = digits_value(load(w, i), digits) as i32;
-        i += digits;
         exponent += if negative { -e } else { e };
     }
     let Some(&power) = EXACT_POWERS_OF_TEN.get(exponent.unsigned_abs() as usize) else {
         return short_decimal(w);
     };
-    let x = mantissa as f64;
+    // Exact: m < 2^53.
+    let x = mantissa as i64 as f64;
     let x = if exponent < 0 { x / power } else { x * power };
     Some((if negative { -x } else { x }, i))
 }
 
-const POWERS_OF_TEN: [u64; 8] = [1, 10, 100, 1000, 10_000, 100_000, 1_000_000, 10_000_000];
-
-/// How many of the eight bytes `v` (the first lowest) are ASCII digits before the first that is
-/// not. A byte is a digit when its high nibble is 3 and stays 3 when 6 is added (a carry out of a
-/// byte only reaches the bytes after it, past the first non-digit).
+/// The bytes of `v` that are not ASCII digits, nonzero (only the first one is exact: a byte is a
+/// digit when its high nibble is 3 and stays 3 when 6 is added, and a carry out of a byte reaches
+/// only the bytes after it, past a non-digit).
 #[inline(always)]
-fn leading_digits(v: u64) -> usize {
+fn not_digit_bytes(v: u64) -> u64 {
     const HIGH_NIBBLES: u64 = 0xf0f0_f0f0_f0f0_f0f0;
     let x = (v & HIGH_NIBBLES) | ((v.wrapping_add(0x0606_0606_0606_0606) & HIGH_NIBBLES) >> 4);
-    let not_digits = x ^ 0x3333_3333_3333_3333;
-    not_digits.trailing_zeros() as usize / 8
+    x ^ 0x3333_3333_3333_3333
 }
 
-/// The value of the first `n` (fewer than 8) bytes of `v`, decimal digits: the digits moved up to
+/// The value of the first `n` (up to 8) bytes of `v`, decimal digits: the digits moved up to
 /// the top bytes (zeros ahead of them), then combined in pairs, fours and eights (SWAR, as
 /// `fast_float` parses eight digits).
 #[inline(always)]
@@ -435,27 +454,32 @@ fn digits_value(v: u64, n: usize) -> u64 {
     ((d & 0x0000_ffff_0000_ffff).wrapping_mul((10_000 << 32) + 1)) >> 32
 }
 
-/// The first `\n` at or after `from`.
+/// The first `\n` at or after `from`, the words read or-ed into `bytes`.
 #[inline]
-fn newline(text: &[u8], mut from: usize) -> Option<usize> {
+fn newline(text: &[u8], mut from: usize, bytes: &mut u64) -> Option<usize> {
     while from + 8 <= text.len() {
-        let z = zero_bytes(load(text, from) ^ NEWLINES);
+        let w = load(text, from);
+        *bytes |= w;
+        let z = zero_bytes(w ^ NEWLINES);
         if z != 0 {
             return Some(from + z.trailing_zeros() as usize / 8);
         }
         from += 8;
     }
+    *bytes |= load(text, from);
     memchr::memchr(b'\n', &text[from..]).map(|i| from + i)
 }
 
-/// The first `\n` at or after `from` and the [`line_hash`] of the text before it, read once; `None`
+/// The first `\n` at or after `from` and the [`line_hash`] of the text before it, read once (the
+/// words or-ed into `bytes`); `None`
 /// when no `\n` comes before the last eight bytes of `text` (the caller takes the general path).
 #[inline]
-fn text_to_newline(text: &[u8], from: usize) -> Option<(usize, u64)> {
+fn text_to_newline(text: &[u8], from: usize, bytes: &mut u64) -> Option<(usize, u64)> {
     let mut h = HASH_SEED;
     let mut at = from;
     while at + 8 <= text.len() {
         let w = load(text, at);
+        *bytes |= w;
         let z = zero_bytes(w ^ NEWLINES);
         if z != 0 {
             let j = z.trailing_zeros() as usize / 8;
@@ -833,7 +857,7 @@ mod tests {
     /// exponents of 0 to 4 digits, signs, cases, what follows), and `str::parse`'s where it takes one.
     #[test]
     fn decimal_is_short_decimal() {
-        let runs = ["", "0", "7", "10", "123", "9999", "12345", "999999", "1234567", "09876543", "123456789"];
+        let runs = ["", "0", "7", "10", "123", "9999", "12345", "999999", "1234567", "09876543", "123456789", "1234567890123"];
         let exps = ["", "e", "E+", "e-", "e0", "e+00", "e-01", "E07", "e-22", "e+22", "e23", "e-23", "e-307", "e0001", "e12345"];
         let mut n = 0;
         for sign in ["", "-", "+"] {

@@ -345,3 +345,80 @@ fn streamed_ascii_errors_and_oddities_are_the_whole_text_parse() {
     bad.extend_from_slice(facet.repeat(40).as_bytes());
     check(&bad, "not UTF-8");
 }
+
+/// The per-line fast path of the chunk parser against the whole-text reader, on what it must take
+/// exactly as the general path does or hand back to it: keywords in any case and followed by any
+/// blank, `facet normal` lines whose numbers are never read (garbage included: accepted, as the
+/// whole-text reader has always accepted them), coordinates in every decimal form (exponents,
+/// signs, a point first or last, runs of digits longer than eight), words that only begin like a
+/// keyword, and bytes that are not ASCII inside lines the fast path skips.
+#[test]
+fn streamed_ascii_fast_path_is_the_whole_text_parse() {
+    let corners = [
+        "0 0 0",
+        "1e0 0 0",
+        "0 1E+00 0",
+        "0 0 .1e1",
+        "1. 1 1",
+        "+1.5e-3 -0.0 -0",
+        "12345678.5 0.12345678901 1",
+        "123456789012345678901 1 1",
+        "-1.000000e+00 2.500000E-01 3.125000e+001",
+        "1.2999373516471264 0.012762515138294503 0",
+    ];
+    let mut facets = String::new();
+    for (k, c) in corners.iter().enumerate() {
+        let (a, b) = (corners[(k + 1) % corners.len()], corners[(k + 2) % corners.len()]);
+        facets += &format!(
+            "facet normal 0 0 1\nouter loop\nvertex {c}\nvertex {a}\nvertex {b}\nendloop\nendfacet\n"
+        );
+    }
+    let plain = format!("solid s\n{facets}endsolid s\n");
+    let shouted = plain
+        .replace("facet", "FACET")
+        .replace("normal", "NORMAL")
+        .replace("outer loop", "Outer Loop")
+        .replace("vertex", "VeRtEx")
+        .replace("endloop", "ENDLOOP")
+        .replace("solid", "SOLID");
+    let blanks = plain
+        .replace("vertex ", "vertex\t")
+        .replace("endloop\n", "endloop\r\n")
+        .replace("outer ", "outer\x0c")
+        .replace("\nfacet", "\n \t\r facet");
+    let garbage = plain.replace("normal 0 0 1", "normal nan x ∞ 1e999 junk");
+    let non_ascii = plain.replace("endfacet\n", "endfacet ünïcödé\n");
+    for (text, what) in [
+        (&plain, "plain"),
+        (&shouted, "upper and mixed case"),
+        (&blanks, "tabs, CR, form feeds"),
+        (&garbage, "facet normal garbage"),
+        (&non_ascii, "non-ASCII after a keyword"),
+    ] {
+        check(text.as_bytes(), what);
+    }
+    let parse = |t: &str| ascii(t.as_bytes(), Path::new("t"));
+    let reference = parse(&plain).expect("parses");
+    for text in [&shouted, &blanks, &garbage, &non_ascii] {
+        same(&Ok(reference.clone()), &parse(text), "the same mesh as plain");
+    }
+    // Words that only begin like a keyword are errors, on their line.
+    for (from, to, line) in [
+        ("vertex 0 0 0", "vertexx 0 0 0", 4),
+        ("endloop\n", "endloops\n", 7),
+        ("facet normal", "facets normal", 2),
+        ("solid s\n", "solid2 s\n", 1),
+    ] {
+        let text = plain.replacen(from, to, 1);
+        check(text.as_bytes(), to);
+        let e = parse(&text).expect_err(to);
+        assert_eq!(e.line, Some(line), "{to}: {e}");
+    }
+    // A byte that is not UTF-8 in a line the fast path does not read to the end.
+    let mut bad = plain.clone().into_bytes();
+    let at = plain.find("normal 0 0 1").expect("a facet") + 10;
+    bad[at] = 0xff;
+    check(&bad, "not UTF-8 in a facet normal");
+    let e = ascii(&bad, Path::new("t")).expect_err("not UTF-8");
+    assert!(e.to_string().contains(&format!("not valid UTF-8 at byte {at}")), "{e}");
+}
