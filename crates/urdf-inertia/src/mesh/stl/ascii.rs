@@ -119,12 +119,13 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
         in_loop: start.in_loop,
         current: start.current.clone(),
         base,
-        bytes: 0,
     };
+    // The bitwise or of the words the fast path loaded ([`HIGHS`] after a line of the general path).
+    let mut bytes = 0;
     let mut at = 0;
     while at < text.len() {
         p.out.lines += 1;
-        if let Some(next) = p.fast_line(text, at) {
+        if let Some(next) = p.fast_line(text, at, &mut bytes) {
             at = next;
             continue;
         }
@@ -134,7 +135,7 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
             None => (&text[at..], text.len()),
         };
         at = next;
-        p.bytes |= HIGHS;
+        bytes |= HIGHS;
         let mut words = AsciiWords { rest: line };
         let Some(word) = words.next() else { continue };
         if let Err(kind) = p.line(word, words) {
@@ -145,7 +146,7 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
     // Every byte the fast path took was in a word it loaded: when none had its top bit set, the
     // text is ASCII, so UTF-8; else (and after a line of the general path, or an error) the whole
     // chunk is checked, and text that is not UTF-8 gives nothing but where it stops being so.
-    if p.bytes & HIGHS != 0 {
+    if bytes & HIGHS != 0 {
         if let Err(e) = std::str::from_utf8(text) {
             let mut out = empty(start);
             out.utf8 = Some(e.valid_up_to());
@@ -171,8 +172,6 @@ struct ChunkParse<'t> {
     current: Vec<u32>,
     /// The number of the chunk's first new vertex.
     base: u32,
-    /// The bitwise or of the words the fast path loaded ([`HIGHS`] after a line of the general path).
-    bytes: u64,
 }
 
 impl<'t> ChunkParse<'t> {
@@ -237,14 +236,15 @@ impl<'t> ChunkParse<'t> {
     /// The line that starts at `at` when it is a well-formed line of the common shapes (a keyword
     /// in any case after blanks, a vertex whose text was seen or parses), done as [`Self::line`] does
     /// it, and where the next line starts; `None`, with nothing changed, for anything else (errors
-    /// included), which [`Self::line`] then decides. Each byte is read about once, eight at a time:
+    /// included), which [`Self::line`] then decides. Each byte is read about once, eight at a time
+    /// (every word loaded is or-ed into `bytes`, for the UTF-8 check):
     /// the blanks, the keyword (one load, its case folded), and the rest of the line up to its `\n`,
     /// hashed on the way when it is a vertex's text.
     #[inline]
-    fn fast_line(&mut self, text: &'t [u8], mut at: usize) -> Option<usize> {
+    fn fast_line(&mut self, text: &'t [u8], mut at: usize, bytes: &mut u64) -> Option<usize> {
         loop {
             let v = load(text, at);
-            self.bytes |= v;
+            *bytes |= v;
             let blanks = v ^ SPACES;
             if blanks == 0 {
                 at += 8;
@@ -258,14 +258,14 @@ impl<'t> ChunkParse<'t> {
             }
         }
         let w = load(text, at);
-        self.bytes |= w;
+        *bytes |= w;
         match w as u8 | 0x20 {
             b'v' if is_word(text, at, w, b"vertex") => {
                 if !self.in_loop {
                     return None;
                 }
                 let from = at + 6;
-                let (end, h) = text_to_newline(text, from, &mut self.bytes)?;
+                let (end, h) = text_to_newline(text, from, bytes)?;
                 let key = &text[from..end];
                 let (slot, seen) = self.seen.find(key, h);
                 let i = match seen {
@@ -306,7 +306,7 @@ impl<'t> ChunkParse<'t> {
         }
         // The rest of a line other than `vertex` is not read (as `Keyword::of` decides on the
         // first word alone).
-        Some(newline(text, at, &mut self.bytes).map_or(text.len(), |i| i + 1))
+        Some(newline(text, at, bytes).map_or(text.len(), |i| i + 1))
     }
 }
 
@@ -367,11 +367,10 @@ fn coordinates(text: &[u8], mut from: usize) -> Option<[f64; 3]> {
     Some(p)
 }
 
-/// [`short_decimal`], with the digits before and after the point read eight bytes at a time: in
-/// one step when they fit in eight bytes with the point (`-1.234567e+00`, `0.125`), else in two
-/// runs of fewer than eight (longer runs, and anything it does not take, go to [`short_decimal`]).
-/// The value is m·10^e with m < 10^15 and |e| ≤ 22, rounded once, so it is `short_decimal`'s to the
-/// bit.
+/// [`short_decimal`], with the digits before and after the point read in one eight-byte step when
+/// they fit in eight bytes with it (`-1.234567e+00`, `0.125`, `42`); longer numbers, and anything it
+/// does not take, go to [`short_decimal`]. The value is m·10^e with m < 10^8 and |e| ≤ 22, rounded
+/// once, so it is `short_decimal`'s to the bit.
 #[inline]
 fn decimal(w: &[u8]) -> Option<(f64, usize)> {
     let (negative, mut i) = match w.first() {
