@@ -268,14 +268,13 @@ impl<'t> ChunkParse<'t> {
                 let (end, h) = text_to_newline(text, from, bytes)?;
                 let key = &text[from..end];
                 let (slot, seen) = self.seen.find(key, h);
-                let i = match seen {
-                    Some(i) => i,
-                    None => {
-                        let p = coordinates(text, from)?;
-                        let i = self.table.insert(p);
-                        self.seen.insert(slot, key, h, i);
-                        i
-                    }
+                let i = if let Some(i) = seen {
+                    i
+                } else {
+                    let p = coordinates(text, from)?;
+                    let i = self.table.insert(p);
+                    self.seen.insert(slot, key, h, i);
+                    i
                 };
                 self.out.dependent |= !self.out.outer;
                 self.current.push(self.base + i);

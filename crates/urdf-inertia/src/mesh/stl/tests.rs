@@ -369,7 +369,8 @@ fn streamed_ascii_fast_path_is_the_whole_text_parse() {
     let mut facets = String::new();
     for (k, c) in corners.iter().enumerate() {
         let (a, b) = (corners[(k + 1) % corners.len()], corners[(k + 2) % corners.len()]);
-        facets += &format!(
+        let _ = write!(
+            facets,
             "facet normal 0 0 1\nouter loop\nvertex {c}\nvertex {a}\nvertex {b}\nendloop\nendfacet\n"
         );
     }
