@@ -1,0 +1,255 @@
+//! The byte-level readers of the ASCII STL fast path ([`super::ChunkParse`]): eight bytes loaded at
+//! a time, the newline and keyword tests on them, the hash of a vertex's text, and the decimal
+//! reader of its coordinates.
+
+use crate::mesh::{short_decimal, EXACT_POWERS_OF_TEN};
+
+const ONES: u64 = 0x0101_0101_0101_0101;
+pub(super) const HIGHS: u64 = 0x8080_8080_8080_8080;
+pub(super) const SPACES: u64 = 0x2020_2020_2020_2020;
+const NEWLINES: u64 = 0x0a0a_0a0a_0a0a_0a0a;
+
+/// The eight bytes of `text` from `at` (little-endian: the first byte lowest), zeros past its end.
+#[inline(always)]
+pub(super) fn load(text: &[u8], at: usize) -> u64 {
+    if let Some(&b) = text.get(at..at + 8).and_then(|b| b.first_chunk::<8>()) {
+        u64::from_le_bytes(b)
+    } else {
+        let mut w = [0u8; 8];
+        let tail = text.get(at..).unwrap_or_default();
+        w[..tail.len()].copy_from_slice(tail);
+        u64::from_le_bytes(w)
+    }
+}
+
+/// The bit of the first zero byte of `x` and above it (0 when none): exact for the first one.
+#[inline(always)]
+fn zero_bytes(x: u64) -> u64 {
+    x.wrapping_sub(ONES) & !x & HIGHS
+}
+
+/// Whether the word at `at` (whose first eight bytes are `w`) is the keyword `k` (lowercase letters,
+/// 5 to 8 of them) in any case, followed by ASCII whitespace. A letter `b` is `k`'s in either
+/// case exactly when `b | 0x20` is.
+#[inline(always)]
+pub(super) fn is_word(text: &[u8], at: usize, w: u64, k: &[u8]) -> bool {
+    let n = k.len();
+    let mask = if n >= 8 { u64::MAX } else { (1 << (8 * n)) - 1 };
+    let mut pattern = [0u8; 8];
+    pattern[..n].copy_from_slice(k);
+    (w | SPACES) & mask == u64::from_le_bytes(pattern)
+        && text.get(at + n).is_some_and(u8::is_ascii_whitespace)
+}
+
+/// The three coordinates of the vertex line whose text after `vertex` starts at `from` (and ends
+/// at a `\n`), when each is a decimal [`decimal`] reads (−0.0 folded into 0.0): what
+/// [`super::AsciiWords::vertex`] gives then; `None` for anything else, which it decides.
+#[inline]
+pub(super) fn coordinates(text: &[u8], mut from: usize) -> Option<[f64; 3]> {
+    let mut p = [0.0; 3];
+    for c in &mut p {
+        while let Some(b' ' | b'\t' | b'\r' | b'\x0c') = text.get(from) {
+            from += 1;
+        }
+        let (x, n) = decimal(text.get(from..)?)?;
+        from += n;
+        if !text.get(from)?.is_ascii_whitespace() {
+            return None;
+        }
+        *c = x + 0.0;
+    }
+    Some(p)
+}
+
+/// [`short_decimal`], with the digits before and after the point read in one eight-byte step when
+/// they fit in eight bytes with it (`-1.234567e+00`, `0.125`, `42`); longer numbers, and anything it
+/// does not take, go to [`short_decimal`]. The value is m·10^e with m < 10^8 and |e| ≤ 22, rounded
+/// once, so it is `short_decimal`'s to the bit.
+#[inline]
+fn decimal(w: &[u8]) -> Option<(f64, usize)> {
+    let (negative, mut i) = match w.first() {
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        _ => (false, 0),
+    };
+    let v = load(w, i);
+    let not_digits = not_digit_bytes(v);
+    let whole = not_digits.trailing_zeros() as usize / 8;
+    let (mantissa, fraction) = if whole < 7 && (v >> (8 * whole)) as u8 == b'.' {
+        // The digits after the point: up to the first non-digit after it.
+        let end = (not_digits & !(0xff << (8 * whole))).trailing_zeros() as usize / 8;
+        if end == 1 || (end == 8 && w.get(i + 8).is_some_and(u8::is_ascii_digit)) {
+            return short_decimal(w);
+        }
+        // The point dropped: the whole digits moved up one byte over it, a zero digit ahead.
+        let low = v & ((1 << (8 * whole)) - 1);
+        let digits = (v & !((1 << (8 * (whole + 1))) - 1)) | (low << 8);
+        i += end;
+        (digits_value(digits, end), end - whole - 1)
+    } else {
+        if whole == 8 || whole == 0 || (v >> (8 * whole)) as u8 == b'.' {
+            return short_decimal(w);
+        }
+        i += whole;
+        (digits_value(v, whole), 0)
+    };
+    let mut exponent = -(fraction as i32);
+    if let Some(b'e' | b'E') = w.get(i) {
+        i += 1;
+        let negative = w.get(i) == Some(&b'-');
+        if let Some(b'-' | b'+') = w.get(i) {
+            i += 1;
+        }
+        let from = i;
+        let mut e = 0;
+        while let Some(&d @ b'0'..=b'9') = w.get(i) {
+            if i - from == 3 {
+                return short_decimal(w);
+            }
+            e = 10 * e + i32::from(d - b'0');
+            i += 1;
+        }
+        if i == from {
+            return short_decimal(w);
+        }
+        exponent += if negative { -e } else { e };
+    }
+    let Some(&power) = EXACT_POWERS_OF_TEN.get(exponent.unsigned_abs() as usize) else {
+        return short_decimal(w);
+    };
+    // Exact: m < 2^53.
+    let x = mantissa as i64 as f64;
+    let x = if exponent < 0 { x / power } else { x * power };
+    Some((if negative { -x } else { x }, i))
+}
+
+/// The bytes of `v` that are not ASCII digits, nonzero (only the first one is exact: a byte is a
+/// digit when its high nibble is 3 and stays 3 when 6 is added, and a carry out of a byte reaches
+/// only the bytes after it, past a non-digit).
+#[inline(always)]
+fn not_digit_bytes(v: u64) -> u64 {
+    const HIGH_NIBBLES: u64 = 0xf0f0_f0f0_f0f0_f0f0;
+    let x = (v & HIGH_NIBBLES) | ((v.wrapping_add(0x0606_0606_0606_0606) & HIGH_NIBBLES) >> 4);
+    x ^ 0x3333_3333_3333_3333
+}
+
+/// The value of the first `n` (up to 8) bytes of `v`, decimal digits: the digits moved up to
+/// the top bytes (zeros ahead of them), then combined in pairs, fours and eights (SWAR, as
+/// `fast_float` parses eight digits).
+#[inline(always)]
+fn digits_value(v: u64, n: usize) -> u64 {
+    if n == 0 {
+        return 0;
+    }
+    let d = (v & 0x0f0f_0f0f_0f0f_0f0f) << (8 * (8 - n));
+    let d = d.wrapping_mul(10).wrapping_add(d >> 8);
+    let d = ((d & 0x00ff_00ff_00ff_00ff).wrapping_mul((100 << 16) + 1)) >> 16;
+    ((d & 0x0000_ffff_0000_ffff).wrapping_mul((10_000 << 32) + 1)) >> 32
+}
+
+/// The first `\n` at or after `from`, the words read or-ed into `bytes`.
+#[inline]
+pub(super) fn newline(text: &[u8], mut from: usize, bytes: &mut u64) -> Option<usize> {
+    while from + 8 <= text.len() {
+        let w = load(text, from);
+        *bytes |= w;
+        let z = zero_bytes(w ^ NEWLINES);
+        if z != 0 {
+            return Some(from + z.trailing_zeros() as usize / 8);
+        }
+        from += 8;
+    }
+    *bytes |= load(text, from);
+    memchr::memchr(b'\n', &text[from..]).map(|i| from + i)
+}
+
+/// The first `\n` at or after `from` and the [`line_hash`] of the text before it, read once (the
+/// words or-ed into `bytes`); `None`
+/// when no `\n` comes before the last eight bytes of `text` (the caller takes the general path).
+#[inline]
+pub(super) fn text_to_newline(text: &[u8], from: usize, bytes: &mut u64) -> Option<(usize, u64)> {
+    let mut h = HASH_SEED;
+    let mut at = from;
+    while at + 8 <= text.len() {
+        let w = load(text, at);
+        *bytes |= w;
+        let z = zero_bytes(w ^ NEWLINES);
+        if z != 0 {
+            let j = z.trailing_zeros() as usize / 8;
+            let tail = w & ((1u64 << (8 * j)) - 1);
+            let end = at + j;
+            return Some((end, hash_finish(hash_word(h, tail), end - from)));
+        }
+        h = hash_word(h, w);
+        at += 8;
+    }
+    None
+}
+
+/// A hash of a line's bytes, eight at a time, every bit mixed into the top (the slot) and the
+/// bottom (the tag).
+pub(super) fn line_hash(b: &[u8]) -> u64 {
+    let mut h = HASH_SEED;
+    let mut words = b.chunks_exact(8);
+    for c in &mut words {
+        let mut w = [0u8; 8];
+        w.copy_from_slice(c);
+        h = hash_word(h, u64::from_le_bytes(w));
+    }
+    let tail = words.remainder();
+    let mut w = [0u8; 8];
+    w[..tail.len()].copy_from_slice(tail);
+    hash_finish(hash_word(h, u64::from_le_bytes(w)), b.len())
+}
+
+const HASH_K: u64 = 0x9e37_79b9_7f4a_7c15;
+const HASH_SEED: u64 = 0x2545_f491_4f6c_dd1d;
+
+#[inline(always)]
+fn hash_word(h: u64, w: u64) -> u64 {
+    (h.rotate_left(23) ^ w).wrapping_mul(HASH_K)
+}
+
+#[inline(always)]
+fn hash_finish(h: u64, len: usize) -> u64 {
+    // murmur3's finaliser, the length folded in first.
+    let mut h = h ^ len as u64;
+    h ^= h >> 33;
+    h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+    h ^= h >> 33;
+    h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+    h ^ (h >> 33)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The eight-at-a-time decimal reader gives `short_decimal`'s value and length, bit for bit, on
+    /// every shape of number around its limits (digit runs of 0 to 9 before and after the point,
+    /// exponents of 0 to 4 digits, signs, cases, what follows), and `str::parse`'s where it takes one.
+    #[test]
+    fn decimal_is_short_decimal() {
+        let runs = ["", "0", "7", "10", "123", "9999", "12345", "999999", "1234567", "09876543", "123456789", "1234567890123"];
+        let exps = ["", "e", "E+", "e-", "e0", "e+00", "e-01", "E07", "e-22", "e+22", "e23", "e-23", "e-307", "e0001", "e12345"];
+        let mut n = 0;
+        for sign in ["", "-", "+"] {
+            for whole in runs {
+                for (point, fraction) in [("", ""), (".", "")].into_iter().chain(runs.iter().map(|f| (".", *f))) {
+                    for e in exps {
+                        for end in ["", " ", "\n", "x", " 1"] {
+                            let w = format!("{sign}{whole}{point}{fraction}{e}{end}");
+                            let (a, b) = (decimal(w.as_bytes()), short_decimal(w.as_bytes()));
+                            assert_eq!(a.map(|(x, n)| (x.to_bits(), n)), b.map(|(x, n)| (x.to_bits(), n)), "{w:?}");
+                            if let Some((x, len)) = a {
+                                assert_eq!(w[..len].parse::<f64>().map(f64::to_bits), Ok(x.to_bits()), "{w:?}");
+                                n += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(n > 10_000, "{n}");
+    }
+}
