@@ -4,30 +4,61 @@ use super::geometry::{
     bbox, component_boxes, component_volumes, vector_area,
 };
 use super::ladder::Ladder;
+use super::closed_consistent;
 use super::topology::{Edges, Orientation};
 use super::welding::Welding;
 use super::{HealthKind, ModelError, Rung, Solid};
 use crate::geometry::{cross, dot, sub};
-use crate::mass::integrals::{bounding_box_centre, volume_integrals};
+use crate::mass::integrals::{bounding_box_centre, volume_integrals, VolumeIntegrals};
 use crate::mass::{IntegrationOptions, Polygons};
 use crate::mesh::MeshError;
+
+/// [`closed_consistent`] on `faces`, and beside it, when the pool has more than one thread, the
+/// integrals of `faces` as stored that [`consistent_closed`] starts from.
+///
+/// The proof is serial and the kernel parallel: run one after the other, the second thread idles
+/// through the proof; run side by side (`rayon::join`), the kernel's chunks go to the other thread
+/// while the proof runs, and to both once it is done. Integrals are the same bits on any thread
+/// (fixed chunks summed in order). On one thread nothing runs beside the proof, so a mesh that
+/// fails it pays for no integral; on more, a failed proof wastes the integral unless the tolerant
+/// weld leaves the stored faces as they are (the common case of cracks only), where it is used.
+pub(super) fn prove(
+    vertices: &[[f64; 3]],
+    faces: &Polygons,
+) -> (Option<(Vec<u32>, usize)>, Option<VolumeIntegrals>) {
+    // Below two of the kernel's chunks the integral is one sequence anyway.
+    if faces.len() < 1 << 16 {
+        return (closed_consistent(faces), None);
+    }
+    crate::threads::install(|| {
+        if rayon::current_num_threads() < 2 {
+            return (closed_consistent(faces), None);
+        }
+        let (proof, t) = rayon::join(
+            || closed_consistent(faces),
+            || volume_integrals(vertices, faces, &IntegrationOptions::accurate()),
+        );
+        (proof, Some(t))
+    })
+}
 
 /// Closed and consistent (bit-exact or after the tolerant weld): as stored, flipped if inward, or with
 /// the components re-oriented whose winding contradicts their nesting.
 ///
 /// `kept` are the faces the topology (the component ids `comp`) numbers, `None` when they are `stored`
-/// themselves.
+/// themselves. `known` are `stored`'s integrals when [`prove`] computed them.
 pub(super) fn consistent_closed(
     mut ladder: Ladder<'_>,
     vertices: Vec<[f64; 3]>,
-    stored: Polygons,
+    (stored, known): (Polygons, Option<VolumeIntegrals>),
     kept: Option<Polygons>,
     (comp, ncomp): (Vec<u32>, usize),
     rung: Rung,
 ) -> Result<Solid, MeshError> {
     // Closed only once welded within tolerance: the stored surface's vector area is not exactly 0.
     let welded = kept.is_some();
-    let t = volume_integrals(&vertices, &stored, &IntegrationOptions::accurate());
+    let t = known
+        .unwrap_or_else(|| volume_integrals(&vertices, &stored, &IntegrationOptions::accurate()));
     let inverted = t.t1 < 0.0;
     let mut faces = stored;
     let mut kept = kept;
