@@ -186,3 +186,49 @@ fn chunked_area(vertices: &[[f64; 3]], faces: &Polygons) -> Option<f64> {
         Some(sums.iter().sum())
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On more than one thread, the chunked area decides as the sequential floor does, also for
+    /// volumes on, just above and just below that floor (where it falls back to the sequential sum).
+    #[test]
+    fn the_chunked_area_decides_as_the_sequential_floor() {
+        // A strip of 2^17 + 5 unequal triangles (more than two chunks, the last one short).
+        let n = (1u32 << 17) + 5;
+        let mut vertices = Vec::new();
+        let mut triangles = Vec::new();
+        for i in 0..n {
+            let x = f64::from(i);
+            vertices.extend([[x, 0.0, 0.0], [x + 1.0, 0.1, 0.0], [x, 1.0 + x.sin() * 0.3, 0.7]]);
+            triangles.push([3 * i, 3 * i + 1, 3 * i + 2]);
+        }
+        let faces = Polygons::from_triangles(&triangles);
+        let diagonal = 1.0e5;
+        let area: f64 = faces.iter().map(|f| polygon_area(&vertices, f)).sum();
+        let floor = ZERO_VOLUME_ROUNDOFFS * f64::EPSILON * area * diagonal;
+        let step = |x: f64, d: i64| f64::from_bits((x.to_bits() as i64 + d) as u64);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .expect("pool");
+        pool.install(|| {
+            assert!(chunked_area(&vertices, &faces).is_some());
+            for volume in [
+                0.0,
+                floor,
+                step(floor, 1),
+                step(floor, -1),
+                floor * (1.0 + 1e-9),
+                floor * (1.0 - 1e-9),
+                2.0 * floor,
+                0.5 * floor,
+                1.0,
+            ] {
+                assert_eq!(empty(&vertices, &faces, diagonal, volume), volume <= floor, "{volume}");
+            }
+            assert!(empty(&vertices, &faces, diagonal, f64::NAN));
+        });
+    }
+}

@@ -182,4 +182,28 @@ mod tests {
         assert_eq!(w.faces.len(), 1);
         assert_eq!(w.dropped, 1);
     }
+
+    /// A collapsed face found on the pool in any chunk, the last face included, or none: as the
+    /// search in order finds it.
+    #[test]
+    fn collapsed_faces_are_found_in_any_chunk_on_the_pool() {
+        let n = 5 * ANY_CHUNK + 3;
+        let vertices: Vec<[f64; 3]> = (0..n + 2).map(|i| [i as f64, 0.0, 0.0]).collect();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .expect("pool");
+        for at in [None, Some(0), Some(2 * ANY_CHUNK + 1), Some(n - 1)] {
+            let triangles: Vec<[u32; 3]> = (0..n as u32)
+                .map(|i| match at {
+                    Some(a) if a == i as usize => [i, i + 1, i],
+                    _ => [i, i + 1, i + 2],
+                })
+                .collect();
+            let faces = Polygons::from_triangles(&triangles);
+            let w = pool.install(|| already_welded(vertices.clone(), faces.clone()));
+            assert_eq!(w.dropped, usize::from(at.is_some()), "{at:?}");
+            assert_eq!(w.faces.len(), n - w.dropped, "{at:?}");
+        }
+    }
 }
