@@ -40,7 +40,7 @@ mod welding;
 use super::open::OpenMeshModel;
 use super::{weld, MeshError, MeshErrorKind, RawMesh};
 use crate::mass::{MassProperties, Polygons};
-use closed::{consistent_closed, prove, reoriented};
+use closed::{consistent_closed, prove, reoriented, welded_closed};
 pub use geometry::Aabb;
 use ladder::Ladder;
 use open_surface::open_or_nonmanifold;
@@ -378,17 +378,7 @@ pub fn heal(
             tolerance: w.tolerant.tolerance.largest,
         };
         let components = te.components(w.topology.len());
-        // The stored faces are the exact weld's unless duplicates were dropped: then the integrals
-        // computed beside the proof are theirs.
-        let known = stored_integrals.filter(|_| w.duplicates == 0 && w.cancelled == 0);
-        return consistent_closed(
-            ladder,
-            w.vertices,
-            (w.stored, known),
-            Some(w.kept),
-            components,
-            rung,
-        );
+        return welded_closed(ladder, w, components, rung, stored_integrals);
     }
     if te.closed() {
         if let Some(o) = orient(w.topology.len(), &te.pairs) {

@@ -129,6 +129,19 @@ pub(super) fn consistent_closed(
     )
 }
 
+/// [`consistent_closed`] for a mesh closed by the tolerant weld; `known` are the integrals of the exact
+/// weld's faces from [`prove`], which are the stored faces unless duplicates were dropped.
+pub(super) fn welded_closed(
+    ladder: Ladder<'_>,
+    w: Welding,
+    components: (Vec<u32>, usize),
+    rung: Rung,
+    known: Option<VolumeIntegrals>,
+) -> Result<Solid, MeshError> {
+    let known = known.filter(|_| w.duplicates == 0 && w.cancelled == 0);
+    consistent_closed(ladder, w.vertices, (w.stored, known), Some(w.kept), components, rung)
+}
+
 /// Components beyond this many are not checked for nesting (quadratic in the components).
 pub(super) const NESTING_CHECK: usize = 2_000;
 
