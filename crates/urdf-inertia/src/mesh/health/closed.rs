@@ -5,7 +5,7 @@ use super::geometry::{
 };
 use super::ladder::Ladder;
 use super::closed_consistent;
-use super::topology::{Edges, Orientation};
+use super::topology::{closed_consistent_split, Edges, Orientation};
 use super::welding::Welding;
 use super::{HealthKind, ModelError, Rung, Solid};
 use crate::geometry::{cross, dot, sub};
@@ -16,9 +16,9 @@ use crate::mesh::MeshError;
 /// [`closed_consistent`] on `faces`, and beside it, when the pool has more than one thread, the
 /// integrals of `faces` as stored that [`consistent_closed`] starts from.
 ///
-/// The proof is serial and the kernel parallel: run one after the other, the second thread idles
-/// through the proof; run side by side (`rayon::join`), the kernel's chunks go to the other thread
-/// while the proof runs, and to both once it is done. Integrals are the same bits on any thread
+/// The proof is mostly serial and the kernel parallel: run one after the other, the second thread
+/// idles through the proof; run side by side (`rayon::join`), with the proof's scan split in two
+/// halves ([`closed_consistent_split`]), the threads share the halves and the kernel's chunks. Integrals are the same bits on any thread
 /// (fixed chunks summed in order). On one thread nothing runs beside the proof, so a mesh that
 /// fails it pays for no integral; on more, a failed proof wastes the integral unless the tolerant
 /// weld leaves the stored faces as they are (the common case of cracks only), where it is used.
@@ -35,7 +35,7 @@ pub(super) fn prove(
             return (closed_consistent(faces), None);
         }
         let (proof, t) = rayon::join(
-            || closed_consistent(faces),
+            || closed_consistent_split(faces),
             || volume_integrals(vertices, faces, &IntegrationOptions::accurate()),
         );
         (proof, Some(t))
@@ -338,10 +338,10 @@ mod tests {
         (s.rung.name(), format!("{s:?}"))
     }
 
-    /// The proof beside the kernel (more than one thread, 2^16 faces and more) gives the solid one
-    /// thread gives, bit for bit: clean, wound inward, and closed only by the tolerant weld, with
-    /// and without a duplicate face dropped (the integrals computed beside the proof are used only
-    /// without).
+    /// The proof beside the kernel, its scan split in two (more than one thread, 2^16 faces and
+    /// more), gives the solid one thread gives, bit for bit: clean, two components, wound inward,
+    /// and closed only by the tolerant weld, with and without a duplicate face dropped (the
+    /// integrals computed beside the proof are used only without).
     #[test]
     fn the_proof_beside_the_kernel_gives_the_one_thread_solid() {
         let (v, t) = torus(256, 160);
@@ -359,8 +359,18 @@ mod tests {
         cracked[f] = cracked[f].map(|i| if i == 0 { v.len() as u32 } else { i });
         let mut doubled = cracked.clone();
         doubled.push(t[7]);
+        // A second, smaller torus beside the first and wound inward, their faces interleaved: two
+        // components, and the faces flipped are those of the component ids the split scan gives.
+        let mut two_v = v.clone();
+        two_v.extend(v.iter().map(|p| [0.5 * p[0] + 5.0, 0.5 * p[1], 0.5 * p[2]]));
+        let shift = v.len() as u32;
+        let two: Vec<[u32; 3]> = t
+            .iter()
+            .flat_map(|f| [[f[0], f[2], f[1]].map(|i| i + shift), *f])
+            .collect();
         let cases = [
             ("clean", mesh(&v, &t), "exact"),
+            ("two tori", mesh(&two_v, &two), "reoriented"),
             ("inward", mesh(&v, &inward), "inverted"),
             ("cracked", mesh(&cracked_v, &cracked), "welded"),
             ("cracked, a face twice", mesh(&cracked_v, &doubled), "welded"),
