@@ -18,10 +18,11 @@ use crate::mesh::MeshError;
 ///
 /// The proof is mostly serial and the kernel parallel: run one after the other, the second thread
 /// idles through the proof; run side by side (`rayon::join`), with the proof's scan split in two
-/// halves ([`closed_consistent_split`]), the threads share the halves and the kernel's chunks. Integrals are the same bits on any thread
-/// (fixed chunks summed in order). On one thread nothing runs beside the proof, so a mesh that
-/// fails it pays for no integral; on more, a failed proof wastes the integral unless the tolerant
-/// weld leaves the stored faces as they are (the common case of cracks only), where it is used.
+/// halves ([`closed_consistent_split`]), the threads share the halves and the kernel's chunks.
+/// Integrals are the same bits on any thread (fixed chunks summed in order). On one thread nothing
+/// runs beside the proof, so a mesh that fails it pays for no integral; on more, a failed proof
+/// wastes the integral unless the tolerant weld leaves the stored faces as they are (the common
+/// case of cracks only), where it is used.
 pub(super) fn prove(
     vertices: &[[f64; 3]],
     faces: &Polygons,

@@ -223,8 +223,8 @@ fn half_edges(faces: &Polygons, n: usize) -> (Vec<u32>, Vec<(u32, u32)>) {
 /// a pool of two threads or more: each half joins faces in its own union-find forest, and the second
 /// forest's sets are joined into the first afterwards, so the sets and the components numbered from
 /// them are the one scan's. The second forest is a second array of the faces' size, which one thread
-/// does not pay for. (The scan is [`closed_consistent`]'s, not shared with it: as one function
-/// called by both it cost one thread 33 M instructions more at 1.3 M faces.)
+/// does not pay for. (The scan is [`closed_consistent`]'s, written twice: as one function called by
+/// both it cost one thread instructions; figures: docs/benchmarks.md, "One thread against two".)
 pub(super) fn closed_consistent_split(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
     let n = *faces.indices.iter().max()? as usize + 1;
     let (start, out) = half_edges(faces, n);
