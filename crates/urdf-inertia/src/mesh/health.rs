@@ -40,7 +40,7 @@ mod welding;
 use super::open::OpenMeshModel;
 use super::{weld, MeshError, MeshErrorKind, RawMesh};
 use crate::mass::{MassProperties, Polygons};
-use closed::{consistent_closed, reoriented};
+use closed::{consistent_closed, prove, reoriented, welded_closed};
 pub use geometry::Aabb;
 use ladder::Ladder;
 use open_surface::open_or_nonmanifold;
@@ -329,11 +329,12 @@ pub fn heal(
     // Only a clean surface stops here, so only the proof that it is one runs: when it fails, the full
     // edge analysis is done once, on the tolerant weld's topology (on ERD's 152 meshes that are not
     // clean as stored, it ran twice before).
-    if let Some(components) = closed_consistent(&exact.faces) {
+    let (proof, stored_integrals) = prove(&exact.vertices, &exact.faces);
+    if let Some(components) = proof {
         return consistent_closed(
             ladder,
             exact.vertices,
-            exact.faces,
+            (exact.faces, stored_integrals),
             None,
             components,
             Rung::Exact,
@@ -377,7 +378,7 @@ pub fn heal(
             tolerance: w.tolerant.tolerance.largest,
         };
         let components = te.components(w.topology.len());
-        return consistent_closed(ladder, w.vertices, w.stored, Some(w.kept), components, rung);
+        return welded_closed(ladder, w, components, rung, stored_integrals);
     }
     if te.closed() {
         if let Some(o) = orient(w.topology.len(), &te.pairs) {

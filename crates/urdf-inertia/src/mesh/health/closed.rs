@@ -4,30 +4,62 @@ use super::geometry::{
     bbox, component_boxes, component_volumes, vector_area,
 };
 use super::ladder::Ladder;
-use super::topology::{Edges, Orientation};
+use super::closed_consistent;
+use super::topology::{closed_consistent_split, Edges, Orientation};
 use super::welding::Welding;
 use super::{HealthKind, ModelError, Rung, Solid};
 use crate::geometry::{cross, dot, sub};
-use crate::mass::integrals::{bounding_box_centre, volume_integrals};
+use crate::mass::integrals::{bounding_box_centre, volume_integrals, VolumeIntegrals};
 use crate::mass::{IntegrationOptions, Polygons};
 use crate::mesh::MeshError;
+
+/// [`closed_consistent`] on `faces`, and beside it, when the pool has more than one thread, the
+/// integrals of `faces` as stored that [`consistent_closed`] starts from.
+///
+/// The proof is mostly serial and the kernel parallel: run one after the other, the second thread
+/// idles through the proof; run side by side (`rayon::join`), with the proof's scan split in two
+/// halves ([`closed_consistent_split`]), the threads share the halves and the kernel's chunks.
+/// Integrals are the same bits on any thread (fixed chunks summed in order). On one thread nothing
+/// runs beside the proof, so a mesh that fails it pays for no integral; on more, a failed proof
+/// wastes the integral unless the tolerant weld leaves the stored faces as they are (the common
+/// case of cracks only), where it is used.
+pub(super) fn prove(
+    vertices: &[[f64; 3]],
+    faces: &Polygons,
+) -> (Option<(Vec<u32>, usize)>, Option<VolumeIntegrals>) {
+    // Below two of the kernel's chunks the integral is one sequence anyway.
+    if faces.len() < 1 << 16 {
+        return (closed_consistent(faces), None);
+    }
+    crate::threads::install(|| {
+        if rayon::current_num_threads() < 2 {
+            return (closed_consistent(faces), None);
+        }
+        let (proof, t) = rayon::join(
+            || closed_consistent_split(faces),
+            || volume_integrals(vertices, faces, &IntegrationOptions::accurate()),
+        );
+        (proof, Some(t))
+    })
+}
 
 /// Closed and consistent (bit-exact or after the tolerant weld): as stored, flipped if inward, or with
 /// the components re-oriented whose winding contradicts their nesting.
 ///
 /// `kept` are the faces the topology (the component ids `comp`) numbers, `None` when they are `stored`
-/// themselves.
+/// themselves. `known` are `stored`'s integrals when [`prove`] computed them.
 pub(super) fn consistent_closed(
     mut ladder: Ladder<'_>,
     vertices: Vec<[f64; 3]>,
-    stored: Polygons,
+    (stored, known): (Polygons, Option<VolumeIntegrals>),
     kept: Option<Polygons>,
     (comp, ncomp): (Vec<u32>, usize),
     rung: Rung,
 ) -> Result<Solid, MeshError> {
     // Closed only once welded within tolerance: the stored surface's vector area is not exactly 0.
     let welded = kept.is_some();
-    let t = volume_integrals(&vertices, &stored, &IntegrationOptions::accurate());
+    let t = known
+        .unwrap_or_else(|| volume_integrals(&vertices, &stored, &IntegrationOptions::accurate()));
     let inverted = t.t1 < 0.0;
     let mut faces = stored;
     let mut kept = kept;
@@ -96,6 +128,19 @@ pub(super) fn consistent_closed(
         (model, ModelError::Cracks),
         |_, _| None,
     )
+}
+
+/// [`consistent_closed`] for a mesh closed by the tolerant weld; `known` are the integrals of the exact
+/// weld's faces from [`prove`], which are the stored faces unless duplicates were dropped.
+pub(super) fn welded_closed(
+    ladder: Ladder<'_>,
+    w: Welding,
+    components: (Vec<u32>, usize),
+    rung: Rung,
+    known: Option<VolumeIntegrals>,
+) -> Result<Solid, MeshError> {
+    let known = known.filter(|_| w.duplicates == 0 && w.cancelled == 0);
+    consistent_closed(ladder, w.vertices, (w.stored, known), Some(w.kept), components, rung)
 }
 
 /// Components beyond this many are not checked for nesting (quadratic in the components).
@@ -248,6 +293,93 @@ pub(super) fn apply(faces: &mut Polygons, reversed: &[bool]) {
     for (i, r) in reversed.iter().enumerate() {
         if *r {
             faces.reverse_face(i);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{make_solid, HealthOptions};
+    use crate::mass::Polygons;
+    use crate::mesh::RawMesh;
+    use std::path::Path;
+
+    /// A torus of `n` × `m` quads, each split in two triangles wound outward: 2·n·m faces.
+    fn torus(n: u32, m: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let mut v = Vec::new();
+        for i in 0..n {
+            let a = std::f64::consts::TAU * f64::from(i) / f64::from(n);
+            for j in 0..m {
+                let b = std::f64::consts::TAU * f64::from(j) / f64::from(m);
+                let r = 1.0 + 0.3 * b.cos();
+                v.push([r * a.cos(), r * a.sin(), 0.3 * b.sin()]);
+            }
+        }
+        let at = |i: u32, j: u32| (i % n) * m + j % m;
+        let mut t = Vec::new();
+        for i in 0..n {
+            for j in 0..m {
+                let (p, q, r, s) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                t.extend([[p, q, r], [p, r, s]]);
+            }
+        }
+        (v, t)
+    }
+
+    /// The rung of the solid healed in a pool of `threads` threads, and every field of it in its
+    /// shortest round-trip form (equal strings, equal bits).
+    fn healed(threads: usize, mesh: &RawMesh) -> (&'static str, String) {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        let s = pool
+            .install(|| make_solid(mesh, Path::new("t"), HealthOptions::default()))
+            .expect("a solid");
+        (s.rung.name(), format!("{s:?}"))
+    }
+
+    /// The proof beside the kernel, its scan split in two (more than one thread, 2^16 faces and
+    /// more), gives the solid one thread gives, bit for bit: clean, two components, wound inward,
+    /// and closed only by the tolerant weld, with and without a duplicate face dropped (the
+    /// integrals computed beside the proof are used only without).
+    #[test]
+    fn the_proof_beside_the_kernel_gives_the_one_thread_solid() {
+        let (v, t) = torus(256, 160);
+        let mesh = |v: &[[f64; 3]], t: &[[u32; 3]]| RawMesh {
+            vertices: v.to_vec(),
+            faces: Polygons::from_triangles(t),
+            ..Default::default()
+        };
+        let inward: Vec<[u32; 3]> = t.iter().map(|f| [f[0], f[2], f[1]]).collect();
+        // Vertex 0 stored a second time 1e-12 away and used by one of its faces: a crack.
+        let mut cracked_v = v.clone();
+        cracked_v.push([v[0][0] + 1e-12, v[0][1], v[0][2]]);
+        let mut cracked = t.clone();
+        let f = cracked.iter().position(|f| f.contains(&0)).expect("a face at 0");
+        cracked[f] = cracked[f].map(|i| if i == 0 { v.len() as u32 } else { i });
+        let mut doubled = cracked.clone();
+        doubled.push(t[7]);
+        // A second, smaller torus beside the first and wound inward, their faces interleaved: two
+        // components, and the faces flipped are those of the component ids the split scan gives.
+        let mut two_v = v.clone();
+        two_v.extend(v.iter().map(|p| [0.5 * p[0] + 5.0, 0.5 * p[1], 0.5 * p[2]]));
+        let shift = v.len() as u32;
+        let two: Vec<[u32; 3]> = t
+            .iter()
+            .flat_map(|f| [[f[0], f[2], f[1]].map(|i| i + shift), *f])
+            .collect();
+        let cases = [
+            ("clean", mesh(&v, &t), "exact"),
+            ("two tori", mesh(&two_v, &two), "reoriented"),
+            ("inward", mesh(&v, &inward), "inverted"),
+            ("cracked", mesh(&cracked_v, &cracked), "welded"),
+            ("cracked, a face twice", mesh(&cracked_v, &doubled), "welded"),
+        ];
+        for (name, m, rung) in cases {
+            let one = healed(1, &m);
+            assert_eq!(one.0, rung, "{name}");
+            assert_eq!(healed(3, &m), one, "{name}");
         }
     }
 }

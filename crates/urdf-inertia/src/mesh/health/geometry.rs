@@ -83,6 +83,7 @@ pub(super) fn vector_area(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
 }
 
 /// Area of a planar polygon (fan from its first vertex).
+#[inline(always)]
 pub(super) fn polygon_area(vertices: &[[f64; 3]], face: &[u32]) -> f64 {
     let p = vertices[face[0] as usize];
     let mut a = [0.0f64; 3];

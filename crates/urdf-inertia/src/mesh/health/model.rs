@@ -120,9 +120,7 @@ pub(super) fn check_volume(
     volume: f64,
     path: &Path,
 ) -> Result<(), MeshError> {
-    let area: f64 = faces.iter().map(|f| polygon_area(vertices, f)).sum();
-    let floor = ZERO_VOLUME_ROUNDOFFS * f64::EPSILON * area * bounds.diagonal();
-    if volume.is_nan() || volume <= floor {
+    if empty(vertices, faces, bounds.diagonal(), volume) {
         return Err(MeshError::new(
             path,
             None,
@@ -133,4 +131,104 @@ pub(super) fn check_volume(
         ));
     }
     Ok(())
+}
+
+/// Whether `volume` is NaN or at most the floor of [`check_volume`], the floor taken from the area
+/// summed face by face in order. On more than one thread a large mesh's area is summed in chunks on
+/// the pool first: that sum and the sequential one differ by less than `slack` of either (each is
+/// within (n − 1)·u of the exact sum of n non-negative terms), and the floor grows with the area
+/// (products by positive factors round monotonically), so a volume outside the floors of the area
+/// ± `slack` is decided as the sequential sum decides it; only a volume inside that band, which a
+/// solid is not, sums again in order.
+fn empty(vertices: &[[f64; 3]], faces: &Polygons, diagonal: f64, volume: f64) -> bool {
+    let floor = |area: f64| ZERO_VOLUME_ROUNDOFFS * f64::EPSILON * area * diagonal;
+    if volume.is_nan() {
+        return true;
+    }
+    if let Some(area) = chunked_area(vertices, faces) {
+        let slack = 4.0 * faces.len() as f64 * f64::EPSILON;
+        if area.is_finite() && slack < 0.5 {
+            if volume <= floor(area * (1.0 - slack)) {
+                return true;
+            }
+            if volume > floor(area * (1.0 + slack)) {
+                return false;
+            }
+        }
+    }
+    let area: f64 = faces.iter().map(|f| polygon_area(vertices, f)).sum();
+    volume <= floor(area)
+}
+
+/// Faces per chunk of [`chunked_area`]; meshes of fewer than two chunks are summed in order.
+const AREA_CHUNK: usize = 1 << 15;
+
+/// The faces' area summed in fixed chunks on the pool, when it has more than one thread and the mesh
+/// at least two chunks: on one thread the sequential sum is all [`empty`] needs.
+fn chunked_area(vertices: &[[f64; 3]], faces: &Polygons) -> Option<f64> {
+    use rayon::prelude::*;
+    let n = faces.len();
+    if n < 2 * AREA_CHUNK {
+        return None;
+    }
+    crate::threads::install(|| {
+        if rayon::current_num_threads() < 2 {
+            return None;
+        }
+        let sums: Vec<f64> = (0..n.div_ceil(AREA_CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                (c * AREA_CHUNK..((c + 1) * AREA_CHUNK).min(n))
+                    .map(|i| polygon_area(vertices, faces.face(i)))
+                    .sum()
+            })
+            .collect();
+        Some(sums.iter().sum())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On more than one thread, the chunked area decides as the sequential floor does, also for
+    /// volumes on, just above and just below that floor (where it falls back to the sequential sum).
+    #[test]
+    fn the_chunked_area_decides_as_the_sequential_floor() {
+        // A strip of 2^17 + 5 unequal triangles (more than two chunks, the last one short).
+        let n = (1u32 << 17) + 5;
+        let mut vertices = Vec::new();
+        let mut triangles = Vec::new();
+        for i in 0..n {
+            let x = f64::from(i);
+            vertices.extend([[x, 0.0, 0.0], [x + 1.0, 0.1, 0.0], [x, 1.0 + x.sin() * 0.3, 0.7]]);
+            triangles.push([3 * i, 3 * i + 1, 3 * i + 2]);
+        }
+        let faces = Polygons::from_triangles(&triangles);
+        let diagonal = 1.0e5;
+        let area: f64 = faces.iter().map(|f| polygon_area(&vertices, f)).sum();
+        let floor = ZERO_VOLUME_ROUNDOFFS * f64::EPSILON * area * diagonal;
+        let step = |x: f64, d: i64| f64::from_bits((x.to_bits() as i64 + d) as u64);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .expect("pool");
+        pool.install(|| {
+            assert!(chunked_area(&vertices, &faces).is_some());
+            for volume in [
+                0.0,
+                floor,
+                step(floor, 1),
+                step(floor, -1),
+                floor * (1.0 + 1e-9),
+                floor * (1.0 - 1e-9),
+                2.0 * floor,
+                0.5 * floor,
+                1.0,
+            ] {
+                assert_eq!(empty(&vertices, &faces, diagonal, volume), volume <= floor, "{volume}");
+            }
+            assert!(empty(&vertices, &faces, diagonal, f64::NAN));
+        });
+    }
 }

@@ -146,8 +146,45 @@ pub(super) fn grouped<T: Copy + Default>(
 /// Measured on a 1.3 M-face sphere (callgrind): 503 → 329 instructions per face for the proof and the
 /// components together.
 pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
+    let n = *faces.indices.iter().max()? as usize + 1;
+    let h = faces.indices.len();
+    let (start, out) = half_edges(faces, n);
+    let bucket = |u: usize| {
+        let lo = if u == 0 { 0 } else { start[u - 1] as usize };
+        &out[lo..start[u] as usize]
+    };
+    let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
+    // Each half-edge u → v with u < v must be alone in u's list and find exactly one v → u; when
+    // those pairs account for every half-edge, no half-edge v → u is left without its twin.
+    let mut paired = 0usize;
+    for u in 0..n {
+        let mine = bucket(u);
+        for (i, &(v, f)) in mine.iter().enumerate() {
+            if v as usize <= u {
+                if v as usize == u {
+                    return None;
+                }
+                continue;
+            }
+            if mine[..i].iter().any(|e| e.0 == v) {
+                return None;
+            }
+            let mut twins = bucket(v as usize).iter().filter(|e| e.0 as usize == u);
+            let &(_, g) = twins.next()?;
+            if twins.next().is_some() {
+                return None;
+            }
+            union(&mut parent, f, g);
+            paired += 1;
+        }
+    }
+    (2 * paired == h).then(|| label(parent))
+}
+
+/// Half-edges bucketed by their start vertex (a counting sort), each entry holding its end and its
+/// face: after the fill, u's entries are `out[start[u - 1]..start[u]]` (from 0 for u = 0).
+fn half_edges(faces: &Polygons, n: usize) -> (Vec<u32>, Vec<(u32, u32)>) {
     let idx = &faces.indices;
-    let n = *idx.iter().max()? as usize + 1;
     let h = idx.len();
     // Entries starting at vertex u, after the fill: `out[start[u]..start[u + 1]]`, with start[0] = 0.
     let mut start = vec![0u32; n + 1];
@@ -179,15 +216,51 @@ pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
             }
         }
     }
+    (start, out)
+}
+
+/// [`closed_consistent`] with its twin scan split in two halves of the vertices on `rayon::join`, for
+/// a pool of two threads or more: each half joins faces in its own union-find forest, and the second
+/// forest's sets are joined into the first afterwards, so the sets and the components numbered from
+/// them are the one scan's. The second forest is a second array of the faces' size, which one thread
+/// does not pay for. (The scan is [`closed_consistent`]'s, written twice: as one function called by
+/// both it cost one thread instructions; figures: docs/benchmarks.md, "One thread against two".)
+pub(super) fn closed_consistent_split(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
+    let n = *faces.indices.iter().max()? as usize + 1;
+    let (start, out) = half_edges(faces, n);
+    let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
+    let mut other = parent.clone();
+    let (a, b) = rayon::join(
+        || twins(&start, &out, 0..n / 2, &mut parent),
+        || twins(&start, &out, n / 2..n, &mut other),
+    );
+    let paired = a? + b?;
+    for f in 0..faces.len() as u32 {
+        let r = root(&mut other, f);
+        if r != f {
+            union(&mut parent, f, r);
+        }
+    }
+    (2 * paired == faces.indices.len()).then(|| label(parent))
+}
+
+/// The twin scan of [`closed_consistent_split`] over the half-edges leaving `vertices` (`out`'s buckets
+/// as its fill left `start`): the number of pairs found, faces joined in `parent` as they are; `None`
+/// at the first half-edge without exactly one twin.
+fn twins(
+    start: &[u32],
+    out: &[(u32, u32)],
+    vertices: std::ops::Range<usize>,
+    parent: &mut [u32],
+) -> Option<usize> {
     let bucket = |u: usize| {
         let lo = if u == 0 { 0 } else { start[u - 1] as usize };
         &out[lo..start[u] as usize]
     };
-    let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
     // Each half-edge u → v with u < v must be alone in u's list and find exactly one v → u; when
     // those pairs account for every half-edge, no half-edge v → u is left without its twin.
     let mut paired = 0usize;
-    for u in 0..n {
+    for u in vertices {
         let mine = bucket(u);
         for (i, &(v, f)) in mine.iter().enumerate() {
             if v as usize <= u {
@@ -204,11 +277,11 @@ pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
             if twins.next().is_some() {
                 return None;
             }
-            union(&mut parent, f, g);
+            union(parent, f, g);
             paired += 1;
         }
     }
-    (2 * paired == h).then(|| label(parent))
+    Some(paired)
 }
 
 /// The root of `x` in a union-find forest, halving the path on the way.
@@ -352,6 +425,25 @@ mod tests {
         let full = edge_analysis(&f);
         assert_eq!((full.boundary, full.nonmanifold, full.inconsistent), (0, 0, 0));
         assert_eq!(full.pairs.len(), 6);
+    }
+
+    /// The scan split in two halves on a pool gives the one scan's components: 20,000 tetrahedra,
+    /// their faces in an order that mixes them, and the same with one face reversed (no proof).
+    #[test]
+    fn the_split_scan_gives_the_components_of_one_scan() {
+        let mut v = tets(20_000);
+        let n = v.len();
+        v = (0..n).map(|i| v[(i * 7919) % n].clone()).collect();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .expect("pool");
+        let f = faces(&v);
+        let one = closed_consistent(&f).expect("clean");
+        assert_eq!(one.1, 20_000);
+        assert_eq!(pool.install(|| closed_consistent_split(&f)), Some(one));
+        v[n - 1].reverse();
+        assert_eq!(pool.install(|| closed_consistent_split(&faces(&v))), None);
     }
 
     #[test]

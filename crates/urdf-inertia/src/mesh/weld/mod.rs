@@ -81,7 +81,7 @@ pub fn already_welded(vertices: Vec<[f64; 3]>, faces: Polygons) -> ExactWeld {
         // Polygons fold runs of a repeated corner: `remap_faces` decides.
         _ => true,
     };
-    if !faces.iter().any(collapsed) {
+    if !any_face(&faces, collapsed) {
         return ExactWeld {
             vertices,
             faces,
@@ -96,6 +96,27 @@ pub fn already_welded(vertices: Vec<[f64; 3]>, faces: Polygons) -> ExactWeld {
         faces,
         dropped,
     }
+}
+
+/// Faces per chunk of [`any_face`]; meshes of fewer than two chunks are searched in order.
+const ANY_CHUNK: usize = 1 << 15;
+
+/// Whether some face is `hit`: on the pool in fixed chunks when it has more than one thread and the
+/// mesh at least two chunks (the answer is the same), in order otherwise.
+fn any_face(faces: &Polygons, hit: impl Fn(&[u32]) -> bool + Sync) -> bool {
+    use rayon::prelude::*;
+    let n = faces.len();
+    if n < 2 * ANY_CHUNK {
+        return faces.iter().any(hit);
+    }
+    crate::threads::install(|| {
+        if rayon::current_num_threads() < 2 {
+            return faces.iter().any(&hit);
+        }
+        (0..n.div_ceil(ANY_CHUNK)).into_par_iter().any(|c| {
+            (c * ANY_CHUNK..((c + 1) * ANY_CHUNK).min(n)).any(|i| hit(faces.face(i)))
+        })
+    })
 }
 
 /// Faces through a vertex map: runs of a repeated vertex are folded, and faces left with fewer than
@@ -160,5 +181,29 @@ mod tests {
         assert_eq!(w.vertices.len(), 3);
         assert_eq!(w.faces.len(), 1);
         assert_eq!(w.dropped, 1);
+    }
+
+    /// A collapsed face found on the pool in any chunk, the last face included, or none: as the
+    /// search in order finds it.
+    #[test]
+    fn collapsed_faces_are_found_in_any_chunk_on_the_pool() {
+        let n = 5 * ANY_CHUNK + 3;
+        let vertices: Vec<[f64; 3]> = (0..n + 2).map(|i| [i as f64, 0.0, 0.0]).collect();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .expect("pool");
+        for at in [None, Some(0), Some(2 * ANY_CHUNK + 1), Some(n - 1)] {
+            let triangles: Vec<[u32; 3]> = (0..n as u32)
+                .map(|i| match at {
+                    Some(a) if a == i as usize => [i, i + 1, i],
+                    _ => [i, i + 1, i + 2],
+                })
+                .collect();
+            let faces = Polygons::from_triangles(&triangles);
+            let w = pool.install(|| already_welded(vertices.clone(), faces.clone()));
+            assert_eq!(w.dropped, usize::from(at.is_some()), "{at:?}");
+            assert_eq!(w.faces.len(), n - w.dropped, "{at:?}");
+        }
     }
 }

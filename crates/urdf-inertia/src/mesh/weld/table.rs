@@ -149,9 +149,21 @@ pub fn join(vertices: Vec<[f64; 3]>, indices: &mut [u32], runs: Option<usize>) -
         };
     }
     vertices.truncate(distinct);
-    for i in indices.iter_mut() {
-        *i = first[*i as usize];
-    }
+    // The corners, 5 or 6 a vertex, are renumbered on the pool when it has more than one thread
+    // (on one, rayon's split costs more instructions than the plain loop).
+    let first: &[u32] = &first;
+    let renumber = |c: &mut [u32]| {
+        for i in c {
+            *i = first[*i as usize];
+        }
+    };
+    crate::threads::install(|| {
+        if rayon::current_num_threads() < 2 {
+            renumber(indices);
+        } else {
+            indices.par_chunks_mut(1 << 16).for_each(renumber);
+        }
+    });
     vertices
 }
 
