@@ -22,6 +22,9 @@ use std::collections::BinaryHeap;
 /// Splits (one piece into four) beyond which the pieces still cut are bounded, not split.
 const MAX_SPLITS: usize = 60_000;
 
+/// Pieces met by more triangles than this are split in four before they are cut along planes.
+const MAX_CUTS: usize = 8;
+
 /// Rays tried on a patch of uncut faces before it is split like a cut one.
 const MAX_TRIES: usize = 8;
 
@@ -351,34 +354,44 @@ impl Faces<'_> {
         out.faces.push(&face);
     }
 
-    /// When every blocker lies in one plane other than `t`'s: the piece cut along that plane, each
-    /// side (which no triangle meets any more) decided by a ray, or bounded when it is a sliver
-    /// the plane tests cannot tell from the cut. Whether it did so.
+    /// When no blocker lies in `t`'s plane (and they are few): the piece cut along the blockers'
+    /// planes into convex cells that no triangle meets any more, each decided by a ray, or bounded
+    /// when it is a sliver the plane tests cannot tell from a cut. Whether it did so.
     fn cut(&self, piece: &Corners, t: u32, blockers: &[u32], seen: &mut Seen, out: &mut Resolved) -> bool {
-        let [a, b, c] = self.corners[blockers[0] as usize];
-        let on_plane = |x: [f64; 3]| orient3d(c3(a), c3(b), c3(c), c3(x)) == 0.0;
-        if self.corners[t as usize].iter().all(|&x| on_plane(x))
-            || !blockers[1..]
-                .iter()
-                .all(|&u| self.corners[u as usize].iter().all(|&x| on_plane(x)))
-        {
+        if blockers.len() > MAX_CUTS {
             return false;
         }
-        let (ab, ac) = (sub(b, a), sub(c, a));
-        let n = cross(ab, ac);
-        let m = self.margin * norm(ab) * norm(ac);
-        let d = piece.map(|p| dot(n, sub(p, a)));
-        for side in [1.0, -1.0] {
-            let poly = clip(piece, &d, side);
-            if poly.len() < 3 {
-                continue;
+        let [p, q, r] = self.corners[t as usize].map(c3);
+        let mut planes = Vec::with_capacity(blockers.len());
+        for &u in blockers {
+            let [a, b, c] = self.corners[u as usize];
+            if [a, b, c].iter().all(|&x| orient3d(p, q, r, c3(x)) == 0.0) {
+                return false;
             }
-            let kappa = self.decide_where(&poly, t, seen, |p| dot(n, sub(p, a)).abs() > m);
-            match kappa {
-                Some(k) => self.emit(&poly, k, out),
+            let (ab, ac) = (sub(b, a), sub(c, a));
+            planes.push((a, cross(ab, ac), self.margin * norm(ab) * norm(ac)));
+        }
+        let mut cells = vec![piece.to_vec()];
+        for &(a, n, _) in &planes {
+            let mut next = Vec::with_capacity(2 * cells.len());
+            for cell in &cells {
+                let d: Vec<f64> = cell.iter().map(|x| dot(n, sub(*x, a))).collect();
+                for side in [1.0, -1.0] {
+                    let part = clip(cell, &d, side);
+                    if part.len() >= 3 {
+                        next.push(part);
+                    }
+                }
+            }
+            cells = next;
+        }
+        let apart = |x: [f64; 3]| planes.iter().all(|&(a, n, m)| dot(n, sub(x, a)).abs() > m);
+        for cell in cells {
+            match self.decide_where(&cell, t, seen, apart) {
+                Some(k) => self.emit(&cell, k, out),
                 None => {
-                    out.bound += self.delta(&poly, t);
-                    self.emit(&poly, self.sign[t as usize], out);
+                    out.bound += self.delta(&cell, t);
+                    self.emit(&cell, self.sign[t as usize], out);
                 }
             }
         }

@@ -76,8 +76,6 @@ struct Shell {
     /// itself with the reference point; `motion` is then that move, m³.
     closed: bool,
     motion: f64,
-    /// Every edge shared by exactly two of its faces (no cracks at all).
-    sealed: bool,
     /// Twice the vector area (Σ of the fans' cross products), zero for a closed shell.
     area2: [f64; 3],
     /// Six times the signed volume about the surface's box centre.
@@ -121,15 +119,13 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
     }
     let mut out = ShellOutcome::default();
     // A pair with an undecided side is bounded whatever the other side's classification, unless
-    // both are sealed: those are decided face by face.
-    let mut relevant = vec![false; shells.len()];
+    // its cluster is a closed cycle: that is decided face by face.
+    let relevant = resolvable(faces, &shells, &pairs, &decided);
     for &(a, b) in &pairs {
         if decided[a] && decided[b] {
             continue;
         }
-        if shells[a].sealed && shells[b].sealed {
-            relevant[a] = true;
-            relevant[b] = true;
+        if relevant[a] {
             out.resolved_pairs += 1;
         } else {
             out.undecided_pairs += 1;
@@ -152,6 +148,59 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
         resolve_pairs(vertices, &shells, &tris, &relevant, &sign, &mut out);
     }
     out
+}
+
+/// The shells to decide face by face: clusters of shells (joined by overlapping boxes, and by edges
+/// they share where the surface is non-manifold) that hold an undecided pair and whose edges all
+/// balance (as many uses each way: a closed cycle, whose winding number is an integer everywhere and
+/// is counted exactly by a ray's crossings).
+fn resolvable(
+    faces: &Polygons,
+    shells: &[Shell],
+    pairs: &[(usize, usize)],
+    decided: &[bool],
+) -> Vec<bool> {
+    let mut shell_of = vec![0u32; faces.len()];
+    for (i, s) in shells.iter().enumerate() {
+        s.faces.iter().for_each(|&f| shell_of[f as usize] = i as u32);
+    }
+    let mut parent: Vec<u32> = (0..shells.len() as u32).collect();
+    let join = |parent: &mut Vec<u32>, a: u32, b: u32| {
+        let (a, b) = (root(parent, a), root(parent, b));
+        parent[a.max(b) as usize] = a.min(b);
+    };
+    for &(a, b) in pairs {
+        join(&mut parent, a as u32, b as u32);
+    }
+    // Per edge: the first shell using it, and its uses one way less the other.
+    let mut edges: FxHashMap<(u32, u32), (u32, i64)> = FxHashMap::default();
+    for (i, face) in faces.iter().enumerate() {
+        for k in 0..face.len() {
+            let (u, v) = (face[k], face[(k + 1) % face.len()]);
+            let e = edges.entry((u.min(v), u.max(v))).or_insert((shell_of[i], 0));
+            e.1 += if u < v { 1 } else { -1 };
+            let first = e.0;
+            join(&mut parent, first, shell_of[i]);
+        }
+    }
+    let mut open = vec![false; shells.len()];
+    for &(s, net) in edges.values() {
+        if net != 0 {
+            open[root(&mut parent, s) as usize] = true;
+        }
+    }
+    let mut wanted = vec![false; shells.len()];
+    for &(a, b) in pairs {
+        if !decided[a] || !decided[b] {
+            wanted[root(&mut parent, a as u32) as usize] = true;
+        }
+    }
+    (0..shells.len() as u32)
+        .map(|i| {
+            let r = root(&mut parent, i) as usize;
+            wanted[r] && !open[r]
+        })
+        .collect()
 }
 
 /// Turns and drops the decided closed shells (see the module docs); each shell's orientation as
@@ -275,7 +324,6 @@ fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
                 faces: Vec::new(),
                 closed: true,
                 motion: 0.0,
-                sealed: true,
                 area2: [0.0; 3],
                 volume6: 0.0,
                 bounds: Aabb::EMPTY,
@@ -297,7 +345,6 @@ fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
         }
     }
     for s in &mut out {
-        s.sealed = s.closed;
         if !s.closed {
             let diag = s.bounds.diagonal();
             s.motion = dot(s.area2, s.area2).sqrt() / 2.0 * diag / 6.0;
