@@ -22,8 +22,13 @@ use std::collections::BinaryHeap;
 /// Splits (one piece into four) beyond which the pieces still cut are bounded, not split.
 const MAX_SPLITS: usize = 60_000;
 
-/// Pieces met by more triangles than this are split in four before they are cut along planes.
-const MAX_CUTS: usize = 8;
+/// Pieces that more planes than this would cut (a triangle's, or a coplanar triangle's three edges)
+/// are split in four first.
+const MAX_CUTS: usize = 40;
+
+/// A triangle whose plane is within this share of the diagonal of a piece everywhere on it is taken
+/// as lying in the piece's plane.
+const NEAR: f64 = 1e-7;
 
 /// Rays tried on a patch of uncut faces before it is split like a cut one.
 const MAX_TRIES: usize = 8;
@@ -96,7 +101,7 @@ pub(super) fn resolve(
         .collect();
     let boxes: Vec<Aabb> = corners.iter().map(|c| Aabb::of(*c)).collect();
     let grid = Grid::new(&boxes);
-    let margin = 1e-9 * grid.bounds.diagonal();
+    let margin = 1e-12 * grid.bounds.diagonal();
     let f = Faces {
         vertices,
         tris,
@@ -275,15 +280,12 @@ impl Faces<'_> {
     /// The most a piece of triangle `t` oriented wrongly can change the volume: its cone from the
     /// centre, twice when the classification kept it (it may count −1 instead of 1).
     fn delta(&self, poly: &[[f64; 3]], t: u32) -> f64 {
-        let area: f64 = (1..poly.len() - 1)
-            .map(|k| norm(cross(sub(poly[k], poly[0]), sub(poly[k + 1], poly[0]))) / 2.0)
-            .sum();
         let reach = poly
             .iter()
             .map(|c| norm(sub(*c, self.centre)))
             .fold(0.0, f64::max);
         let s = self.sign[t as usize].abs() as f64;
-        (1.0 + s) * area * reach / 3.0
+        (1.0 + s) * area(poly) * reach / 3.0
     }
 
     /// Whether triangle `u` may meet the piece: not when the piece lies beyond the margin on one
@@ -300,17 +302,20 @@ impl Faces<'_> {
     /// How a piece of triangle `t` no other triangle meets bounds Ω: 1 outward, −1 inward, 0 not
     /// at all; `None` when no ray from its centre counts exactly.
     fn decide(&self, piece: &[[f64; 3]], t: u32, seen: &mut Seen) -> Option<i64> {
-        self.decide_where(piece, t, seen, |_| true)
+        self.decide_where(piece, t, seen, |_| true, &[])
     }
 
     /// [`Faces::decide`] from the first of a few points inside the piece that `usable` accepts and
-    /// from which a ray counts exactly (a ray along a face's edge or plane does not).
+    /// from which a ray counts exactly (a ray along a face's edge or plane does not). Triangles in
+    /// `t`'s plane that cover the point add their jumps to `t`'s; the lowest-numbered of them
+    /// carries the sum, the others nothing.
     fn decide_where(
         &self,
         piece: &[[f64; 3]],
         t: u32,
         seen: &mut Seen,
         usable: impl Fn([f64; 3]) -> bool,
+        coplanar: &[Coplanar],
     ) -> Option<i64> {
         let c = self.corners[t as usize];
         let n = cross(sub(c[1], c[0]), sub(c[2], c[0]));
@@ -318,16 +323,28 @@ impl Faces<'_> {
         axes.sort_by(|&a, &b| n[b].abs().total_cmp(&n[a].abs()));
         let mid = centroid(piece);
         let inner = piece.iter().map(|v| [0, 1, 2].map(|k| (3.0 * mid[k] + v[k]) / 4.0));
-        let front = std::iter::once(mid)
+        let mut skip = vec![t];
+        let (jump, front) = std::iter::once(mid)
             .chain(inner)
             .filter(|&p| usable(p))
             .find_map(|p| {
-                axes.iter()
-                    .filter(|&&k| n[k] != 0.0)
-                    .find_map(|&k| self.grid.winding(&self.corners, p, k, n[k].signum(), t, seen))
+                skip.truncate(1);
+                let mut jump = 1;
+                for cp in coplanar.iter().filter(|cp| cp.covers(p)) {
+                    skip.push(cp.u);
+                    jump += if cp.same { 1 } else { -1 };
+                }
+                let front = axes.iter().filter(|&&k| n[k] != 0.0).find_map(|&k| {
+                    self.grid
+                        .winding(&self.corners, p, k, n[k].signum(), &skip, seen)
+                })?;
+                Some((jump, front))
             })?;
+        if skip.iter().any(|&u| u < t) {
+            return Some(0);
+        }
         let solid = |w: i64| i64::from(w.abs() >= 1);
-        Some(solid(front + 1) - solid(front))
+        Some(solid(front + jump) - solid(front))
     }
 
     fn emit_whole(&self, t: u32, kappa: i64, out: &mut Resolved) {
@@ -358,18 +375,37 @@ impl Faces<'_> {
     /// planes into convex cells that no triangle meets any more, each decided by a ray, or bounded
     /// when it is a sliver the plane tests cannot tell from a cut. Whether it did so.
     fn cut(&self, piece: &Corners, t: u32, blockers: &[u32], seen: &mut Seen, out: &mut Resolved) -> bool {
-        if blockers.len() > MAX_CUTS {
-            return false;
-        }
         let [p, q, r] = self.corners[t as usize].map(c3);
+        let nt = {
+            let c = self.corners[t as usize];
+            cross(sub(c[1], c[0]), sub(c[2], c[0]))
+        };
         let mut planes = Vec::with_capacity(blockers.len());
+        let mut coplanar = Vec::new();
         for &u in blockers {
             let [a, b, c] = self.corners[u as usize];
-            if [a, b, c].iter().all(|&x| orient3d(p, q, r, c3(x)) == 0.0) {
-                return false;
-            }
             let (ab, ac) = (sub(b, a), sub(c, a));
-            planes.push((a, cross(ab, ac), self.margin * norm(ab) * norm(ac)));
+            let n = cross(ab, ac);
+            let gap = piece
+                .iter()
+                .map(|x| dot(n, sub(*x, a)).abs() / norm(n))
+                .fold(0.0, f64::max);
+            let exact = [a, b, c].iter().all(|&x| orient3d(p, q, r, c3(x)) == 0.0);
+            if exact || gap <= NEAR * self.grid.bounds.diagonal() {
+                // Nearly in t's plane: taken as in it, which moves the solid by at most the slab
+                // between the two over the piece (on both sides).
+                if !exact {
+                    out.bound += 2.0 * area(piece) * gap;
+                }
+                let cp = Coplanar::new(u, [a, b, c], nt, self.margin);
+                planes.extend_from_slice(&cp.edges);
+                coplanar.push(cp);
+            } else {
+                planes.push((a, cross(ab, ac), self.margin * norm(ab) * norm(ac)));
+            }
+        }
+        if planes.len() > MAX_CUTS {
+            return false;
         }
         let mut cells = vec![piece.to_vec()];
         for &(a, n, _) in &planes {
@@ -387,7 +423,7 @@ impl Faces<'_> {
         }
         let apart = |x: [f64; 3]| planes.iter().all(|&(a, n, m)| dot(n, sub(x, a)).abs() > m);
         for cell in cells {
-            match self.decide_where(&cell, t, seen, apart) {
+            match self.decide_where(&cell, t, seen, apart, &coplanar) {
                 Some(k) => self.emit(&cell, k, out),
                 None => {
                     out.bound += self.delta(&cell, t);
@@ -396,6 +432,38 @@ impl Faces<'_> {
             }
         }
         true
+    }
+}
+
+/// A triangle in the plane of the one being decided: its edges as planes across that plane (normals
+/// pointing into it), and whether it faces the same way.
+struct Coplanar {
+    u: u32,
+    edges: [([f64; 3], [f64; 3], f64); 3],
+    same: bool,
+}
+
+impl Coplanar {
+    fn new(u: u32, c: Corners, nt: [f64; 3], margin: f64) -> Coplanar {
+        let nu = cross(sub(c[1], c[0]), sub(c[2], c[0]));
+        let edges = [0, 1, 2].map(|k| {
+            let (a, b, o) = (c[k], c[(k + 1) % 3], c[(k + 2) % 3]);
+            let mut n = cross(nt, sub(b, a));
+            if dot(n, sub(o, a)) < 0.0 {
+                n = n.map(|x| -x);
+            }
+            (a, n, margin * norm(nt) * norm(sub(b, a)))
+        });
+        Coplanar {
+            u,
+            edges,
+            same: dot(nu, nt) > 0.0,
+        }
+    }
+
+    /// Whether `p` (off every edge plane by more than its margin) lies inside.
+    fn covers(&self, p: [f64; 3]) -> bool {
+        self.edges.iter().all(|&(a, n, _)| dot(n, sub(p, a)) > 0.0)
     }
 }
 
@@ -466,6 +534,12 @@ fn clip(poly: &[[f64; 3]], d: &[f64], side: f64) -> Vec<[f64; 3]> {
         }
     }
     out
+}
+
+fn area(poly: &[[f64; 3]]) -> f64 {
+    (1..poly.len() - 1)
+        .map(|k| norm(cross(sub(poly[k], poly[0]), sub(poly[k + 1], poly[0]))) / 2.0)
+        .sum()
 }
 
 fn centroid(poly: &[[f64; 3]]) -> [f64; 3] {

@@ -139,7 +139,7 @@ impl Grid {
         });
     }
 
-    /// The winding number of the triangles (all but `skip`) at `p`, counted along the ray from `p`
+    /// The winding number of the triangles (all but those in `skip`) at `p`, counted along the ray from `p`
     /// in direction `sign`·e_`axis` to beyond the grid; `None` when the ray touches an edge, a
     /// vertex or a plane of one of them.
     pub(super) fn winding(
@@ -148,7 +148,7 @@ impl Grid {
         p: [f64; 3],
         axis: usize,
         sign: f64,
-        skip: u32,
+        skip: &[u32],
         seen: &mut Seen,
     ) -> Option<i64> {
         let mut end = p;
@@ -173,7 +173,7 @@ impl Grid {
             (idx[axis], idx[j], idx[l]) = (ck, cj, cl);
             let c = (idx[0] * self.dims[1] + idx[1]) * self.dims[2] + idx[2];
             for &i in self.cell_items(c) {
-                if i == skip || !seen.first(i) {
+                if skip.contains(&i) || !seen.first(i) {
                     continue;
                 }
                 match crossing(p, end, &corners[i as usize]) {
@@ -240,14 +240,14 @@ mod tests {
         let inside = [0.3, 0.4, 0.45];
         for axis in 0..3 {
             for sign in [1.0, -1.0] {
-                let w = grid.winding(&corners, inside, axis, sign, u32::MAX, &mut seen);
+                let w = grid.winding(&corners, inside, axis, sign, &[], &mut seen);
                 assert_eq!(w, Some(1));
-                let w = grid.winding(&corners, [1.5, 0.3, 0.4], axis, sign, u32::MAX, &mut seen);
+                let w = grid.winding(&corners, [1.5, 0.3, 0.4], axis, sign, &[], &mut seen);
                 assert_eq!(w, Some(0));
             }
         }
         // Through the diagonal of a face: degenerate.
-        let w = grid.winding(&corners, [0.5, 0.5, 0.5], 2, 1.0, u32::MAX, &mut seen);
+        let w = grid.winding(&corners, [0.5, 0.5, 0.5], 2, 1.0, &[], &mut seen);
         assert_eq!(w, None);
     }
 }

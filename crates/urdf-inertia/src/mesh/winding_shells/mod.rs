@@ -76,6 +76,8 @@ struct Shell {
     /// itself with the reference point; `motion` is then that move, m³.
     closed: bool,
     motion: f64,
+    /// Every edge shared by exactly two of its faces with opposite directions (no cracks at all).
+    sealed: bool,
     /// Twice the vector area (Σ of the fans' cross products), zero for a closed shell.
     area2: [f64; 3],
     /// Six times the signed volume about the surface's box centre.
@@ -119,13 +121,16 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
     }
     let mut out = ShellOutcome::default();
     // A pair with an undecided side is bounded whatever the other side's classification, unless
-    // its cluster is a closed cycle: that is decided face by face.
-    let relevant = resolvable(faces, &shells, &pairs, &decided);
+    // its cluster is a closed cycle, or both shells are: then it is decided face by face (the open
+    // shells around sealed ones keep their pairs' bounds).
+    let mut relevant = resolvable(faces, &shells, &pairs, &decided);
     for &(a, b) in &pairs {
         if decided[a] && decided[b] {
             continue;
         }
-        if relevant[a] {
+        if relevant[a] || (shells[a].sealed && shells[b].sealed) {
+            relevant[a] = true;
+            relevant[b] = true;
             out.resolved_pairs += 1;
         } else {
             out.undecided_pairs += 1;
@@ -324,6 +329,7 @@ fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
                 faces: Vec::new(),
                 closed: true,
                 motion: 0.0,
+                sealed: true,
                 area2: [0.0; 3],
                 volume6: 0.0,
                 bounds: Aabb::EMPTY,
@@ -345,6 +351,7 @@ fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
         }
     }
     for s in &mut out {
+        s.sealed = s.closed;
         if !s.closed {
             let diag = s.bounds.diagonal();
             s.motion = dot(s.area2, s.area2).sqrt() / 2.0 * diag / 6.0;
