@@ -20,7 +20,7 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 /// Splits (one piece into four) beyond which the pieces still cut are bounded, not split.
-const MAX_SPLITS: usize = 60_000;
+const MAX_SPLITS: usize = 20_000;
 
 /// Pieces that more planes than this would cut (a triangle's, or a coplanar triangle's three edges)
 /// are split in four first.
@@ -29,6 +29,9 @@ const MAX_CUTS: usize = 40;
 /// A triangle whose plane is within this share of the diagonal of a piece everywhere on it is taken
 /// as lying in the piece's plane.
 const NEAR: f64 = 1e-7;
+
+/// Cells beyond which a piece is split in four rather than cut.
+const MAX_CELLS: usize = 256;
 
 /// Rays tried on a patch of uncut faces before it is split like a cut one.
 const MAX_TRIES: usize = 8;
@@ -408,10 +411,15 @@ impl Faces<'_> {
             return false;
         }
         let mut cells = vec![piece.to_vec()];
-        for &(a, n, _) in &planes {
+        for &(a, n, m) in &planes {
             let mut next = Vec::with_capacity(2 * cells.len());
             for cell in &cells {
                 let d: Vec<f64> = cell.iter().map(|x| dot(n, sub(*x, a))).collect();
+                // A plane along the cell's side (one cut already, or a shared edge) leaves it whole.
+                if d.iter().all(|&x| x >= -m) || d.iter().all(|&x| x <= m) {
+                    next.push(cell.clone());
+                    continue;
+                }
                 for side in [1.0, -1.0] {
                     let part = clip(cell, &d, side);
                     if part.len() >= 3 {
@@ -420,6 +428,9 @@ impl Faces<'_> {
                 }
             }
             cells = next;
+            if cells.len() > MAX_CELLS {
+                return false;
+            }
         }
         let apart = |x: [f64; 3]| planes.iter().all(|&(a, n, m)| dot(n, sub(x, a)).abs() > m);
         for cell in cells {

@@ -176,7 +176,21 @@ impl Grid {
                 if skip.contains(&i) || !seen.first(i) {
                     continue;
                 }
-                match crossing(p, end, &corners[i as usize]) {
+                let t = &corners[i as usize];
+                // The segment varies along `axis` only: a triangle whose box misses its line, or
+                // lies wholly behind its start, is missed (exact comparisons).
+                let outside = |k: usize, x: f64| {
+                    t.iter().all(|c| c[k] < x) || t.iter().all(|c| c[k] > x)
+                };
+                let behind = if sign > 0.0 {
+                    t.iter().all(|c| c[axis] < p[axis])
+                } else {
+                    t.iter().all(|c| c[axis] > p[axis])
+                };
+                if outside(j, p[j]) || outside(l, p[l]) || behind {
+                    continue;
+                }
+                match crossing(p, end, t) {
                     Crossing::Miss => {}
                     Crossing::Through(d) => w += d,
                     Crossing::Degenerate => return None,
