@@ -434,12 +434,11 @@ impl Faces<'_> {
         }
         let apart = |x: [f64; 3]| planes.iter().all(|&(a, n, m)| dot(n, sub(x, a)).abs() > m);
         for cell in cells {
-            match self.decide_where(&cell, t, seen, apart, &coplanar) {
-                Some(k) => self.emit(&cell, k, out),
-                None => {
-                    out.bound += self.delta(&cell, t);
-                    self.emit(&cell, self.sign[t as usize], out);
-                }
+            if let Some(k) = self.decide_where(&cell, t, seen, apart, &coplanar) {
+                self.emit(&cell, k, out);
+            } else {
+                out.bound += self.delta(&cell, t);
+                self.emit(&cell, self.sign[t as usize], out);
             }
         }
         true

@@ -217,7 +217,7 @@ fn crossing(s: [f64; 3], e: [f64; 3], t: &Corners) -> Crossing {
     if q.iter().any(|x| *x > 0.0) && q.iter().any(|x| *x < 0.0) {
         return Crossing::Miss;
     }
-    if os == 0.0 || oe == 0.0 || q.iter().any(|x| *x == 0.0) {
+    if os == 0.0 || oe == 0.0 || q.contains(&0.0) {
         return Crossing::Degenerate;
     }
     // orient3d > 0: the point is behind the triangle (its corners turn clockwise seen from it).

@@ -260,7 +260,7 @@ fn resolve_pairs(
     let (mut all, mut signs) = (Vec::new(), Vec::new());
     for i in (0..shells.len()).filter(|&i| relevant[i]) {
         all.extend_from_slice(&tris[i]);
-        signs.extend(std::iter::repeat(sign[i]).take(tris[i].len()));
+        signs.extend(std::iter::repeat_n(sign[i], tris[i].len()));
     }
     let volume: f64 = shells.iter().map(|s| s.volume6.abs() / 6.0).sum();
     let bounds = Aabb::of(vertices.iter().copied());
