@@ -8,7 +8,7 @@
 //!
 //! The `shells_` rows are two shells in one open mesh: the cost of deciding that one lies inside the
 //! other (exact segment–triangle tests where their boxes overlap, one winding number each way), or
-//! of finding that they cut each other.
+//! of deciding their faces piece by piece where they cut each other.
 //!
 //! `cargo bench --bench open_mesh`. The figures go to docs/benchmarks.md.
 
@@ -69,7 +69,7 @@ fn bench(c: &mut Criterion) {
     }
     // Shells classified by the winding number: a level-6 icosphere (20,480 faces) with one face
     // removed (a planar hole: exact caps) around a second one at half the radius (doubly enclosed:
-    // dropped), or moved half a radius so that the two cut each other (bounded).
+    // dropped), or moved half a radius so that the two cut each other (decided face by face).
     for (name, offset, radius) in [("nested", 0.0, 0.5), ("crossing", 0.5, 0.5)] {
         let mesh = two_spheres(offset, radius);
         let faces = mesh.faces.len();

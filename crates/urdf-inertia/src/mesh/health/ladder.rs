@@ -69,7 +69,7 @@ impl<'a> Ladder<'a> {
     /// left undecided bounded in `model`. The surfaces integrated as stored pay nothing.
     pub(super) fn shells(
         &mut self,
-        vertices: &[[f64; 3]],
+        vertices: &mut Vec<[f64; 3]>,
         faces: Polygons,
         rung: &Rung,
         model: &mut Model,
@@ -80,7 +80,10 @@ impl<'a> Ladder<'a> {
         ) {
             return faces;
         }
-        let s = winding_shells::classify(vertices, &faces);
+        let mut s = winding_shells::classify(vertices, &faces);
+        if s.resolved_pairs > 0 {
+            self.resolved(&s, model);
+        }
         if s.overlap_bound > 0.0 {
             let others: f64 = model.terms.iter().map(|t| t.0).sum();
             if s.overlap_bound > others {
@@ -96,6 +99,7 @@ impl<'a> Ladder<'a> {
             return faces;
         }
         self.known = None;
+        vertices.append(&mut s.vertices);
         let mut done = Vec::new();
         if s.dropped_shells > 0 {
             done.push(format!(
@@ -109,11 +113,37 @@ impl<'a> Ladder<'a> {
                 s.turned_shells
             ));
         }
-        self.warn(
-            HealthKind::Repaired,
-            format!("overlapping shells: {}", done.join("; ")),
-        );
+        if !done.is_empty() {
+            self.warn(
+                HealthKind::Repaired,
+                format!("overlapping shells: {}", done.join("; ")),
+            );
+        }
         s.faces
+    }
+
+    /// What deciding touching or cutting closed shells face by face left open, in `model` and in a
+    /// warning.
+    fn resolved(&mut self, s: &winding_shells::ShellOutcome, model: &mut Model) {
+        let bound = if s.resolved_bound > 0.0 {
+            let others: f64 = model.terms.iter().map(|t| t.0).sum();
+            if s.resolved_bound > others {
+                model.source = ModelError::Overlap;
+            }
+            model
+                .terms
+                .push((s.resolved_bound, Lever::Ball(s.ball.0, s.ball.1)));
+            format!(
+                "; the pieces along the cuts left undecided may change at most {:.2e} m³, which is in the error estimate",
+                s.resolved_bound
+            )
+        } else {
+            String::new()
+        };
+        self.warn(HealthKind::Repaired, format!(
+            "{} pair(s) of closed shells touch or cut each other: their faces are decided piece by piece by the winding number on each side ({} triangle(s) cut by others and split){bound}",
+            s.resolved_pairs, s.cut_faces
+        ));
     }
 
     /// Integrates, checks the volume and estimates the error: the last step of every rung. `model`
@@ -128,7 +158,8 @@ impl<'a> Ladder<'a> {
         message: impl FnOnce(f64, f64) -> Option<String>,
     ) -> Result<Solid, MeshError> {
         let mut model = model.into();
-        let faces = self.shells(&vertices, faces, &rung, &mut model);
+        let mut vertices = vertices;
+        let faces = self.shells(&mut vertices, faces, &rung, &mut model);
         let unit = match self.known.take() {
             Some(t) => MassProperties::from_integrals(&t, 1.0),
             None => unit_props(&vertices, &faces, None),

@@ -10,10 +10,15 @@
 //! outward when `w_out` = 0 (so an inside-out shell counts once) and inward when `w_in` = 0 (a cavity);
 //! when both sides are inside Ω (an internal wall, a doubly enclosed shell) it drops out.
 //!
-//! Pairs of shells that touch or cut each other, or that are open, are not decided: the region they
-//! can count twice lies in the intersection of their bounding boxes (a closed shell's winding number is
-//! 0 outside its box), whose volume enters the error estimate. A shell that passes through itself is
-//! beyond this module: its own ∫w is taken as its volume.
+//! Closed shells that touch or cut each other (and the shells around them) are decided face by face
+//! ([`correction`]): a piece of face that no other triangle meets has one winding number in front of
+//! it, which an exact ray counts; the pieces along the cuts that stay undecided bound the error. Pairs
+//! with an open shell are not decided: the region they can count twice lies in the intersection of
+//! their bounding boxes (a closed shell's winding number is 0 outside its box), whose volume enters
+//! the error estimate.
+
+mod correction;
+mod grid;
 
 use crate::geometry::{cross, dot, sub, Aabb};
 use crate::mass::Polygons;
@@ -48,9 +53,21 @@ pub struct ShellOutcome {
     pub undecided_pairs: usize,
     /// Bound on the volume those pairs can count twice or cancel, m³: their boxes' intersections.
     pub overlap_bound: f64,
-    /// Whether anything changed (faces dropped or turned).
+    /// Pairs of closed shells that touch or cut each other, decided face by face.
+    pub resolved_pairs: usize,
+    /// Their triangles that other triangles cut (split into pieces).
+    pub cut_faces: usize,
+    /// What the pieces left undecided can change: volume (m³), within a ball (centre, radius).
+    pub resolved_bound: f64,
+    pub ball: ([f64; 3], f64),
+    /// The pieces' corners, numbered on from the surface's vertices.
+    pub vertices: Vec<[f64; 3]>,
+    /// Whether anything changed (faces dropped, turned or split).
     pub changed: bool,
 }
+
+/// The pieces of faces left undecided may change the volume by at most this share of it.
+const RESOLVED_TARGET: f64 = 1e-9;
 
 /// One connected shell.
 struct Shell {
@@ -59,6 +76,8 @@ struct Shell {
     /// itself with the reference point; `motion` is then that move, m³.
     closed: bool,
     motion: f64,
+    /// Every edge shared by exactly two of its faces with opposite directions (no cracks at all).
+    sealed: bool,
     /// Twice the vector area (Σ of the fans' cross products), zero for a closed shell.
     area2: [f64; 3],
     /// Six times the signed volume about the surface's box centre.
@@ -91,7 +110,6 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
     // w_out per shell (the others' winding numbers on it), and whether every pair around it is decided.
     let mut w_out = vec![0i64; shells.len()];
     let mut decided = vec![true; shells.len()];
-    let mut undecided = Vec::new();
     for &(a, b) in &pairs {
         if let Some((wa, wb)) = nesting(vertices, &shells, &tris, a, b) {
             w_out[a] += wa;
@@ -99,21 +117,108 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
         } else {
             decided[a] = false;
             decided[b] = false;
-            undecided.push((a, b));
         }
     }
-    let mut out = ShellOutcome {
-        undecided_pairs: undecided.len(),
-        ..ShellOutcome::default()
-    };
-    // A pair with an undecided side is bounded whatever the other side's classification.
+    let mut out = ShellOutcome::default();
+    // A pair with an undecided side is bounded whatever the other side's classification, unless
+    // its cluster is a closed cycle, or both shells are: then it is decided face by face (the open
+    // shells around sealed ones keep their pairs' bounds).
+    let mut relevant = resolvable(faces, &shells, &pairs, &decided);
     for &(a, b) in &pairs {
-        if !decided[a] || !decided[b] {
+        if decided[a] && decided[b] {
+            continue;
+        }
+        if relevant[a] || (shells[a].sealed && shells[b].sealed) {
+            relevant[a] = true;
+            relevant[b] = true;
+            out.resolved_pairs += 1;
+        } else {
+            out.undecided_pairs += 1;
             out.overlap_bound += box_overlap(&shells[a], &shells[b]);
         }
     }
     let mut keep = vec![true; faces.len()];
     let mut turn = vec![false; faces.len()];
+    let sign = orient(&shells, &decided, &w_out, &mut keep, &mut turn, &mut out);
+    out.changed = out.dropped_shells > 0 || out.turned_shells > 0;
+    if out.resolved_pairs > 0 {
+        for (i, s) in shells.iter().enumerate() {
+            if relevant[i] {
+                s.faces.iter().for_each(|&f| keep[f as usize] = false);
+            }
+        }
+    }
+    out.faces = rebuilt(faces, &keep, &turn);
+    if out.resolved_pairs > 0 {
+        resolve_pairs(vertices, &shells, &tris, &relevant, &sign, &mut out);
+    }
+    out
+}
+
+/// The shells to decide face by face: clusters of shells (joined by overlapping boxes, and by edges
+/// they share where the surface is non-manifold) that hold an undecided pair and whose edges all
+/// balance (as many uses each way: a closed cycle, whose winding number is an integer everywhere and
+/// is counted exactly by a ray's crossings).
+fn resolvable(
+    faces: &Polygons,
+    shells: &[Shell],
+    pairs: &[(usize, usize)],
+    decided: &[bool],
+) -> Vec<bool> {
+    let mut shell_of = vec![0u32; faces.len()];
+    for (i, s) in shells.iter().enumerate() {
+        s.faces.iter().for_each(|&f| shell_of[f as usize] = i as u32);
+    }
+    let mut parent: Vec<u32> = (0..shells.len() as u32).collect();
+    let join = |parent: &mut Vec<u32>, a: u32, b: u32| {
+        let (a, b) = (root(parent, a), root(parent, b));
+        parent[a.max(b) as usize] = a.min(b);
+    };
+    for &(a, b) in pairs {
+        join(&mut parent, a as u32, b as u32);
+    }
+    // Per edge: the first shell using it, and its uses one way less the other.
+    let mut edges: FxHashMap<(u32, u32), (u32, i64)> = FxHashMap::default();
+    for (i, face) in faces.iter().enumerate() {
+        for k in 0..face.len() {
+            let (u, v) = (face[k], face[(k + 1) % face.len()]);
+            let e = edges.entry((u.min(v), u.max(v))).or_insert((shell_of[i], 0));
+            e.1 += if u < v { 1 } else { -1 };
+            let first = e.0;
+            join(&mut parent, first, shell_of[i]);
+        }
+    }
+    let mut open = vec![false; shells.len()];
+    for &(s, net) in edges.values() {
+        if net != 0 {
+            open[root(&mut parent, s) as usize] = true;
+        }
+    }
+    let mut wanted = vec![false; shells.len()];
+    for &(a, b) in pairs {
+        if !decided[a] || !decided[b] {
+            wanted[root(&mut parent, a as u32) as usize] = true;
+        }
+    }
+    (0..shells.len() as u32)
+        .map(|i| {
+            let r = root(&mut parent, i) as usize;
+            wanted[r] && !open[r]
+        })
+        .collect()
+}
+
+/// Turns and drops the decided closed shells (see the module docs); each shell's orientation as
+/// kept: 1, −1 (turned) or 0 (dropped).
+fn orient(
+    shells: &[Shell],
+    decided: &[bool],
+    w_out: &[i64],
+    keep: &mut [bool],
+    turn: &mut [bool],
+    out: &mut ShellOutcome,
+) -> Vec<i64> {
+    let mut sign = vec![1; shells.len()];
     for (i, s) in shells.iter().enumerate() {
         if !decided[i] || !s.closed || s.volume6 == 0.0 {
             continue;
@@ -129,17 +234,46 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
                 out.dropped_shells += 1;
                 out.dropped_faces += s.faces.len();
                 s.faces.iter().for_each(|&f| keep[f as usize] = false);
+                sign[i] = 0;
                 continue;
             }
         };
         if wanted_outward != (own > 0) {
             out.turned_shells += 1;
             s.faces.iter().for_each(|&f| turn[f as usize] = true);
+            sign[i] = -1;
         }
     }
-    out.changed = out.dropped_shells > 0 || out.turned_shells > 0;
-    out.faces = rebuilt(faces, &keep, &turn);
-    out
+    sign
+}
+
+/// Decides the faces of the `relevant` shells one by one ([`correction::resolve`]) and appends them
+/// to `out.faces`.
+fn resolve_pairs(
+    vertices: &[[f64; 3]],
+    shells: &[Shell],
+    tris: &[Vec<[u32; 3]>],
+    relevant: &[bool],
+    sign: &[i64],
+    out: &mut ShellOutcome,
+) {
+    let (mut all, mut signs) = (Vec::new(), Vec::new());
+    for i in (0..shells.len()).filter(|&i| relevant[i]) {
+        all.extend_from_slice(&tris[i]);
+        signs.extend(std::iter::repeat_n(sign[i], tris[i].len()));
+    }
+    let volume: f64 = shells.iter().map(|s| s.volume6.abs() / 6.0).sum();
+    let bounds = Aabb::of(vertices.iter().copied());
+    let centre = crate::mass::integrals::bounding_box_centre(vertices);
+    let r = correction::resolve(vertices, &all, &signs, centre, RESOLVED_TARGET * volume);
+    for face in r.faces.iter() {
+        out.faces.push(face);
+    }
+    out.vertices = r.vertices;
+    out.resolved_bound = r.bound;
+    out.ball = (centre, bounds.diagonal() / 2.0);
+    out.cut_faces = r.cut;
+    out.changed |= r.changed;
 }
 
 /// The faces kept, those marked turned reversed.
@@ -195,6 +329,7 @@ fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
                 faces: Vec::new(),
                 closed: true,
                 motion: 0.0,
+                sealed: true,
                 area2: [0.0; 3],
                 volume6: 0.0,
                 bounds: Aabb::EMPTY,
@@ -216,6 +351,7 @@ fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
         }
     }
     for s in &mut out {
+        s.sealed = s.closed;
         if !s.closed {
             let diag = s.bounds.diagonal();
             s.motion = dot(s.area2, s.area2).sqrt() / 2.0 * diag / 6.0;
@@ -225,7 +361,7 @@ fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
     out
 }
 
-fn root(parent: &mut [u32], mut x: u32) -> u32 {
+pub(super) fn root(parent: &mut [u32], mut x: u32) -> u32 {
     while parent[x as usize] != x {
         let up = parent[parent[x as usize] as usize];
         parent[x as usize] = up;
@@ -336,7 +472,7 @@ fn integer(w: f64) -> Option<i64> {
     ((w - r).abs() <= NOT_INTEGER).then_some(r as i64)
 }
 
-fn c3(p: [f64; 3]) -> Coord3D<f64> {
+pub(super) fn c3(p: [f64; 3]) -> Coord3D<f64> {
     Coord3D {
         x: p[0],
         y: p[1],
@@ -347,7 +483,7 @@ fn c3(p: [f64; 3]) -> Coord3D<f64> {
 /// Whether two triangles may touch: exact, and conservative for coplanar ones (any coplanar pair
 /// whose boxes meet counts as touching). Non-coplanar triangles meet only where an edge of one
 /// crosses the other.
-fn triangles_touch(v: &[[f64; 3]], x: &[u32; 3], y: &[u32; 3]) -> bool {
+pub(super) fn triangles_touch(v: &[[f64; 3]], x: &[u32; 3], y: &[u32; 3]) -> bool {
     let p = |t: &[u32; 3]| t.map(|i| v[i as usize]);
     let (px, py) = (p(x), p(y));
     let boxes_meet = (0..3).all(|k| {
@@ -372,7 +508,7 @@ fn triangles_touch(v: &[[f64; 3]], x: &[u32; 3], y: &[u32; 3]) -> bool {
 }
 
 /// Whether the closed segment `s e` meets the closed triangle `t` (coplanar: yes, conservatively).
-fn segment_meets(s: [f64; 3], e: [f64; 3], t: [[f64; 3]; 3]) -> bool {
+pub(super) fn segment_meets(s: [f64; 3], e: [f64; 3], t: [[f64; 3]; 3]) -> bool {
     let (a, b, c) = (c3(t[0]), c3(t[1]), c3(t[2]));
     let (o1, o2) = (orient3d(a, b, c, c3(s)), orient3d(a, b, c, c3(e)));
     if (o1 > 0.0 && o2 > 0.0) || (o1 < 0.0 && o2 < 0.0) {

@@ -1,0 +1,577 @@
+//! Closed shells that touch or cut each other, decided face by face.
+//!
+//! The solid's integral is a sum over faces: across a face the winding number w jumps by one, from
+//! W in front of it to W + 1 behind, so a piece of face bounds Ω = {|w| ≥ 1} outward when only the
+//! back is in Ω, inward when only the front is, and not at all when both or neither are. W is
+//! constant on a piece of face that no other triangle meets, so one exact ray (`orient3d` crossings)
+//! decides it. A triangle that another one cuts is split in four, again and again, and its pieces
+//! that no triangle meets any more are decided the same way; the pieces still cut when the work or
+//! the wanted bound is reached keep the orientation the shells' classification gave, and each adds
+//! the cone it spans from the surface's box centre (the volume a wrong orientation can change) to
+//! the bound, twice when it may count twice.
+
+use super::grid::{Corners, Grid, Seen};
+use super::{c3, segment_meets, triangles_touch};
+use crate::geometry::{cross, dot, sub, Aabb};
+use crate::mass::Polygons;
+use robust::{orient2d, orient3d, Coord};
+use rustc_hash::FxHashMap;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// Splits (one piece into four) beyond which the pieces still cut are bounded, not split.
+const MAX_SPLITS: usize = 20_000;
+
+/// Pieces that more planes than this would cut (a triangle's, or a coplanar triangle's three edges)
+/// are split in four first.
+const MAX_CUTS: usize = 40;
+
+/// A triangle whose plane is within this share of the diagonal of a piece everywhere on it is taken
+/// as lying in the piece's plane.
+const NEAR: f64 = 1e-7;
+
+/// Cells beyond which a piece is split in four rather than cut.
+const MAX_CELLS: usize = 256;
+
+/// Rays tried on a patch of uncut faces before it is split like a cut one.
+const MAX_TRIES: usize = 8;
+
+/// The faces of the shells that touch or cut each other, as far as the winding number decides them.
+pub(super) struct Resolved {
+    /// The triangles and pieces, oriented as they bound Ω (the undecided ones as classified).
+    pub(super) faces: Polygons,
+    /// The pieces' new corners, numbered on from the surface's vertices.
+    pub(super) vertices: Vec<[f64; 3]>,
+    /// The volume the undecided pieces can change, m³ (cones about `centre`).
+    pub(super) bound: f64,
+    /// Triangles that other triangles cut (split into pieces).
+    pub(super) cut: usize,
+    /// Whether some face's orientation differs from the classification's.
+    pub(super) changed: bool,
+}
+
+/// A piece of triangle `t` waiting to be decided: the volume it may change, its corners and the
+/// triangles that may meet it.
+struct Piece {
+    delta: f64,
+    corners: Corners,
+    t: u32,
+    blockers: Vec<u32>,
+}
+
+impl PartialEq for Piece {
+    fn eq(&self, other: &Self) -> bool {
+        self.delta.total_cmp(&other.delta) == Ordering::Equal
+    }
+}
+impl Eq for Piece {}
+impl PartialOrd for Piece {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Piece {
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.delta.total_cmp(&other.delta)
+    }
+}
+
+/// The triangles and what the decision needs about them.
+struct Faces<'a> {
+    vertices: &'a [[f64; 3]],
+    tris: &'a [[u32; 3]],
+    /// The orientation the classification gave each triangle's shell: 1, −1 (turned) or 0 (dropped).
+    sign: &'a [i64],
+    corners: Vec<Corners>,
+    grid: Grid,
+    centre: [f64; 3],
+    /// Distances below this are not trusted to f64 plane tests.
+    margin: f64,
+}
+
+/// Decides the triangles `tris` (closed shells whose pairs the classification left open; `sign` per
+/// triangle) until the pieces left undecided change at most `target` m³, or the work is spent.
+pub(super) fn resolve(
+    vertices: &[[f64; 3]],
+    tris: &[[u32; 3]],
+    sign: &[i64],
+    centre: [f64; 3],
+    target: f64,
+) -> Resolved {
+    let corners: Vec<Corners> = tris
+        .iter()
+        .map(|t| t.map(|i| vertices[i as usize]))
+        .collect();
+    let boxes: Vec<Aabb> = corners.iter().map(|c| Aabb::of(*c)).collect();
+    let grid = Grid::new(&boxes);
+    let margin = 1e-12 * grid.bounds.diagonal();
+    let f = Faces {
+        vertices,
+        tris,
+        sign,
+        corners,
+        grid,
+        centre,
+        margin,
+    };
+    let mut seen = Seen::new(tris.len());
+    let blockers = f.all_blockers(&boxes, &mut seen);
+    let mut out = Resolved {
+        faces: Polygons::new(),
+        vertices: Vec::new(),
+        bound: 0.0,
+        cut: blockers.iter().filter(|b| !b.is_empty()).count(),
+        changed: false,
+    };
+    let mut heap = BinaryHeap::new();
+    f.patches(&blockers, &mut seen, &mut out, &mut heap);
+    for (t, b) in blockers.into_iter().enumerate() {
+        if !b.is_empty() && !f.cut(&f.corners[t], t as u32, &b, &mut seen, &mut out) {
+            heap.push(f.piece(f.corners[t], t as u32, b));
+        }
+    }
+    f.refine(heap, target, &mut seen, &mut out);
+    out
+}
+
+impl Faces<'_> {
+    /// For each triangle, the others that may meet it other than along a shared edge or at a
+    /// shared corner.
+    fn all_blockers(&self, boxes: &[Aabb], seen: &mut Seen) -> Vec<Vec<u32>> {
+        let mut near = Vec::new();
+        (0..self.tris.len())
+            .map(|t| {
+                let b = inflated(boxes[t], self.margin);
+                self.grid.candidates(&b, seen, &mut near);
+                near.iter()
+                    .copied()
+                    .filter(|&u| {
+                        u as usize != t
+                            && overlap(&b, &boxes[u as usize])
+                            && self.blocks(t, u as usize)
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Whether triangle `u` may meet the relative interior of triangle `t` (exact, conservative).
+    fn blocks(&self, t: usize, u: usize) -> bool {
+        let (tt, tu) = (self.tris[t], self.tris[u]);
+        let shared: Vec<u32> = tt.iter().copied().filter(|v| tu.contains(v)).collect();
+        let (pt, pu) = (self.corners[t], self.corners[u]);
+        match shared.len() {
+            0 => triangles_touch(self.vertices, &tt, &tu),
+            1 => {
+                let v = shared[0];
+                let rot = |tri: [u32; 3], p: Corners| {
+                    let i = tri.iter().position(|&x| x == v).unwrap_or(0);
+                    [p[i], p[(i + 1) % 3], p[(i + 2) % 3]]
+                };
+                shares_corner(rot(tt, pt), rot(tu, pu))
+            }
+            2 => {
+                let other = |tri: [u32; 3], p: Corners| {
+                    let i = tri.iter().position(|x| !shared.contains(x)).unwrap_or(0);
+                    p[i]
+                };
+                let (a, b) = (self.vertices[shared[0] as usize], self.vertices[shared[1] as usize]);
+                let (x, y) = (other(tt, pt), other(tu, pu));
+                if orient3d(c3(a), c3(b), c3(x), c3(y)) != 0.0 {
+                    return false;
+                }
+                // Coplanar: a blocker unless the two lie on opposite sides of the shared edge.
+                let k = normal_axis(pt);
+                let s = orient2d(c2(a, k), c2(b, k), c2(x, k)) * orient2d(c2(a, k), c2(b, k), c2(y, k));
+                s >= 0.0
+            }
+            _ => true,
+        }
+    }
+
+    /// Uncut triangles joined across the edges they share, each patch decided by one ray; the
+    /// patches no ray decides go to `heap` whole.
+    fn patches(&self, blockers: &[Vec<u32>], seen: &mut Seen, out: &mut Resolved, heap: &mut BinaryHeap<Piece>) {
+        let n = self.tris.len();
+        let mut by_edge: FxHashMap<(u32, u32), Vec<(u32, bool)>> = FxHashMap::default();
+        for (i, t) in self.tris.iter().enumerate() {
+            if !blockers[i].is_empty() {
+                continue;
+            }
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                by_edge.entry((a.min(b), a.max(b))).or_default().push((i as u32, a < b));
+            }
+        }
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        for users in by_edge.values() {
+            if users.len() == 2 && users[0].1 != users[1].1 {
+                let (a, b) = (
+                    super::root(&mut parent, users[0].0),
+                    super::root(&mut parent, users[1].0),
+                );
+                parent[a.max(b) as usize] = a.min(b);
+            }
+        }
+        let mut members: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+        for t in 0..n as u32 {
+            if blockers[t as usize].is_empty() {
+                members.entry(super::root(&mut parent, t)).or_default().push(t);
+            }
+        }
+        let mut roots: Vec<u32> = members.keys().copied().collect();
+        roots.sort_unstable();
+        for r in roots {
+            let patch = &members[&r];
+            let kappa = patch
+                .iter()
+                .take(MAX_TRIES)
+                .find_map(|&t| self.decide(&self.corners[t as usize], t, seen));
+            for &t in patch {
+                match kappa {
+                    Some(k) => self.emit_whole(t, k, out),
+                    None => heap.push(self.piece(self.corners[t as usize], t, Vec::new())),
+                }
+            }
+        }
+    }
+
+    /// Splits the pieces that may change the most until those left change at most `target`.
+    fn refine(&self, mut heap: BinaryHeap<Piece>, target: f64, seen: &mut Seen, out: &mut Resolved) {
+        let mut pending: f64 = heap.iter().map(|p| p.delta).sum();
+        let mut splits = 0;
+        while pending > target && splits < MAX_SPLITS {
+            let Some(p) = heap.pop() else { break };
+            pending -= p.delta;
+            splits += 1;
+            for child in split(p.corners) {
+                let b = inflated(Aabb::of(child), self.margin);
+                let blockers: Vec<u32> = p
+                    .blockers
+                    .iter()
+                    .copied()
+                    .filter(|&u| overlap(&b, &Aabb::of(self.corners[u as usize])) && self.may_meet(&child, u))
+                    .collect();
+                if blockers.is_empty() {
+                    if let Some(k) = self.decide(&child, p.t, seen) {
+                        self.emit(&child, k, out);
+                        continue;
+                    }
+                } else if self.cut(&child, p.t, &blockers, seen, out) {
+                    continue;
+                }
+                let piece = self.piece(child, p.t, blockers);
+                pending += piece.delta;
+                heap.push(piece);
+            }
+        }
+        for p in heap {
+            out.bound += p.delta;
+            self.emit(&p.corners, self.sign[p.t as usize], out);
+        }
+    }
+
+    fn piece(&self, corners: Corners, t: u32, blockers: Vec<u32>) -> Piece {
+        Piece {
+            delta: self.delta(&corners, t),
+            corners,
+            t,
+            blockers,
+        }
+    }
+
+    /// The most a piece of triangle `t` oriented wrongly can change the volume: its cone from the
+    /// centre, twice when the classification kept it (it may count −1 instead of 1).
+    fn delta(&self, poly: &[[f64; 3]], t: u32) -> f64 {
+        let reach = poly
+            .iter()
+            .map(|c| norm(sub(*c, self.centre)))
+            .fold(0.0, f64::max);
+        let s = self.sign[t as usize].abs() as f64;
+        (1.0 + s) * area(poly) * reach / 3.0
+    }
+
+    /// Whether triangle `u` may meet the piece: not when the piece lies beyond the margin on one
+    /// side of `u`'s plane.
+    fn may_meet(&self, piece: &Corners, u: u32) -> bool {
+        let [a, b, c] = self.corners[u as usize];
+        let (ab, ac) = (sub(b, a), sub(c, a));
+        let n = cross(ab, ac);
+        let m = self.margin * norm(ab) * norm(ac);
+        let d = piece.map(|p| dot(n, sub(p, a)));
+        !(d.iter().all(|x| *x > m) || d.iter().all(|x| *x < -m))
+    }
+
+    /// How a piece of triangle `t` no other triangle meets bounds Ω: 1 outward, −1 inward, 0 not
+    /// at all; `None` when no ray from its centre counts exactly.
+    fn decide(&self, piece: &[[f64; 3]], t: u32, seen: &mut Seen) -> Option<i64> {
+        self.decide_where(piece, t, seen, |_| true, &[])
+    }
+
+    /// [`Faces::decide`] from the first of a few points inside the piece that `usable` accepts and
+    /// from which a ray counts exactly (a ray along a face's edge or plane does not). Triangles in
+    /// `t`'s plane that cover the point add their jumps to `t`'s; the lowest-numbered of them
+    /// carries the sum, the others nothing.
+    fn decide_where(
+        &self,
+        piece: &[[f64; 3]],
+        t: u32,
+        seen: &mut Seen,
+        usable: impl Fn([f64; 3]) -> bool,
+        coplanar: &[Coplanar],
+    ) -> Option<i64> {
+        let c = self.corners[t as usize];
+        let n = cross(sub(c[1], c[0]), sub(c[2], c[0]));
+        let mut axes = [0, 1, 2];
+        axes.sort_by(|&a, &b| n[b].abs().total_cmp(&n[a].abs()));
+        let mid = centroid(piece);
+        let inner = piece.iter().map(|v| [0, 1, 2].map(|k| (3.0 * mid[k] + v[k]) / 4.0));
+        let mut skip = vec![t];
+        let (jump, front) = std::iter::once(mid)
+            .chain(inner)
+            .filter(|&p| usable(p))
+            .find_map(|p| {
+                skip.truncate(1);
+                let mut jump = 1;
+                for cp in coplanar.iter().filter(|cp| cp.covers(p)) {
+                    skip.push(cp.u);
+                    jump += if cp.same { 1 } else { -1 };
+                }
+                let front = axes.iter().filter(|&&k| n[k] != 0.0).find_map(|&k| {
+                    self.grid
+                        .winding(&self.corners, p, k, n[k].signum(), &skip, seen)
+                })?;
+                Some((jump, front))
+            })?;
+        if skip.iter().any(|&u| u < t) {
+            return Some(0);
+        }
+        let solid = |w: i64| i64::from(w.abs() >= 1);
+        Some(solid(front + jump) - solid(front))
+    }
+
+    fn emit_whole(&self, t: u32, kappa: i64, out: &mut Resolved) {
+        let tri = self.tris[t as usize];
+        out.changed |= kappa != self.sign[t as usize];
+        match kappa {
+            1 => out.faces.push(&tri),
+            -1 => out.faces.push(&[tri[2], tri[1], tri[0]]),
+            _ => {}
+        }
+    }
+
+    fn emit(&self, piece: &[[f64; 3]], kappa: i64, out: &mut Resolved) {
+        out.changed = true;
+        if kappa == 0 {
+            return;
+        }
+        let base = (self.vertices.len() + out.vertices.len()) as u32;
+        out.vertices.extend_from_slice(piece);
+        let mut face: Vec<u32> = (base..base + piece.len() as u32).collect();
+        if kappa < 0 {
+            face.reverse();
+        }
+        out.faces.push(&face);
+    }
+
+    /// When no blocker lies in `t`'s plane (and they are few): the piece cut along the blockers'
+    /// planes into convex cells that no triangle meets any more, each decided by a ray, or bounded
+    /// when it is a sliver the plane tests cannot tell from a cut. Whether it did so.
+    fn cut(&self, piece: &Corners, t: u32, blockers: &[u32], seen: &mut Seen, out: &mut Resolved) -> bool {
+        let [p, q, r] = self.corners[t as usize].map(c3);
+        let nt = {
+            let c = self.corners[t as usize];
+            cross(sub(c[1], c[0]), sub(c[2], c[0]))
+        };
+        let mut planes = Vec::with_capacity(blockers.len());
+        let mut coplanar = Vec::new();
+        for &u in blockers {
+            let [a, b, c] = self.corners[u as usize];
+            let (ab, ac) = (sub(b, a), sub(c, a));
+            let n = cross(ab, ac);
+            let gap = piece
+                .iter()
+                .map(|x| dot(n, sub(*x, a)).abs() / norm(n))
+                .fold(0.0, f64::max);
+            let exact = [a, b, c].iter().all(|&x| orient3d(p, q, r, c3(x)) == 0.0);
+            if exact || gap <= NEAR * self.grid.bounds.diagonal() {
+                // Nearly in t's plane: taken as in it, which moves the solid by at most the slab
+                // between the two over the piece (on both sides).
+                if !exact {
+                    out.bound += 2.0 * area(piece) * gap;
+                }
+                let cp = Coplanar::new(u, [a, b, c], nt, self.margin);
+                planes.extend_from_slice(&cp.edges);
+                coplanar.push(cp);
+            } else {
+                planes.push((a, cross(ab, ac), self.margin * norm(ab) * norm(ac)));
+            }
+        }
+        if planes.len() > MAX_CUTS {
+            return false;
+        }
+        let mut cells = vec![piece.to_vec()];
+        for &(a, n, m) in &planes {
+            let mut next = Vec::with_capacity(2 * cells.len());
+            for cell in &cells {
+                let d: Vec<f64> = cell.iter().map(|x| dot(n, sub(*x, a))).collect();
+                // A plane along the cell's side (one cut already, or a shared edge) leaves it whole.
+                if d.iter().all(|&x| x >= -m) || d.iter().all(|&x| x <= m) {
+                    next.push(cell.clone());
+                    continue;
+                }
+                for side in [1.0, -1.0] {
+                    let part = clip(cell, &d, side);
+                    if part.len() >= 3 {
+                        next.push(part);
+                    }
+                }
+            }
+            cells = next;
+            if cells.len() > MAX_CELLS {
+                return false;
+            }
+        }
+        let apart = |x: [f64; 3]| planes.iter().all(|&(a, n, m)| dot(n, sub(x, a)).abs() > m);
+        for cell in cells {
+            if let Some(k) = self.decide_where(&cell, t, seen, apart, &coplanar) {
+                self.emit(&cell, k, out);
+            } else {
+                out.bound += self.delta(&cell, t);
+                self.emit(&cell, self.sign[t as usize], out);
+            }
+        }
+        true
+    }
+}
+
+/// A triangle in the plane of the one being decided: its edges as planes across that plane (normals
+/// pointing into it), and whether it faces the same way.
+struct Coplanar {
+    u: u32,
+    edges: [([f64; 3], [f64; 3], f64); 3],
+    same: bool,
+}
+
+impl Coplanar {
+    fn new(u: u32, c: Corners, nt: [f64; 3], margin: f64) -> Coplanar {
+        let nu = cross(sub(c[1], c[0]), sub(c[2], c[0]));
+        let edges = [0, 1, 2].map(|k| {
+            let (a, b, o) = (c[k], c[(k + 1) % 3], c[(k + 2) % 3]);
+            let mut n = cross(nt, sub(b, a));
+            if dot(n, sub(o, a)) < 0.0 {
+                n = n.map(|x| -x);
+            }
+            (a, n, margin * norm(nt) * norm(sub(b, a)))
+        });
+        Coplanar {
+            u,
+            edges,
+            same: dot(nu, nt) > 0.0,
+        }
+    }
+
+    /// Whether `p` (off every edge plane by more than its margin) lies inside.
+    fn covers(&self, p: [f64; 3]) -> bool {
+        self.edges.iter().all(|&(a, n, _)| dot(n, sub(p, a)) > 0.0)
+    }
+}
+
+/// Two triangles `[v, …]` sharing their first corner: whether they may meet elsewhere (exact,
+/// conservative).
+fn shares_corner(t: Corners, u: Corners) -> bool {
+    let (a, b, c) = (c3(t[0]), c3(t[1]), c3(t[2]));
+    let (ub, uc) = (orient3d(a, b, c, c3(u[1])), orient3d(a, b, c, c3(u[2])));
+    if (ub > 0.0 && uc > 0.0) || (ub < 0.0 && uc < 0.0) {
+        return false;
+    }
+    if ub == 0.0 && uc == 0.0 {
+        return !coplanar_apart(t, u);
+    }
+    let (p, q, r) = (c3(u[0]), c3(u[1]), c3(u[2]));
+    let (tb, tc) = (orient3d(p, q, r, c3(t[1])), orient3d(p, q, r, c3(t[2])));
+    if ub == 0.0 || uc == 0.0 || tb == 0.0 || tc == 0.0 {
+        return true;
+    }
+    segment_meets(u[1], u[2], t) || segment_meets(t[1], t[2], u)
+}
+
+/// Two coplanar triangles sharing their first corner: whether a line through it along one of their
+/// edges separates them.
+fn coplanar_apart(t: Corners, u: Corners) -> bool {
+    let k = normal_axis(t);
+    let p = |x: [f64; 3]| c2(x, k);
+    let apart = |x: Corners, y: Corners| {
+        [(1, 2), (2, 1)].iter().any(|&(e, o)| {
+            let s = orient2d(p(x[0]), p(x[e]), p(x[o]));
+            s != 0.0
+                && orient2d(p(x[0]), p(x[e]), p(y[1])) * s <= 0.0
+                && orient2d(p(x[0]), p(x[e]), p(y[2])) * s <= 0.0
+        })
+    };
+    apart(t, u) || apart(u, t)
+}
+
+/// The axis along which a triangle's normal is largest (dropping it projects the triangle without
+/// folding it).
+fn normal_axis(t: Corners) -> usize {
+    let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+    (0..3)
+        .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
+        .unwrap_or(2)
+}
+
+fn c2(p: [f64; 3], drop: usize) -> Coord<f64> {
+    Coord {
+        x: p[(drop + 1) % 3],
+        y: p[(drop + 2) % 3],
+    }
+}
+
+/// The part of a convex polygon on one side (`side` = ±1) of a plane, given its corners' signed
+/// distances `d` (corners on the plane belong to both sides).
+fn clip(poly: &[[f64; 3]], d: &[f64], side: f64) -> Vec<[f64; 3]> {
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for i in 0..poly.len() {
+        let j = (i + 1) % poly.len();
+        let (di, dj) = (d[i] * side, d[j] * side);
+        if di >= 0.0 {
+            out.push(poly[i]);
+        }
+        if (di > 0.0 && dj < 0.0) || (di < 0.0 && dj > 0.0) {
+            let s = di / (di - dj);
+            out.push([0, 1, 2].map(|k| poly[i][k] + s * (poly[j][k] - poly[i][k])));
+        }
+    }
+    out
+}
+
+fn area(poly: &[[f64; 3]]) -> f64 {
+    (1..poly.len() - 1)
+        .map(|k| norm(cross(sub(poly[k], poly[0]), sub(poly[k + 1], poly[0]))) / 2.0)
+        .sum()
+}
+
+fn centroid(poly: &[[f64; 3]]) -> [f64; 3] {
+    let n = poly.len() as f64;
+    [0, 1, 2].map(|k| poly.iter().map(|p| p[k]).sum::<f64>() / n)
+}
+
+/// The four halves-of-edges triangles of a triangle.
+fn split(t: Corners) -> [Corners; 4] {
+    let mid = |a: [f64; 3], b: [f64; 3]| [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
+    let (ab, bc, ca) = (mid(t[0], t[1]), mid(t[1], t[2]), mid(t[2], t[0]));
+    [[t[0], ab, ca], [ab, t[1], bc], [ca, bc, t[2]], [ab, bc, ca]]
+}
+
+fn inflated(b: Aabb, m: f64) -> Aabb {
+    Aabb::new(b.lo.map(|x| x - m), b.hi.map(|x| x + m))
+}
+
+fn overlap(a: &Aabb, b: &Aabb) -> bool {
+    (0..3).all(|k| a.lo[k] <= b.hi[k] && b.lo[k] <= a.hi[k])
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}

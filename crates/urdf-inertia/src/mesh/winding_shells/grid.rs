@@ -1,0 +1,267 @@
+//! A uniform grid of triangles: which triangles may meet a box, and the winding number in front of a
+//! point on a face, counted by exact crossings (`orient3d`) of an axis-parallel ray.
+
+use crate::geometry::Aabb;
+use robust::orient3d;
+
+use super::c3;
+
+/// A triangle's three corners.
+pub(super) type Corners = [[f64; 3]; 3];
+
+/// Cells per axis at most (the grid has about as many cells as triangles).
+const MAX_DIM: usize = 128;
+
+/// Triangles bucketed by the cells their boxes cover.
+pub(super) struct Grid {
+    lo: [f64; 3],
+    cell: [f64; 3],
+    dims: [usize; 3],
+    /// Where each cell's triangles start in `items` (one more entry than cells).
+    start: Vec<u32>,
+    items: Vec<u32>,
+    /// The box of every triangle in the grid.
+    pub(super) bounds: Aabb,
+}
+
+/// Which triangles a query has seen already (a triangle sits in every cell its box covers).
+pub(super) struct Seen {
+    mark: Vec<u32>,
+    round: u32,
+}
+
+impl Seen {
+    pub(super) fn new(n: usize) -> Seen {
+        Seen {
+            mark: vec![0; n],
+            round: 0,
+        }
+    }
+
+    fn next(&mut self) {
+        self.round = self.round.wrapping_add(1);
+        if self.round == 0 {
+            self.mark.iter_mut().for_each(|m| *m = 0);
+            self.round = 1;
+        }
+    }
+
+    /// Marks `i`; whether it was new in this round.
+    fn first(&mut self, i: u32) -> bool {
+        let m = &mut self.mark[i as usize];
+        let new = *m != self.round;
+        *m = self.round;
+        new
+    }
+}
+
+/// What an axis-parallel segment does at a triangle.
+enum Crossing {
+    Miss,
+    /// Crosses its interior: +1 leaving through its front (the side its normal points to), −1 entering.
+    Through(i64),
+    /// Touches an edge, a vertex or its plane: the count would not be exact.
+    Degenerate,
+}
+
+impl Grid {
+    pub(super) fn new(boxes: &[Aabb]) -> Grid {
+        let bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
+        let ext = bounds.extent();
+        let largest = ext.iter().copied().fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+        let ext = ext.map(|e| e.max(largest * 1e-6));
+        let h = (ext.iter().product::<f64>() / boxes.len().max(1) as f64).cbrt();
+        let dims = ext.map(|e| ((e / h).ceil() as usize).clamp(1, MAX_DIM));
+        let cell = [0, 1, 2].map(|k| ext[k] / dims[k] as f64);
+        let mut grid = Grid {
+            lo: bounds.lo,
+            cell,
+            dims,
+            start: Vec::new(),
+            items: Vec::new(),
+            bounds,
+        };
+        let cells = dims.iter().product::<usize>();
+        let mut count = vec![0u32; cells + 1];
+        for b in boxes {
+            grid.each_cell(b, |c| count[c + 1] += 1);
+        }
+        for c in 0..cells {
+            count[c + 1] += count[c];
+        }
+        let mut fill = count.clone();
+        let mut items = vec![0u32; count[cells] as usize];
+        for (i, b) in boxes.iter().enumerate() {
+            grid.each_cell(b, |c| {
+                items[fill[c] as usize] = i as u32;
+                fill[c] += 1;
+            });
+        }
+        grid.start = count;
+        grid.items = items;
+        grid
+    }
+
+    fn index(&self, k: usize, x: f64) -> usize {
+        let i = ((x - self.lo[k]) / self.cell[k]).floor();
+        if i.is_nan() || i < 0.0 {
+            0
+        } else {
+            (i as usize).min(self.dims[k] - 1)
+        }
+    }
+
+    fn each_cell(&self, b: &Aabb, mut f: impl FnMut(usize)) {
+        let r = [0, 1, 2].map(|k| (self.index(k, b.lo[k]), self.index(k, b.hi[k])));
+        for x in r[0].0..=r[0].1 {
+            for y in r[1].0..=r[1].1 {
+                for z in r[2].0..=r[2].1 {
+                    f((x * self.dims[1] + y) * self.dims[2] + z);
+                }
+            }
+        }
+    }
+
+    fn cell_items(&self, c: usize) -> &[u32] {
+        &self.items[self.start[c] as usize..self.start[c + 1] as usize]
+    }
+
+    /// The triangles whose cells meet `b`, each once (a superset of those whose boxes meet it).
+    pub(super) fn candidates(&self, b: &Aabb, seen: &mut Seen, out: &mut Vec<u32>) {
+        out.clear();
+        seen.next();
+        self.each_cell(b, |c| {
+            for &i in self.cell_items(c) {
+                if seen.first(i) {
+                    out.push(i);
+                }
+            }
+        });
+    }
+
+    /// The winding number of the triangles (all but those in `skip`) at `p`, counted along the ray from `p`
+    /// in direction `sign`·e_`axis` to beyond the grid; `None` when the ray touches an edge, a
+    /// vertex or a plane of one of them.
+    pub(super) fn winding(
+        &self,
+        corners: &[Corners],
+        p: [f64; 3],
+        axis: usize,
+        sign: f64,
+        skip: &[u32],
+        seen: &mut Seen,
+    ) -> Option<i64> {
+        let mut end = p;
+        let margin = self.cell[axis];
+        end[axis] = if sign > 0.0 {
+            self.bounds.hi[axis].max(p[axis]) + margin
+        } else {
+            self.bounds.lo[axis].min(p[axis]) - margin
+        };
+        seen.next();
+        let (j, l) = ((axis + 1) % 3, (axis + 2) % 3);
+        let (cj, cl) = (self.index(j, p[j]), self.index(l, p[l]));
+        let from = self.index(axis, p[axis]);
+        let row: Box<dyn Iterator<Item = usize>> = if sign > 0.0 {
+            Box::new(from..self.dims[axis])
+        } else {
+            Box::new((0..=from).rev())
+        };
+        let mut w = 0;
+        for ck in row {
+            let mut idx = [0; 3];
+            (idx[axis], idx[j], idx[l]) = (ck, cj, cl);
+            let c = (idx[0] * self.dims[1] + idx[1]) * self.dims[2] + idx[2];
+            for &i in self.cell_items(c) {
+                if skip.contains(&i) || !seen.first(i) {
+                    continue;
+                }
+                let t = &corners[i as usize];
+                // The segment varies along `axis` only: a triangle whose box misses its line, or
+                // lies wholly behind its start, is missed (exact comparisons).
+                let outside = |k: usize, x: f64| {
+                    t.iter().all(|c| c[k] < x) || t.iter().all(|c| c[k] > x)
+                };
+                let behind = if sign > 0.0 {
+                    t.iter().all(|c| c[axis] < p[axis])
+                } else {
+                    t.iter().all(|c| c[axis] > p[axis])
+                };
+                if outside(j, p[j]) || outside(l, p[l]) || behind {
+                    continue;
+                }
+                match crossing(p, end, t) {
+                    Crossing::Miss => {}
+                    Crossing::Through(d) => w += d,
+                    Crossing::Degenerate => return None,
+                }
+            }
+        }
+        Some(w)
+    }
+}
+
+/// The segment `s e` at the triangle `t`, exactly.
+fn crossing(s: [f64; 3], e: [f64; 3], t: &Corners) -> Crossing {
+    let (a, b, c) = (c3(t[0]), c3(t[1]), c3(t[2]));
+    let (os, oe) = (orient3d(a, b, c, c3(s)), orient3d(a, b, c, c3(e)));
+    if (os > 0.0 && oe > 0.0) || (os < 0.0 && oe < 0.0) {
+        return Crossing::Miss;
+    }
+    let (cs, ce) = (c3(s), c3(e));
+    let q = [
+        orient3d(cs, ce, a, b),
+        orient3d(cs, ce, b, c),
+        orient3d(cs, ce, c, a),
+    ];
+    if q.iter().any(|x| *x > 0.0) && q.iter().any(|x| *x < 0.0) {
+        return Crossing::Miss;
+    }
+    if os == 0.0 || oe == 0.0 || q.contains(&0.0) {
+        return Crossing::Degenerate;
+    }
+    // orient3d > 0: the point is behind the triangle (its corners turn clockwise seen from it).
+    Crossing::Through(if os > 0.0 { 1 } else { -1 })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The unit cube's twelve triangles, outward.
+    fn cube() -> Vec<Corners> {
+        let p = |i: usize| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64];
+        let quads = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        quads
+            .iter()
+            .flat_map(|q| [[p(q[0]), p(q[1]), p(q[2])], [p(q[0]), p(q[2]), p(q[3])]])
+            .collect()
+    }
+
+    #[test]
+    fn winding_inside_and_outside_a_cube() {
+        let corners = cube();
+        let boxes: Vec<Aabb> = corners.iter().map(|t| Aabb::of(*t)).collect();
+        let grid = Grid::new(&boxes);
+        let mut seen = Seen::new(corners.len());
+        let inside = [0.3, 0.4, 0.45];
+        for axis in 0..3 {
+            for sign in [1.0, -1.0] {
+                let w = grid.winding(&corners, inside, axis, sign, &[], &mut seen);
+                assert_eq!(w, Some(1));
+                let w = grid.winding(&corners, [1.5, 0.3, 0.4], axis, sign, &[], &mut seen);
+                assert_eq!(w, Some(0));
+            }
+        }
+        // Through the diagonal of a face: degenerate.
+        let w = grid.winding(&corners, [0.5, 0.5, 0.5], 2, 1.0, &[], &mut seen);
+        assert_eq!(w, None);
+    }
+}

@@ -1,0 +1,264 @@
+//! Closed shells that cut or touch each other on the repaired rungs: the solid Ω = {x : |w(x)| ≥ ½}
+//! against exact rational integrals of boxes (a union of boxes is exact through inclusion–exclusion)
+//! and, for a sphere through a box, against an independent winding number sampled here.
+
+// The test helpers are the library tests' own (exact integrals, mesh generators).
+#[path = "../crates/urdf-inertia/tests/common/mod.rs"]
+mod common;
+
+use common::{ExactMass, Mesh};
+use num_rational::BigRational;
+use std::path::Path;
+use urdf_inertia::mass::Polygons;
+use urdf_inertia::mesh::health::{HealthOptions, Solid};
+use urdf_inertia::mesh::RawMesh;
+
+fn solid(mesh: &Mesh) -> Solid {
+    let raw = RawMesh {
+        vertices: mesh.0.clone(),
+        faces: Polygons::from_triangles(&mesh.1),
+        ..Default::default()
+    };
+    urdf_inertia::mesh::solid_from_raw(
+        &raw,
+        [1.0; 3],
+        Path::new("shells.obj"),
+        HealthOptions::default(),
+    )
+    .expect("a solid")
+}
+
+/// A box from `lo` to `hi` (outward triangles).
+fn box_at(lo: [f64; 3], hi: [f64; 3]) -> Mesh {
+    let (v, f) = common::box_mesh([hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]]);
+    let v = v
+        .iter()
+        .map(|p| std::array::from_fn(|k| p[k] + f64::midpoint(lo[k], hi[k])))
+        .collect();
+    (v, f)
+}
+
+/// The box's faces without those on its top (largest z): open, so the mesh reaches the capped rung.
+fn open_top(b: &Mesh) -> Mesh {
+    let top = b.0.iter().map(|p| p[2]).fold(f64::MIN, f64::max);
+    let f =
+        b.1.iter()
+            .copied()
+            .filter(|t| !t.iter().all(|&i| b.0[i as usize][2] == top))
+            .collect();
+    (b.0.clone(), f)
+}
+
+/// The meshes in one vertex list, those marked `true` wound inward.
+fn together(parts: &[(&Mesh, bool)]) -> Mesh {
+    let (mut v, mut f) = (Vec::new(), Vec::new());
+    for (m, inward) in parts {
+        let n = v.len() as u32;
+        v.extend_from_slice(&m.0);
+        f.extend(m.1.iter().map(|t| {
+            let t = t.map(|i| i + n);
+            if *inward {
+                [t[0], t[2], t[1]]
+            } else {
+                t
+            }
+        }));
+    }
+    (v, f)
+}
+
+/// Σ cᵢ × (integrals of box i): a union or difference of boxes through inclusion–exclusion.
+fn exact_sum(terms: &[(i32, &Mesh)]) -> ExactMass {
+    let mut t: [BigRational; 10] = std::array::from_fn(|_| common::rat(0.0));
+    for (c, m) in terms {
+        let u = common::exact_integrals(&m.0, &m.1);
+        let c = BigRational::from_integer((*c).into());
+        t = std::array::from_fn(|k| &t[k] + &u[k] * &c);
+    }
+    common::exact_mass(&t)
+}
+
+/// Volume, inertia and centre errors of `s` against `exact`, asserted within its estimate.
+fn within_estimate(name: &str, s: &Solid, exact: &ExactMass) -> f64 {
+    let volume = common::rel_error(s.unit.mass, &exact.volume);
+    let inertia = common::inertia_error(&s.unit.inertia, &exact.inertia);
+    let com = common::com_error(s.unit.com, &exact.com, 1.0);
+    assert!(
+        volume <= s.error_estimate && inertia <= s.error_estimate && com <= s.error.com,
+        "{name}: volume {volume:e}, inertia {inertia:e}, com {com:e}, estimate {:e} (com {:e})\n{:?}",
+        s.error_estimate,
+        s.error.com,
+        s.warnings
+    );
+    volume.max(inertia)
+}
+
+/// An open box (capped) and a closed box through its wall: the region inside both counted once,
+/// exactly (the faces are decided piece by piece), against box + box − their intersection.
+#[test]
+fn two_boxes_that_cut_each_other_count_their_intersection_once() {
+    let a = box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let b = box_at([0.75, 0.25, 0.25], [1.25, 0.5, 0.5]);
+    let both = box_at([0.75, 0.25, 0.25], [1.0, 0.5, 0.5]);
+    let s = solid(&together(&[(&open_top(&a), false), (&b, false)]));
+    let exact = exact_sum(&[(1, &a), (1, &b), (-1, &both)]);
+    let error = within_estimate("two boxes", &s, &exact);
+    assert!(s.error_estimate <= 1e-6, "{error:e} {:e}", s.error_estimate);
+}
+
+/// Oblique: a box rotated about two axes through another's wall: its faces cut the other's at angles
+/// no grid lines up with. The truth is the same inclusion–exclusion on the exact rotated integrals:
+/// the intersection of an axis box and a rotated box is not a box, so here the truth is sampled.
+#[test]
+fn a_rotated_box_through_a_wall() {
+    let a = box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let r = common::rotation([0.3, 0.2, 0.1]);
+    let b = common::transform(
+        &box_at([-0.3, -0.15, -0.1], [0.3, 0.15, 0.1]),
+        1.0,
+        &r,
+        [1.0, 0.5, 0.5],
+    );
+    let mesh = together(&[(&open_top(&a), false), (&b, false)]);
+    let s = solid(&mesh);
+    let closed = together(&[(&a, false), (&b, false)]);
+    let (truth, sigma) = omega_volume(&closed, [60, 60, 60], 7);
+    let diff = (s.unit.mass - truth).abs();
+    assert!(
+        diff <= s.error_estimate * s.unit.mass + 3.0 * sigma,
+        "{} vs {truth} ± {sigma}",
+        s.unit.mass
+    );
+    assert!(
+        s.error_estimate <= 1e-3,
+        "{:e}\n{:?}",
+        s.error_estimate,
+        s.warnings
+    );
+}
+
+/// One box inside-out: the repair turns it outward first (its faces are re-oriented with the
+/// others), so the solid is the union again, counted once.
+#[test]
+fn an_inside_out_box_through_a_wall_is_turned_and_counted_once() {
+    let a = box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let b = box_at([0.75, 0.25, 0.25], [1.25, 0.5, 0.5]);
+    let both = box_at([0.75, 0.25, 0.25], [1.0, 0.5, 0.5]);
+    let s = solid(&together(&[(&open_top(&a), false), (&b, true)]));
+    let exact = exact_sum(&[(1, &a), (1, &b), (-1, &both)]);
+    let error = within_estimate("inside-out", &s, &exact);
+    assert!(s.error_estimate <= 1e-6, "{error:e} {:e}", s.error_estimate);
+}
+
+/// Three boxes, each cutting the other two: inclusion–exclusion of the union.
+#[test]
+fn three_boxes_pairwise_overlapping() {
+    let a = box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let b = box_at([0.75, 0.25, 0.25], [1.5, 0.75, 0.75]);
+    let c = box_at([1.25, 0.5, 0.5], [2.0, 0.875, 0.625]);
+    let ab = box_at([0.75, 0.25, 0.25], [1.0, 0.75, 0.75]);
+    let bc = box_at([1.25, 0.5, 0.5], [1.5, 0.75, 0.625]);
+    let s = solid(&together(&[
+        (&open_top(&a), false),
+        (&b, false),
+        (&c, false),
+    ]));
+    // a ∩ c is empty, so the union is a + b + c − ab − bc.
+    let exact = exact_sum(&[(1, &a), (1, &b), (1, &c), (-1, &ab), (-1, &bc)]);
+    let error = within_estimate("three boxes", &s, &exact);
+    assert!(
+        s.error_estimate <= 1e-6,
+        "{error:e} {:e} {:?}",
+        s.error_estimate,
+        s.warnings
+    );
+}
+
+/// A box sitting on the other's top, sharing part of that face: nothing is enclosed twice, the
+/// solid is both boxes; the coincident faces are undecided pieces, bounded.
+#[test]
+fn boxes_sharing_part_of_a_face() {
+    let a = box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let b = box_at([0.5, 0.25, 1.0], [1.5, 0.75, 1.5]);
+    let s = solid(&together(&[(&open_top(&a), false), (&b, false)]));
+    let exact = exact_sum(&[(1, &a), (1, &b)]);
+    within_estimate("sharing a face", &s, &exact);
+    assert!(s.error_estimate.is_finite(), "{:?}", s.warnings);
+}
+
+/// A sphere-like polyhedron through a box's wall: the truth sampled from an independent winding
+/// number, with its standard error σ.
+#[test]
+fn a_sphere_through_a_box() {
+    let a = box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let ball = common::transform(
+        &common::icosphere(3),
+        0.3,
+        &common::rotation([0.0; 3]),
+        [1.0, 0.45, 0.55],
+    );
+    let s = solid(&together(&[(&open_top(&a), false), (&ball, false)]));
+    let (truth, sigma) = omega_volume(&together(&[(&a, false), (&ball, false)]), [60, 40, 40], 11);
+    let diff = (s.unit.mass - truth).abs();
+    assert!(
+        diff <= s.error_estimate * s.unit.mass + 3.0 * sigma,
+        "{} vs {truth} ± {sigma}",
+        s.unit.mass
+    );
+    assert!(
+        s.error_estimate <= 1e-3,
+        "{:e}\n{:?}",
+        s.error_estimate,
+        s.warnings
+    );
+}
+
+/// The winding number of a triangle mesh at `x`: its triangles' solid angles over 4π (Van Oosterom
+/// and Strackee 1983), computed here independently of the library.
+fn winding_number(v: &[[f64; 3]], f: &[[u32; 3]], x: [f64; 3]) -> f64 {
+    let sub = |a: [f64; 3]| [a[0] - x[0], a[1] - x[1], a[2] - x[2]];
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let norm = |a: [f64; 3]| dot(a, a).sqrt();
+    let mut sum = 0.0;
+    for t in f {
+        let [a, b, c] = t.map(|i| sub(v[i as usize]));
+        let det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+            + a[2] * (b[0] * c[1] - b[1] * c[0]);
+        let (la, lb, lc) = (norm(a), norm(b), norm(c));
+        let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+        sum += 2.0 * det.atan2(den);
+    }
+    sum / (4.0 * std::f64::consts::PI)
+}
+
+/// The volume of Ω = {x : |w(x)| ≥ ½} in the mesh's box and its standard error: stratified sampling,
+/// two uniform points in each cell of a `g` grid.
+fn omega_volume(mesh: &Mesh, g: [usize; 3], seed: u64) -> (f64, f64) {
+    let (v, f) = mesh;
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in v {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let cell = [0, 1, 2].map(|k| (hi[k] - lo[k]) / g[k] as f64);
+    let cell_volume = cell[0] * cell[1] * cell[2];
+    let mut rng = common::Rng(seed);
+    let (mut inside, mut var) = (0.0, 0.0);
+    for i in 0..g[0] {
+        for j in 0..g[1] {
+            for k in 0..g[2] {
+                let mut point = || {
+                    let x = [i, j, k].map(|n| n as f64);
+                    let p = [0, 1, 2].map(|a| lo[a] + (x[a] + rng.f64()) * cell[a]);
+                    f64::from(u8::from(winding_number(v, f, p).abs() >= 0.5))
+                };
+                let (a, b) = (point(), point());
+                inside += a + b;
+                var += (a - b) * (a - b);
+            }
+        }
+    }
+    (cell_volume * inside / 2.0, cell_volume * (var / 4.0).sqrt())
+}
