@@ -11,6 +11,7 @@ use num_traits::{ToPrimitive, Zero};
 use std::collections::HashMap;
 
 pub mod wild;
+pub mod winding;
 
 /// The workspace's root: these helpers serve the library's tests (manifest at the root) and the
 /// command line's (manifest in `cli/`).
