@@ -496,27 +496,8 @@ pub(crate) fn short_decimal(w: &[u8]) -> Option<(f64, usize)> {
     if digits == 0 || digits > 19 {
         return None;
     }
-    let mut exponent = -(fraction as i32);
-    if let Some(b'e' | b'E') = w.get(i) {
-        i += 1;
-        let negative = w.get(i) == Some(&b'-');
-        if let Some(b'-' | b'+') = w.get(i) {
-            i += 1;
-        }
-        let from = i;
-        let mut e = 0i32;
-        while let Some(&d @ b'0'..=b'9') = w.get(i) {
-            if i - from == 4 {
-                return None;
-            }
-            e = 10 * e + i32::from(d - b'0');
-            i += 1;
-        }
-        if i == from {
-            return None;
-        }
-        exponent += if negative { -e } else { e };
-    }
+    let (e, i) = exponent_suffix(w, i, 4)?;
+    let exponent = e - fraction as i32;
     if mantissa > 1 << 53 {
         return None;
     }
@@ -524,6 +505,33 @@ pub(crate) fn short_decimal(w: &[u8]) -> Option<(f64, usize)> {
     let x = mantissa as f64;
     let x = if exponent < 0 { x / power } else { x * power };
     Some((if negative { -x } else { x }, i))
+}
+
+/// The exponent `(e|E)[+-]digits` of a decimal at `w[i..]`, with at most `max_digits` digits, and
+/// the index after it: `(0, i)` when there is none, `None` when it is malformed or longer.
+#[inline]
+pub(crate) fn exponent_suffix(w: &[u8], mut i: usize, max_digits: usize) -> Option<(i32, usize)> {
+    if !matches!(w.get(i), Some(b'e' | b'E')) {
+        return Some((0, i));
+    }
+    i += 1;
+    let negative = w.get(i) == Some(&b'-');
+    if let Some(b'-' | b'+') = w.get(i) {
+        i += 1;
+    }
+    let from = i;
+    let mut e = 0i32;
+    while let Some(&d @ b'0'..=b'9') = w.get(i) {
+        if i - from == max_digits {
+            return None;
+        }
+        e = 10 * e + i32::from(d - b'0');
+        i += 1;
+    }
+    if i == from {
+        return None;
+    }
+    Some((if negative { -e } else { e }, i))
 }
 
 /// Appends the leading decimal digits of `w` to `mantissa` (wrapping: a caller refuses more than 19

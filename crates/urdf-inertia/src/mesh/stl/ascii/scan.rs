@@ -2,7 +2,7 @@
 //! a time, the newline and keyword tests on them, the hash of a vertex's text, and the decimal
 //! reader of its coordinates.
 
-use crate::mesh::{short_decimal, EXACT_POWERS_OF_TEN};
+use crate::mesh::{exponent_suffix, short_decimal, EXACT_POWERS_OF_TEN};
 
 const ONES: u64 = 0x0101_0101_0101_0101;
 pub(super) const HIGHS: u64 = 0x8080_8080_8080_8080;
@@ -93,27 +93,10 @@ fn decimal(w: &[u8]) -> Option<(f64, usize)> {
         i += whole;
         (digits_value(v, whole), 0)
     };
-    let mut exponent = -(fraction as i32);
-    if let Some(b'e' | b'E') = w.get(i) {
-        i += 1;
-        let negative = w.get(i) == Some(&b'-');
-        if let Some(b'-' | b'+') = w.get(i) {
-            i += 1;
-        }
-        let from = i;
-        let mut e = 0;
-        while let Some(&d @ b'0'..=b'9') = w.get(i) {
-            if i - from == 3 {
-                return short_decimal(w);
-            }
-            e = 10 * e + i32::from(d - b'0');
-            i += 1;
-        }
-        if i == from {
-            return short_decimal(w);
-        }
-        exponent += if negative { -e } else { e };
-    }
+    let Some((e, i)) = exponent_suffix(w, i, 3) else {
+        return short_decimal(w);
+    };
+    let exponent = e - fraction as i32;
     let Some(&power) = EXACT_POWERS_OF_TEN.get(exponent.unsigned_abs() as usize) else {
         return short_decimal(w);
     };
