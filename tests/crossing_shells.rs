@@ -29,16 +29,6 @@ fn solid(mesh: &Mesh) -> Solid {
     .expect("a solid")
 }
 
-/// A box from `lo` to `hi` (outward triangles).
-fn box_at(lo: [f64; 3], hi: [f64; 3]) -> Mesh {
-    let (v, f) = common::box_mesh([hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]]);
-    let v = v
-        .iter()
-        .map(|p| std::array::from_fn(|k| p[k] + f64::midpoint(lo[k], hi[k])))
-        .collect();
-    (v, f)
-}
-
 /// The box's faces without those on its top (largest z): open, so the mesh reaches the capped rung.
 fn open_top(b: &Mesh) -> Mesh {
     let top = b.0.iter().map(|p| p[2]).fold(f64::MIN, f64::max);
@@ -98,9 +88,9 @@ fn within_estimate(name: &str, s: &Solid, exact: &ExactMass) -> f64 {
 /// exactly (the faces are decided piece by piece), against box + box − their intersection.
 #[test]
 fn two_boxes_that_cut_each_other_count_their_intersection_once() {
-    let a = box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
-    let b = box_at([0.75, 0.25, 0.25], [1.25, 0.5, 0.5]);
-    let both = box_at([0.75, 0.25, 0.25], [1.0, 0.5, 0.5]);
+    let a = common::box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let b = common::box_at([0.75, 0.25, 0.25], [1.25, 0.5, 0.5]);
+    let both = common::box_at([0.75, 0.25, 0.25], [1.0, 0.5, 0.5]);
     let s = solid(&together(&[(&open_top(&a), false), (&b, false)]));
     let exact = exact_sum(&[(1, &a), (1, &b), (-1, &both)]);
     let error = within_estimate("two boxes", &s, &exact);
@@ -112,10 +102,10 @@ fn two_boxes_that_cut_each_other_count_their_intersection_once() {
 /// the intersection of an axis box and a rotated box is not a box, so here the truth is sampled.
 #[test]
 fn a_rotated_box_through_a_wall() {
-    let a = box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let a = common::box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
     let r = common::rotation([0.3, 0.2, 0.1]);
     let b = common::transform(
-        &box_at([-0.3, -0.15, -0.1], [0.3, 0.15, 0.1]),
+        &common::box_at([-0.3, -0.15, -0.1], [0.3, 0.15, 0.1]),
         1.0,
         &r,
         [1.0, 0.5, 0.5],
@@ -142,9 +132,9 @@ fn a_rotated_box_through_a_wall() {
 /// others), so the solid is the union again, counted once.
 #[test]
 fn an_inside_out_box_through_a_wall_is_turned_and_counted_once() {
-    let a = box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
-    let b = box_at([0.75, 0.25, 0.25], [1.25, 0.5, 0.5]);
-    let both = box_at([0.75, 0.25, 0.25], [1.0, 0.5, 0.5]);
+    let a = common::box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let b = common::box_at([0.75, 0.25, 0.25], [1.25, 0.5, 0.5]);
+    let both = common::box_at([0.75, 0.25, 0.25], [1.0, 0.5, 0.5]);
     let s = solid(&together(&[(&open_top(&a), false), (&b, true)]));
     let exact = exact_sum(&[(1, &a), (1, &b), (-1, &both)]);
     let error = within_estimate("inside-out", &s, &exact);
@@ -154,11 +144,11 @@ fn an_inside_out_box_through_a_wall_is_turned_and_counted_once() {
 /// Three boxes, each cutting the other two: inclusion–exclusion of the union.
 #[test]
 fn three_boxes_pairwise_overlapping() {
-    let a = box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
-    let b = box_at([0.75, 0.25, 0.25], [1.5, 0.75, 0.75]);
-    let c = box_at([1.25, 0.5, 0.5], [2.0, 0.875, 0.625]);
-    let ab = box_at([0.75, 0.25, 0.25], [1.0, 0.75, 0.75]);
-    let bc = box_at([1.25, 0.5, 0.5], [1.5, 0.75, 0.625]);
+    let a = common::box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let b = common::box_at([0.75, 0.25, 0.25], [1.5, 0.75, 0.75]);
+    let c = common::box_at([1.25, 0.5, 0.5], [2.0, 0.875, 0.625]);
+    let ab = common::box_at([0.75, 0.25, 0.25], [1.0, 0.75, 0.75]);
+    let bc = common::box_at([1.25, 0.5, 0.5], [1.5, 0.75, 0.625]);
     let s = solid(&together(&[
         (&open_top(&a), false),
         (&b, false),
@@ -179,8 +169,8 @@ fn three_boxes_pairwise_overlapping() {
 /// solid is both boxes; the coincident faces are undecided pieces, bounded.
 #[test]
 fn boxes_sharing_part_of_a_face() {
-    let a = box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
-    let b = box_at([0.5, 0.25, 1.0], [1.5, 0.75, 1.5]);
+    let a = common::box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let b = common::box_at([0.5, 0.25, 1.0], [1.5, 0.75, 1.5]);
     let s = solid(&together(&[(&open_top(&a), false), (&b, false)]));
     let exact = exact_sum(&[(1, &a), (1, &b)]);
     within_estimate("sharing a face", &s, &exact);
@@ -191,7 +181,7 @@ fn boxes_sharing_part_of_a_face() {
 /// number, with its standard error σ.
 #[test]
 fn a_sphere_through_a_box() {
-    let a = box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let a = common::box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
     let ball = common::transform(
         &common::icosphere(3),
         0.3,

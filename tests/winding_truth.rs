@@ -422,16 +422,6 @@ fn open_mesh_flag_and_code_through_the_binary() {
     );
 }
 
-/// A box from `lo` to `hi` (outward triangles).
-fn box_at(lo: [f64; 3], hi: [f64; 3]) -> Mesh {
-    let (v, f) = common::box_mesh([hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]]);
-    let v = v
-        .iter()
-        .map(|p| std::array::from_fn(|k| p[k] + f64::midpoint(lo[k], hi[k])))
-        .collect();
-    (v, f)
-}
-
 /// `a` and `b` in one vertex list, `b`'s faces reversed when `inward`.
 fn together(a: &Mesh, b: &Mesh, inward: bool) -> Mesh {
     let mut v = a.0.clone();
@@ -483,9 +473,9 @@ fn within_estimate(name: &str, s: &Solid, exact: &common::ExactMass) -> (f64, f6
 /// counts once. All exact to round-off, against rational integrals.
 #[test]
 fn nested_shells_count_once_and_cavities_stay() {
-    let outer = box_at([0.25, -0.5, 1.0], [1.25, 0.5, 1.75]);
-    let inner = box_at([0.5, -0.25, 1.125], [1.0, 0.25, 1.5]);
-    let beside = box_at([2.0, 0.0, 1.0], [2.5, 0.5, 1.25]);
+    let outer = common::box_at([0.25, -0.5, 1.0], [1.25, 0.5, 1.75]);
+    let inner = common::box_at([0.5, -0.25, 1.125], [1.0, 0.25, 1.5]);
+    let beside = common::box_at([2.0, 0.0, 1.0], [2.5, 0.5, 1.25]);
     let open_outer = (outer.0.clone(), without_side(&outer.0, &outer.1, 2, true));
     let cases: [(&str, Mesh, common::ExactMass); 3] = [
         (
@@ -522,9 +512,9 @@ fn nested_shells_count_once_and_cavities_stay() {
 /// intersection counts once, and what stays undecided where the cuts meet is in the estimate.
 #[test]
 fn interpenetrating_shells_are_bounded_not_assumed_apart() {
-    let outer = box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
-    let through = box_at([0.75, 0.25, 0.25], [1.25, 0.5, 0.5]);
-    let both = box_at([0.75, 0.25, 0.25], [1.0, 0.5, 0.5]);
+    let outer = common::box_at([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let through = common::box_at([0.75, 0.25, 0.25], [1.25, 0.5, 0.5]);
+    let both = common::box_at([0.75, 0.25, 0.25], [1.0, 0.5, 0.5]);
     let open_outer = (outer.0.clone(), without_side(&outer.0, &outer.1, 2, true));
     let (v, f) = together(&open_outer, &through, false);
     let s = solid(&v, &f, OpenMeshModel::default()).expect("capped");

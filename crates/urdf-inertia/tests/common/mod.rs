@@ -322,6 +322,16 @@ pub fn box_mesh(s: [f64; 3]) -> Mesh {
     (v, f)
 }
 
+/// A box from `lo` to `hi` (outward triangles).
+pub fn box_at(lo: [f64; 3], hi: [f64; 3]) -> Mesh {
+    let (v, f) = box_mesh([hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]]);
+    let v = v
+        .iter()
+        .map(|p| std::array::from_fn(|k| p[k] + f64::midpoint(lo[k], hi[k])))
+        .collect();
+    (v, f)
+}
+
 /// A closed cylinder along Z with `n` segments (outward triangles).
 pub fn cylinder_mesh(r: f64, l: f64, n: u32) -> Mesh {
     let mut v = vec![[0.0, 0.0, -l / 2.0], [0.0, 0.0, l / 2.0]];
