@@ -18,6 +18,7 @@
 //! the error estimate.
 
 mod correction;
+mod cracks;
 mod grid;
 
 use crate::geometry::{cross, dot, sub, Aabb};
@@ -123,7 +124,12 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
     // A pair with an undecided side is bounded whatever the other side's classification, unless
     // its cluster is a closed cycle, or both shells are: then it is decided face by face (the open
     // shells around sealed ones keep their pairs' bounds).
-    let mut relevant = resolvable(faces, &shells, &pairs, &decided);
+    let (mut relevant, cracked) = resolvable(faces, &shells, &pairs, &decided, None);
+    // Clusters left open by cracks alone balance once welded, and are decided on welded corners.
+    let welded = cracked.then(|| cracks::representatives(vertices));
+    if let Some(rep) = &welded {
+        relevant = resolvable(faces, &shells, &pairs, &decided, Some(rep)).0;
+    }
     for &(a, b) in &pairs {
         if decided[a] && decided[b] {
             continue;
@@ -150,7 +156,8 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
     }
     out.faces = rebuilt(faces, &keep, &turn);
     if out.resolved_pairs > 0 {
-        resolve_pairs(vertices, &shells, &tris, &relevant, &sign, &mut out);
+        let welded = welded.as_deref();
+        resolve_pairs(vertices, &shells, &tris, &relevant, &sign, welded, &mut out);
     }
     out
 }
@@ -158,13 +165,16 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
 /// The shells to decide face by face: clusters of shells (joined by overlapping boxes, and by edges
 /// they share where the surface is non-manifold) that hold an undecided pair and whose edges all
 /// balance (as many uses each way: a closed cycle, whose winding number is an integer everywhere and
-/// is counted exactly by a ray's crossings).
+/// is counted exactly by a ray's crossings), with vertices taken as their representatives `rep`
+/// when given. Also whether some cluster holding an undecided pair does not balance.
 fn resolvable(
     faces: &Polygons,
     shells: &[Shell],
     pairs: &[(usize, usize)],
     decided: &[bool],
-) -> Vec<bool> {
+    rep: Option<&[u32]>,
+) -> (Vec<bool>, bool) {
+    let at = |v: u32| rep.map_or(v, |r| r[v as usize]);
     let mut shell_of = vec![0u32; faces.len()];
     for (i, s) in shells.iter().enumerate() {
         s.faces.iter().for_each(|&f| shell_of[f as usize] = i as u32);
@@ -181,7 +191,10 @@ fn resolvable(
     let mut edges: FxHashMap<(u32, u32), (u32, i64)> = FxHashMap::default();
     for (i, face) in faces.iter().enumerate() {
         for k in 0..face.len() {
-            let (u, v) = (face[k], face[(k + 1) % face.len()]);
+            let (u, v) = (at(face[k]), at(face[(k + 1) % face.len()]));
+            if u == v {
+                continue;
+            }
             let e = edges.entry((u.min(v), u.max(v))).or_insert((shell_of[i], 0));
             e.1 += if u < v { 1 } else { -1 };
             let first = e.0;
@@ -200,12 +213,14 @@ fn resolvable(
             wanted[root(&mut parent, a as u32) as usize] = true;
         }
     }
-    (0..shells.len() as u32)
+    let relevant = (0..shells.len() as u32)
         .map(|i| {
             let r = root(&mut parent, i) as usize;
             wanted[r] && !open[r]
         })
-        .collect()
+        .collect();
+    let unbalanced = (0..shells.len()).any(|r| wanted[r] && open[r]);
+    (relevant, unbalanced)
 }
 
 /// Turns and drops the decided closed shells (see the module docs); each shell's orientation as
@@ -248,19 +263,29 @@ fn orient(
 }
 
 /// Decides the faces of the `relevant` shells one by one ([`correction::resolve`]) and appends them
-/// to `out.faces`.
+/// to `out.faces`; on welded corners when `welded` gives representatives ([`cracks`]).
 fn resolve_pairs(
     vertices: &[[f64; 3]],
     shells: &[Shell],
     tris: &[Vec<[u32; 3]>],
     relevant: &[bool],
     sign: &[i64],
+    welded: Option<&[u32]>,
     out: &mut ShellOutcome,
 ) {
     let (mut all, mut signs) = (Vec::new(), Vec::new());
+    let mut swept = 0.0;
     for i in (0..shells.len()).filter(|&i| relevant[i]) {
-        all.extend_from_slice(&tris[i]);
-        signs.extend(std::iter::repeat_n(sign[i], tris[i].len()));
+        let t = match welded {
+            Some(rep) => {
+                let (t, s) = cracks::welded_triangles(vertices, &tris[i], rep);
+                swept += s;
+                t
+            }
+            None => tris[i].clone(),
+        };
+        signs.extend(std::iter::repeat_n(sign[i], t.len()));
+        all.extend(t);
     }
     let volume: f64 = shells.iter().map(|s| s.volume6.abs() / 6.0).sum();
     let bounds = Aabb::of(vertices.iter().copied());
@@ -270,7 +295,7 @@ fn resolve_pairs(
         out.faces.push(face);
     }
     out.vertices = r.vertices;
-    out.resolved_bound = r.bound;
+    out.resolved_bound = r.bound + swept;
     out.ball = (centre, bounds.diagonal() / 2.0);
     out.cut_faces = r.cut;
     out.changed |= r.changed;
