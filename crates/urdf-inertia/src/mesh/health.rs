@@ -38,7 +38,7 @@ mod topology;
 mod welding;
 
 use super::open::OpenMeshModel;
-use super::{weld, MeshError, MeshErrorKind, RawMesh};
+use super::{weld, winding_shells, MeshError, MeshErrorKind, RawMesh};
 use crate::mass::{MassProperties, Polygons};
 use closed::{consistent_closed, prove, reoriented, welded_closed};
 pub use geometry::Aabb;
@@ -341,7 +341,11 @@ pub fn heal(
         );
     }
     let precision = precision(&exact.vertices);
-    let w = tolerant_welding(exact, precision);
+    let mut w = tolerant_welding(exact, precision);
+    ladder.as_stored = winding_shells::AsStored {
+        faces: w.kept.clone(),
+        copies: std::mem::take(&mut w.copies),
+    };
     // Nothing merged or dropped: the topology is the exact weld's faces, which just failed the proof.
     let unchanged =
         w.tolerant.merged == 0 && w.collapsed == 0 && w.duplicates == 0 && w.cancelled == 0;

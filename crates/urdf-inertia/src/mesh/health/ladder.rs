@@ -21,6 +21,9 @@ pub(super) struct Ladder<'a> {
     /// The integrals of the faces `finish` gets, when a rung already has them (a clean mesh is then
     /// integrated twice, not three times: once here, once about a second reference point).
     pub(super) known: Option<VolumeIntegrals>,
+    /// The faces as stored, where welding and the rungs changed them (whose winding number defines
+    /// the solid where shells overlap).
+    pub(super) as_stored: winding_shells::AsStored,
 }
 
 impl<'a> Ladder<'a> {
@@ -41,6 +44,7 @@ impl<'a> Ladder<'a> {
                 .collect(),
             faces_read: mesh.faces.len(),
             known: None,
+            as_stored: winding_shells::AsStored::default(),
         }
     }
 
@@ -80,7 +84,7 @@ impl<'a> Ladder<'a> {
         ) {
             return faces;
         }
-        let mut s = winding_shells::classify(vertices, &faces);
+        let mut s = winding_shells::classify(vertices, &faces, &self.as_stored);
         if s.resolved_pairs > 0 {
             self.resolved(&s, model);
         }

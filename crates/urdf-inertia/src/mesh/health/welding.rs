@@ -23,13 +23,17 @@ pub(super) struct Welding {
     pub(super) duplicates: usize,
     /// Faces dropped in pairs, a face and its reverse, which cancel in the integral anyway.
     pub(super) cancelled: usize,
+    /// The extra copies dropped, as stored (a face kept once stands for them): the winding number of
+    /// the surface as stored counts them, so deciding overlapping shells face by face puts them back.
+    pub(super) copies: Polygons,
 }
 
 pub(super) fn tolerant_welding(exact: weld::ExactWeld, precision: weld::Precision) -> Welding {
     let tol = weld::tolerance(&exact.vertices, precision);
     let tolerant = weld::tolerant(&exact.vertices, tol);
     let (all_topology, kept_mask) = weld::remap_faces(&exact.faces, &tolerant.representative);
-    let (dropped, duplicates, cancelled) = duplicate_faces(&all_topology);
+    let (dropped, duplicates, cancelled, extra) = duplicate_faces(&all_topology);
+    let mut copies = Polygons::new();
     let mut stored = Polygons::new();
     let mut kept = Polygons::new();
     let mut topology = Polygons::new();
@@ -39,6 +43,7 @@ pub(super) fn tolerant_welding(exact: weld::ExactWeld, precision: weld::Precisio
             stored.push(face);
             continue;
         }
+        (0..extra[t]).for_each(|_| copies.push(face));
         if !dropped[t] {
             stored.push(face);
             kept.push(face);
@@ -55,13 +60,15 @@ pub(super) fn tolerant_welding(exact: weld::ExactWeld, precision: weld::Precisio
         kept,
         topology,
         tolerant,
+        copies,
     }
 }
 
 /// Faces that repeat another one's vertices in the same cyclic order (a duplicate: kept once) or in
 /// the reverse order (a zero-thickness wall: the pair cancels, both dropped). Returns per face whether
-/// it is dropped, how many extra copies were dropped and how many faces in cancelling pairs.
-pub(super) fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize, usize) {
+/// it is dropped, how many extra copies were dropped, how many faces in cancelling pairs, and per
+/// face kept how many extra copies it stands for.
+pub(super) fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize, usize, Vec<u32>) {
     // Each face's vertices rotated to start at the smallest index, in whichever direction reads
     // smaller, and whether that was backwards. Sorting the keys groups the copies.
     let canonical = |f: &[u32]| -> (Vec<u32>, bool) {
@@ -102,18 +109,21 @@ pub(super) fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize, usize) {
     sort_by_first_vertex(&mut keys);
     others.sort_unstable();
     let mut dropped = vec![false; faces.len()];
+    let mut extra = vec![0u32; faces.len()];
     let (mut repeated, mut cancelled) = (0, 0);
     let mut drop_group = |members: &[(bool, u32)]| {
         let ahead = members.iter().filter(|m| !m.0).count();
         let back = members.len() - ahead;
         cancelled += 2 * ahead.min(back);
-        repeated += (ahead.max(back) - ahead.min(back)).saturating_sub(1);
+        let copies = (ahead.max(back) - ahead.min(back)).saturating_sub(1);
+        repeated += copies;
         // Keep one face of the majority direction (none when the directions balance).
         let keep_dir = back > ahead;
         let mut keep = usize::from(ahead != back);
         for &(reversed, i) in members {
             if reversed == keep_dir && keep > 0 {
                 keep -= 1;
+                extra[i as usize] = copies as u32;
             } else {
                 dropped[i as usize] = true;
             }
@@ -127,7 +137,7 @@ pub(super) fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize, usize) {
         let members: Vec<(bool, u32)> = group.iter().map(|m| (m.1, m.2)).collect();
         drop_group(&members);
     }
-    (dropped, repeated, cancelled)
+    (dropped, repeated, cancelled, extra)
 }
 
 /// Sorts triangle keys as `sort_unstable` would (they are all distinct, so the order is the same):

@@ -88,7 +88,10 @@ struct Shell {
 }
 
 /// Classifies the shells of `faces` (see the module docs). A surface of one shell comes back as it is.
-pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
+/// The shells decided face by face are decided with the copies of faces that welding dropped put
+/// back (`stored.copies`: the winding number of the file's surface counts them), and where their
+/// edges balance only so, with the faces the ladder turned round turned back (`stored.faces`).
+pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> ShellOutcome {
     let shells = shells(vertices, faces);
     let unchanged = |undecided_pairs, overlap_bound| ShellOutcome {
         faces: faces.clone(),
@@ -124,12 +127,17 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
     // A pair with an undecided side is bounded whatever the other side's classification, unless
     // its cluster is a closed cycle, or both shells are: then it is decided face by face (the open
     // shells around sealed ones keep their pairs' bounds).
-    let (mut relevant, cracked) = resolvable(faces, &shells, &pairs, &decided, None);
+    let flip = turned_round(faces, &stored.faces);
+    let copies = (&stored.copies, &flip[..]);
+    let mut clusters = resolvable(faces, copies, &shells, &pairs, &decided, None);
     // Clusters left open by cracks alone balance once welded, and are decided on welded corners.
-    let welded = cracked.then(|| cracks::representatives(vertices));
+    let welded = clusters
+        .unbalanced
+        .then(|| cracks::representatives(vertices));
     if let Some(rep) = &welded {
-        relevant = resolvable(faces, &shells, &pairs, &decided, Some(rep)).0;
+        clusters = resolvable(faces, copies, &shells, &pairs, &decided, Some(rep));
     }
+    let mut relevant = clusters.relevant.clone();
     for &(a, b) in &pairs {
         if decided[a] && decided[b] {
             continue;
@@ -157,55 +165,95 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons) -> ShellOutcome {
     out.faces = rebuilt(faces, &keep, &turn);
     if out.resolved_pairs > 0 {
         let welded = welded.as_deref();
-        resolve_pairs(vertices, &shells, &tris, &relevant, &sign, welded, &mut out);
+        let copied = copied(&stored.copies, &clusters.copy_shell, &relevant);
+        let tris = as_stored(faces, &shells, &tris, &clusters.unflip, &flip);
+        let shells = (&shells[..], &tris[..], &relevant[..], &sign[..]);
+        resolve_pairs(vertices, shells, &copied, welded, &mut out);
     }
     out
+}
+
+/// The surface as the file stores it, where the ladder's repairs changed it: its winding number
+/// defines Ω.
+#[derive(Debug, Clone, Default)]
+pub struct AsStored {
+    /// The faces in the same order as those classified, each in its stored orientation (the ladder
+    /// may have turned some round to agree with their neighbours).
+    pub faces: Polygons,
+    /// Extra copies of faces, in their stored orientation, that welding dropped as duplicates.
+    pub copies: Polygons,
+}
+
+/// Which shells [`resolvable`] gives to the face-by-face decision.
+struct Clusters {
+    relevant: Vec<bool>,
+    /// Per shell: decided with its faces in their stored orientation (its cluster balances so).
+    unflip: Vec<bool>,
+    /// Whether some cluster holding an undecided pair does not balance.
+    unbalanced: bool,
+    /// Per extra copy of a face: the shell of the face it copies, when it has one.
+    copy_shell: Vec<Option<usize>>,
 }
 
 /// The shells to decide face by face: clusters of shells (joined by overlapping boxes, and by edges
 /// they share where the surface is non-manifold) that hold an undecided pair and whose edges all
 /// balance (as many uses each way: a closed cycle, whose winding number is an integer everywhere and
-/// is counted exactly by a ray's crossings), with vertices taken as their representatives `rep`
-/// when given. Also whether some cluster holding an undecided pair does not balance.
+/// is counted exactly by a ray's crossings), counting the extra `copies` of faces and taking
+/// vertices as their representatives `rep` when given. A cluster balances with its faces as
+/// classified (the ladder's repairs kept), or else in their stored orientation (the faces marked in
+/// `flip` turned back: a re-orientation that broke a closed cycle of the file is undone).
 fn resolvable(
     faces: &Polygons,
+    (copies, flip): (&Polygons, &[bool]),
     shells: &[Shell],
     pairs: &[(usize, usize)],
     decided: &[bool],
     rep: Option<&[u32]>,
-) -> (Vec<bool>, bool) {
+) -> Clusters {
     let at = |v: u32| rep.map_or(v, |r| r[v as usize]);
+    let key = |u: u32, v: u32| (u.min(v), u.max(v));
     let mut shell_of = vec![0u32; faces.len()];
     for (i, s) in shells.iter().enumerate() {
         s.faces.iter().for_each(|&f| shell_of[f as usize] = i as u32);
     }
     let mut parent: Vec<u32> = (0..shells.len() as u32).collect();
-    let join = |parent: &mut Vec<u32>, a: u32, b: u32| {
-        let (a, b) = (root(parent, a), root(parent, b));
-        parent[a.max(b) as usize] = a.min(b);
-    };
     for &(a, b) in pairs {
         join(&mut parent, a as u32, b as u32);
     }
-    // Per edge: the first shell using it, and its uses one way less the other.
-    let mut edges: FxHashMap<(u32, u32), (u32, i64)> = FxHashMap::default();
-    for (i, face) in faces.iter().enumerate() {
+    // Per edge: the first shell using it, and its uses one way less the other, with the faces as
+    // classified and as stored.
+    type Edges = FxHashMap<(u32, u32), (u32, i64, i64)>;
+    let mut edges = Edges::default();
+    let count = |edges: &mut Edges, parent: &mut Vec<u32>, face: &[u32], shell: u32, turned: bool| {
         for k in 0..face.len() {
             let (u, v) = (at(face[k]), at(face[(k + 1) % face.len()]));
-            if u == v {
-                continue;
+            if u != v {
+                let e = edges.entry(key(u, v)).or_insert((shell, 0, 0));
+                let d = if u < v { 1 } else { -1 };
+                e.1 += d;
+                e.2 += if turned { -d } else { d };
+                join(parent, e.0, shell);
             }
-            let e = edges.entry((u.min(v), u.max(v))).or_insert((shell_of[i], 0));
-            e.1 += if u < v { 1 } else { -1 };
-            let first = e.0;
-            join(&mut parent, first, shell_of[i]);
         }
+    };
+    for (i, face) in faces.iter().enumerate() {
+        count(&mut edges, &mut parent, face, shell_of[i], flip[i]);
     }
-    let mut open = vec![false; shells.len()];
-    for &(s, net) in edges.values() {
-        if net != 0 {
-            open[root(&mut parent, s) as usize] = true;
+    let mut copy_shell = Vec::with_capacity(copies.len());
+    for face in copies.iter() {
+        let (u, v) = (at(face[0]), at(face[1]));
+        let shell = edges.get(&key(u, v)).map(|e| e.0);
+        if let Some(s) = shell {
+            count(&mut edges, &mut parent, face, s, false);
         }
+        copy_shell.push(shell.map(|s| s as usize));
+    }
+    // Per cluster: open as classified, open as stored.
+    let mut open = vec![(false, false); shells.len()];
+    for &(s, net, stored) in edges.values() {
+        let r = root(&mut parent, s) as usize;
+        open[r].0 |= net != 0;
+        open[r].1 |= stored != 0;
     }
     let mut wanted = vec![false; shells.len()];
     for &(a, b) in pairs {
@@ -213,14 +261,20 @@ fn resolvable(
             wanted[root(&mut parent, a as u32) as usize] = true;
         }
     }
-    let relevant = (0..shells.len() as u32)
-        .map(|i| {
-            let r = root(&mut parent, i) as usize;
-            wanted[r] && !open[r]
-        })
+    let roots: Vec<usize> = (0..shells.len() as u32)
+        .map(|i| root(&mut parent, i) as usize)
         .collect();
-    let unbalanced = (0..shells.len()).any(|r| wanted[r] && open[r]);
-    (relevant, unbalanced)
+    Clusters {
+        relevant: roots.iter().map(|&r| wanted[r] && !(open[r].0 && open[r].1)).collect(),
+        unflip: roots.iter().map(|&r| wanted[r] && open[r].0 && !open[r].1).collect(),
+        unbalanced: (0..shells.len()).any(|r| wanted[r] && open[r].0 && open[r].1),
+        copy_shell,
+    }
+}
+
+fn join(parent: &mut [u32], a: u32, b: u32) {
+    let (a, b) = (root(parent, a), root(parent, b));
+    parent[a.max(b) as usize] = a.min(b);
 }
 
 /// Turns and drops the decided closed shells (see the module docs); each shell's orientation as
@@ -266,23 +320,22 @@ fn orient(
 /// to `out.faces`; on welded corners when `welded` gives representatives ([`cracks`]).
 fn resolve_pairs(
     vertices: &[[f64; 3]],
-    shells: &[Shell],
-    tris: &[Vec<[u32; 3]>],
-    relevant: &[bool],
-    sign: &[i64],
+    (shells, tris, relevant, sign): (&[Shell], &[Vec<[u32; 3]>], &[bool], &[i64]),
+    copied: &[(usize, Vec<[u32; 3]>)],
     welded: Option<&[u32]>,
     out: &mut ShellOutcome,
 ) {
     let (mut all, mut signs) = (Vec::new(), Vec::new());
     let mut swept = 0.0;
-    for i in (0..shells.len()).filter(|&i| relevant[i]) {
+    let own = (0..shells.len()).filter(|&i| relevant[i]).map(|i| (i, &tris[i]));
+    for (i, tris) in own.chain(copied.iter().map(|(i, t)| (*i, t))) {
         let t = match welded {
             Some(rep) => {
-                let (t, s) = cracks::welded_triangles(vertices, &tris[i], rep);
+                let (t, s) = cracks::welded_triangles(vertices, tris, rep);
                 swept += s;
                 t
             }
-            None => tris[i].clone(),
+            None => tris.clone(),
         };
         signs.extend(std::iter::repeat_n(sign[i], t.len()));
         all.extend(t);
@@ -299,6 +352,53 @@ fn resolve_pairs(
     out.ball = (centre, bounds.diagonal() / 2.0);
     out.cut_faces = r.cut;
     out.changed |= r.changed;
+}
+
+/// The triangles of the copies whose shells are decided face by face, with their shells.
+fn copied(copies: &Polygons, shell: &[Option<usize>], relevant: &[bool]) -> Vec<(usize, Vec<[u32; 3]>)> {
+    let all: Vec<u32> = (0..copies.len() as u32).collect();
+    let tris = |f: u32| fan(copies, &all[f as usize..=f as usize]);
+    (0..copies.len())
+        .filter_map(|c| shell[c].filter(|&s| relevant[s]).map(|s| (s, tris(c as u32))))
+        .collect()
+}
+
+/// Per face: whether it is `stored`'s face at the same place turned round.
+fn turned_round(faces: &Polygons, stored: &Polygons) -> Vec<bool> {
+    (0..faces.len())
+        .map(|i| {
+            i < stored.len() && {
+                let (f, s) = (faces.face(i), stored.face(i));
+                f.len() == s.len() && f != s && f.iter().eq(s.iter().rev())
+            }
+        })
+        .collect()
+}
+
+/// The shells' triangles, those of the shells marked in `unflip` with their faces in the stored
+/// orientation (the faces in `flip` turned back).
+fn as_stored(
+    faces: &Polygons,
+    shells: &[Shell],
+    tris: &[Vec<[u32; 3]>],
+    unflip: &[bool],
+    flip: &[bool],
+) -> Vec<Vec<[u32; 3]>> {
+    let mut out = tris.to_vec();
+    for (i, s) in shells.iter().enumerate() {
+        if unflip[i] && s.faces.iter().any(|&f| flip[f as usize]) {
+            out[i] = s
+                .faces
+                .iter()
+                .flat_map(|&f| {
+                    let t = fan(faces, &[f]);
+                    let back = flip[f as usize];
+                    t.into_iter().map(move |t| if back { [t[2], t[1], t[0]] } else { t })
+                })
+                .collect();
+        }
+    }
+    out
 }
 
 /// The faces kept, those marked turned reversed.
