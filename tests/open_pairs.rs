@@ -109,7 +109,12 @@ fn a_cracked_box_through_a_wall_counts_the_intersection_once() {
     let exact = exact_sum(&[(1, &a), (1, &b), (-1, &both)]);
     let error = within_estimate("cracked box", &s, &exact);
     assert!(error <= 1e-8, "{error:e}");
-    assert!(s.error_estimate <= 1e-6, "{:e} {:?}", s.error_estimate, s.warnings);
+    assert!(
+        s.error_estimate <= 1e-6,
+        "{:e} {:?}",
+        s.error_estimate,
+        s.warnings
+    );
 }
 
 /// The same with the crack inside the open box (where w decides whether the faces count).
@@ -123,7 +128,12 @@ fn a_crack_inside_the_other_shell() {
     let exact = exact_sum(&[(1, &a), (1, &b), (-1, &both)]);
     let error = within_estimate("crack inside", &s, &exact);
     assert!(error <= 1e-8, "{error:e}");
-    assert!(s.error_estimate <= 1e-6, "{:e} {:?}", s.error_estimate, s.warnings);
+    assert!(
+        s.error_estimate <= 1e-6,
+        "{:e} {:?}",
+        s.error_estimate,
+        s.warnings
+    );
 }
 
 /// A tetrahedron with outward faces, on corners `p`.
@@ -152,5 +162,9 @@ fn a_face_stored_twice_for_two_shells_counts_once() {
     let error = within_estimate("face twice", &s, &exact);
     assert!(error <= 1e-8, "{error:e} {:?}", s.warnings);
     // The sampled winding number of the mesh as stored agrees (Ω is the taller tetrahedron).
-    assert!((s.unit.mass - sampled).abs() <= 4.0 * sigma + 1e-3, "{} vs {sampled} ± {sigma}", s.unit.mass);
+    assert!(
+        (s.unit.mass - sampled).abs() <= 4.0 * sigma + 1e-3,
+        "{} vs {sampled} ± {sigma}",
+        s.unit.mass
+    );
 }

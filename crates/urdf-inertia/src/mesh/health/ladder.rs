@@ -144,8 +144,23 @@ impl<'a> Ladder<'a> {
         } else {
             String::new()
         };
+        let mut stored = Vec::new();
+        if s.copies_restored > 0 {
+            stored.push(format!("{} face copies put back", s.copies_restored));
+        }
+        if s.turned_back > 0 {
+            stored.push(format!("{} re-oriented faces as stored", s.turned_back));
+        }
+        if s.cracks_welded {
+            stored.push("cracks welded".to_string());
+        }
+        let stored = if stored.is_empty() {
+            String::new()
+        } else {
+            format!(", on the surface as stored: {}", stored.join(", "))
+        };
         self.warn(HealthKind::Repaired, format!(
-            "{} pair(s) of closed shells touch or cut each other: their faces are decided piece by piece by the winding number on each side ({} triangle(s) cut by others and split){bound}",
+            "{} pair(s) of closed shells touch or cut each other: their faces are decided piece by piece by the winding number on each side ({} triangle(s) cut by others and split{stored}){bound}",
             s.resolved_pairs, s.cut_faces
         ));
     }

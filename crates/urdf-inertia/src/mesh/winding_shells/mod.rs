@@ -12,8 +12,10 @@
 //!
 //! Closed shells that touch or cut each other (and the shells around them) are decided face by face
 //! ([`correction`]): a piece of face that no other triangle meets has one winding number in front of
-//! it, which an exact ray counts; the pieces along the cuts that stay undecided bound the error. Pairs
-//! with an open shell are not decided: the region they can count twice lies in the intersection of
+//! it, which an exact ray counts; the pieces along the cuts that stay undecided bound the error. A
+//! cluster is decided so when its edges balance (a closed cycle), if need be on the surface as the
+//! file stores it: cracks welded ([`cracks`]), copies of faces that welding dropped put back, faces
+//! the ladder turned round turned back. Pairs with an open shell even so are not decided: the region they can count twice lies in the intersection of
 //! their bounding boxes (a closed shell's winding number is 0 outside its box), whose volume enters
 //! the error estimate.
 
@@ -58,6 +60,11 @@ pub struct ShellOutcome {
     pub resolved_pairs: usize,
     /// Their triangles that other triangles cut (split into pieces).
     pub cut_faces: usize,
+    /// Copies of faces that welding dropped, put back to decide them; faces the ladder turned round,
+    /// turned back; whether cracks were welded (see [`classify`]).
+    pub copies_restored: usize,
+    pub turned_back: usize,
+    pub cracks_welded: bool,
     /// What the pieces left undecided can change: volume (m³), within a ball (centre, radius).
     pub resolved_bound: f64,
     pub ball: ([f64; 3], f64),
@@ -127,16 +134,7 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
     // A pair with an undecided side is bounded whatever the other side's classification, unless
     // its cluster is a closed cycle, or both shells are: then it is decided face by face (the open
     // shells around sealed ones keep their pairs' bounds).
-    let flip = turned_round(faces, &stored.faces);
-    let copies = (&stored.copies, &flip[..]);
-    let mut clusters = resolvable(faces, copies, &shells, &pairs, &decided, None);
-    // Clusters left open by cracks alone balance once welded, and are decided on welded corners.
-    let welded = clusters
-        .unbalanced
-        .then(|| cracks::representatives(vertices));
-    if let Some(rep) = &welded {
-        clusters = resolvable(faces, copies, &shells, &pairs, &decided, Some(rep));
-    }
+    let (clusters, flip, welded) = clusters(vertices, faces, stored, &shells, &pairs, &decided);
     let mut relevant = clusters.relevant.clone();
     for &(a, b) in &pairs {
         if decided[a] && decided[b] {
@@ -166,9 +164,20 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
     if out.resolved_pairs > 0 {
         let welded = welded.as_deref();
         let copied = copied(&stored.copies, &clusters.copy_shell, &relevant);
+        out.copies_restored = copied.len();
+        out.cracks_welded = welded.is_some();
         let tris = as_stored(faces, &shells, &tris, &clusters.unflip, &flip);
-        let shells = (&shells[..], &tris[..], &relevant[..], &sign[..]);
-        resolve_pairs(vertices, shells, &copied, welded, &mut out);
+        out.turned_back = (shells.iter().enumerate())
+            .filter(|&(i, _)| clusters.unflip[i])
+            .map(|(_, s)| s.faces.iter().filter(|&&f| flip[f as usize]).count())
+            .sum();
+        let set = ShellSet {
+            shells: &shells,
+            tris: &tris,
+            relevant: &relevant,
+            sign: &sign,
+        };
+        resolve_pairs(vertices, &set, &copied, welded, &mut out);
     }
     out
 }
@@ -183,6 +192,33 @@ pub struct AsStored {
     /// Extra copies of faces, in their stored orientation, that welding dropped as duplicates.
     pub copies: Polygons,
 }
+
+/// [`resolvable`] on the faces as given (and the stored orientation of those `flip` marks), then,
+/// when a cluster does not balance so, on welded corners: clusters left open by cracks alone
+/// balance once welded, and are decided on welded corners (then returned too).
+fn clusters(
+    vertices: &[[f64; 3]],
+    faces: &Polygons,
+    stored: &AsStored,
+    shells: &[Shell],
+    pairs: &[(usize, usize)],
+    decided: &[bool],
+) -> (Clusters, Vec<bool>, Option<Vec<u32>>) {
+    let flip = turned_round(faces, &stored.faces);
+    let copies = (&stored.copies, &flip[..]);
+    let mut clusters = resolvable(faces, copies, shells, pairs, decided, None);
+    let welded = clusters
+        .unbalanced
+        .then(|| cracks::representatives(vertices));
+    if let Some(rep) = &welded {
+        clusters = resolvable(faces, copies, shells, pairs, decided, Some(rep));
+    }
+    (clusters, flip, welded)
+}
+
+/// Per edge: the first shell using it, and its uses one way less the other, with the faces as
+/// classified and as stored.
+type EdgeUses = FxHashMap<(u32, u32), (u32, i64, i64)>;
 
 /// Which shells [`resolvable`] gives to the face-by-face decision.
 struct Clusters {
@@ -220,11 +256,8 @@ fn resolvable(
     for &(a, b) in pairs {
         join(&mut parent, a as u32, b as u32);
     }
-    // Per edge: the first shell using it, and its uses one way less the other, with the faces as
-    // classified and as stored.
-    type Edges = FxHashMap<(u32, u32), (u32, i64, i64)>;
-    let mut edges = Edges::default();
-    let count = |edges: &mut Edges, parent: &mut Vec<u32>, face: &[u32], shell: u32, turned: bool| {
+    let mut edges = EdgeUses::default();
+    let count = |edges: &mut EdgeUses, parent: &mut Vec<u32>, face: &[u32], shell: u32, turned: bool| {
         for k in 0..face.len() {
             let (u, v) = (at(face[k]), at(face[(k + 1) % face.len()]));
             if u != v {
@@ -316,17 +349,32 @@ fn orient(
     sign
 }
 
+/// The shells, their triangles, which are decided face by face and their orientation as classified.
+#[derive(Clone, Copy)]
+struct ShellSet<'a> {
+    shells: &'a [Shell],
+    tris: &'a [Vec<[u32; 3]>],
+    relevant: &'a [bool],
+    sign: &'a [i64],
+}
+
 /// Decides the faces of the `relevant` shells one by one ([`correction::resolve`]) and appends them
 /// to `out.faces`; on welded corners when `welded` gives representatives ([`cracks`]).
 fn resolve_pairs(
     vertices: &[[f64; 3]],
-    (shells, tris, relevant, sign): (&[Shell], &[Vec<[u32; 3]>], &[bool], &[i64]),
+    set: &ShellSet<'_>,
     copied: &[(usize, Vec<[u32; 3]>)],
     welded: Option<&[u32]>,
     out: &mut ShellOutcome,
 ) {
     let (mut all, mut signs) = (Vec::new(), Vec::new());
     let mut swept = 0.0;
+    let ShellSet {
+        shells,
+        tris,
+        relevant,
+        sign,
+    } = *set;
     let own = (0..shells.len()).filter(|&i| relevant[i]).map(|i| (i, &tris[i]));
     for (i, tris) in own.chain(copied.iter().map(|(i, t)| (*i, t))) {
         let t = match welded {
