@@ -1,5 +1,6 @@
 //! Overlapping shells that are not closed as the classification first sees them, on the repaired
-//! rungs: a shell closed up to a crack, a face stored twice that the surface needs twice. The solid
+//! rungs: a shell closed up to a crack, a face stored twice that the surface needs twice, a face the
+//! ladder turned round against the stored cycle. The solid
 //! Ω = {x : |w(x)| ≥ ½}, w the winding number of the surface as stored, against exact rational
 //! integrals (a union of boxes through inclusion–exclusion; a tetrahedron), every estimate at least
 //! the real error.
@@ -166,5 +167,32 @@ fn a_face_stored_twice_for_two_shells_counts_once() {
         (s.unit.mass - sampled).abs() <= 4.0 * sigma + 1e-3,
         "{} vs {sampled} ± {sigma}",
         s.unit.mass
+    );
+}
+
+/// The same two tetrahedra with a box far below them, so that the surface's centre lies under the
+/// shared base: seen from there the base alone (a component of its own between the non-manifold
+/// edges) is wound inward, and the ladder turns it round, which leaves the edges unbalanced. The
+/// cluster is decided as stored: Ω is the taller tetrahedron and the box, exactly.
+#[test]
+fn a_face_the_ladder_turns_round_is_decided_as_stored() {
+    let base = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let tall = tetrahedron([base[0], base[1], base[2], [0.25, 0.25, 1.0]]);
+    let low = tetrahedron([base[0], base[1], base[2], [0.25, 0.25, 0.5]]);
+    let far = common::box_at([0.0, 0.0, -10.0], [0.5, 0.5, -9.5]);
+    let mut mesh = tall.clone();
+    mesh.0.push(low.0[3]);
+    mesh.1
+        .extend(low.1.iter().map(|t| t.map(|i| if i == 3 { 4 } else { i })));
+    let mesh = together(&[&mesh, &far]);
+    let s = solid(&mesh);
+    let exact = exact_sum(&[(1, &tall), (1, &far)]);
+    let error = within_estimate("turned round", &s, &exact);
+    assert!(error <= 1e-8, "{error:e} {:?}", s.warnings);
+    let said = |what: &str| s.warnings.iter().any(|w| w.text.contains(what));
+    assert!(
+        said("1 re-oriented faces as stored") && said("1 face copies put back"),
+        "{:?}",
+        s.warnings
     );
 }
