@@ -162,6 +162,13 @@ fn a_face_stored_twice_for_two_shells_counts_once() {
     let exact = exact_sum(&[(1, &tall)]);
     let error = within_estimate("face twice", &s, &exact);
     assert!(error <= 1e-8, "{error:e} {:?}", s.warnings);
+    // Every face decided on the surface as stored: the rung's terms for the copy it dropped go.
+    assert!(
+        s.error_estimate <= 1e-6,
+        "{:e} {:?}",
+        s.error_estimate,
+        s.warnings
+    );
     // The sampled winding number of the mesh as stored agrees (Ω is the taller tetrahedron).
     assert!(
         (s.unit.mass - sampled).abs() <= 4.0 * sigma + 1e-3,
@@ -189,6 +196,12 @@ fn a_face_the_ladder_turns_round_is_decided_as_stored() {
     let exact = exact_sum(&[(1, &tall), (1, &far)]);
     let error = within_estimate("turned round", &s, &exact);
     assert!(error <= 1e-8, "{error:e} {:?}", s.warnings);
+    assert!(
+        s.error_estimate <= 1e-6,
+        "{:e} {:?}",
+        s.error_estimate,
+        s.warnings
+    );
     let said = |what: &str| s.warnings.iter().any(|w| w.text.contains(what));
     assert!(
         said("1 re-oriented faces as stored") && said("1 face copies put back"),

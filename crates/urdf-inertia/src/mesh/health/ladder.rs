@@ -85,6 +85,11 @@ impl<'a> Ladder<'a> {
             return faces;
         }
         let mut s = winding_shells::classify(vertices, &faces, &self.as_stored);
+        if s.whole_as_stored {
+            // The file's surface, every face decided by its winding number: what the rung assumed
+            // about closure and orientation no longer enters the solid.
+            model.terms.clear();
+        }
         if s.resolved_pairs > 0 {
             self.resolved(&s, model);
         }

@@ -65,6 +65,11 @@ pub struct ShellOutcome {
     pub copies_restored: usize,
     pub turned_back: usize,
     pub cracks_welded: bool,
+    /// Every face was decided face by face or lies on a sealed shell, on the surface exactly as
+    /// stored (all copies put back, every face turned round turned back, no face added): the solid
+    /// is Ω of the file's surface up to the bounds here, whatever the rung assumed about its
+    /// closure and orientation.
+    pub whole_as_stored: bool,
     /// What the pieces left undecided can change: volume (m³), within a ball (centre, radius).
     pub resolved_bound: f64,
     pub ball: ([f64; 3], f64),
@@ -171,6 +176,10 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
             .filter(|&(i, _)| clusters.unflip[i])
             .map(|(_, s)| s.faces.iter().filter(|&&f| flip[f as usize]).count())
             .sum();
+        out.whole_as_stored = (shells.iter().enumerate()).all(|(i, s)| relevant[i] || s.sealed)
+            && copied.len() == stored.copies.len()
+            && out.turned_back == flip.iter().filter(|&&f| f).count()
+            && faces.len() == stored.faces.len();
         let set = ShellSet {
             shells: &shells,
             tris: &tris,
