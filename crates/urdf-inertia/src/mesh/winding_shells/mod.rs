@@ -171,11 +171,8 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
         let copied = copied(&stored.copies, &clusters.copy_shell, &relevant);
         out.copies_restored = copied.len();
         out.cracks_welded = welded.is_some();
-        let tris = as_stored(faces, &shells, &tris, &clusters.unflip, &flip);
-        out.turned_back = (shells.iter().enumerate())
-            .filter(|&(i, _)| clusters.unflip[i])
-            .map(|(_, s)| s.faces.iter().filter(|&&f| flip[f as usize]).count())
-            .sum();
+        let (tris, turned) = as_stored(faces, &shells, &tris, &clusters.unflip, &flip);
+        out.turned_back = turned;
         out.whole_as_stored = (shells.iter().enumerate()).all(|(i, s)| relevant[i] || s.sealed)
             && copied.len() == stored.copies.len()
             && out.turned_back == flip.iter().filter(|&&f| f).count()
@@ -433,17 +430,19 @@ fn turned_round(faces: &Polygons, stored: &Polygons) -> Vec<bool> {
 }
 
 /// The shells' triangles, those of the shells marked in `unflip` with their faces in the stored
-/// orientation (the faces in `flip` turned back).
+/// orientation (the faces in `flip` turned back), and how many faces were turned back.
 fn as_stored(
     faces: &Polygons,
     shells: &[Shell],
     tris: &[Vec<[u32; 3]>],
     unflip: &[bool],
     flip: &[bool],
-) -> Vec<Vec<[u32; 3]>> {
+) -> (Vec<Vec<[u32; 3]>>, usize) {
     let mut out = tris.to_vec();
+    let mut turned = 0;
     for (i, s) in shells.iter().enumerate() {
         if unflip[i] && s.faces.iter().any(|&f| flip[f as usize]) {
+            turned += s.faces.iter().filter(|&&f| flip[f as usize]).count();
             out[i] = s
                 .faces
                 .iter()
@@ -455,7 +454,7 @@ fn as_stored(
                 .collect();
         }
     }
-    out
+    (out, turned)
 }
 
 /// The faces kept, those marked turned reversed.
