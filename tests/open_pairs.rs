@@ -175,6 +175,15 @@ fn a_face_stored_twice_for_two_shells_counts_once() {
         "{} vs {sampled} ± {sigma}",
         s.unit.mass
     );
+    // Welding's message that the copy was dropped says that it was put back.
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.text.contains("more than once")
+                && w.text.contains("1 of the copies put back")),
+        "{:?}",
+        s.warnings
+    );
 }
 
 /// The same two tetrahedra with a box far below them, so that the surface's centre lies under the

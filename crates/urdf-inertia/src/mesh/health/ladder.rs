@@ -152,6 +152,17 @@ impl<'a> Ladder<'a> {
         let mut stored = Vec::new();
         if s.copies_restored > 0 {
             stored.push(format!("{} face copies put back", s.copies_restored));
+            // Welding said the copies were dropped; where shells are decided, they are not.
+            if let Some(w) = self
+                .warnings
+                .iter_mut()
+                .find(|w| w.kind == HealthKind::FacesDropped && w.text.contains("more than once"))
+            {
+                w.text.push_str(&format!(
+                    "; {} of the copies put back where overlapping shells are decided by the winding number of the surface as stored, which counts each copy",
+                    s.copies_restored
+                ));
+            }
         }
         if s.turned_back > 0 {
             stored.push(format!("{} re-oriented faces as stored", s.turned_back));
