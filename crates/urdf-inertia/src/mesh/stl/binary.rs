@@ -25,20 +25,32 @@ pub(super) const PIECE: usize = 4;
 /// either way, so the result is the sequential weld's, bit for bit, for any number of threads; and
 /// the cross-chunk weld sees each vertex about once instead of at each of its six or so corners.
 ///
-/// The corners are written where they end up, each chunk's into its own part of one array made for
-/// all of them (as indices into the chunk's vertices, which the join rebases), so that no thread
-/// waits for a serial copy, and the pages of that array are touched by the thread that fills them.
+/// Each chunk writes where its results end up, so that no thread waits for a serial copy and the
+/// pages are touched by the thread that fills them: its corners into its own part of one array made
+/// for all of them (as indices into the chunk's vertices, which the join rebases), and its vertices
+/// into its own region of one array of [`region`] vertices a chunk, in which the join then moves
+/// the distinct ones together ([`crate::mesh::weld::join_in_place`]), so that no second array is
+/// faulted in for them. A chunk with more vertices than its region (faces in no order, a soup of
+/// unshared corners) keeps them in a list of its own, and the join copies them all out instead.
 pub(super) struct Binary {
-    /// Each chunk's distinct vertices, in file order.
-    chunks: Vec<Vec<[f64; 3]>>,
+    /// Chunk `c`'s vertices from `c · region` on, unless they are in `overflow[c]`.
+    vertices: Vec<[f64; 3]>,
+    /// Each chunk's number of vertices.
+    lens: Vec<usize>,
+    /// Each chunk's vertices when they did not fit its region.
+    overflow: Vec<Option<Vec<[f64; 3]>>>,
     /// Corners, each chunk's as indices into its own vertices until [`Binary::finish`].
     indices: Vec<u32>,
-    /// Corners written so far.
-    filled: usize,
     /// Records in a chunk: [`CHUNK`], but for [`read_split`](super::read_split).
     chunk: usize,
     /// Runs of the cross-chunk join: `None` (the join's choice), but for [`read_split`](super::read_split).
     runs: Option<usize>,
+}
+
+/// Vertices a chunk of `chunk` records has room for in [`Binary`]'s array: a closed mesh has about
+/// half as many vertices as faces, and a chunk repeats those on its border.
+fn region(chunk: usize) -> usize {
+    chunk / 2 + chunk / 16 + 16
 }
 
 /// Records welded on their own before the cross-chunk join: 16 Ki faces make about 8 Ki vertices, a
@@ -46,13 +58,17 @@ pub(super) struct Binary {
 /// which the one big table of all vertices needed, measured no faster here).
 pub(super) const CHUNK: usize = 16 * 1024;
 
-/// The distinct vertices of a chunk of records in order of first appearance; its corners, as
-/// indices into them, go to `out` (three per record). `table` is reused from chunk to chunk.
-fn weld_chunk(records: &[u8], table: &mut VertexTable, out: &mut [u32]) -> Vec<[f64; 3]> {
-    let n = records.len() / 50;
-    // A closed mesh has about half as many vertices as faces, and a chunk repeats those on its
-    // border.
-    table.clear(n / 2 + n / 16 + 16);
+/// Welds a chunk of records: its corners, as indices into its distinct vertices, go to `out` (three
+/// per record), and its distinct vertices in order of first appearance to `room` when they fit
+/// (their number is returned), in a list of their own when they do not. `table` is reused from
+/// chunk to chunk.
+fn weld_chunk(
+    records: &[u8],
+    table: &mut VertexTable,
+    out: &mut [u32],
+    room: &mut [[f64; 3]],
+) -> (usize, Option<Vec<[f64; 3]>>) {
+    table.clear(room.len());
     for (r, out) in records.chunks_exact(50).zip(out.chunks_exact_mut(3)) {
         // + 0.0 folds −0.0 into 0.0, so that both weld (`RawMesh::welded`).
         let f =
@@ -62,7 +78,14 @@ fn weld_chunk(records: &[u8], table: &mut VertexTable, out: &mut [u32]) -> Vec<[
         out[1] = table.insert([f(24), f(28), f(32)]);
         out[2] = table.insert([f(36), f(40), f(44)]);
     }
-    table.take_vertices()
+    let v = table.vertices();
+    match room.get_mut(..v.len()) {
+        Some(room) => {
+            room.copy_from_slice(v);
+            (v.len(), None)
+        }
+        None => (v.len(), Some(v.to_vec())),
+    }
 }
 
 /// Fills `buf` from `file` at `offset` without moving a shared cursor, so that several threads read
@@ -92,31 +115,43 @@ pub(super) fn read_exact_at(file: &File, mut buf: &mut [u8], mut offset: u64) ->
 
 impl Binary {
     pub(super) fn new(n: usize, chunk: usize, runs: Option<usize>) -> Self {
+        let chunks = n.div_ceil(chunk.max(1));
         Binary {
             chunk,
             runs,
-            chunks: Vec::with_capacity(n.div_ceil(chunk.max(1))),
-            // Zeroed memory from the allocator is fresh pages, faulted in by the threads that write them.
+            // Zeroed memory from the allocator: fresh pages, faulted in by the threads that write
+            // them, and a region's end that no vertex reaches is never touched.
+            vertices: vec![[0.0; 3]; chunks * region(chunk)],
+            lens: Vec::with_capacity(chunks),
+            overflow: Vec::with_capacity(chunks),
             indices: vec![0; 3 * n],
-            filled: 0,
         }
     }
 
     /// Welds whole records, in chunks on the pool.
     pub(super) fn feed(&mut self, records: &[u8]) {
         use rayon::prelude::*;
-        let chunk = self.chunk;
-        let end = self.filled + 3 * (records.len() / 50);
-        let out = &mut self.indices[self.filled..end];
-        let welded: Vec<Vec<[f64; 3]>> = crate::threads::install(|| {
+        let (chunk, done) = (self.chunk, self.lens.len());
+        let corners = &mut self.indices[3 * chunk * done..][..3 * (records.len() / 50)];
+        let rooms = &mut self.vertices[region(chunk) * done..];
+        let welded: Vec<(usize, Option<Vec<[f64; 3]>>)> = crate::threads::install(|| {
             records
                 .par_chunks(50 * chunk)
-                .zip(out.par_chunks_mut(3 * chunk))
-                .map_init(VertexTable::default, |table, (r, o)| weld_chunk(r, table, o))
+                .zip(corners.par_chunks_mut(3 * chunk))
+                .zip(rooms.par_chunks_mut(region(chunk)))
+                .map_init(VertexTable::default, |table, ((r, o), room)| {
+                    weld_chunk(r, table, o, room)
+                })
                 .collect()
         });
-        self.chunks.extend(welded);
-        self.filled = end;
+        self.keep(welded);
+    }
+
+    fn keep(&mut self, welded: Vec<(usize, Option<Vec<[f64; 3]>>)>) {
+        for (len, overflow) in welded {
+            self.lens.push(len);
+            self.overflow.push(overflow);
+        }
     }
 
     /// Reads and welds all the records from `file`, the first at `offset`: each chunk is read by
@@ -126,41 +161,53 @@ impl Binary {
     pub(super) fn read_at(&mut self, file: &File, offset: u64) -> Result<(), (usize, io::Error)> {
         use rayon::prelude::*;
         let chunk = self.chunk;
-        let out = &mut self.indices[self.filled..];
-        let welded: Vec<io::Result<Vec<[f64; 3]>>> = crate::threads::install(|| {
-            out.par_chunks_mut(3 * chunk)
+        let rooms = &mut self.vertices[..];
+        let welded: Vec<io::Result<_>> = crate::threads::install(|| {
+            self.indices
+                .par_chunks_mut(3 * chunk)
+                .zip(rooms.par_chunks_mut(region(chunk)))
                 .enumerate()
                 .map_init(
                     || (Vec::new(), VertexTable::default()),
-                    |(buf, table), (c, o)| {
+                    |(buf, table), (c, (o, room))| {
                         buf.resize(50 * (o.len() / 3), 0);
                         read_exact_at(file, buf, offset + 50 * (chunk * c) as u64)?;
-                        Ok(weld_chunk(buf, table, o))
+                        Ok(weld_chunk(buf, table, o, room))
                     },
                 )
                 .collect()
         });
-        for (c, w) in welded.into_iter().enumerate() {
-            self.chunks.push(w.map_err(|e| (c * chunk, e))?);
-        }
-        self.filled = self.indices.len();
+        let welded = (welded.into_iter().enumerate())
+            .map(|(c, w)| w.map_err(|e| (c * chunk, e)))
+            .collect::<Result<Vec<_>, _>>()?;
+        self.keep(welded);
         Ok(())
     }
 
     pub(super) fn finish(self, header_count: Option<usize>) -> RawMesh {
         let Binary {
-            chunks,
+            mut vertices,
+            lens,
+            overflow,
             mut indices,
             chunk,
             runs,
-            ..
         } = self;
         let n = indices.len() / 3;
-        let blocks: Vec<&[[f64; 3]]> = chunks.iter().map(Vec::as_slice).collect();
-        let vertices =
-            crate::mesh::weld::join_chunks(&blocks, &mut indices, Some(3 * chunk), runs);
-        drop(blocks);
-        drop(chunks);
+        let rebase = Some(3 * chunk);
+        let room = region(chunk);
+        let vertices = if overflow.iter().all(Option::is_none) {
+            crate::mesh::weld::join_in_place(&mut vertices, room, &lens, &mut indices, rebase, runs);
+            vertices
+        } else {
+            let blocks: Vec<&[[f64; 3]]> = (overflow.iter().zip(&lens).enumerate())
+                .map(|(c, (o, &len))| match o {
+                    Some(o) => o.as_slice(),
+                    None => &vertices[c * room..][..len],
+                })
+                .collect();
+            crate::mesh::weld::join_chunks(&blocks, &mut indices, rebase, runs)
+        };
         let starts = crate::threads::install(|| {
             use rayon::prelude::*;
             (0..=n as u32).into_par_iter().map(|i| 3 * i).collect()

@@ -12,21 +12,19 @@ use rayon::prelude::*;
 /// `stl_stream` fuzz target: the inputs they can afford have a few thousand vertices at most, one
 /// run by the choice here.
 pub fn join(vertices: Vec<[f64; 3]>, indices: &mut [u32], runs: Option<usize>) -> Vec<[f64; 3]> {
-    let blocks: Vec<&[[f64; 3]]> = vertices.chunks(BLOCK).collect();
-    let distinct = join_chunks(&blocks, indices, None, runs);
-    // Taken by value: the list, whose distinct vertices are now copied out, is freed here.
-    drop(blocks);
-    drop(vertices);
-    distinct
+    let lens: Vec<usize> = vertices.chunks(BLOCK).map(<[_]>::len).collect();
+    let mut vertices = vertices;
+    join_in_place(&mut vertices, BLOCK, &lens, indices, None, runs);
+    vertices
 }
 
 /// Vertices a block of [`join`]'s input, the unit of its parallel passes (a chunk's worth).
 const BLOCK: usize = 1 << 13;
 
-/// [`join`] of vertices given in blocks, one after the other. With `rebase` `Some(corners)`, the
-/// corners come in chunks of `corners`, chunk `c` pointing into block `c` (a reader that welds
-/// chunks in parallel writes each chunk's corners in place, and this pass rebases them); with
-/// `None`, into the blocks as one list.
+/// [`join`] of vertices given in blocks, one after the other, into a new list. With `rebase`
+/// `Some(corners)`, the corners come in chunks of `corners`, chunk `c` pointing into block `c` (a
+/// reader that welds chunks in parallel writes each chunk's corners in place, and this pass rebases
+/// them); with `None`, into the blocks as one list.
 ///
 /// One table over all vertices is what this replaces: once table and vertices outgrow the L3 cache
 /// its inserts are DRAM and TLB misses (figures: docs/benchmarks.md, "Figures behind choices in the
@@ -43,6 +41,89 @@ pub fn join_chunks(
     rebase: Option<usize>,
     runs: Option<usize>,
 ) -> Vec<[f64; 3]> {
+    let numbered = numbered(blocks, runs);
+    let Numbered {
+        first,
+        bases,
+        starts,
+    } = &numbered;
+    let mut out = vec![[0.0; 3]; starts[blocks.len()]];
+    crate::threads::install(|| {
+        split(&mut out, starts)
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(c, out)| {
+                let first = &first[bases[c]..bases[c + 1]];
+                let mut k = 0;
+                for (&f, p) in first.iter().zip(blocks[c]) {
+                    if f as usize == starts[c] + k {
+                        out[k] = *p;
+                        k += 1;
+                    }
+                }
+            });
+    });
+    renumber(first, indices, rebase, bases);
+    out
+}
+
+/// [`join_chunks`] of blocks held in `vertices` itself, block `c`'s `lens[c]` vertices (at most
+/// `cap`) from `c · cap` on, welded in place: `vertices` becomes the distinct vertices. No memory is
+/// taken for them beyond the blocks': each block moves its first copies to its front on the pool,
+/// then the blocks move down one after the other (each to no later than where it is).
+pub fn join_in_place(
+    vertices: &mut Vec<[f64; 3]>,
+    cap: usize,
+    lens: &[usize],
+    indices: &mut [u32],
+    rebase: Option<usize>,
+    runs: Option<usize>,
+) {
+    let cap = cap.max(1);
+    debug_assert!(lens.iter().all(|&l| l <= cap));
+    let blocks: Vec<&[[f64; 3]]> = (lens.iter().enumerate())
+        .map(|(c, &l)| &vertices[c * cap..c * cap + l])
+        .collect();
+    let Numbered {
+        first,
+        bases,
+        starts,
+    } = numbered(&blocks, runs);
+    drop(blocks);
+    crate::threads::install(|| {
+        vertices
+            .par_chunks_mut(cap)
+            .zip(lens)
+            .enumerate()
+            .for_each(|(c, (block, &len))| {
+                let first = &first[bases[c]..bases[c] + len];
+                let mut k = 0;
+                for (i, &f) in first.iter().enumerate() {
+                    if f as usize == starts[c] + k {
+                        block[k] = block[i];
+                        k += 1;
+                    }
+                }
+            });
+    });
+    // A block's distinct vertices go to `starts[c]`, no later than `bases[c]` (the vertices before
+    // it), no later than `c · cap`: moved in order, none overwrites one still to move.
+    for c in 0..lens.len() {
+        vertices.copy_within(c * cap..c * cap + starts[c + 1] - starts[c], starts[c]);
+    }
+    vertices.truncate(starts[lens.len()]);
+    renumber(&first, indices, rebase, &bases);
+}
+
+/// Each vertex's number among the distinct ones (`first`), where each block starts among all the
+/// vertices (`bases`) and among the distinct ones (`starts`), both with the end.
+struct Numbered {
+    first: Vec<u32>,
+    bases: Vec<usize>,
+    starts: Vec<usize>,
+}
+
+fn numbered(blocks: &[&[[f64; 3]]], runs: Option<usize>) -> Numbered {
     let mut bases = Vec::with_capacity(blocks.len() + 1);
     bases.push(0usize);
     for b in blocks {
@@ -55,7 +136,7 @@ pub fn join_chunks(
         || (n / 2048).next_power_of_two().clamp(1, 256),
         |r| r.clamp(1, 256),
     );
-    let (first, distinct) = crate::threads::install(|| {
+    crate::threads::install(|| {
         let parts: Vec<Part> = blocks
             .par_iter()
             .zip(&bases)
@@ -67,10 +148,13 @@ pub fn join_chunks(
             .collect();
         let first = scatter(&parts, &firsts, &bases, n);
         drop(firsts);
-        number(first, blocks, &bases)
-    });
-    renumber(&first, indices, rebase, &bases);
-    distinct
+        let (first, starts) = number(first, &bases);
+        Numbered {
+            first,
+            bases,
+            starts,
+        }
+    })
 }
 
 /// A block's entries (the hash's low half above the position), grouped by run, each run's in file
@@ -178,11 +262,12 @@ fn scatter(parts: &[Part], firsts: &[Vec<u32>], bases: &[usize], n: usize) -> Ve
     first
 }
 
-/// The distinct vertices in file order, and `first` turned from each vertex's first copy into the
-/// number of that copy among them: each block counts its first copies, and with those counts summed
-/// in order, numbers its own and copies them out.
-fn number(mut first: Vec<u32>, blocks: &[&[[f64; 3]]], bases: &[usize]) -> (Vec<u32>, Vec<[f64; 3]>) {
-    let counts: Vec<usize> = (0..blocks.len())
+/// `first` turned from each vertex's first copy into the number of that copy among the first
+/// copies, and where each block's first copies start among them (with the end): each block counts
+/// its first copies, and with those counts summed in order, numbers its own.
+fn number(mut first: Vec<u32>, bases: &[usize]) -> (Vec<u32>, Vec<usize>) {
+    let blocks = bases.len() - 1;
+    let counts: Vec<usize> = (0..blocks)
         .into_par_iter()
         .map(|c| {
             let base = bases[c];
@@ -190,24 +275,21 @@ fn number(mut first: Vec<u32>, blocks: &[&[[f64; 3]]], bases: &[usize]) -> (Vec<
             f.iter().enumerate().filter(|&(i, &f)| f as usize == base + i).count()
         })
         .collect();
-    let mut starts = Vec::with_capacity(counts.len() + 1);
+    let mut starts = Vec::with_capacity(blocks + 1);
     starts.push(0usize);
     for c in &counts {
         starts.push(starts[starts.len() - 1] + c);
     }
-    let mut vertices = vec![[0.0; 3]; starts[counts.len()]];
     // A first copy's number; the others' are read from their first copy's below.
     let mut numbers = vec![0u32; first.len()];
     split(&mut numbers, bases)
         .into_par_iter()
-        .zip(split(&mut vertices, &starts))
         .enumerate()
-        .for_each(|(c, (numbers, out))| {
+        .for_each(|(c, numbers)| {
             let (base, mut k) = (bases[c], 0);
-            for (i, (&f, p)) in first[base..bases[c + 1]].iter().zip(blocks[c]).enumerate() {
+            for (i, &f) in first[base..bases[c + 1]].iter().enumerate() {
                 if f as usize == base + i {
                     numbers[i] = (starts[c] + k) as u32;
-                    out[k] = *p;
                     k += 1;
                 }
             }
@@ -217,7 +299,7 @@ fn number(mut first: Vec<u32>, blocks: &[&[[f64; 3]]], bases: &[usize]) -> (Vec<
             *f = numbers[*f as usize];
         }
     });
-    (first, vertices)
+    (first, starts)
 }
 
 /// `v` cut at `bounds` (ascending, from 0 to `v.len()`) into consecutive slices.
@@ -268,8 +350,9 @@ mod tests {
     /// order does: corners drawn from a small pool (so most repeat, within and across chunks), in
     /// chunks of several sizes, from one run of entries to the most, with run counts forced (powers
     /// of two or not) on the smaller cases; the chunks' vertices given as one list ([`join`], cut in
-    /// blocks of its own) and as the chunks themselves with their corners local ([`join_chunks`]),
-    /// on a pool of one thread and of three.
+    /// blocks of its own, welded in place), as the chunks themselves with their corners local
+    /// ([`join_chunks`]) and in regions of one array ([`join_in_place`]), on a pool of one thread
+    /// and of three.
     #[test]
     fn joined_chunks_are_the_sequential_weld() {
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
@@ -314,6 +397,19 @@ mod tests {
                     let joined = p.install(|| join_chunks(&blocks, &mut indices, Some(chunk), runs));
                     assert_eq!(indices, want, "{case}, in chunks");
                     assert_eq!(bits(&joined), reference, "{case}, in chunks");
+                    // In regions of one array, a little larger than the largest chunk.
+                    let cap = blocks.iter().map(|b| b.len()).max().unwrap_or(0) + 3;
+                    let mut regions = vec![[f64::NAN; 3]; cap * blocks.len()];
+                    for (r, b) in regions.chunks_mut(cap).zip(&blocks) {
+                        r[..b.len()].copy_from_slice(b);
+                    }
+                    let lens: Vec<usize> = blocks.iter().map(|b| b.len()).collect();
+                    let mut indices = local.clone();
+                    p.install(|| {
+                        join_in_place(&mut regions, cap, &lens, &mut indices, Some(chunk), runs);
+                    });
+                    assert_eq!(indices, want, "{case}, in place");
+                    assert_eq!(bits(&regions), reference, "{case}, in place");
                     let mut base = 0;
                     let mut indices = local.clone();
                     for (c, b) in indices.chunks_mut(chunk).zip(&blocks) {

@@ -34,7 +34,7 @@ mod join;
 mod table;
 mod tolerant;
 
-pub use join::{join, join_chunks};
+pub use join::{join, join_chunks, join_in_place};
 pub use table::VertexTable;
 pub use tolerant::{tolerance, tolerant, Precision, TolerantWeld};
 #[cfg(any(test, feature = "internals"))]

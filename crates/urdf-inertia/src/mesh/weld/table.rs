@@ -81,7 +81,8 @@ impl VertexTable {
     /// [`VertexTable::with_capacity`] would give (a reader welding chunk after chunk).
     pub fn clear(&mut self, expected: usize) {
         let size = (2 * expected).max(16).next_power_of_two();
-        self.vertices = Vec::with_capacity(expected);
+        self.vertices.clear();
+        self.vertices.reserve(expected);
         if self.slots.len() == size {
             self.slots.fill(0);
         } else {
@@ -89,9 +90,9 @@ impl VertexTable {
         }
     }
 
-    /// The distinct vertices in order of first appearance, leaving the table to be cleared.
-    pub fn take_vertices(&mut self) -> Vec<[f64; 3]> {
-        std::mem::take(&mut self.vertices)
+    /// The distinct vertices so far, in order of first appearance.
+    pub fn vertices(&self) -> &[[f64; 3]] {
+        &self.vertices
     }
 }
 
