@@ -5,8 +5,9 @@
 //! header with a wrong triangle count is tolerated when the length still holds whole records (noted);
 //! a file shorter than its records is an error.
 //!
-//! Both are streamed from a file: binary records in pieces of a few megabytes, ASCII text in pieces
-//! of [`ASCII_PIECE`] bytes cut into chunks at `facet` lines; chunks are parsed and welded on their own
+//! Both are streamed from a file: binary records a chunk at a time, each read (positioned reads) by
+//! the thread that welds it, ASCII text in pieces of [`ASCII_PIECE`] bytes cut into chunks at `facet`
+//! lines; chunks are parsed and welded on their own
 //! in parallel and their vertices welded across chunks at the end, so the file is never held whole
 //! and the result is one sequential parse's, bit for bit (the ASCII reader is tested against the
 //! whole-text reader it replaced, kept in the tests).

@@ -208,7 +208,9 @@ fn first_copies(r: usize, parts: &[Part], blocks: &[&[[f64; 3]]], bases: &[usize
     for (part, (block, &base)) in parts.iter().zip(blocks.iter().zip(bases)) {
         for &e in part.run(r) {
             let p = e as u32 as usize;
-            let bits = block[p - base].map(f64::to_bits);
+            // Read only when a tag matches (a copy, nearly always): a vertex read for every entry
+            // is a cache miss for every entry once the vertices outgrow the cache.
+            let bits = || block[p - base].map(f64::to_bits);
             // The hash's low half picks the slot (its top bits picked the run).
             let mut s = (e >> 32) as usize & mask;
             loop {
@@ -218,7 +220,7 @@ fn first_copies(r: usize, parts: &[Part], blocks: &[&[[f64; 3]]], bases: &[usize
                         out.push(p as u32);
                         break;
                     }
-                    f if f >> 32 == e >> 32 && vertex(f as u32 as usize) == bits => {
+                    f if f >> 32 == e >> 32 && vertex(f as u32 as usize) == bits() => {
                         out.push(f as u32);
                         break;
                     }
