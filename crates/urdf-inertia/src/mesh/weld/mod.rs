@@ -30,10 +30,12 @@
 use crate::mass::Polygons;
 
 /// Relative tolerance of the second pass, against the largest side of the bounding box.
+mod join;
 mod table;
 mod tolerant;
 
-pub use table::{join, VertexTable};
+pub use join::{join, join_chunks, join_in_place};
+pub use table::VertexTable;
 pub use tolerant::{tolerance, tolerant, Precision, TolerantWeld};
 #[cfg(any(test, feature = "internals"))]
 pub use tolerant::Tolerance;

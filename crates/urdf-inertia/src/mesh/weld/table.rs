@@ -1,4 +1,4 @@
-//! Bit-identical welding: the vertex table, and chunks welded on their own then joined.
+//! Bit-identical welding: the vertex table.
 
 /// Distinct vertices keyed by their bit patterns: an open-addressing table of vertex indices (with a
 /// 32-bit tag of the hash beside each) over the vertex list itself, so a vertex is stored once and a
@@ -76,127 +76,24 @@ impl VertexTable {
     pub fn into_vertices(self) -> Vec<[f64; 3]> {
         self.vertices
     }
-}
 
-/// Welds vertices that repeat across independently welded chunks: `vertices` are the chunks'
-/// distinct vertices one chunk after the other, `indices` point into them. Returns the distinct
-/// vertices in order of first appearance and rewrites `indices` to them: what one table fed the
-/// vertices in order gives, bit for bit.
-///
-/// One table over all vertices is what this replaces: once table and vertices outgrow the L3 cache
-/// its inserts are DRAM and TLB misses (figures: docs/benchmarks.md, "Figures behind choices in the
-/// code"). Here the vertices are first partitioned by the top bits of their hash into at most 256
-/// runs (8 bytes each: the hash's low half and the position), so each run is welded in its own
-/// small table (in parallel); a run keeps file order, so its first copy of a vertex is the first in
-/// the file. Numbers then follow in one pass in file order.
-///
-/// `runs` forces the number of runs (clamped to 1–256), for tests and the `stl_stream` fuzz target:
-/// the inputs they can afford have a few thousand vertices at most, one run by the choice here.
-pub fn join(vertices: Vec<[f64; 3]>, indices: &mut [u32], runs: Option<usize>) -> Vec<[f64; 3]> {
-    use rayon::prelude::*;
-    let n = vertices.len();
-    // About 2 Ki vertices a run; at most 256 runs, each written as one stream.
-    let runs = runs.map_or_else(
-        || (n / 2048).next_power_of_two().clamp(1, 256),
-        |r| r.clamp(1, 256),
-    );
-    let run_of = |h: u64| ((h >> 32) as usize * runs) >> 32;
-    let hashes: Vec<u64> = crate::threads::install(|| {
-        vertices
-            .par_iter()
-            .map(|v| hash(&v.map(f64::to_bits)))
-            .collect()
-    });
-    let mut starts = vec![0usize; runs + 1];
-    for &h in &hashes {
-        starts[run_of(h) + 1] += 1;
-    }
-    for r in 0..runs {
-        starts[r + 1] += starts[r];
-    }
-    let mut entries = vec![0u64; n];
-    let mut fill = starts.clone();
-    for (p, &h) in hashes.iter().enumerate() {
-        let r = run_of(h);
-        entries[fill[r]] = (h << 32) | p as u64;
-        fill[r] += 1;
-    }
-    drop(hashes);
-    let firsts: Vec<Vec<u32>> = crate::threads::install(|| {
-        (0..runs)
-            .into_par_iter()
-            .map(|r| first_copies(&entries[starts[r]..starts[r + 1]], &vertices))
-            .collect()
-    });
-    // Each vertex's first copy, in file order.
-    let mut first = vec![0u32; n];
-    for (&e, &f) in entries.iter().zip(firsts.iter().flatten()) {
-        first[e as u32 as usize] = f;
-    }
-    drop(entries);
-    // In place: a vertex's first copy comes no later than it, so `first[f]` already holds f's number
-    // and the distinct vertices move only towards the front.
-    let mut vertices = vertices;
-    let mut distinct = 0;
-    for p in 0..n {
-        let f = first[p] as usize;
-        first[p] = if f == p {
-            vertices[distinct] = vertices[p];
-            distinct += 1;
-            distinct as u32 - 1
+    /// Empties the table for about `expected` vertices, keeping its slots when they are the size
+    /// [`VertexTable::with_capacity`] would give (a reader welding chunk after chunk).
+    pub fn clear(&mut self, expected: usize) {
+        let size = (2 * expected).max(16).next_power_of_two();
+        self.vertices.clear();
+        self.vertices.reserve(expected);
+        if self.slots.len() == size {
+            self.slots.fill(0);
         } else {
-            first[f]
-        };
+            self.resize(size);
+        }
     }
-    vertices.truncate(distinct);
-    // The corners, 5 or 6 a vertex, are renumbered on the pool when it has more than one thread
-    // (on one, rayon's split costs more instructions than the plain loop).
-    let first: &[u32] = &first;
-    let renumber = |c: &mut [u32]| {
-        for i in c {
-            *i = first[*i as usize];
-        }
-    };
-    crate::threads::install(|| {
-        if rayon::current_num_threads() < 2 {
-            renumber(indices);
-        } else {
-            indices.par_chunks_mut(1 << 16).for_each(renumber);
-        }
-    });
-    vertices
-}
 
-/// For each entry of a run (the hash's low half above the position, in file order), the position of
-/// the first entry with the same vertex.
-fn first_copies(entries: &[u64], vertices: &[[f64; 3]]) -> Vec<u32> {
-    let size = (2 * entries.len()).max(16).next_power_of_two();
-    let mask = size - 1;
-    let mut slots = vec![u32::MAX; size];
-    let bits = |e: u64| vertices[e as u32 as usize].map(f64::to_bits);
-    entries
-        .iter()
-        .enumerate()
-        .map(|(i, &e)| {
-            // The hash's low half picks the slot (its top bits picked the run).
-            let mut s = (e >> 32) as usize & mask;
-            loop {
-                match slots[s] {
-                    u32::MAX => {
-                        slots[s] = i as u32;
-                        return e as u32;
-                    }
-                    j => {
-                        let f = entries[j as usize];
-                        if f >> 32 == e >> 32 && bits(f) == bits(e) {
-                            return f as u32;
-                        }
-                    }
-                }
-                s = (s + 1) & mask;
-            }
-        })
-        .collect()
+    /// The distinct vertices so far, in order of first appearance.
+    pub fn vertices(&self) -> &[[f64; 3]] {
+        &self.vertices
+    }
 }
 
 /// Multiplicative hash of three coordinates' bits: the slot is its top bits and the tag its low half,
@@ -210,7 +107,7 @@ fn first_copies(entries: &[u64], vertices: &[[f64; 3]]) -> Vec<u32> {
 /// points took 16,266 distinct values for 110,592 points, and the weld turned quadratic (test
 /// `integer_and_millimetre_grids_hash_apart`).
 #[inline(always)]
-fn hash(b: &[u64; 3]) -> u64 {
+pub(super) fn hash(b: &[u64; 3]) -> u64 {
     const K: u64 = 0x9e37_79b9_7f4a_7c15;
     let fold = |x: u64| x ^ (x >> 32);
     let h = (fold(b[0]).wrapping_mul(K) ^ fold(b[1])).wrapping_mul(K) ^ fold(b[2]);
@@ -241,46 +138,6 @@ mod tests {
         assert_eq!(t.into_vertices().len(), 39);
         let w = exact(&[[-0.0, 0.0, 0.0], [0.0, 0.0, 0.0]], &Polygons::new());
         assert_eq!(w.vertices, vec![[0.0, 0.0, 0.0]]);
-    }
-
-    /// Chunks welded on their own and then joined number every vertex as one weld of all corners in
-    /// order does: corners drawn from a small pool (so most repeat, within and across chunks), in
-    /// chunks of several sizes, from one run of entries to the most, and with run counts forced
-    /// (powers of two or not) on the smaller cases.
-    #[test]
-    fn joined_chunks_are_the_sequential_weld() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let pool: Vec<[f64; 3]> = (0..40_000)
-            .map(|_| [0; 3].map(|_| f64::from(crate::xorshift(&mut state) as u32 as f32) * 1e-6))
-            .collect();
-        let cases: [(usize, usize, &[Option<usize>]); 3] = [
-            (300, 7, &[None, Some(1), Some(3), Some(256)]),
-            (50_000, 1_000, &[None, Some(5), Some(256)]),
-            (1_500_000, 65_536, &[None]),
-        ];
-        for (corners, chunk, runs) in cases {
-            let picks: Vec<[f64; 3]> = (0..corners)
-                .map(|_| pool[(crate::xorshift(&mut state) % pool.len() as u64) as usize])
-                .collect();
-            let mut reference = VertexTable::with_capacity(16);
-            let want: Vec<u32> = picks.iter().map(|&p| reference.insert(p)).collect();
-            let bits = |v: &[[f64; 3]]| v.iter().map(|p| p.map(f64::to_bits)).collect::<Vec<_>>();
-            let reference = bits(&reference.into_vertices());
-            for &runs in runs {
-                let (mut vertices, mut indices) = (Vec::new(), Vec::new());
-                for c in picks.chunks(chunk) {
-                    let mut table = VertexTable::with_capacity(16);
-                    let local: Vec<u32> = c.iter().map(|&p| table.insert(p)).collect();
-                    let base = vertices.len() as u32;
-                    vertices.extend(table.into_vertices());
-                    indices.extend(local.iter().map(|&i| base + i));
-                }
-                let joined = join(vertices, &mut indices, runs);
-                let case = format!("{corners} corners in chunks of {chunk}, runs {runs:?}");
-                assert_eq!(indices, want, "{case}");
-                assert_eq!(bits(&joined), reference, "{case}");
-            }
-        }
     }
 
     /// Integer-grid and whole-millimetre coordinates (40 and more zero low bits) spread over the
