@@ -10,11 +10,11 @@
 //! the cone it spans from the surface's box centre (the volume a wrong orientation can change) to
 //! the bound, twice when it may count twice.
 
-use super::grid::{Corners, Grid, Seen};
+use super::grid::{orient3d, Corners, Grid, Seen};
 use super::{c3, segment_meets, triangles_touch};
 use crate::geometry::{cross, dot, sub, Aabb};
 use crate::mass::Polygons;
-use robust::{orient2d, orient3d, Coord};
+use robust::{orient2d, Coord};
 use rustc_hash::FxHashMap;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -142,14 +142,10 @@ impl Faces<'_> {
         (0..self.tris.len())
             .map(|t| {
                 let b = inflated(boxes[t], self.margin);
-                self.grid.candidates(&b, seen, &mut near);
+                self.grid.overlapping(&b, seen, &mut near);
                 near.iter()
                     .copied()
-                    .filter(|&u| {
-                        u as usize != t
-                            && overlap(&b, &boxes[u as usize])
-                            && self.blocks(t, u as usize)
-                    })
+                    .filter(|&u| u as usize != t && self.blocks(t, u as usize))
                     .collect()
             })
             .collect()
@@ -158,7 +154,13 @@ impl Faces<'_> {
     /// Whether triangle `u` may meet the relative interior of triangle `t` (exact, conservative).
     fn blocks(&self, t: usize, u: usize) -> bool {
         let (tt, tu) = (self.tris[t], self.tris[u]);
-        let shared: Vec<u32> = tt.iter().copied().filter(|v| tu.contains(v)).collect();
+        // The shared corners, in `t`'s order (a fixed array: this runs for every pair of neighbours).
+        let (mut shared, mut n) = ([0u32; 3], 0);
+        for v in tt.into_iter().filter(|v| tu.contains(v)) {
+            shared[n] = v;
+            n += 1;
+        }
+        let shared = &shared[..n];
         let (pt, pu) = (self.corners[t], self.corners[u]);
         match shared.len() {
             0 => triangles_touch(self.vertices, &tt, &tu),

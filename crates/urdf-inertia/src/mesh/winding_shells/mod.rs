@@ -22,7 +22,8 @@ mod grid;
 
 use crate::geometry::{cross, dot, sub, Aabb};
 use crate::mass::Polygons;
-use robust::{orient3d, Coord3D};
+use grid::orient3d;
+use robust::Coord3D;
 use rustc_hash::FxHashMap;
 
 /// Pairs of shells with overlapping boxes beyond this many are not decided one by one: all are bounded.
