@@ -11,7 +11,7 @@
 //! the bound, twice when it may count twice.
 
 use super::grid::{orient3d, Corners, Grid, Seen};
-use super::{c3, segment_meets, triangles_touch};
+use super::{c3, edge_meets, triangles_touch};
 use crate::geometry::{cross, dot, sub, Aabb};
 use crate::mass::Polygons;
 use robust::{orient2d, Coord};
@@ -324,8 +324,6 @@ impl Faces<'_> {
     ) -> Option<i64> {
         let c = self.corners[t as usize];
         let n = cross(sub(c[1], c[0]), sub(c[2], c[0]));
-        let mut axes = [0, 1, 2];
-        axes.sort_by(|&a, &b| n[b].abs().total_cmp(&n[a].abs()));
         let mid = centroid(piece);
         let inner = piece.iter().map(|v| [0, 1, 2].map(|k| (3.0 * mid[k] + v[k]) / 4.0));
         let mut skip = vec![t];
@@ -339,9 +337,11 @@ impl Faces<'_> {
                     skip.push(cp.u);
                     jump += if cp.same { 1 } else { -1 };
                 }
-                let front = axes.iter().filter(|&&k| n[k] != 0.0).find_map(|&k| {
-                    self.grid
-                        .winding(&self.corners, p, k, n[k].signum(), &skip, seen)
+                // A ray to the back counts the winding number behind the face and the
+                // triangles in its plane over `p`, which is the front's plus their jump.
+                let front = self.grid.rays(p, n).into_iter().find_map(|(k, sign, front)| {
+                    let w = self.grid.winding(&self.corners, p, k, sign, &skip, seen)?;
+                    Some(if front { w } else { w - jump })
                 })?;
                 Some((jump, front))
             })?;
@@ -495,7 +495,7 @@ fn shares_corner(t: Corners, u: Corners) -> bool {
     if ub == 0.0 || uc == 0.0 || tb == 0.0 || tc == 0.0 {
         return true;
     }
-    segment_meets(u[1], u[2], t) || segment_meets(t[1], t[2], u)
+    edge_meets(u[1], u[2], ub, uc, t) || edge_meets(t[1], t[2], tb, tc, u)
 }
 
 /// Two coplanar triangles sharing their first corner: whether a line through it along one of their
