@@ -195,19 +195,25 @@ impl Faces<'_> {
     /// patches no ray decides go to `heap` whole.
     fn patches(&self, blockers: &[Vec<u32>], seen: &mut Seen, out: &mut Resolved, heap: &mut BinaryHeap<Piece>) {
         let n = self.tris.len();
-        let mut by_edge: FxHashMap<(u32, u32), Vec<(u32, bool)>> = FxHashMap::default();
+        // Per edge: its first two uses (face, direction) and how many there are (no Vec per edge).
+        let mut by_edge: FxHashMap<(u32, u32), ([(u32, bool); 2], u32)> =
+            FxHashMap::with_capacity_and_hasher(3 * n / 2, Default::default());
         for (i, t) in self.tris.iter().enumerate() {
             if !blockers[i].is_empty() {
                 continue;
             }
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
-                by_edge.entry((a.min(b), a.max(b))).or_default().push((i as u32, a < b));
+                let e = by_edge.entry((a.min(b), a.max(b))).or_insert(([(0, false); 2], 0));
+                if e.1 < 2 {
+                    e.0[e.1 as usize] = (i as u32, a < b);
+                }
+                e.1 += 1;
             }
         }
         let mut parent: Vec<u32> = (0..n as u32).collect();
-        for users in by_edge.values() {
-            if users.len() == 2 && users[0].1 != users[1].1 {
+        for &(users, count) in by_edge.values() {
+            if count == 2 && users[0].1 != users[1].1 {
                 let (a, b) = (
                     super::root(&mut parent, users[0].0),
                     super::root(&mut parent, users[1].0),
@@ -215,21 +221,21 @@ impl Faces<'_> {
                 parent[a.max(b) as usize] = a.min(b);
             }
         }
-        let mut members: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+        // (patch root, triangle), sorted: the patches in the order of their roots (each root is
+        // its patch's lowest triangle), each patch's triangles in order.
+        let mut members = Vec::new();
         for t in 0..n as u32 {
             if blockers[t as usize].is_empty() {
-                members.entry(super::root(&mut parent, t)).or_default().push(t);
+                members.push((super::root(&mut parent, t), t));
             }
         }
-        let mut roots: Vec<u32> = members.keys().copied().collect();
-        roots.sort_unstable();
-        for r in roots {
-            let patch = &members[&r];
+        members.sort_unstable();
+        for patch in members.chunk_by(|x, y| x.0 == y.0) {
             let kappa = patch
                 .iter()
                 .take(MAX_TRIES)
-                .find_map(|&t| self.decide(&self.corners[t as usize], t, seen));
-            for &t in patch {
+                .find_map(|&(_, t)| self.decide(&self.corners[t as usize], t, seen));
+            for &(_, t) in patch {
                 match kappa {
                     Some(k) => self.emit_whole(t, k, out),
                     None => heap.push(self.piece(self.corners[t as usize], t, Vec::new())),
