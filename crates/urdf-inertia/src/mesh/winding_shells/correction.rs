@@ -15,7 +15,7 @@ use super::{c3, edge_meets, triangles_touch};
 use crate::geometry::{cross, dot, sub, Aabb};
 use crate::mass::Polygons;
 use robust::{orient2d, Coord};
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxBuildHasher, FxHashMap};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
@@ -75,6 +75,9 @@ impl Ord for Piece {
         self.delta.total_cmp(&other.delta)
     }
 }
+
+/// An edge's first two uses (triangle, direction) and how many there are (no Vec per edge).
+type EdgeUses = ([(u32, bool); 2], u32);
 
 /// The triangles and what the decision needs about them.
 struct Faces<'a> {
@@ -195,9 +198,8 @@ impl Faces<'_> {
     /// patches no ray decides go to `heap` whole.
     fn patches(&self, blockers: &[Vec<u32>], seen: &mut Seen, out: &mut Resolved, heap: &mut BinaryHeap<Piece>) {
         let n = self.tris.len();
-        // Per edge: its first two uses (face, direction) and how many there are (no Vec per edge).
-        let mut by_edge: FxHashMap<(u32, u32), ([(u32, bool); 2], u32)> =
-            FxHashMap::with_capacity_and_hasher(3 * n / 2, Default::default());
+        let mut by_edge: FxHashMap<(u32, u32), EdgeUses> =
+            FxHashMap::with_capacity_and_hasher(3 * n / 2, FxBuildHasher);
         for (i, t) in self.tris.iter().enumerate() {
             if !blockers[i].is_empty() {
                 continue;
@@ -330,6 +332,8 @@ impl Faces<'_> {
     ) -> Option<i64> {
         let c = self.corners[t as usize];
         let n = cross(sub(c[1], c[0]), sub(c[2], c[0]));
+        let mut axes = [0, 1, 2];
+        axes.sort_by(|&a, &b| n[b].abs().total_cmp(&n[a].abs()));
         let mid = centroid(piece);
         let inner = piece.iter().map(|v| [0, 1, 2].map(|k| (3.0 * mid[k] + v[k]) / 4.0));
         let mut skip = vec![t];
@@ -343,11 +347,9 @@ impl Faces<'_> {
                     skip.push(cp.u);
                     jump += if cp.same { 1 } else { -1 };
                 }
-                // A ray to the back counts the winding number behind the face and the
-                // triangles in its plane over `p`, which is the front's plus their jump.
-                let front = self.grid.rays(p, n).into_iter().find_map(|(k, sign, front)| {
-                    let w = self.grid.winding(&self.corners, p, k, sign, &skip, seen)?;
-                    Some(if front { w } else { w - jump })
+                let front = axes.iter().filter(|&&k| n[k] != 0.0).find_map(|&k| {
+                    self.grid
+                        .winding(&self.corners, p, k, n[k].signum(), &skip, seen)
                 })?;
                 Some((jump, front))
             })?;

@@ -20,9 +20,6 @@ pub(super) struct Grid {
     /// Where each cell's triangles start in `items` (one more entry than cells).
     start: Vec<u32>,
     items: Vec<u32>,
-    /// Per axis and cell: the entries of the cells from the start of its row along that axis up to
-    /// it, itself included (what a ray along the row will look at).
-    upto: [Vec<u32>; 3],
     /// The box of each entry of `items`, beside it: a ray or a box query rejects most entries by
     /// their boxes, and reading them in cell order is cheaper than looking each triangle up.
     item_boxes: Vec<Aabb>,
@@ -86,7 +83,6 @@ impl Grid {
             start: Vec::new(),
             items: Vec::new(),
             item_boxes: Vec::new(),
-            upto: [Vec::new(), Vec::new(), Vec::new()],
             bounds,
         };
         let cells = dims.iter().product::<usize>();
@@ -110,7 +106,6 @@ impl Grid {
         grid.start = count;
         grid.items = items;
         grid.item_boxes = item_boxes;
-        grid.upto = [0, 1, 2].map(|k| grid.row_counts(k));
         grid
     }
 
@@ -133,52 +128,6 @@ impl Grid {
                 }
             }
         }
-    }
-
-    /// [`Grid::upto`] along `axis`.
-    fn row_counts(&self, axis: usize) -> Vec<u32> {
-        let stride = [self.dims[1] * self.dims[2], self.dims[2], 1];
-        let mut upto = vec![0u32; self.start.len() - 1];
-        // Cells in increasing order: the one before along `axis` comes first.
-        let mut c = 0;
-        for x in 0..self.dims[0] {
-            for y in 0..self.dims[1] {
-                for z in 0..self.dims[2] {
-                    let own = self.start[c + 1] - self.start[c];
-                    upto[c] = own + if [x, y, z][axis] > 0 { upto[c - stride[axis]] } else { 0 };
-                    c += 1;
-                }
-            }
-        }
-        upto
-    }
-
-    /// The axis-parallel rays from `p` that [`Grid::winding`] can count for a face of normal `n`
-    /// (not along its plane), fewest entries to look at first: (axis, direction ±1, whether it
-    /// leaves through the face's front). Ties keep the front rays first, largest normal component
-    /// first.
-    pub(super) fn rays(&self, p: [f64; 3], n: [f64; 3]) -> Vec<(usize, f64, bool)> {
-        let mut axes = [0, 1, 2];
-        axes.sort_by(|&a, &b| n[b].abs().total_cmp(&n[a].abs()));
-        let idx = [0, 1, 2].map(|k| self.index(k, p[k]));
-        let cell = (idx[0] * self.dims[1] + idx[1]) * self.dims[2] + idx[2];
-        let stride = [self.dims[1] * self.dims[2], self.dims[2], 1];
-        let mut rays: Vec<(u32, usize, f64, bool)> = Vec::with_capacity(6);
-        for front in [true, false] {
-            for &k in axes.iter().filter(|&&k| n[k] != 0.0) {
-                let sign = if front { n[k].signum() } else { -n[k].signum() };
-                let last = cell + (self.dims[k] - 1 - idx[k]) * stride[k];
-                let own = self.start[cell + 1] - self.start[cell];
-                let entries = if sign > 0.0 {
-                    self.upto[k][last] - self.upto[k][cell] + own
-                } else {
-                    self.upto[k][cell]
-                };
-                rays.push((entries, k, sign, front));
-            }
-        }
-        rays.sort_by_key(|r| r.0);
-        rays.into_iter().map(|(_, k, s, f)| (k, s, f)).collect()
     }
 
     /// A cell's triangles and their boxes.
