@@ -284,6 +284,35 @@ mod tests {
             .collect()
     }
 
+    /// The inlined first stage gives `robust::orient3d`'s value, bit for bit, also where it hands
+    /// over to the adaptive stages (points on or within rounding of the plane).
+    #[test]
+    fn orient3d_is_robusts() {
+        let mut state = 0x9E37_79B9_7F4A_7C15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for i in 0..20_000 {
+            let [a, b, c] = [0; 3].map(|_| [next(), next(), next()]);
+            let d = match i % 3 {
+                0 => [next(), next(), next()],
+                // On the plane of a, b, c up to the rounding of the combination.
+                1 => {
+                    let (s, t) = (next(), next());
+                    [0, 1, 2].map(|k| a[k] + s * (b[k] - a[k]) + t * (c[k] - a[k]))
+                }
+                // The midpoint of an edge: on the plane up to its rounding.
+                _ => [0, 1, 2].map(|k| 0.5 * (a[k] + b[k])),
+            };
+            let ours = orient3d(c3(a), c3(b), c3(c), c3(d));
+            let theirs = robust::orient3d(c3(a), c3(b), c3(c), c3(d));
+            assert_eq!(ours.to_bits(), theirs.to_bits(), "{a:?} {b:?} {c:?} {d:?}");
+        }
+    }
+
     #[test]
     fn winding_inside_and_outside_a_cube() {
         let corners = cube();
