@@ -10,12 +10,12 @@
 //! the cone it spans from the surface's box centre (the volume a wrong orientation can change) to
 //! the bound, twice when it may count twice.
 
-use super::grid::{Corners, Grid, Seen};
-use super::{c3, segment_meets, triangles_touch};
+use super::grid::{orient3d, Corners, Grid, Seen};
+use super::{c3, edge_meets, triangles_touch};
 use crate::geometry::{cross, dot, sub, Aabb};
 use crate::mass::Polygons;
-use robust::{orient2d, orient3d, Coord};
-use rustc_hash::FxHashMap;
+use robust::{orient2d, Coord};
+use rustc_hash::{FxBuildHasher, FxHashMap};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
@@ -75,6 +75,9 @@ impl Ord for Piece {
         self.delta.total_cmp(&other.delta)
     }
 }
+
+/// An edge's first two uses (triangle, direction) and how many there are (no Vec per edge).
+type EdgeUses = ([(u32, bool); 2], u32);
 
 /// The triangles and what the decision needs about them.
 struct Faces<'a> {
@@ -142,14 +145,10 @@ impl Faces<'_> {
         (0..self.tris.len())
             .map(|t| {
                 let b = inflated(boxes[t], self.margin);
-                self.grid.candidates(&b, seen, &mut near);
+                self.grid.overlapping(&b, seen, &mut near);
                 near.iter()
                     .copied()
-                    .filter(|&u| {
-                        u as usize != t
-                            && overlap(&b, &boxes[u as usize])
-                            && self.blocks(t, u as usize)
-                    })
+                    .filter(|&u| u as usize != t && self.blocks(t, u as usize))
                     .collect()
             })
             .collect()
@@ -158,7 +157,13 @@ impl Faces<'_> {
     /// Whether triangle `u` may meet the relative interior of triangle `t` (exact, conservative).
     fn blocks(&self, t: usize, u: usize) -> bool {
         let (tt, tu) = (self.tris[t], self.tris[u]);
-        let shared: Vec<u32> = tt.iter().copied().filter(|v| tu.contains(v)).collect();
+        // The shared corners, in `t`'s order (a fixed array: this runs for every pair of neighbours).
+        let (mut shared, mut n) = ([0u32; 3], 0);
+        for v in tt.into_iter().filter(|v| tu.contains(v)) {
+            shared[n] = v;
+            n += 1;
+        }
+        let shared = &shared[..n];
         let (pt, pu) = (self.corners[t], self.corners[u]);
         match shared.len() {
             0 => triangles_touch(self.vertices, &tt, &tu),
@@ -193,19 +198,24 @@ impl Faces<'_> {
     /// patches no ray decides go to `heap` whole.
     fn patches(&self, blockers: &[Vec<u32>], seen: &mut Seen, out: &mut Resolved, heap: &mut BinaryHeap<Piece>) {
         let n = self.tris.len();
-        let mut by_edge: FxHashMap<(u32, u32), Vec<(u32, bool)>> = FxHashMap::default();
+        let mut by_edge: FxHashMap<(u32, u32), EdgeUses> =
+            FxHashMap::with_capacity_and_hasher(3 * n / 2, FxBuildHasher);
         for (i, t) in self.tris.iter().enumerate() {
             if !blockers[i].is_empty() {
                 continue;
             }
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
-                by_edge.entry((a.min(b), a.max(b))).or_default().push((i as u32, a < b));
+                let e = by_edge.entry((a.min(b), a.max(b))).or_insert(([(0, false); 2], 0));
+                if e.1 < 2 {
+                    e.0[e.1 as usize] = (i as u32, a < b);
+                }
+                e.1 += 1;
             }
         }
         let mut parent: Vec<u32> = (0..n as u32).collect();
-        for users in by_edge.values() {
-            if users.len() == 2 && users[0].1 != users[1].1 {
+        for &(users, count) in by_edge.values() {
+            if count == 2 && users[0].1 != users[1].1 {
                 let (a, b) = (
                     super::root(&mut parent, users[0].0),
                     super::root(&mut parent, users[1].0),
@@ -213,21 +223,21 @@ impl Faces<'_> {
                 parent[a.max(b) as usize] = a.min(b);
             }
         }
-        let mut members: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+        // (patch root, triangle), sorted: the patches in the order of their roots (each root is
+        // its patch's lowest triangle), each patch's triangles in order.
+        let mut members = Vec::new();
         for t in 0..n as u32 {
             if blockers[t as usize].is_empty() {
-                members.entry(super::root(&mut parent, t)).or_default().push(t);
+                members.push((super::root(&mut parent, t), t));
             }
         }
-        let mut roots: Vec<u32> = members.keys().copied().collect();
-        roots.sort_unstable();
-        for r in roots {
-            let patch = &members[&r];
+        members.sort_unstable();
+        for patch in members.chunk_by(|x, y| x.0 == y.0) {
             let kappa = patch
                 .iter()
                 .take(MAX_TRIES)
-                .find_map(|&t| self.decide(&self.corners[t as usize], t, seen));
-            for &t in patch {
+                .find_map(|&(_, t)| self.decide(&self.corners[t as usize], t, seen));
+            for &(_, t) in patch {
                 match kappa {
                     Some(k) => self.emit_whole(t, k, out),
                     None => heap.push(self.piece(self.corners[t as usize], t, Vec::new())),
@@ -493,7 +503,7 @@ fn shares_corner(t: Corners, u: Corners) -> bool {
     if ub == 0.0 || uc == 0.0 || tb == 0.0 || tc == 0.0 {
         return true;
     }
-    segment_meets(u[1], u[2], t) || segment_meets(t[1], t[2], u)
+    edge_meets(u[1], u[2], ub, uc, t) || edge_meets(t[1], t[2], tb, tc, u)
 }
 
 /// Two coplanar triangles sharing their first corner: whether a line through it along one of their

@@ -2,7 +2,7 @@
 //! point on a face, counted by exact crossings (`orient3d`) of an axis-parallel ray.
 
 use crate::geometry::Aabb;
-use robust::orient3d;
+use robust::Coord3D;
 
 use super::c3;
 
@@ -20,6 +20,9 @@ pub(super) struct Grid {
     /// Where each cell's triangles start in `items` (one more entry than cells).
     start: Vec<u32>,
     items: Vec<u32>,
+    /// The box of each entry of `items`, beside it: a ray or a box query rejects most entries by
+    /// their boxes, and reading them in cell order is cheaper than looking each triangle up.
+    item_boxes: Vec<Aabb>,
     /// The box of every triangle in the grid.
     pub(super) bounds: Aabb,
 }
@@ -79,6 +82,7 @@ impl Grid {
             dims,
             start: Vec::new(),
             items: Vec::new(),
+            item_boxes: Vec::new(),
             bounds,
         };
         let cells = dims.iter().product::<usize>();
@@ -91,19 +95,23 @@ impl Grid {
         }
         let mut fill = count.clone();
         let mut items = vec![0u32; count[cells] as usize];
+        let mut item_boxes = vec![Aabb::EMPTY; count[cells] as usize];
         for (i, b) in boxes.iter().enumerate() {
             grid.each_cell(b, |c| {
                 items[fill[c] as usize] = i as u32;
+                item_boxes[fill[c] as usize] = *b;
                 fill[c] += 1;
             });
         }
         grid.start = count;
         grid.items = items;
+        grid.item_boxes = item_boxes;
         grid
     }
 
     fn index(&self, k: usize, x: f64) -> usize {
-        let i = ((x - self.lo[k]) / self.cell[k]).floor();
+        // Truncation is the floor for the non-negative values that reach the cast.
+        let i = (x - self.lo[k]) / self.cell[k];
         if i.is_nan() || i < 0.0 {
             0
         } else {
@@ -122,17 +130,21 @@ impl Grid {
         }
     }
 
-    fn cell_items(&self, c: usize) -> &[u32] {
-        &self.items[self.start[c] as usize..self.start[c + 1] as usize]
+    /// A cell's triangles and their boxes.
+    fn cell_items(&self, c: usize) -> (&[u32], &[Aabb]) {
+        let r = self.start[c] as usize..self.start[c + 1] as usize;
+        (&self.items[r.clone()], &self.item_boxes[r])
     }
 
-    /// The triangles whose cells meet `b`, each once (a superset of those whose boxes meet it).
-    pub(super) fn candidates(&self, b: &Aabb, seen: &mut Seen, out: &mut Vec<u32>) {
+    /// The triangles whose boxes meet `b` (closed boxes), each once.
+    pub(super) fn overlapping(&self, b: &Aabb, seen: &mut Seen, out: &mut Vec<u32>) {
         out.clear();
         seen.next();
         self.each_cell(b, |c| {
-            for &i in self.cell_items(c) {
-                if seen.first(i) {
+            let (items, boxes) = self.cell_items(c);
+            for (&i, x) in items.iter().zip(boxes) {
+                let meets = (0..3).all(|k| b.lo[k] <= x.hi[k] && x.lo[k] <= b.hi[k]);
+                if meets && seen.first(i) {
                     out.push(i);
                 }
             }
@@ -172,25 +184,23 @@ impl Grid {
             let mut idx = [0; 3];
             (idx[axis], idx[j], idx[l]) = (ck, cj, cl);
             let c = (idx[0] * self.dims[1] + idx[1]) * self.dims[2] + idx[2];
-            for &i in self.cell_items(c) {
+            let (items, boxes) = self.cell_items(c);
+            for (&i, b) in items.iter().zip(boxes) {
+                // The segment varies along `axis` only: a triangle whose box misses its line, or
+                // lies wholly behind its start, is missed (exact comparisons).
+                let outside = |k: usize| b.hi[k] < p[k] || b.lo[k] > p[k];
+                let behind = if sign > 0.0 {
+                    b.hi[axis] < p[axis]
+                } else {
+                    b.lo[axis] > p[axis]
+                };
+                if outside(j) || outside(l) || behind {
+                    continue;
+                }
                 if skip.contains(&i) || !seen.first(i) {
                     continue;
                 }
-                let t = &corners[i as usize];
-                // The segment varies along `axis` only: a triangle whose box misses its line, or
-                // lies wholly behind its start, is missed (exact comparisons).
-                let outside = |k: usize, x: f64| {
-                    t.iter().all(|c| c[k] < x) || t.iter().all(|c| c[k] > x)
-                };
-                let behind = if sign > 0.0 {
-                    t.iter().all(|c| c[axis] < p[axis])
-                } else {
-                    t.iter().all(|c| c[axis] > p[axis])
-                };
-                if outside(j, p[j]) || outside(l, p[l]) || behind {
-                    continue;
-                }
-                match crossing(p, end, t) {
+                match crossing(p, end, &corners[i as usize]) {
                     Crossing::Miss => {}
                     Crossing::Through(d) => w += d,
                     Crossing::Degenerate => return None,
@@ -199,6 +209,35 @@ impl Grid {
         }
         Some(w)
     }
+}
+
+/// Half the gap between 1 and the next f64 (Shewchuk's ε).
+const EPSILON: f64 = f64::EPSILON / 2.0;
+
+/// Shewchuk's error bound of orient3d's floating-point stage, as `robust` computes it.
+const O3DERRBOUND_A: f64 = (7.0 + 56.0 * EPSILON) * EPSILON;
+
+/// `robust::orient3d`, whose first stage (the determinant in f64 and its error bound) is inlined
+/// here: most calls end there, and the crate's function is not inlined across crates. The value
+/// is the crate's: the same determinant when the bound certifies its sign, else the crate's
+/// adaptive stages.
+#[inline(always)] // a few dozen flops run for every ray crossing and neighbour test
+pub(super) fn orient3d(pa: Coord3D<f64>, pb: Coord3D<f64>, pc: Coord3D<f64>, pd: Coord3D<f64>) -> f64 {
+    let (adx, bdx, cdx) = (pa.x - pd.x, pb.x - pd.x, pc.x - pd.x);
+    let (ady, bdy, cdy) = (pa.y - pd.y, pb.y - pd.y, pc.y - pd.y);
+    let (adz, bdz, cdz) = (pa.z - pd.z, pb.z - pd.z, pc.z - pd.z);
+    let (bdxcdy, cdxbdy) = (bdx * cdy, cdx * bdy);
+    let (cdxady, adxcdy) = (cdx * ady, adx * cdy);
+    let (adxbdy, bdxady) = (adx * bdy, bdx * ady);
+    let det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
+    let permanent = (bdxcdy.abs() + cdxbdy.abs()) * adz.abs()
+        + (cdxady.abs() + adxcdy.abs()) * bdz.abs()
+        + (adxbdy.abs() + bdxady.abs()) * cdz.abs();
+    let errbound = O3DERRBOUND_A * permanent;
+    if det > errbound || -det > errbound {
+        return det;
+    }
+    robust::orient3d(pa, pb, pc, pd)
 }
 
 /// The segment `s e` at the triangle `t`, exactly.
@@ -245,6 +284,35 @@ mod tests {
             .collect()
     }
 
+    /// The inlined first stage gives `robust::orient3d`'s value, bit for bit, also where it hands
+    /// over to the adaptive stages (points on or within rounding of the plane).
+    #[test]
+    fn orient3d_is_robusts() {
+        let mut state = 0x9E37_79B9_7F4A_7C15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for i in 0..20_000 {
+            let [a, b, c] = [0; 3].map(|_| [next(), next(), next()]);
+            let d = match i % 3 {
+                0 => [next(), next(), next()],
+                // On the plane of a, b, c up to the rounding of the combination.
+                1 => {
+                    let (s, t) = (next(), next());
+                    [0, 1, 2].map(|k| a[k] + s * (b[k] - a[k]) + t * (c[k] - a[k]))
+                }
+                // The midpoint of an edge: on the plane up to its rounding.
+                _ => [0, 1, 2].map(|k| 0.5 * (a[k] + b[k])),
+            };
+            let ours = orient3d(c3(a), c3(b), c3(c), c3(d));
+            let theirs = robust::orient3d(c3(a), c3(b), c3(c), c3(d));
+            assert_eq!(ours.to_bits(), theirs.to_bits(), "{a:?} {b:?} {c:?} {d:?}");
+        }
+    }
+
     #[test]
     fn winding_inside_and_outside_a_cube() {
         let corners = cube();
@@ -265,3 +333,4 @@ mod tests {
         assert_eq!(w, None);
     }
 }
+

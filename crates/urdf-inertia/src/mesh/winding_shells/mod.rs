@@ -25,7 +25,8 @@ mod grid;
 
 use crate::geometry::{cross, dot, sub, Aabb};
 use crate::mass::Polygons;
-use robust::{orient3d, Coord3D};
+use grid::orient3d;
+use robust::Coord3D;
 use rustc_hash::FxHashMap;
 
 /// Pairs of shells with overlapping boxes beyond this many are not decided one by one: all are bounded.
@@ -683,15 +684,23 @@ pub(super) fn triangles_touch(v: &[[f64; 3]], x: &[u32; 3], y: &[u32; 3]) -> boo
     if !boxes_meet {
         return false;
     }
-    let edges = |t: [[f64; 3]; 3]| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])];
-    edges(px).iter().any(|&(s, e)| segment_meets(s, e, py))
-        || edges(py).iter().any(|&(s, e)| segment_meets(s, e, px))
+    // Each corner's side of the other's plane once (both edges at a corner use it).
+    let sides = |t: [[f64; 3]; 3], q: [[f64; 3]; 3]| {
+        q.map(|x| orient3d(c3(t[0]), c3(t[1]), c3(t[2]), c3(x)))
+    };
+    let edges_meet = |p: [[f64; 3]; 3], o: [f64; 3], t| {
+        (0..3).any(|i| {
+            let j = (i + 1) % 3;
+            edge_meets(p[i], p[j], o[i], o[j], t)
+        })
+    };
+    edges_meet(px, sides(py, px), py) || edges_meet(py, sides(px, py), px)
 }
 
-/// Whether the closed segment `s e` meets the closed triangle `t` (coplanar: yes, conservatively).
-pub(super) fn segment_meets(s: [f64; 3], e: [f64; 3], t: [[f64; 3]; 3]) -> bool {
+/// Whether the closed segment `s e` meets the closed triangle `t` (coplanar: yes, conservatively),
+/// given `s`'s and `e`'s sides of `t`'s plane (`orient3d` of `t`'s corners and each).
+pub(super) fn edge_meets(s: [f64; 3], e: [f64; 3], o1: f64, o2: f64, t: [[f64; 3]; 3]) -> bool {
     let (a, b, c) = (c3(t[0]), c3(t[1]), c3(t[2]));
-    let (o1, o2) = (orient3d(a, b, c, c3(s)), orient3d(a, b, c, c3(e)));
     if (o1 > 0.0 && o2 > 0.0) || (o1 < 0.0 && o2 < 0.0) {
         return false;
     }
