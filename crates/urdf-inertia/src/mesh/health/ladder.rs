@@ -158,10 +158,11 @@ impl<'a> Ladder<'a> {
                 .iter_mut()
                 .find(|w| w.kind == HealthKind::FacesDropped && w.text.contains("more than once"))
             {
-                w.text.push_str(&format!(
+                let put_back = format!(
                     "; {} of the copies put back where overlapping shells are decided by the winding number of the surface as stored, which counts each copy",
                     s.copies_restored
-                ));
+                );
+                w.text += &put_back;
             }
         }
         if s.turned_back > 0 {

@@ -36,6 +36,11 @@ const MAX_CELLS: usize = 256;
 /// Rays tried on a patch of uncut faces before it is split like a cut one.
 const MAX_TRIES: usize = 8;
 
+/// A face's normal component along a second ray's axis, as a share of its length, from which that
+/// ray checks the first (below it, the ray runs so close to the face's plane that a centre rounded
+/// a few ulps behind the face could pass behind a neighbour; then one ray decides).
+const SECOND_RAY: f64 = 0.3;
+
 /// The faces of the shells that touch or cut each other, as far as the winding number decides them.
 pub(super) struct Resolved {
     /// The triangles and pieces, oriented as they bound Ω (the undecided ones as classified).
@@ -347,10 +352,22 @@ impl Faces<'_> {
                     skip.push(cp.u);
                     jump += if cp.same { 1 } else { -1 };
                 }
-                let front = axes.iter().filter(|&&k| n[k] != 0.0).find_map(|&k| {
+                let ray = |k: usize, seen: &mut Seen| {
                     self.grid
                         .winding(&self.corners, p, k, n[k].signum(), &skip, seen)
-                })?;
+                };
+                let mut rest = axes.iter().filter(|&&k| n[k] != 0.0);
+                let front = rest.by_ref().find_map(|&k| ray(k, seen))?;
+                // A second ray, where one leaves the face steeply enough, must count the same:
+                // on a surface that is not watertight near `p` (a cap's crack, a sliver whose
+                // centre rounds a few ulps behind a neighbour) rays disagree, and the piece is
+                // left undecided, so it enters the bound.
+                let again = rest
+                    .filter(|&&k| n[k].abs() >= SECOND_RAY * norm(n))
+                    .find_map(|&k| ray(k, seen));
+                if again.is_some_and(|w| w != front) {
+                    return None;
+                }
                 Some((jump, front))
             })?;
         if skip.iter().any(|&u| u < t) {
