@@ -1,0 +1,54 @@
+#!/bin/bash
+# One thread against two, whole process, old against new binary (docs/benchmarks.md, "One thread
+# against two"). Run on an idle machine:
+#   bash validation/threads.sh OLD_BIN NEW_BIN [ROUNDS_1.3M] [ROUNDS_10M]
+# Inputs (made if missing, never in a repository): the torus of `make_large_inputs meshes` at
+# 1,299,600 and 9,998,244 faces, binary STL, in $THREADS_INPUTS (default /tmp/urdf-inertia-threads; written by validation/torus_stl.py,
+# byte for byte the example's torus.stl; needs numpy).
+# Rounds are interleaved (old 1, old 2, new 1, new 2 in each round, the order rotated every round);
+# each run is the whole `urdf-inertia mesh FILE` process with RAYON_NUM_THREADS=1 or 2. Printed per
+# binary, file and thread count: medians of wall, CPU (user + system, the child's rusage), user,
+# system, minor page faults and max RSS; then the ratio of wall medians, one thread over two. The
+# outputs of every binary and thread count are also compared (md5 of the report without its
+# `time` line): all must be equal.
+set -euo pipefail
+old=${1:?old binary}; new=${2:?new binary}; r13=${3:-15}; r10=${4:-5}
+big=${THREADS_INPUTS:-/tmp/urdf-inertia-threads}; mkdir -p "$big"
+PY=${PYTHON:-python3}
+[ -s "$big/torus13.stl" ] || "$PY" "$(dirname "$0")/torus_stl.py" 1300000 "$big/torus13.stl"
+[ -s "$big/torus10m.stl" ] || "$PY" "$(dirname "$0")/torus_stl.py" 10000000 "$big/torus10m.stl"
+echo "load before: $(cat /proc/loadavg)"; nproc
+for f in "$big/torus13.stl" "$big/torus10m.stl"; do
+  sums=$(for b in "$old" "$new"; do for t in 1 2; do
+    RAYON_NUM_THREADS=$t "$b" mesh "$f" | grep -v 'time' | md5sum; done; done | sort -u | wc -l)
+  echo "$(basename "$f"): distinct outputs over binaries and thread counts: $sums (must be 1)"
+done
+python3 - "$old" "$new" "$big/torus13.stl" "$r13" "$big/torus10m.stl" "$r10" <<'PY'
+import os, resource, statistics as st, subprocess, sys, time
+old, new = sys.argv[1], sys.argv[2]
+for f, rounds in ((sys.argv[3], int(sys.argv[4])), (sys.argv[5], int(sys.argv[6]))):
+    runs = [(b, t) for b in (old, new) for t in ('1', '2')]
+    d = {}
+    # Warm the page cache.
+    subprocess.run([old, 'mesh', f], stdout=subprocess.DEVNULL, check=True)
+    for r in range(rounds):
+        k = r % len(runs)
+        for b, t in runs[k:] + runs[:k]:
+            env = dict(os.environ, RAYON_NUM_THREADS=t)
+            r0 = resource.getrusage(resource.RUSAGE_CHILDREN); t0 = time.perf_counter()
+            subprocess.run([b, 'mesh', f], env=env, stdout=subprocess.DEVNULL, check=True)
+            t1 = time.perf_counter(); r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            d.setdefault((b, t), []).append((t1 - t0, r1.ru_utime - r0.ru_utime,
+                r1.ru_stime - r0.ru_stime, r1.ru_minflt - r0.ru_minflt))
+    faces = (os.path.getsize(f) - 84) // 50
+    print(f"\n{os.path.basename(f)}: {faces} faces, {rounds} rounds, load after {os.getloadavg()[0]:.2f}")
+    for (b, t), v in d.items():
+        med = lambda i: st.median(x[i] for x in v)
+        cpu = st.median(x[1] + x[2] for x in v)
+        print(f"  {os.path.basename(b):>8} {t} thread(s): wall {1e3*med(0):8.1f} ms (min {1e3*min(x[0] for x in v):7.1f}), "
+              f"cpu {1e3*cpu:8.1f} ms ({1e9*cpu/faces:5.1f} ns/face; user {1e3*med(1):7.1f}, sys {1e3*med(2):6.1f}), "
+              f"faults {med(3):9.0f}")
+    for b in (old, new):
+        w1 = st.median(x[0] for x in d[(b, '1')]); w2 = st.median(x[0] for x in d[(b, '2')])
+        print(f"  {os.path.basename(b):>8}: one thread over two, wall medians: {w1/w2:.2f}x")
+PY
