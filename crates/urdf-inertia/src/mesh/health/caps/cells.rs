@@ -34,7 +34,7 @@ use std::f64::consts::PI;
 
 /// Work units (a triangle or a far group of triangles looked at from one cell) before the cells
 /// left count whole.
-const WORK_BUDGET: u64 = 1 << 21;
+const WORK_BUDGET: u64 = 1 << 19;
 
 /// Levels of the octree below its root: its cells are then 1/65536 of the root's sides.
 const MAX_DEPTH: u32 = 16;
@@ -97,7 +97,8 @@ pub(super) fn certify(tris: &[[[f64; 3]; 3]], enough: f64) -> Certified {
     }
     let mut work = 0u64;
     // Uncertified volume per part: the cell of depth `PART_DEPTH` (or less) it lies in, by its path.
-    let mut parts: rustc_hash::FxHashMap<u32, (f64, [f64; 3], [f64; 3])> = Default::default();
+    let mut parts: rustc_hash::FxHashMap<u32, (f64, [f64; 3], [f64; 3])> =
+        rustc_hash::FxHashMap::default();
     let cell_volume = |lo: [f64; 3], hi: [f64; 3]| (0..3).map(|k| hi[k] - lo[k]).product::<f64>();
     // Counted and still queued: the bound if the work stopped now.
     let mut open = cell_volume(root.0, root.1);

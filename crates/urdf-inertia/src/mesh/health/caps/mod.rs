@@ -17,8 +17,8 @@ pub(super) struct Caps {
     pub(super) holes: usize,
     /// Boundary edges left open (cracks, T-junctions).
     pub(super) cracks: usize,
-    /// Bound on the volume uncertainty the caps leave apart from [`Caps::interaction`], m³ (all of
-    /// it when the certified cells bound them).
+    /// The flatness term: 2 × deviation × area summed over the caps (0 when flat), m³; the model
+    /// error uses the certified cells instead when they are larger ([`Caps::terms`]).
     pub(super) bound: f64,
     /// Total area of the caps, m².
     pub(super) area: f64,
@@ -34,7 +34,7 @@ pub(super) struct Caps {
     /// What the caps seeing each other can change ([`Caps::interaction`]), set once all are closed.
     pub(super) interaction: Interaction,
     /// The certified cells' bound on the volume the caps can change ([`cells`]) with its parts, when
-    /// it is used instead of the flatness and interaction terms (it is then [`Caps::bound`]).
+    /// it is used instead of the flatness and interaction terms.
     cells: Option<Interaction>,
 }
 
@@ -144,7 +144,8 @@ impl Caps {
     /// Sets [`Caps::bound`], [`Caps::interaction`] and [`Caps::points`] once every hole is closed.
     ///
     /// Flat caps (every loop in its plane, exactly): one hole is exact, several are bounded by
-    /// [`Caps::interaction`] or, when smaller, by the certified cells ([`cells`]), both proven.
+    /// [`Caps::interaction`]. (The cells bound them too, sometimes with less volume, but their
+    /// parts sit elsewhere: the smaller volume is not the smaller bound on inertia.)
     /// A cap that is not flat has no proven closed-form bound (2 × deviation × area, the flatness
     /// term, is a heuristic): the certified cells bound every cap together, their flatness and
     /// their seeing each other at once, each part in the ball of its cells. The bound reported is
@@ -156,27 +157,19 @@ impl Caps {
     fn certify(&mut self) {
         let flat = self.loops.iter().all(|c| c.deviation == 0.0);
         self.interaction = self.interaction();
-        if flat && self.interaction.volume == 0.0 {
+        if flat {
             return;
         }
+        // Not flat: the larger of the proven cells and the flatness and interaction terms, whose
+        // proof assumes what the cells assume (the capped surface's winding number is 0 or 1),
+        // and which the ladder's overlapping shells may break: the larger stays honest where
+        // today's terms were, and the certification stops once it is below them.
         let terms = self.bound + self.interaction.volume;
-        let cert = if flat {
-            cells::certify(&self.triangles, 0.0)
-        } else {
-            // Not flat: the larger of the proven cells and the flatness and interaction terms,
-            // whose proof assumes what the cells assume (the capped surface's winding number is 0
-            // or 1), and which the ladder's overlapping shells may break: the larger stays honest
-            // where today's terms were, and the certification stops once it is below them.
-            cells::certify(&self.triangles, terms)
-        };
-        if (flat && cert.volume >= terms) || (!flat && cert.volume <= terms) {
+        let cert = cells::certify(&self.triangles, terms);
+        if cert.volume <= terms {
             return;
         }
-        self.interaction = Interaction {
-            volume: 0.0,
-            parts: Vec::new(),
-        };
-        self.bound = cert.volume;
+        // The flatness and interaction terms stay as they were, for what the warnings say of them.
         self.cells = Some(Interaction {
             volume: cert.volume,
             parts: (cert.parts.iter())
@@ -192,12 +185,11 @@ impl Caps {
     /// bound the caps, else the flatness term near the loops and the interaction's parts.
     pub(super) fn terms(&self) -> Vec<(f64, Lever)> {
         let mut terms = Vec::new();
-        let parts = match &self.cells {
-            Some(cells) => cells,
-            None => {
-                terms.push((self.bound, Lever::Near(self.points.clone())));
-                &self.interaction
-            }
+        let parts = if let Some(cells) = &self.cells {
+            cells
+        } else {
+            terms.push((self.bound, Lever::Near(self.points.clone())));
+            &self.interaction
         };
         if parts.volume.is_finite() {
             terms.extend(
