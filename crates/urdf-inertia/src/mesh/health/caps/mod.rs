@@ -68,7 +68,8 @@ pub(super) struct Interaction {
 /// Closes every boundary loop of `faces` with a fan from the loop's centroid, wound against the loop's
 /// edges so the result is consistently oriented. The volume uncertainty bound ([`Caps::certify`]):
 /// none for flat caps over one hole, [`Caps::interaction`] for several flat ones, and otherwise the
-/// cells' certified volume where the caps' winding number can reach ½ ([`cells`]); boundary chains
+/// flatness and interaction terms or, when larger, the cells' certified volume where the caps'
+/// winding number can reach ½ ([`cells`]); boundary chains
 /// that do not close are the caller's (the capped surface's vector area).
 /// `None` when there are no boundary edges. `half` are the boundary edges as directed in their faces,
 /// in the order of [`edges`].
