@@ -188,19 +188,8 @@ pub(super) fn non_manifold(
 /// seeing each other can change near them ([`Caps::interaction`]), cracks left open and components
 /// re-oriented anywhere.
 pub(super) fn caps_model(caps: &Caps, cracks: f64, nested: f64) -> Model {
-    let mut terms = vec![
-        (caps.bound, Lever::Near(caps.points.clone())),
-        (cracks, Lever::Anywhere),
-        (nested, Lever::Anywhere),
-    ];
-    let seen = &caps.interaction;
-    if seen.volume.is_finite() {
-        terms.extend(
-            (seen.parts.iter()).map(|&(volume, centre, radius)| (volume, Lever::Ball(centre, radius))),
-        );
-    } else {
-        terms.push((seen.volume, Lever::Anywhere));
-    }
+    let mut terms = caps.terms();
+    terms.extend([(cracks, Lever::Anywhere), (nested, Lever::Anywhere)]);
     Model {
         terms,
         source: ModelError::Caps,
