@@ -7,26 +7,18 @@
 #[path = "../crates/urdf-inertia/tests/common/mod.rs"]
 mod common;
 
+use common::shells::solid_with;
 use common::winding::omega_volume;
 use common::Mesh;
-use std::path::Path;
-use urdf_inertia::mass::Polygons;
 use urdf_inertia::mesh::health::{HealthOptions, Solid};
 use urdf_inertia::mesh::open::OpenMeshModel;
-use urdf_inertia::mesh::RawMesh;
 
 fn capped(mesh: &Mesh) -> Solid {
-    let raw = RawMesh {
-        vertices: mesh.0.clone(),
-        faces: Polygons::from_triangles(&mesh.1),
-        ..Default::default()
-    };
     let options = HealthOptions {
         open_mesh: OpenMeshModel::Caps,
         ..HealthOptions::default()
     };
-    urdf_inertia::mesh::solid_from_raw(&raw, [1.0; 3], Path::new("caps_bound.obj"), options)
-        .expect("a capped solid")
+    solid_with(mesh, options, "caps_bound.obj")
 }
 
 /// The capped volume against Ω's sampled volume: the estimate bounds the difference (up to 3σ),

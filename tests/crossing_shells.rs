@@ -6,82 +6,13 @@
 #[path = "../crates/urdf-inertia/tests/common/mod.rs"]
 mod common;
 
+use common::shells::{exact_sum, open_top, solid_with, together, within_estimate};
 use common::winding::omega_volume;
-use common::{ExactMass, Mesh};
-use num_rational::BigRational;
-use std::path::Path;
-use urdf_inertia::mass::Polygons;
+use common::Mesh;
 use urdf_inertia::mesh::health::{HealthOptions, Solid};
-use urdf_inertia::mesh::RawMesh;
 
 fn solid(mesh: &Mesh) -> Solid {
-    let raw = RawMesh {
-        vertices: mesh.0.clone(),
-        faces: Polygons::from_triangles(&mesh.1),
-        ..Default::default()
-    };
-    urdf_inertia::mesh::solid_from_raw(
-        &raw,
-        [1.0; 3],
-        Path::new("shells.obj"),
-        HealthOptions::default(),
-    )
-    .expect("a solid")
-}
-
-/// The box's faces without those on its top (largest z): open, so the mesh reaches the capped rung.
-fn open_top(b: &Mesh) -> Mesh {
-    let top = b.0.iter().map(|p| p[2]).fold(f64::MIN, f64::max);
-    let f =
-        b.1.iter()
-            .copied()
-            .filter(|t| !t.iter().all(|&i| b.0[i as usize][2] == top))
-            .collect();
-    (b.0.clone(), f)
-}
-
-/// The meshes in one vertex list, those marked `true` wound inward.
-fn together(parts: &[(&Mesh, bool)]) -> Mesh {
-    let (mut v, mut f) = (Vec::new(), Vec::new());
-    for (m, inward) in parts {
-        let n = v.len() as u32;
-        v.extend_from_slice(&m.0);
-        f.extend(m.1.iter().map(|t| {
-            let t = t.map(|i| i + n);
-            if *inward {
-                [t[0], t[2], t[1]]
-            } else {
-                t
-            }
-        }));
-    }
-    (v, f)
-}
-
-/// Σ cᵢ × (integrals of box i): a union or difference of boxes through inclusion–exclusion.
-fn exact_sum(terms: &[(i32, &Mesh)]) -> ExactMass {
-    let mut t: [BigRational; 10] = std::array::from_fn(|_| common::rat(0.0));
-    for (c, m) in terms {
-        let u = common::exact_integrals(&m.0, &m.1);
-        let c = BigRational::from_integer((*c).into());
-        t = std::array::from_fn(|k| &t[k] + &u[k] * &c);
-    }
-    common::exact_mass(&t)
-}
-
-/// Volume, inertia and centre errors of `s` against `exact`, asserted within its estimate.
-fn within_estimate(name: &str, s: &Solid, exact: &ExactMass) -> f64 {
-    let volume = common::rel_error(s.unit.mass, &exact.volume);
-    let inertia = common::inertia_error(&s.unit.inertia, &exact.inertia);
-    let com = common::com_error(s.unit.com, &exact.com, 1.0);
-    assert!(
-        volume <= s.error_estimate && inertia <= s.error_estimate && com <= s.error.com,
-        "{name}: volume {volume:e}, inertia {inertia:e}, com {com:e}, estimate {:e} (com {:e})\n{:?}",
-        s.error_estimate,
-        s.error.com,
-        s.warnings
-    );
-    volume.max(inertia)
+    solid_with(mesh, HealthOptions::default(), "shells.obj")
 }
 
 /// An open box (capped) and a closed box through its wall: the region inside both counted once,

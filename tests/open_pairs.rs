@@ -9,76 +9,13 @@
 #[path = "../crates/urdf-inertia/tests/common/mod.rs"]
 mod common;
 
+use common::shells::{exact_sum, open_top, solid_with, together, within_estimate};
 use common::winding::omega_volume;
-use common::{ExactMass, Mesh};
-use num_rational::BigRational;
-use std::path::Path;
-use urdf_inertia::mass::Polygons;
+use common::Mesh;
 use urdf_inertia::mesh::health::{HealthOptions, Solid};
-use urdf_inertia::mesh::RawMesh;
 
 fn solid(mesh: &Mesh) -> Solid {
-    let raw = RawMesh {
-        vertices: mesh.0.clone(),
-        faces: Polygons::from_triangles(&mesh.1),
-        ..Default::default()
-    };
-    urdf_inertia::mesh::solid_from_raw(
-        &raw,
-        [1.0; 3],
-        Path::new("open_pairs.obj"),
-        HealthOptions::default(),
-    )
-    .expect("a solid")
-}
-
-/// The box's faces without those on its top (largest z): open, so the mesh reaches the capped rung.
-fn open_top(b: &Mesh) -> Mesh {
-    let top = b.0.iter().map(|p| p[2]).fold(f64::MIN, f64::max);
-    let f =
-        b.1.iter()
-            .copied()
-            .filter(|t| !t.iter().all(|&i| b.0[i as usize][2] == top))
-            .collect();
-    (b.0.clone(), f)
-}
-
-/// The meshes in one vertex list.
-fn together(parts: &[&Mesh]) -> Mesh {
-    let (mut v, mut f) = (Vec::new(), Vec::new());
-    for m in parts {
-        let n = v.len() as u32;
-        v.extend_from_slice(&m.0);
-        f.extend(m.1.iter().map(|t| t.map(|i| i + n)));
-    }
-    (v, f)
-}
-
-/// Σ cᵢ × (integrals of mesh i): a union of boxes through inclusion–exclusion.
-fn exact_sum(terms: &[(i32, &Mesh)]) -> ExactMass {
-    let mut t: [BigRational; 10] = std::array::from_fn(|_| common::rat(0.0));
-    for (c, m) in terms {
-        let u = common::exact_integrals(&m.0, &m.1);
-        let c = BigRational::from_integer((*c).into());
-        t = std::array::from_fn(|k| &t[k] + &u[k] * &c);
-    }
-    common::exact_mass(&t)
-}
-
-/// Volume, inertia and centre errors of `s` against `exact`, asserted within its estimate; the
-/// larger of the first two.
-fn within_estimate(name: &str, s: &Solid, exact: &ExactMass) -> f64 {
-    let volume = common::rel_error(s.unit.mass, &exact.volume);
-    let inertia = common::inertia_error(&s.unit.inertia, &exact.inertia);
-    let com = common::com_error(s.unit.com, &exact.com, 1.0);
-    assert!(
-        volume <= s.error_estimate && inertia <= s.error_estimate && com <= s.error.com,
-        "{name}: volume {volume:e}, inertia {inertia:e}, com {com:e}, estimate {:e} (com {:e})\n{:?}",
-        s.error_estimate,
-        s.error.com,
-        s.warnings
-    );
-    volume.max(inertia)
+    solid_with(mesh, HealthOptions::default(), "open_pairs.obj")
 }
 
 /// The mesh with the corner of `m` at `corner` stored a second time, `by` away, for the faces that
@@ -106,7 +43,7 @@ fn a_cracked_box_through_a_wall_counts_the_intersection_once() {
     let b = common::box_at([0.75, 0.25, 0.25], [1.25, 0.5, 0.5]);
     let both = common::box_at([0.75, 0.25, 0.25], [1.0, 0.5, 0.5]);
     let crack = cracked(&b, [1.25, 0.5, 0.5], 0, [1e-10, -1e-10, 0.0]);
-    let s = solid(&together(&[&open_top(&a), &crack]));
+    let s = solid(&together(&[(&open_top(&a), false), (&crack, false)]));
     let exact = exact_sum(&[(1, &a), (1, &b), (-1, &both)]);
     let error = within_estimate("cracked box", &s, &exact);
     assert!(error <= 1e-8, "{error:e}");
@@ -125,7 +62,7 @@ fn a_crack_inside_the_other_shell() {
     let b = common::box_at([0.75, 0.25, 0.25], [1.25, 0.5, 0.5]);
     let both = common::box_at([0.75, 0.25, 0.25], [1.0, 0.5, 0.5]);
     let crack = cracked(&b, [0.75, 0.25, 0.25], 0, [0.0, 1e-10, 1e-10]);
-    let s = solid(&together(&[&open_top(&a), &crack]));
+    let s = solid(&together(&[(&open_top(&a), false), (&crack, false)]));
     let exact = exact_sum(&[(1, &a), (1, &b), (-1, &both)]);
     let error = within_estimate("crack inside", &s, &exact);
     assert!(error <= 1e-8, "{error:e}");
@@ -200,7 +137,7 @@ fn a_face_the_ladder_turns_round_is_decided_as_stored() {
     mesh.0.push(low.0[3]);
     mesh.1
         .extend(low.1.iter().map(|t| t.map(|i| if i == 3 { 4 } else { i })));
-    let mesh = together(&[&mesh, &far]);
+    let mesh = together(&[(&mesh, false), (&far, false)]);
     let s = solid(&mesh);
     let exact = exact_sum(&[(1, &tall), (1, &far)]);
     let error = within_estimate("turned round", &s, &exact);
