@@ -254,19 +254,9 @@ mod tests {
         write_binary(b"soup", &points, &triangles)
     }
 
+    /// `got` is `want`, bit for bit (the stream tests' comparison).
     fn same(got: &Result<RawMesh, MeshError>, want: &RawMesh, what: &str) {
-        let got = got.as_ref().unwrap_or_else(|e| panic!("{what}: {e}"));
-        let bits = |m: &RawMesh| -> Vec<[u64; 3]> {
-            m.vertices.iter().map(|p| p.map(f64::to_bits)).collect()
-        };
-        assert_eq!(bits(got), bits(want), "{what}: vertices");
-        assert_eq!(got.faces.indices, want.faces.indices, "{what}: corners");
-        assert_eq!(got.faces.starts, want.faces.starts, "{what}: faces");
-        assert_eq!(
-            (&got.notes, &got.warnings, got.welded),
-            (&want.notes, &want.warnings, want.welded),
-            "{what}"
-        );
+        crate::mesh::stl::tests::same(got, &Ok(want.clone()), what);
     }
 
     /// A file read a chunk at a time by the threads that weld it (positioned reads), and streamed

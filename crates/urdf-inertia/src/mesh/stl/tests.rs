@@ -223,7 +223,7 @@ fn styles() -> Vec<Style> {
     ]
 }
 
-fn same(a: &Result<RawMesh, MeshError>, b: &Result<RawMesh, MeshError>, what: &str) {
+pub(super) fn same(a: &Result<RawMesh, MeshError>, b: &Result<RawMesh, MeshError>, what: &str) {
     match (a, b) {
         (Ok(a), Ok(b)) => {
             let bits = |m: &RawMesh| -> Vec<[u64; 3]> {
