@@ -29,6 +29,20 @@ pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+/// `|a|`.
+#[inline]
+pub(crate) fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// The signed solid angle of the triangle with corners `a`, `b`, `c` seen from the origin, their
+/// lengths given (Van Oosterom and Strackee 1983): 4π times its share of a winding number.
+pub(crate) fn solid_angle(a: [f64; 3], b: [f64; 3], c: [f64; 3], la: f64, lb: f64, lc: f64) -> f64 {
+    let det = dot(a, cross(b, c));
+    let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+    2.0 * det.atan2(den)
+}
+
 /// An axis-aligned box. [`Aabb::EMPTY`] (lo = +∞, hi = −∞) is the fold's start: adding a point
 /// makes it that point's box. NaN coordinates are skipped, as `f64::min`/`max` skip them.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -10,7 +10,7 @@
 //! [`LOCATOR_ENTRIES`] triangle references (fewer, larger buckets otherwise).
 
 #[cfg(any(test, feature = "internals"))]
-use crate::geometry::{dot, sub};
+use crate::geometry::sub;
 use crate::mesh::health::{Aabb, Solid};
 
 /// Most triangle references a mesh's bucket grid may hold (4 bytes each: 64 MiB).
@@ -553,21 +553,13 @@ pub fn winding_number(solid: &Solid, q: [f64; 3]) -> f64 {
         for k in 1..face.len().saturating_sub(1) {
             let b = sub(solid.vertices[face[k] as usize], q);
             let c = sub(solid.vertices[face[k + 1] as usize], q);
-            let (la, lb, lc) = (norm(a), norm(b), norm(c));
-            let num = a[0] * (b[1] * c[2] - b[2] * c[1])
-                + a[1] * (b[2] * c[0] - b[0] * c[2])
-                + a[2] * (b[0] * c[1] - b[1] * c[0]);
-            let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
-            total += 2.0 * num.atan2(den);
+            let n = crate::geometry::norm;
+            total += crate::geometry::solid_angle(a, b, c, n(a), n(b), n(c));
         }
     }
     total / (4.0 * std::f64::consts::PI)
 }
 
-#[cfg(any(test, feature = "internals"))]
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
-}
 
 #[cfg(test)]
 mod tests {

@@ -12,7 +12,7 @@
 
 use super::grid::{orient3d, Corners, Grid, Seen};
 use super::{c3, edge_meets, triangles_touch};
-use crate::geometry::{cross, dot, sub, Aabb};
+use crate::geometry::{cross, dot, norm, sub, Aabb};
 use crate::mass::Polygons;
 use robust::{orient2d, Coord};
 use rustc_hash::{FxBuildHasher, FxHashMap};
@@ -599,6 +599,3 @@ fn overlap(a: &Aabb, b: &Aabb) -> bool {
     (0..3).all(|k| a.lo[k] <= b.hi[k] && b.lo[k] <= a.hi[k])
 }
 
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
-}

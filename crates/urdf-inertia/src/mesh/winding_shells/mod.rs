@@ -23,7 +23,7 @@ mod correction;
 mod cracks;
 mod grid;
 
-use crate::geometry::{cross, dot, sub, Aabb};
+use crate::geometry::{cross, dot, norm, solid_angle, sub, Aabb};
 use crate::mass::Polygons;
 use grid::orient3d;
 use robust::Coord3D;
@@ -723,10 +723,7 @@ fn winding(vertices: &[[f64; 3]], tris: &[[u32; 3]], p: [f64; 3]) -> f64 {
         let a = sub(vertices[t[0] as usize], p);
         let b = sub(vertices[t[1] as usize], p);
         let c = sub(vertices[t[2] as usize], p);
-        let (la, lb, lc) = (dot(a, a).sqrt(), dot(b, b).sqrt(), dot(c, c).sqrt());
-        let num = dot(a, cross(b, c));
-        let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
-        total += 2.0 * num.atan2(den);
+        total += solid_angle(a, b, c, norm(a), norm(b), norm(c));
     }
     total / (4.0 * std::f64::consts::PI)
 }

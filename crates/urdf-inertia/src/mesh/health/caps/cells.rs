@@ -28,7 +28,7 @@
 //! largest corner distance and δ the distance to the triangle, several hundred times that
 //! conditioning, and a cell's sum must also stay below ½ by a relative margin of 1e-9.
 
-use crate::geometry::{cross, dot, sub};
+use crate::geometry::{cross, dot, norm, solid_angle, sub};
 use std::collections::VecDeque;
 use std::f64::consts::PI;
 
@@ -251,18 +251,6 @@ fn edge_field(c: [f64; 3], r: f64, a: [f64; 3], b: [f64; 3]) -> f64 {
     let shrink = 1.0 - r / m;
     // A relative margin for the rounding of the closed form.
     (along * (1.0 + 1e-9) / (shrink * shrink)).min(crude)
-}
-
-/// The solid angle of the triangle with corners `a`, `b`, `c` seen from the origin (Van Oosterom and
-/// Strackee 1983), their lengths given.
-fn solid_angle(a: [f64; 3], b: [f64; 3], c: [f64; 3], la: f64, lb: f64, lc: f64) -> f64 {
-    let det = dot(a, cross(b, c));
-    let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
-    2.0 * det.atan2(den)
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
 }
 
 /// The distance from `p` to the box `lo..hi` (0 inside).

@@ -3,7 +3,7 @@
 //! winding number defines ([`Caps::interaction`]).
 
 use super::model::Lever;
-use crate::geometry::{cross, dot, sub};
+use crate::geometry::{cross, dot, norm, sub};
 use crate::mass::Polygons;
 use rustc_hash::FxHashMap;
 
@@ -468,9 +468,6 @@ fn any_perpendicular(n: [f64; 3]) -> [f64; 3] {
     u.map(|x| x / l)
 }
 
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
-}
 
 /// The distance between two boxes (0 when they meet).
 fn box_distance(alo: [f64; 3], ahi: [f64; 3], blo: [f64; 3], bhi: [f64; 3]) -> f64 {
