@@ -3,8 +3,8 @@
 # against two"). Run on an idle machine:
 #   bash validation/threads.sh OLD_BIN NEW_BIN [ROUNDS_1.3M] [ROUNDS_10M]
 # Inputs (made if missing, never in a repository): the torus of `make_large_inputs meshes` at
-# 1,299,600 and 9,998,244 faces, binary STL, in $THREADS_INPUTS (default /tmp/urdf-inertia-threads; written by validation/torus_stl.py,
-# byte for byte the example's torus.stl; needs numpy).
+# 1,299,600 and 9,998,244 faces, binary STL, in $THREADS_INPUTS (default /tmp/urdf-inertia-threads),
+# written by `make_large_inputs torus-stl`.
 # Rounds are interleaved (old 1, old 2, new 1, new 2 in each round, the order rotated every round);
 # each run is the whole `urdf-inertia mesh FILE` process with RAYON_NUM_THREADS=1 or 2. Printed per
 # binary, file and thread count: medians of wall, CPU (user + system, the child's rusage), user,
@@ -14,9 +14,13 @@
 set -euo pipefail
 old=${1:?old binary}; new=${2:?new binary}; r13=${3:-15}; r10=${4:-5}
 big=${THREADS_INPUTS:-/tmp/urdf-inertia-threads}; mkdir -p "$big"
-PY=${PYTHON:-python3}
-[ -s "$big/torus13.stl" ] || "$PY" "$(dirname "$0")/torus_stl.py" 1300000 "$big/torus13.stl"
-[ -s "$big/torus10m.stl" ] || "$PY" "$(dirname "$0")/torus_stl.py" 10000000 "$big/torus10m.stl"
+for n in 1300000:torus13 10000000:torus10m; do
+  if [ ! -s "$big/${n#*:}.stl" ]; then
+    mkdir -p "$big/gen"
+    (cd "$(dirname "$0")/.." && cargo run --release --quiet -p urdf-inertia --example make_large_inputs -- torus-stl "$big/gen" "${n%%:*}")
+    mv "$big/gen/torus.stl" "$big/${n#*:}.stl"
+  fi
+done
 echo "load before: $(cat /proc/loadavg)"; nproc
 for f in "$big/torus13.stl" "$big/torus10m.stl"; do
   sums=$(for b in "$old" "$new"; do for t in 1 2; do

@@ -4,6 +4,8 @@
 //! - `make_large_inputs meshes DIR FACES`: one closed torus of about FACES triangles in every format
 //!   the tool reads (binary and ASCII STL, OBJ, COLLADA, glTF binary), as `DIR/torus.{stl,ascii.stl,
 //!   obj,dae,glb}`.
+//! - `make_large_inputs torus-stl DIR FACES`: the same torus as binary STL only, `DIR/torus.stl` (the
+//!   10 M-face input of `validation/threads.sh`, where the other formats would take gigabytes).
 //! - `make_large_inputs pieces DIR N`: one link made of N overlapping convex pieces, what a convex
 //!   decomposition (V-HACD, `CoACD`) gives: `DIR/pieces_N.urdf` and its N binary STL files. Each piece
 //!   is the 320-triangle icosphere of `benches/overlap.rs` made an ellipsoid of semi-axes 0.55 to
@@ -20,7 +22,7 @@ use urdf_inertia::mesh::stl;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: make_large_inputs (meshes DIR FACES | pieces DIR N)";
+    let usage = "usage: make_large_inputs (meshes DIR FACES | torus-stl DIR FACES | pieces DIR N)";
     let (Some(what), Some(dir), Some(count)) = (args.first(), args.get(1), args.get(2)) else {
         eprintln!("{usage}");
         std::process::exit(2);
@@ -32,6 +34,10 @@ fn main() {
     let dir = Path::new(dir);
     let written = match what.as_str() {
         "meshes" => meshes(dir, count),
+        "torus-stl" => {
+            let (v, f) = faces_torus(count);
+            std::fs::write(dir.join("torus.stl"), stl::write_binary(b"torus", &v, &f))
+        }
         "pieces" => pieces(dir, count),
         _ => {
             eprintln!("{usage}");
@@ -67,10 +73,14 @@ fn torus(n: u32, m: u32) -> common::Mesh {
     (v, f)
 }
 
-fn meshes(dir: &Path, faces: u32) -> std::io::Result<()> {
-    // 2 n m faces with n = 2 m.
+/// The torus of about `faces` triangles: 2 n m of them with n = 2 m.
+fn faces_torus(faces: u32) -> common::Mesh {
     let m = ((f64::from(faces) / 4.0).sqrt().round() as u32).max(3);
-    let (v, f) = torus(2 * m, m);
+    torus(2 * m, m)
+}
+
+fn meshes(dir: &Path, faces: u32) -> std::io::Result<()> {
+    let (v, f) = faces_torus(faces);
     std::fs::write(dir.join("torus.stl"), stl::write_binary(b"torus", &v, &f))?;
     std::fs::write(dir.join("torus.ascii.stl"), stl::write_ascii(&v, &f))?;
     let mut obj = String::new();
