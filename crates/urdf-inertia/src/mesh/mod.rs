@@ -227,13 +227,55 @@ fn read_unguarded(path: &Path, max_file_size: u64) -> Result<RawMesh, MeshError>
     Ok(mesh)
 }
 
+/// Items per chunk of [`chunked`].
+const PASS_CHUNK: usize = 1 << 16;
+
+/// `pass` over `items` in fixed chunks of [`PASS_CHUNK`], the chunks' results folded in order by
+/// `join`: the same result on any number of threads. The chunks run on the library's pool when it
+/// has more than one thread (one thread runs them in turn); fewer than two chunks are one pass.
+/// For the passes over a large mesh's vertices or corners that would otherwise run on one thread
+/// while the pool waits (checks, boxes, largest distances).
+pub(crate) fn chunked<T: Sync, R: Send>(
+    items: &[T],
+    pass: impl Fn(&[T]) -> R + Sync + Send,
+    join: impl Fn(R, R) -> R,
+) -> R {
+    use rayon::prelude::*;
+    if items.len() < 2 * PASS_CHUNK {
+        return pass(items);
+    }
+    let parts: Vec<R> = crate::threads::install(|| {
+        if rayon::current_num_threads() < 2 {
+            items.chunks(PASS_CHUNK).map(&pass).collect()
+        } else {
+            items.par_chunks(PASS_CHUNK).map(&pass).collect()
+        }
+    });
+    let mut parts = parts.into_iter();
+    let first = parts.next().unwrap_or_else(|| pass(&[]));
+    parts.fold(first, join)
+}
+
+/// The bounding box of `vertices` ([`chunked`]: a large mesh's on the pool).
+pub(crate) fn bounds(vertices: &[[f64; 3]]) -> crate::geometry::Aabb {
+    chunked(
+        vertices,
+        |c| crate::geometry::Aabb::of(c.iter().copied()),
+        crate::geometry::Aabb::union,
+    )
+}
+
 /// Checks what every reader must guarantee: finite coordinates, indices in range, at least one face.
+/// Both passes are [`chunked`]: a large mesh is checked on the pool.
 pub fn validate(mesh: &RawMesh, path: &Path) -> Result<(), MeshError> {
-    if mesh.vertices.iter().flatten().any(|x| !x.is_finite()) {
+    let finite = |c: &[[f64; 3]]| c.iter().flatten().all(|x| x.is_finite());
+    if !chunked(&mesh.vertices, finite, |a, b| a && b) {
         return Err(MeshError::new(path, None, MeshErrorKind::NotFinite));
     }
     let n = mesh.vertices.len();
-    if let Some(&bad) = mesh.faces.indices.iter().find(|&&i| i as usize >= n) {
+    // The first index out of range, as one pass in order finds it.
+    let beyond = |c: &[u32]| c.iter().copied().find(|&i| i as usize >= n);
+    if let Some(bad) = chunked(&mesh.faces.indices, beyond, Option::or) {
         return Err(MeshError::new(
             path,
             None,
@@ -405,7 +447,7 @@ fn solid_from(
 /// volume (see [`out_of_range`]): a closure, so the common case pays nothing.
 fn flat_or_out_of_range(raw: &RawMesh, scale: [f64; 3]) -> impl Fn() -> f64 + '_ {
     move || {
-        let e = crate::geometry::Aabb::of(raw.vertices.iter().copied()).extent();
+        let e = bounds(&raw.vertices).extent();
         (0..3).map(|k| e[k] * scale[k].abs()).fold(0.0, f64::max)
     }
 }
