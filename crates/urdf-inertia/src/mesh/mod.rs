@@ -595,6 +595,54 @@ fn accumulate_digits(w: &[u8], mantissa: &mut u64) -> usize {
 mod tests {
     use super::*;
 
+    /// The checks and the box of a mesh of several of [`chunked`]'s chunks are those of one pass in
+    /// order, on one thread and on three: the first index out of range of two (in later chunks), a
+    /// non-finite coordinate in the last chunk, and the box against the coordinates sorted.
+    #[test]
+    fn chunked_passes_agree_with_one_pass() {
+        let n = 5 * PASS_CHUNK + 17;
+        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || (crate::xorshift(&mut rng) >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+        let vertices: Vec<[f64; 3]> = (0..n).map(|_| [next(), 1e3 * next(), -next()]).collect();
+        let corners = (0..3 * n as u32).map(|i| i % n as u32).collect::<Vec<u32>>();
+        let mesh = RawMesh {
+            vertices,
+            faces: Polygons {
+                starts: (0..=n as u32).map(|i| 3 * i).collect(),
+                indices: corners,
+            },
+            ..Default::default()
+        };
+        let p = Path::new("m.stl");
+        for threads in [1, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("pool");
+            pool.install(|| {
+                assert_eq!(validate(&mesh, p), Ok(()));
+                let mut bad = mesh.clone();
+                bad.faces.indices[4 * PASS_CHUNK + 3] = n as u32 + 7;
+                bad.faces.indices[2 * PASS_CHUNK + 1] = n as u32 + 5;
+                let e = validate(&bad, p).expect_err("out of range");
+                let want = MeshErrorKind::IndexOutOfRange {
+                    index: n as i64 + 5,
+                    vertices: n,
+                };
+                assert_eq!(e.kind, want);
+                let mut nan = mesh.clone();
+                nan.vertices[n - 2][1] = f64::NAN;
+                assert_eq!(validate(&nan, p).expect_err("NaN").kind, MeshErrorKind::NotFinite);
+                let b = bounds(&mesh.vertices);
+                for k in 0..3 {
+                    let mut c: Vec<f64> = mesh.vertices.iter().map(|v| v[k]).collect();
+                    c.sort_by(f64::total_cmp);
+                    assert_eq!((b.lo[k], b.hi[k]), (c[0], c[n - 1]));
+                }
+            });
+        }
+    }
+
     /// Issue 13.7: a panic in a reader or in the healing fails that mesh, not the run.
     #[test]
     fn a_panic_becomes_the_meshs_error() {

@@ -521,6 +521,32 @@ mod tests {
         assert_eq!(pool.install(|| closed_consistent_split(&f, 80_007)), Some(one));
         v[n - 1].reverse();
         assert_eq!(pool.install(|| closed_consistent_split(&faces(&v), 80_000)), None);
+        // Quads and triangles: cubes of six quads, every other one with a face split in two.
+        const CUBE: [[u32; 4]; 6] = [
+            [0, 3, 2, 1],
+            [4, 5, 6, 7],
+            [0, 1, 5, 4],
+            [1, 2, 6, 5],
+            [2, 3, 7, 6],
+            [3, 0, 4, 7],
+        ];
+        let mut cubes: Vec<Vec<u32>> = Vec::new();
+        for c in 0..10_000u32 {
+            for (k, q) in CUBE.iter().enumerate() {
+                let q = q.map(|v| v + 8 * c);
+                if k == 1 && c % 2 == 1 {
+                    cubes.extend([vec![q[0], q[1], q[2]], vec![q[0], q[2], q[3]]]);
+                } else {
+                    cubes.push(q.to_vec());
+                }
+            }
+        }
+        let m = cubes.len();
+        let cubes: Vec<Vec<u32>> = (0..m).map(|i| cubes[(i * 7919) % m].clone()).collect();
+        let f = faces(&cubes);
+        let one = closed_consistent(&f).expect("clean");
+        assert_eq!(one.1, 10_000);
+        assert_eq!(pool.install(|| closed_consistent_split(&f, 80_000)), Some(one));
     }
 
     #[test]
