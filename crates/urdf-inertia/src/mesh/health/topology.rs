@@ -237,10 +237,26 @@ pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec
     let nfaces = faces.len();
     let h = faces.indices.len();
     let half = nfaces / 2;
-    let ((mut first, mut parent), (mut second, mut other)) = rayon::join(
-        || (counts(faces, 0..half, n), identity(nfaces)),
-        || (counts(faces, half..nfaces, n), identity(nfaces)),
+    // The first half counts in what becomes the first forest once the buckets are filled: a
+    // second array of the vertices' size would be fresh pages.
+    let ((mut parent, mut second), mut other) = rayon::join(
+        || {
+            rayon::join(
+                || {
+                    let mut parent = vec![0u32; nfaces.max(n)];
+                    count(faces, 0..half, &mut parent[..n]);
+                    parent
+                },
+                || {
+                    let mut second = vec![0u32; n];
+                    count(faces, half..nfaces, &mut second);
+                    second
+                },
+            )
+        },
+        || identity(nfaces),
     );
+    let first = &mut parent[..n];
     // Each half's first place in every bucket.
     let mut at = 0u32;
     for (a, b) in first.iter_mut().zip(&mut second) {
@@ -251,15 +267,18 @@ pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec
     }
     let out: Vec<AtomicU64> = (0..h).into_par_iter().map(|_| AtomicU64::new(0)).collect();
     rayon::join(
-        || fill(faces, 0..half, &mut first, &out),
+        || fill(faces, 0..half, first, &out),
         || fill(faces, half..nfaces, &mut second, &out),
     );
-    drop(first);
+    parent.truncate(nfaces);
     // Filling advanced each of the second half's places to where its bucket ends: u's entries are
     // `out[second[u - 1]..second[u]]`, as after [`half_edges`].
     let buckets = (second.as_slice(), out.as_slice());
     let (a, b) = rayon::join(
-        || twins(buckets, 0..n / 2, &mut parent),
+        || {
+            (parent.iter_mut().zip(0..)).for_each(|(p, f)| *p = f);
+            twins(buckets, 0..n / 2, &mut parent)
+        },
         || twins(buckets, n / 2..n, &mut other),
     );
     let paired = a? + b?;
@@ -280,14 +299,12 @@ fn identity(n: usize) -> Vec<u32> {
     (0..n as u32).collect()
 }
 
-/// How many corners of the faces `range` each of the vertices `0..n` has: the half-edges leaving it.
-fn counts(faces: &Polygons, range: std::ops::Range<usize>, n: usize) -> Vec<u32> {
+/// Adds to `count` how many corners of the faces `range` each vertex has: the half-edges leaving it.
+fn count(faces: &Polygons, range: std::ops::Range<usize>, count: &mut [u32]) {
     let (lo, hi) = (faces.starts[range.start], faces.starts[range.end]);
-    let mut count = vec![0u32; n];
     for &u in &faces.indices[lo as usize..hi as usize] {
         count[u as usize] += 1;
     }
-    count
 }
 
 /// Puts the half-edges of the faces `range` into their buckets at `place` (each vertex's next free
