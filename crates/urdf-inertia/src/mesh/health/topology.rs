@@ -539,7 +539,7 @@ mod tests {
         v[n - 1].reverse();
         assert_eq!(pool.install(|| closed_consistent_split(&faces(&v), 80_000)), None);
         // Quads and triangles: cubes of six quads, every other one with a face split in two.
-        const CUBE: [[u32; 4]; 6] = [
+        let cube: [[u32; 4]; 6] = [
             [0, 3, 2, 1],
             [4, 5, 6, 7],
             [0, 1, 5, 4],
@@ -549,7 +549,7 @@ mod tests {
         ];
         let mut cubes: Vec<Vec<u32>> = Vec::new();
         for c in 0..10_000u32 {
-            for (k, q) in CUBE.iter().enumerate() {
+            for (k, q) in cube.iter().enumerate() {
                 let q = q.map(|v| v + 8 * c);
                 if k == 1 && c % 2 == 1 {
                     cubes.extend([vec![q[0], q[1], q[2]], vec![q[0], q[2], q[3]]]);
