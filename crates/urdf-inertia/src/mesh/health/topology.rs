@@ -3,6 +3,7 @@
 //! orientation of each. Moved out of the ladder ([`super`]) as it is.
 
 use crate::mass::Polygons;
+use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 
 /// Edge structure of a welded mesh.
 // `boundary_half_edges`: half-edge is the term of the trade, not a repetition of `Edges`.
@@ -292,8 +293,6 @@ pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec
     (2 * paired == h).then(|| label(parent))
 }
 
-use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
-
 /// A union-find forest of `n` singletons.
 fn identity(n: usize) -> Vec<u32> {
     (0..n as u32).collect()
@@ -519,8 +518,9 @@ mod tests {
         assert_eq!(full.pairs.len(), 6);
     }
 
-    /// The scan split in two halves on a pool gives the one scan's components: 20,000 tetrahedra,
-    /// their faces in an order that mixes them, and the same with one face reversed (no proof).
+    /// The proof split in two halves on a pool gives the one scan's components: 20,000 tetrahedra,
+    /// their faces in an order that mixes them (also with vertices beyond the last corner), the
+    /// same with one face reversed (no proof), and 10,000 cubes of quads and triangles mixed.
     #[test]
     fn the_split_scan_gives_the_components_of_one_scan() {
         let mut v = tets(20_000);
