@@ -183,7 +183,10 @@ pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
 }
 
 /// Half-edges bucketed by their start vertex (a counting sort), each entry holding its end and its
-/// face: after the fill, u's entries are `out[start[u - 1]..start[u]]` (from 0 for u = 0).
+/// face: after the fill, u's entries are `out[start[u - 1]..start[u]]` (from 0 for u = 0). Out of
+/// line: inlined into [`closed_consistent`] the two cost one thread more instructions (figures:
+/// docs/benchmarks.md, "One thread against two").
+#[inline(never)]
 fn half_edges(faces: &Polygons, n: usize) -> (Vec<u32>, Vec<(u32, u32)>) {
     let idx = &faces.indices;
     let h = idx.len();
