@@ -138,14 +138,7 @@ fn rounded(
     };
     let err = urdf_inertia::text::rounding_tolerance(solid.error_estimate);
     let volume = round(volume, err * volume);
-    let length = mp.com.iter().fold(
-        solid
-            .vertices
-            .iter()
-            .flatten()
-            .fold(0.0f64, |m, x| m.max(x.abs())),
-        |m, x| m.max(x.abs()),
-    );
+    let length = (mp.com.iter()).fold(solid.largest_coordinate(), |m, x| m.max(x.abs()));
     let pr = mp.principal();
     let largest = pr.moments[2].abs();
     let mp = MassProperties::new(

@@ -124,7 +124,7 @@ fn primitive_part(c: &Collision, what: String, unit: MassProperties, shape: Part
 /// already scaled by `scale`), if it is: a link's error by default, a warning with
 /// `--allow-large-parts`, and `mesh`'s warning.
 pub fn millimetre_slip(vertices: &[[f64; 3]], scale: [f64; 3]) -> Option<String> {
-    let extent = Aabb::of(vertices.iter().copied()).diagonal();
+    let extent = crate::mesh::bounds(vertices).diagonal();
     if extent <= MILLIMETRE_SLIP {
         return None;
     }

@@ -227,13 +227,55 @@ fn read_unguarded(path: &Path, max_file_size: u64) -> Result<RawMesh, MeshError>
     Ok(mesh)
 }
 
+/// Items per chunk of [`chunked`].
+const PASS_CHUNK: usize = 1 << 16;
+
+/// `pass` over `items` in fixed chunks of [`PASS_CHUNK`], the chunks' results folded in order by
+/// `join`: the same result on any number of threads. The chunks run on the library's pool when it
+/// has more than one thread (one thread runs them in turn); fewer than two chunks are one pass.
+/// For the passes over a large mesh's vertices or corners that would otherwise run on one thread
+/// while the pool waits (checks, boxes, largest distances).
+pub(crate) fn chunked<T: Sync, R: Send>(
+    items: &[T],
+    pass: impl Fn(&[T]) -> R + Sync + Send,
+    join: impl Fn(R, R) -> R,
+) -> R {
+    use rayon::prelude::*;
+    if items.len() < 2 * PASS_CHUNK {
+        return pass(items);
+    }
+    let parts: Vec<R> = crate::threads::install(|| {
+        if rayon::current_num_threads() < 2 {
+            items.chunks(PASS_CHUNK).map(&pass).collect()
+        } else {
+            items.par_chunks(PASS_CHUNK).map(&pass).collect()
+        }
+    });
+    let mut parts = parts.into_iter();
+    let first = parts.next().unwrap_or_else(|| pass(&[]));
+    parts.fold(first, join)
+}
+
+/// The bounding box of `vertices` ([`chunked`]: a large mesh's on the pool).
+pub(crate) fn bounds(vertices: &[[f64; 3]]) -> crate::geometry::Aabb {
+    chunked(
+        vertices,
+        |c| crate::geometry::Aabb::of(c.iter().copied()),
+        crate::geometry::Aabb::union,
+    )
+}
+
 /// Checks what every reader must guarantee: finite coordinates, indices in range, at least one face.
+/// Both passes are [`chunked`]: a large mesh is checked on the pool.
 pub fn validate(mesh: &RawMesh, path: &Path) -> Result<(), MeshError> {
-    if mesh.vertices.iter().flatten().any(|x| !x.is_finite()) {
+    let finite = |c: &[[f64; 3]]| c.iter().flatten().all(|x| x.is_finite());
+    if !chunked(&mesh.vertices, finite, |a, b| a && b) {
         return Err(MeshError::new(path, None, MeshErrorKind::NotFinite));
     }
     let n = mesh.vertices.len();
-    if let Some(&bad) = mesh.faces.indices.iter().find(|&&i| i as usize >= n) {
+    // The first index out of range, as one pass in order finds it.
+    let beyond = |c: &[u32]| c.iter().copied().find(|&i| i as usize >= n);
+    if let Some(bad) = chunked(&mesh.faces.indices, beyond, Option::or) {
         return Err(MeshError::new(
             path,
             None,
@@ -405,7 +447,7 @@ fn solid_from(
 /// volume (see [`out_of_range`]): a closure, so the common case pays nothing.
 fn flat_or_out_of_range(raw: &RawMesh, scale: [f64; 3]) -> impl Fn() -> f64 + '_ {
     move || {
-        let e = crate::geometry::Aabb::of(raw.vertices.iter().copied()).extent();
+        let e = bounds(&raw.vertices).extent();
         (0..3).map(|k| e[k] * scale[k].abs()).fold(0.0, f64::max)
     }
 }
@@ -552,6 +594,54 @@ fn accumulate_digits(w: &[u8], mantissa: &mut u64) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The checks and the box of a mesh of several of [`chunked`]'s chunks are those of one pass in
+    /// order, on one thread and on three: the first index out of range of two (in later chunks), a
+    /// non-finite coordinate in the last chunk, and the box against the coordinates sorted.
+    #[test]
+    fn chunked_passes_agree_with_one_pass() {
+        let n = 5 * PASS_CHUNK + 17;
+        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || (crate::xorshift(&mut rng) >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+        let vertices: Vec<[f64; 3]> = (0..n).map(|_| [next(), 1e3 * next(), -next()]).collect();
+        let corners = (0..3 * n as u32).map(|i| i % n as u32).collect::<Vec<u32>>();
+        let mesh = RawMesh {
+            vertices,
+            faces: Polygons {
+                starts: (0..=n as u32).map(|i| 3 * i).collect(),
+                indices: corners,
+            },
+            ..Default::default()
+        };
+        let p = Path::new("m.stl");
+        for threads in [1, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("pool");
+            pool.install(|| {
+                assert_eq!(validate(&mesh, p), Ok(()));
+                let mut bad = mesh.clone();
+                bad.faces.indices[4 * PASS_CHUNK + 3] = n as u32 + 7;
+                bad.faces.indices[2 * PASS_CHUNK + 1] = n as u32 + 5;
+                let e = validate(&bad, p).expect_err("out of range");
+                let want = MeshErrorKind::IndexOutOfRange {
+                    index: n as i64 + 5,
+                    vertices: n,
+                };
+                assert_eq!(e.kind, want);
+                let mut nan = mesh.clone();
+                nan.vertices[n - 2][1] = f64::NAN;
+                assert_eq!(validate(&nan, p).expect_err("NaN").kind, MeshErrorKind::NotFinite);
+                let b = bounds(&mesh.vertices);
+                for k in 0..3 {
+                    let mut c: Vec<f64> = mesh.vertices.iter().map(|v| v[k]).collect();
+                    c.sort_by(f64::total_cmp);
+                    assert_eq!((b.lo[k], b.hi[k]), (c[0], c[n - 1]));
+                }
+            });
+        }
+    }
 
     /// Issue 13.7: a panic in a reader or in the healing fails that mesh, not the run.
     #[test]

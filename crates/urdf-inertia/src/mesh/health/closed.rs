@@ -36,7 +36,7 @@ pub(super) fn prove(
             return (closed_consistent(faces), None);
         }
         let (proof, t) = rayon::join(
-            || closed_consistent_split(faces),
+            || closed_consistent_split(faces, vertices.len()),
             || volume_integrals(vertices, faces, &IntegrationOptions::accurate()),
         );
         (proof, Some(t))

@@ -20,8 +20,9 @@ pub(super) fn signed_volume(vertices: &[[f64; 3]], faces: &Polygons) -> f64 {
     volume_integrals(vertices, faces, &IntegrationOptions::accurate()).t1
 }
 
+/// The bounding box of `vertices`, a large mesh's on the pool ([`crate::mesh::chunked`]).
 pub(super) fn bbox(vertices: &[[f64; 3]]) -> Aabb {
-    Aabb::of(vertices.iter().copied())
+    crate::mesh::bounds(vertices)
 }
 
 
@@ -102,4 +103,17 @@ pub(super) fn polygon_area(vertices: &[[f64; 3]], face: &[u32]) -> f64 {
 pub(super) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     let d = sub(a, b);
     dot(d, d).sqrt()
+}
+
+impl super::Solid {
+    /// The largest magnitude of a vertex coordinate (0 without vertices): the scale of the centre
+    /// of mass, which `mesh` rounds against. One pass over the vertices, a large mesh's on the pool.
+    pub fn largest_coordinate(&self) -> f64 {
+        if self.vertices.is_empty() {
+            return 0.0;
+        }
+        let b = bbox(&self.vertices);
+        // On each axis the coordinate of largest magnitude is the box's lowest or highest.
+        b.lo.iter().chain(&b.hi).fold(0.0, |m, x| m.max(x.abs()))
+    }
 }

@@ -83,11 +83,11 @@ impl Model {
 }
 
 /// The largest distance of a vertex from the centre of mass.
+/// A large mesh's on the pool ([`crate::mesh::chunked`]; the largest of the chunks' largest is the
+/// largest).
 pub(super) fn reach(unit: &MassProperties, vertices: &[[f64; 3]]) -> f64 {
-    vertices
-        .iter()
-        .map(|v| dist(*v, unit.com))
-        .fold(0.0, f64::max)
+    let largest = |c: &[[f64; 3]]| c.iter().map(|v| dist(*v, unit.com)).fold(0.0, f64::max);
+    crate::mesh::chunked(vertices, largest, f64::max)
 }
 
 /// The round-off estimate: the relative disagreement of volume and central inertia integrated about

@@ -3,6 +3,7 @@
 //! orientation of each. Moved out of the ladder ([`super`]) as it is.
 
 use crate::mass::Polygons;
+use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 
 /// Edge structure of a welded mesh.
 // `boundary_half_edges`: half-edge is the term of the trade, not a repetition of `Edges`.
@@ -182,7 +183,10 @@ pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
 }
 
 /// Half-edges bucketed by their start vertex (a counting sort), each entry holding its end and its
-/// face: after the fill, u's entries are `out[start[u - 1]..start[u]]` (from 0 for u = 0).
+/// face: after the fill, u's entries are `out[start[u - 1]..start[u]]` (from 0 for u = 0). Out of
+/// line: inlined into [`closed_consistent`] the two cost one thread more instructions (figures:
+/// docs/benchmarks.md, "One thread against two").
+#[inline(never)]
 fn half_edges(faces: &Polygons, n: usize) -> (Vec<u32>, Vec<(u32, u32)>) {
     let idx = &faces.indices;
     let h = idx.len();
@@ -219,61 +223,151 @@ fn half_edges(faces: &Polygons, n: usize) -> (Vec<u32>, Vec<(u32, u32)>) {
     (start, out)
 }
 
-/// [`closed_consistent`] with its twin scan split in two halves of the vertices on `rayon::join`, for
-/// a pool of two threads or more: each half joins faces in its own union-find forest, and the second
-/// forest's sets are joined into the first afterwards, so the sets and the components numbered from
-/// them are the one scan's. The second forest is a second array of the faces' size, which one thread
-/// does not pay for. (The scan is [`closed_consistent`]'s, written twice: as one function called by
-/// both it cost one thread instructions; figures: docs/benchmarks.md, "One thread against two".)
-pub(super) fn closed_consistent_split(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
-    let n = *faces.indices.iter().max()? as usize + 1;
-    let (start, out) = half_edges(faces, n);
-    let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
-    let mut other = parent.clone();
+/// [`closed_consistent`] for a pool of two threads or more, each stage split in two on `rayon::join`,
+/// `n` the vertices (no face's corner at `n` or beyond). The half-edges are bucketed as
+/// [`half_edges`] buckets them, by two halves of the faces at once: each counts its half-edges by
+/// start vertex, the counts give each half its place in every bucket (the first half's entries
+/// before the second's, so each bucket holds what one pass puts in it, in the same order), and each
+/// half fills its places. The buckets are shared by both halves' writes, hence atomic, written and
+/// read with relaxed ordering (plain loads and stores; `rayon::join` orders the stages); they are
+/// made on the pool, so both threads fault their pages in. Then the twin scan runs in two halves of
+/// the vertices, each joining faces in a union-find forest of its own, and the second forest's sets
+/// are joined into the first afterwards, so the sets and the components numbered from them are the
+/// one scan's. The second forest and the counts of each half are what one thread does not pay for.
+/// (The scan is [`closed_consistent`]'s, written twice: as one function called by both it cost
+/// one thread instructions; figures: docs/benchmarks.md, "One thread against two".)
+pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec<u32>, usize)> {
+    use rayon::prelude::*;
+    let nfaces = faces.len();
+    let h = faces.indices.len();
+    let half = nfaces / 2;
+    // The first half counts in what becomes the first forest once the buckets are filled: a
+    // second array of the vertices' size would be fresh pages.
+    let ((mut parent, mut second), mut other) = rayon::join(
+        || {
+            rayon::join(
+                || {
+                    let mut parent = vec![0u32; nfaces.max(n)];
+                    count(faces, 0..half, &mut parent[..n]);
+                    parent
+                },
+                || {
+                    let mut second = vec![0u32; n];
+                    count(faces, half..nfaces, &mut second);
+                    second
+                },
+            )
+        },
+        || identity(nfaces),
+    );
+    let first = &mut parent[..n];
+    // Each half's first place in every bucket.
+    let mut at = 0u32;
+    for (a, b) in first.iter_mut().zip(&mut second) {
+        let (ca, cb) = (*a, *b);
+        *a = at;
+        *b = at + ca;
+        at += ca + cb;
+    }
+    let out: Vec<AtomicU64> = (0..h).into_par_iter().map(|_| AtomicU64::new(0)).collect();
+    rayon::join(
+        || fill(faces, 0..half, first, &out),
+        || fill(faces, half..nfaces, &mut second, &out),
+    );
+    parent.truncate(nfaces);
+    // Filling advanced each of the second half's places to where its bucket ends: u's entries are
+    // `out[second[u - 1]..second[u]]`, as after [`half_edges`].
+    let buckets = (second.as_slice(), out.as_slice());
     let (a, b) = rayon::join(
-        || twins(&start, &out, 0..n / 2, &mut parent),
-        || twins(&start, &out, n / 2..n, &mut other),
+        || {
+            (parent.iter_mut().zip(0..)).for_each(|(p, f)| *p = f);
+            twins(buckets, 0..n / 2, &mut parent)
+        },
+        || twins(buckets, n / 2..n, &mut other),
     );
     let paired = a? + b?;
-    for f in 0..faces.len() as u32 {
-        let r = root(&mut other, f);
-        if r != f {
-            union(&mut parent, f, r);
+    // A forest's links span its sets: joining each face to its parent in `other` joins them all.
+    for f in 0..nfaces as u32 {
+        let p = other[f as usize];
+        if p != f {
+            union(&mut parent, f, p);
         }
     }
-    (2 * paired == faces.indices.len()).then(|| label(parent))
+    (2 * paired == h).then(|| label(parent))
 }
 
-/// The twin scan of [`closed_consistent_split`] over the half-edges leaving `vertices` (`out`'s buckets
-/// as its fill left `start`): the number of pairs found, faces joined in `parent` as they are; `None`
-/// at the first half-edge without exactly one twin.
+/// A union-find forest of `n` singletons.
+fn identity(n: usize) -> Vec<u32> {
+    (0..n as u32).collect()
+}
+
+/// Adds to `count` how many corners of the faces `range` each vertex has: the half-edges leaving it.
+fn count(faces: &Polygons, range: std::ops::Range<usize>, count: &mut [u32]) {
+    let (lo, hi) = (faces.starts[range.start], faces.starts[range.end]);
+    for &u in &faces.indices[lo as usize..hi as usize] {
+        count[u as usize] += 1;
+    }
+}
+
+/// Puts the half-edges of the faces `range` into their buckets at `place` (each vertex's next free
+/// entry, advanced as it fills), each entry its end and its face packed as `end | face << 32`.
+fn fill(faces: &Polygons, range: std::ops::Range<usize>, place: &mut [u32], out: &[AtomicU64]) {
+    let mut put = |u: u32, v: u32, f: u32| {
+        let s = &mut place[u as usize];
+        out[*s as usize].store(u64::from(v) | u64::from(f) << 32, Relaxed);
+        *s += 1;
+    };
+    let starts = &faces.starts[range.start..=range.end];
+    let (lo, hi) = (starts[0] as usize, starts[starts.len() - 1] as usize);
+    if 3 * range.len() == hi - lo && starts.windows(2).all(|w| w[1] - w[0] == 3) {
+        for (f, t) in faces.indices[lo..hi].chunks_exact(3).enumerate() {
+            let f = (range.start + f) as u32;
+            put(t[0], t[1], f);
+            put(t[1], t[2], f);
+            put(t[2], t[0], f);
+        }
+    } else {
+        for f in range {
+            let face = faces.face(f);
+            for k in 0..face.len() {
+                put(face[k], face[(k + 1) % face.len()], f as u32);
+            }
+        }
+    }
+}
+
+/// The twin scan of [`closed_consistent_split`] over the half-edges leaving `vertices` (the buckets
+/// as its fill left them: the end of each vertex's, and the entries): the number of pairs found,
+/// faces joined in `parent` as they are; `None` at the first half-edge without exactly one twin.
 fn twins(
-    start: &[u32],
-    out: &[(u32, u32)],
+    (end, out): (&[u32], &[AtomicU64]),
     vertices: std::ops::Range<usize>,
     parent: &mut [u32],
 ) -> Option<usize> {
     let bucket = |u: usize| {
-        let lo = if u == 0 { 0 } else { start[u - 1] as usize };
-        &out[lo..start[u] as usize]
+        let lo = if u == 0 { 0 } else { end[u - 1] as usize };
+        &out[lo..end[u] as usize]
     };
+    let target = |e: &AtomicU64| e.load(Relaxed) as u32;
     // Each half-edge u → v with u < v must be alone in u's list and find exactly one v → u; when
     // those pairs account for every half-edge, no half-edge v → u is left without its twin.
     let mut paired = 0usize;
     for u in vertices {
         let mine = bucket(u);
-        for (i, &(v, f)) in mine.iter().enumerate() {
+        for (i, e) in mine.iter().enumerate() {
+            let e = e.load(Relaxed);
+            let (v, f) = (e as u32, (e >> 32) as u32);
             if v as usize <= u {
                 if v as usize == u {
                     return None;
                 }
                 continue;
             }
-            if mine[..i].iter().any(|e| e.0 == v) {
+            if mine[..i].iter().any(|e| target(e) == v) {
                 return None;
             }
-            let mut twins = bucket(v as usize).iter().filter(|e| e.0 as usize == u);
-            let &(_, g) = twins.next()?;
+            let mut twins = bucket(v as usize).iter().filter(|e| target(e) as usize == u);
+            let g = (twins.next()?.load(Relaxed) >> 32) as u32;
             if twins.next().is_some() {
                 return None;
             }
@@ -427,8 +521,9 @@ mod tests {
         assert_eq!(full.pairs.len(), 6);
     }
 
-    /// The scan split in two halves on a pool gives the one scan's components: 20,000 tetrahedra,
-    /// their faces in an order that mixes them, and the same with one face reversed (no proof).
+    /// The proof split in two halves on a pool gives the one scan's components: 20,000 tetrahedra,
+    /// their faces in an order that mixes them (also with vertices beyond the last corner), the
+    /// same with one face reversed (no proof), and 10,000 cubes of quads and triangles mixed.
     #[test]
     fn the_split_scan_gives_the_components_of_one_scan() {
         let mut v = tets(20_000);
@@ -441,9 +536,37 @@ mod tests {
         let f = faces(&v);
         let one = closed_consistent(&f).expect("clean");
         assert_eq!(one.1, 20_000);
-        assert_eq!(pool.install(|| closed_consistent_split(&f)), Some(one));
+        assert_eq!(pool.install(|| closed_consistent_split(&f, 80_000)), Some(one.clone()));
+        // Vertices beyond the last corner have empty buckets.
+        assert_eq!(pool.install(|| closed_consistent_split(&f, 80_007)), Some(one));
         v[n - 1].reverse();
-        assert_eq!(pool.install(|| closed_consistent_split(&faces(&v))), None);
+        assert_eq!(pool.install(|| closed_consistent_split(&faces(&v), 80_000)), None);
+        // Quads and triangles: cubes of six quads, every other one with a face split in two.
+        let cube: [[u32; 4]; 6] = [
+            [0, 3, 2, 1],
+            [4, 5, 6, 7],
+            [0, 1, 5, 4],
+            [1, 2, 6, 5],
+            [2, 3, 7, 6],
+            [3, 0, 4, 7],
+        ];
+        let mut cubes: Vec<Vec<u32>> = Vec::new();
+        for c in 0..10_000u32 {
+            for (k, q) in cube.iter().enumerate() {
+                let q = q.map(|v| v + 8 * c);
+                if k == 1 && c % 2 == 1 {
+                    cubes.extend([vec![q[0], q[1], q[2]], vec![q[0], q[2], q[3]]]);
+                } else {
+                    cubes.push(q.to_vec());
+                }
+            }
+        }
+        let m = cubes.len();
+        let cubes: Vec<Vec<u32>> = (0..m).map(|i| cubes[(i * 7919) % m].clone()).collect();
+        let f = faces(&cubes);
+        let one = closed_consistent(&f).expect("clean");
+        assert_eq!(one.1, 10_000);
+        assert_eq!(pool.install(|| closed_consistent_split(&f, 80_000)), Some(one));
     }
 
     #[test]

@@ -106,13 +106,45 @@ pub fn join_in_place(
                 }
             });
     });
-    // A block's distinct vertices go to `starts[c]`, no later than `bases[c]` (the vertices before
-    // it), no later than `c · cap`: moved in order, none overwrites one still to move.
-    for c in 0..lens.len() {
-        vertices.copy_within(c * cap..c * cap + starts[c + 1] - starts[c], starts[c]);
-    }
+    move_down(vertices, cap, &starts);
     vertices.truncate(starts[lens.len()]);
     renumber(&first, indices, rebase, &bases);
+}
+
+/// Moves each block's distinct vertices, the first `starts[c + 1] − starts[c]` from `c · cap`, down
+/// to `starts[c]`: no later than `bases[c]` (the vertices before it), no later than `c · cap`, so
+/// that blocks moved in order never overwrite one still to move. In waves on the pool: a wave from
+/// the first block `a` still to move takes the blocks after it whose places all lie below `a · cap`,
+/// where no block from `a` on has vertices left, so the wave's places and its vertices are all
+/// apart and its blocks move at once. A block whose place meets its own vertices (the first few)
+/// is a wave of its own. Each block lands where the moves in order put it.
+fn move_down(vertices: &mut [[f64; 3]], cap: usize, starts: &[usize]) {
+    let blocks = starts.len() - 1;
+    let mut a = 0;
+    crate::threads::install(|| {
+        while a < blocks {
+            if starts[a + 1] > a * cap {
+                vertices.copy_within(a * cap..a * cap + starts[a + 1] - starts[a], starts[a]);
+                a += 1;
+                continue;
+            }
+            let b = (a + 1..=blocks)
+                .find(|&b| b == blocks || starts[b + 1] > a * cap)
+                .unwrap_or(blocks);
+            let (places, from) = vertices.split_at_mut(a * cap);
+            let mut rest = &mut places[starts[a]..starts[b]];
+            let mut moves = Vec::with_capacity(b - a);
+            for c in a..b {
+                let (place, after) = rest.split_at_mut(starts[c + 1] - starts[c]);
+                moves.push((place, &from[(c - a) * cap..][..starts[c + 1] - starts[c]]));
+                rest = after;
+            }
+            moves
+                .into_par_iter()
+                .for_each(|(place, from)| place.copy_from_slice(from));
+            a = b;
+        }
+    });
 }
 
 /// Each vertex's number among the distinct ones (`first`), where each block starts among all the
