@@ -144,19 +144,84 @@ pub(super) fn resolve(
 
 impl Faces<'_> {
     /// For each triangle, the others that may meet it other than along a shared edge or at a
-    /// shared corner.
+    /// shared corner: those whose boxes meet its box grown by the margin, in the order of the
+    /// grid's cells over that box. Each pair of triangles is found once, from the lower-numbered
+    /// one's query over a box grown enough to hold both conditions (the margin twice, and the
+    /// rounding of the coordinates), and each condition is then checked as stated; the few lists
+    /// of two or more are put back in the grid's order.
     fn all_blockers(&self, boxes: &[Aabb], seen: &mut Seen) -> Vec<Vec<u32>> {
+        let n = self.tris.len();
+        let grown: Vec<Aabb> = boxes.iter().map(|b| inflated(*b, self.margin)).collect();
+        let Aabb { lo, hi } = self.grid.bounds;
+        let largest = (0..3).map(|k| lo[k].abs().max(hi[k].abs())).fold(0.0, f64::max);
+        let pad = 2.0 * self.margin + 4.0 * f64::EPSILON * largest;
+        let mut out = vec![Vec::new(); n];
         let mut near = Vec::new();
-        (0..self.tris.len())
-            .map(|t| {
-                let b = inflated(boxes[t], self.margin);
-                self.grid.overlapping(&b, seen, &mut near);
-                near.iter()
-                    .copied()
-                    .filter(|&u| u as usize != t && self.blocks(t, u as usize))
-                    .collect()
-            })
-            .collect()
+        for t in 0..n {
+            self.grid
+                .overlapping(&inflated(boxes[t], pad), Some(t as u32), seen, &mut near);
+            for &u in &near {
+                let u = u as usize;
+                let asked = (overlap(&grown[t], &boxes[u]), overlap(&grown[u], &boxes[t]));
+                let (tu, ut) = self.blocks_both(t, u, asked);
+                if tu {
+                    out[t].push(u as u32);
+                }
+                if ut {
+                    out[u].push(t as u32);
+                }
+            }
+        }
+        for (t, list) in out.iter_mut().enumerate() {
+            if list.len() > 1 {
+                self.grid.overlapping(&grown[t], None, seen, &mut near);
+                near.retain(|u| list.contains(u));
+                list.clone_from(&near);
+            }
+        }
+        out
+    }
+
+    /// [`Faces::blocks`] of `t` by `u` and of `u` by `t`, each when `asked`, with what the two
+    /// share (the corners they have in common, the same seen from either when each has three
+    /// distinct corners) found once.
+    fn blocks_both(&self, t: usize, u: usize, asked: (bool, bool)) -> (bool, bool) {
+        if !asked.0 && !asked.1 {
+            return (false, false);
+        }
+        let (tt, tu) = (self.tris[t], self.tris[u]);
+        let distinct = |x: [u32; 3]| x[0] != x[1] && x[1] != x[2] && x[2] != x[0];
+        if !distinct(tt) || !distinct(tu) {
+            // The corners shared may then differ seen from each.
+            return (asked.0 && self.blocks(t, u), asked.1 && self.blocks(u, t));
+        }
+        let in_u = tt.map(|v| tu.contains(&v));
+        match in_u.iter().filter(|&&x| x).count() {
+            // Symmetric: whether an edge of either crosses the other.
+            0 => {
+                let touch = triangles_touch(self.vertices, &tt, &tu);
+                (asked.0 && touch, asked.1 && touch)
+            }
+            1 => {
+                let i = in_u.iter().position(|&x| x).unwrap_or(0);
+                let j = tu.iter().position(|&x| x == tt[i]).unwrap_or(0);
+                let (pt, pu) = (&self.corners[t], &self.corners[u]);
+                let (plane_t, plane_u) = (&self.planes[t], &self.planes[u]);
+                let one = |p: &Corners, i: usize, q: &Corners, j: usize, plane_p: &Plane, plane_q| {
+                    let sides = (plane_p.side(q[NEXT[j]]), plane_p.side(q[NEXT[NEXT[j]]]));
+                    if (sides.0 > 0.0 && sides.1 > 0.0) || (sides.0 < 0.0 && sides.1 < 0.0) {
+                        return false;
+                    }
+                    shares_corner(rotated(p, i), rotated(q, j), sides, plane_q)
+                };
+                (
+                    asked.0 && one(pt, i, pu, j, plane_t, plane_u),
+                    asked.1 && one(pu, j, pt, i, plane_u, plane_t),
+                )
+            }
+            2 => (asked.0 && self.blocks(t, u), asked.1 && self.blocks(u, t)),
+            _ => asked,
+        }
     }
 
     /// Whether triangle `u` may meet the relative interior of triangle `t` (exact, conservative).

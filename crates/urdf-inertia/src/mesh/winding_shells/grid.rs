@@ -136,15 +136,17 @@ impl Grid {
         (&self.items[r.clone()], &self.item_boxes[r])
     }
 
-    /// The triangles whose boxes meet `b` (closed boxes), each once.
-    pub(super) fn overlapping(&self, b: &Aabb, seen: &mut Seen, out: &mut Vec<u32>) {
+    /// The triangles numbered above `after` (all when `None`) whose boxes meet `b` (closed
+    /// boxes), each once, in the order of the cells `b` covers.
+    pub(super) fn overlapping(&self, b: &Aabb, after: Option<u32>, seen: &mut Seen, out: &mut Vec<u32>) {
         out.clear();
         seen.next();
+        let after = after.map_or(0, |a| u64::from(a) + 1);
         self.each_cell(b, |c| {
             let (items, boxes) = self.cell_items(c);
             for (&i, x) in items.iter().zip(boxes) {
                 let meets = (0..3).all(|k| b.lo[k] <= x.hi[k] && x.lo[k] <= b.hi[k]);
-                if meets && seen.first(i) {
+                if u64::from(i) >= after && meets && seen.first(i) {
                     out.push(i);
                 }
             }
