@@ -10,12 +10,11 @@
 //! the cone it spans from the surface's box centre (the volume a wrong orientation can change) to
 //! the bound, twice when it may count twice.
 
-use super::grid::{orient3d, Corners, Grid, Seen};
+use super::grid::{orient3d, Corners, Grid, Plane, Seen};
 use super::{c3, edge_meets, triangles_touch};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
 use crate::mass::Polygons;
 use robust::{orient2d, Coord};
-use rustc_hash::{FxBuildHasher, FxHashMap};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
@@ -81,9 +80,6 @@ impl Ord for Piece {
     }
 }
 
-/// An edge's first two uses (triangle, direction) and how many there are (no Vec per edge).
-type EdgeUses = ([(u32, bool); 2], u32);
-
 /// The triangles and what the decision needs about them.
 struct Faces<'a> {
     vertices: &'a [[f64; 3]],
@@ -91,6 +87,8 @@ struct Faces<'a> {
     /// The orientation the classification gave each triangle's shell: 1, −1 (turned) or 0 (dropped).
     sign: &'a [i64],
     corners: Vec<Corners>,
+    /// Each triangle's plane, for the sides of its neighbours' corners.
+    planes: Vec<Plane>,
     grid: Grid,
     centre: [f64; 3],
     /// Distances below this are not trusted to f64 plane tests.
@@ -113,11 +111,13 @@ pub(super) fn resolve(
     let boxes: Vec<Aabb> = corners.iter().map(|c| Aabb::of(*c)).collect();
     let grid = Grid::new(&boxes);
     let margin = 1e-12 * grid.bounds.diagonal();
+    let planes = corners.iter().map(Plane::new).collect();
     let f = Faces {
         vertices,
         tris,
         sign,
         corners,
+        planes,
         grid,
         centre,
         margin,
@@ -144,25 +144,119 @@ pub(super) fn resolve(
 
 impl Faces<'_> {
     /// For each triangle, the others that may meet it other than along a shared edge or at a
-    /// shared corner.
+    /// shared corner: those whose boxes meet its box grown by the margin, in the order of the
+    /// grid's cells over that box. Each pair of triangles is found once, from the lower-numbered
+    /// one's query over a box grown enough to hold both conditions (the margin twice, and the
+    /// rounding of the coordinates), and each condition is then checked as stated; the few lists
+    /// of two or more are put back in the grid's order.
     fn all_blockers(&self, boxes: &[Aabb], seen: &mut Seen) -> Vec<Vec<u32>> {
+        let n = self.tris.len();
+        let grown: Vec<Aabb> = boxes.iter().map(|b| inflated(*b, self.margin)).collect();
+        let Aabb { lo, hi } = self.grid.bounds;
+        let largest = (0..3).map(|k| lo[k].abs().max(hi[k].abs())).fold(0.0, f64::max);
+        let pad = 2.0 * self.margin + 4.0 * f64::EPSILON * largest;
+        let mut out = vec![Vec::new(); n];
         let mut near = Vec::new();
-        (0..self.tris.len())
-            .map(|t| {
-                let b = inflated(boxes[t], self.margin);
-                self.grid.overlapping(&b, seen, &mut near);
-                near.iter()
-                    .copied()
-                    .filter(|&u| u as usize != t && self.blocks(t, u as usize))
-                    .collect()
-            })
-            .collect()
+        for t in 0..n {
+            self.grid
+                .overlapping(&inflated(boxes[t], pad), Some(t as u32), seen, &mut near);
+            for &u in &near {
+                let u = u as usize;
+                let asked = (overlap(&grown[t], &boxes[u]), overlap(&grown[u], &boxes[t]));
+                let (tu, ut) = self.blocks_both(t, u, asked);
+                if tu {
+                    out[t].push(u as u32);
+                }
+                if ut {
+                    out[u].push(t as u32);
+                }
+            }
+        }
+        for (t, list) in out.iter_mut().enumerate() {
+            if list.len() > 1 {
+                self.grid.overlapping(&grown[t], None, seen, &mut near);
+                near.retain(|u| list.contains(u));
+                list.clone_from(&near);
+            }
+        }
+        out
+    }
+
+    /// [`Faces::blocks`] of `t` by `u` and of `u` by `t`, each when `asked`, with what the two
+    /// share (the corners they have in common, the same seen from either when each has three
+    /// distinct corners) found once.
+    fn blocks_both(&self, t: usize, u: usize, asked: (bool, bool)) -> (bool, bool) {
+        if !asked.0 && !asked.1 {
+            return (false, false);
+        }
+        let (tt, tu) = (self.tris[t], self.tris[u]);
+        let distinct = |x: [u32; 3]| x[0] != x[1] && x[1] != x[2] && x[2] != x[0];
+        if !distinct(tt) || !distinct(tu) {
+            // The corners shared may then differ seen from each.
+            return (asked.0 && self.blocks(t, u), asked.1 && self.blocks(u, t));
+        }
+        let in_u = tt.map(|v| tu.contains(&v));
+        match in_u.iter().filter(|&&x| x).count() {
+            // Symmetric: whether an edge of either crosses the other.
+            0 => {
+                let touch = triangles_touch(self.vertices, &tt, &tu);
+                (asked.0 && touch, asked.1 && touch)
+            }
+            1 => {
+                let i = in_u.iter().position(|&x| x).unwrap_or(0);
+                let j = tu.iter().position(|&x| x == tt[i]).unwrap_or(0);
+                let (pt, pu) = (&self.corners[t], &self.corners[u]);
+                let (plane_t, plane_u) = (&self.planes[t], &self.planes[u]);
+                let one = |p: &Corners, i: usize, q: &Corners, j: usize, plane_p: &Plane, plane_q| {
+                    let sides = (plane_p.side(q[NEXT[j]]), plane_p.side(q[NEXT[NEXT[j]]]));
+                    if (sides.0 > 0.0 && sides.1 > 0.0) || (sides.0 < 0.0 && sides.1 < 0.0) {
+                        return false;
+                    }
+                    shares_corner(rotated(p, i), rotated(q, j), sides, plane_q)
+                };
+                (
+                    asked.0 && one(pt, i, pu, j, plane_t, plane_u),
+                    asked.1 && one(pu, j, pt, i, plane_u, plane_t),
+                )
+            }
+            2 => (asked.0 && self.blocks(t, u), asked.1 && self.blocks(u, t)),
+            _ => asked,
+        }
     }
 
     /// Whether triangle `u` may meet the relative interior of triangle `t` (exact, conservative).
+    /// This runs for every pair of neighbours: the common cases (a corner shared, the other two on
+    /// one side of `t`'s plane; an edge shared, the planes apart) end before any copy.
     fn blocks(&self, t: usize, u: usize) -> bool {
         let (tt, tu) = (self.tris[t], self.tris[u]);
-        // The shared corners, in `t`'s order (a fixed array: this runs for every pair of neighbours).
+        let in_u = tt.map(|v| tu.contains(&v));
+        match in_u.iter().filter(|&&x| x).count() {
+            0 => triangles_touch(self.vertices, &tt, &tu),
+            1 => {
+                let i = in_u.iter().position(|&x| x).unwrap_or(0);
+                let j = tu.iter().position(|&x| x == tt[i]).unwrap_or(0);
+                let pu = &self.corners[u];
+                let plane = &self.planes[t];
+                let sides = (plane.side(pu[NEXT[j]]), plane.side(pu[NEXT[NEXT[j]]]));
+                if (sides.0 > 0.0 && sides.1 > 0.0) || (sides.0 < 0.0 && sides.1 < 0.0) {
+                    return false;
+                }
+                let (pt, pu) = (rotated(&self.corners[t], i), rotated(pu, j));
+                shares_corner(pt, pu, sides, &self.planes[u])
+            }
+            2 => {
+                // `t`'s plane is that of the shared corners and its third.
+                let j = tu.iter().position(|x| !tt.contains(x)).unwrap_or(0);
+                self.planes[t].side(self.corners[u][j]) == 0.0 && self.coplanar_blocks(t, u)
+            }
+            _ => true,
+        }
+    }
+
+    /// [`Faces::blocks`] for triangles sharing an edge, in one plane: a blocker unless the two lie
+    /// on opposite sides of the shared edge.
+    fn coplanar_blocks(&self, t: usize, u: usize) -> bool {
+        let (tt, tu) = (self.tris[t], self.tris[u]);
         let (mut shared, mut n) = ([0u32; 3], 0);
         for v in tt.into_iter().filter(|v| tu.contains(v)) {
             shared[n] = v;
@@ -170,60 +264,30 @@ impl Faces<'_> {
         }
         let shared = &shared[..n];
         let (pt, pu) = (self.corners[t], self.corners[u]);
-        match shared.len() {
-            0 => triangles_touch(self.vertices, &tt, &tu),
-            1 => {
-                let v = shared[0];
-                let rot = |tri: [u32; 3], p: Corners| {
-                    let i = tri.iter().position(|&x| x == v).unwrap_or(0);
-                    [p[i], p[(i + 1) % 3], p[(i + 2) % 3]]
-                };
-                shares_corner(rot(tt, pt), rot(tu, pu))
-            }
-            2 => {
-                let other = |tri: [u32; 3], p: Corners| {
-                    let i = tri.iter().position(|x| !shared.contains(x)).unwrap_or(0);
-                    p[i]
-                };
-                let (a, b) = (self.vertices[shared[0] as usize], self.vertices[shared[1] as usize]);
-                let (x, y) = (other(tt, pt), other(tu, pu));
-                if orient3d(c3(a), c3(b), c3(x), c3(y)) != 0.0 {
-                    return false;
-                }
-                // Coplanar: a blocker unless the two lie on opposite sides of the shared edge.
-                let k = normal_axis(pt);
-                let s = orient2d(c2(a, k), c2(b, k), c2(x, k)) * orient2d(c2(a, k), c2(b, k), c2(y, k));
-                s >= 0.0
-            }
-            _ => true,
-        }
+        let other = |tri: [u32; 3], p: Corners| {
+            let i = tri.iter().position(|x| !shared.contains(x)).unwrap_or(0);
+            p[i]
+        };
+        let (a, b) = (self.vertices[shared[0] as usize], self.vertices[shared[1] as usize]);
+        let (x, y) = (other(tt, pt), other(tu, pu));
+        let k = normal_axis(pt);
+        let s = orient2d(c2(a, k), c2(b, k), c2(x, k)) * orient2d(c2(a, k), c2(b, k), c2(y, k));
+        s >= 0.0
     }
 
     /// Uncut triangles joined across the edges they share, each patch decided by one ray; the
     /// patches no ray decides go to `heap` whole.
     fn patches(&self, blockers: &[Vec<u32>], seen: &mut Seen, out: &mut Resolved, heap: &mut BinaryHeap<Piece>) {
         let n = self.tris.len();
-        let mut by_edge: FxHashMap<(u32, u32), EdgeUses> =
-            FxHashMap::with_capacity_and_hasher(3 * n / 2, FxBuildHasher);
-        for (i, t) in self.tris.iter().enumerate() {
-            if !blockers[i].is_empty() {
-                continue;
-            }
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                let e = by_edge.entry((a.min(b), a.max(b))).or_insert(([(0, false); 2], 0));
-                if e.1 < 2 {
-                    e.0[e.1 as usize] = (i as u32, a < b);
-                }
-                e.1 += 1;
-            }
-        }
+        let uncut = (0..n).filter(|&i| blockers[i].is_empty());
+        let faces = uncut.map(|i| (i as u32, &self.tris[i][..]));
+        let uses = super::edge_uses(self.vertices.len(), &faces, None);
         let mut parent: Vec<u32> = (0..n as u32).collect();
-        for &(users, count) in by_edge.values() {
-            if count == 2 && users[0].1 != users[1].1 {
+        for users in uses.chunk_by(|x, y| x.key == y.key) {
+            if users.len() == 2 && users[0].forward != users[1].forward {
                 let (a, b) = (
-                    super::root(&mut parent, users[0].0),
-                    super::root(&mut parent, users[1].0),
+                    super::root(&mut parent, users[0].face),
+                    super::root(&mut parent, users[1].face),
                 );
                 parent[a.max(b) as usize] = a.min(b);
             }
@@ -505,22 +569,29 @@ impl Coplanar {
 }
 
 /// Two triangles `[v, …]` sharing their first corner: whether they may meet elsewhere (exact,
-/// conservative).
-fn shares_corner(t: Corners, u: Corners) -> bool {
-    let (a, b, c) = (c3(t[0]), c3(t[1]), c3(t[2]));
-    let (ub, uc) = (orient3d(a, b, c, c3(u[1])), orient3d(a, b, c, c3(u[2])));
-    if (ub > 0.0 && uc > 0.0) || (ub < 0.0 && uc < 0.0) {
-        return false;
-    }
+/// conservative), given the sides of `u`'s other corners of `t`'s plane (not both strictly on one
+/// side) and `u`'s plane (a turn of the corners leaves a plane's sides as they are).
+fn shares_corner(t: Corners, u: Corners, (ub, uc): (f64, f64), plane_u: &Plane) -> bool {
     if ub == 0.0 && uc == 0.0 {
         return !coplanar_apart(t, u);
     }
-    let (p, q, r) = (c3(u[0]), c3(u[1]), c3(u[2]));
-    let (tb, tc) = (orient3d(p, q, r, c3(t[1])), orient3d(p, q, r, c3(t[2])));
+    let (tb, tc) = (plane_u.side(t[1]), plane_u.side(t[2]));
     if ub == 0.0 || uc == 0.0 || tb == 0.0 || tc == 0.0 {
         return true;
     }
     edge_meets(u[1], u[2], ub, uc, t) || edge_meets(t[1], t[2], tb, tc, u)
+}
+
+/// The next corner of a triangle.
+const NEXT: [usize; 3] = [1, 2, 0];
+
+/// A triangle's corners from its `i`-th on.
+fn rotated(p: &Corners, i: usize) -> Corners {
+    match i {
+        0 => *p,
+        1 => [p[1], p[2], p[0]],
+        _ => [p[2], p[0], p[1]],
+    }
 }
 
 /// Two coplanar triangles sharing their first corner: whether a line through it along one of their

@@ -136,15 +136,17 @@ impl Grid {
         (&self.items[r.clone()], &self.item_boxes[r])
     }
 
-    /// The triangles whose boxes meet `b` (closed boxes), each once.
-    pub(super) fn overlapping(&self, b: &Aabb, seen: &mut Seen, out: &mut Vec<u32>) {
+    /// The triangles numbered above `after` (all when `None`) whose boxes meet `b` (closed
+    /// boxes), each once, in the order of the cells `b` covers.
+    pub(super) fn overlapping(&self, b: &Aabb, after: Option<u32>, seen: &mut Seen, out: &mut Vec<u32>) {
         out.clear();
         seen.next();
+        let after = after.map_or(0, |a| u64::from(a) + 1);
         self.each_cell(b, |c| {
             let (items, boxes) = self.cell_items(c);
             for (&i, x) in items.iter().zip(boxes) {
                 let meets = (0..3).all(|k| b.lo[k] <= x.hi[k] && x.lo[k] <= b.hi[k]);
-                if meets && seen.first(i) {
+                if u64::from(i) >= after && meets && seen.first(i) {
                     out.push(i);
                 }
             }
@@ -240,6 +242,63 @@ pub(super) fn orient3d(pa: Coord3D<f64>, pb: Coord3D<f64>, pc: Coord3D<f64>, pd:
     robust::orient3d(pa, pb, pc, pd)
 }
 
+/// A triangle's plane, for the side of many points: `orient3d(a, b, c, d)`'s sign for any `d`, with
+/// the part that depends on the triangle alone computed once.
+///
+/// The filter is Shewchuk's first stage applied to the transposed matrix of the rows b − a, c − a,
+/// d − a: its entries are rounded differences of input coordinates as in `orient3d`, the
+/// expansion and the error bound are the same expressions of them, and the determinant is
+/// unchanged by transposition, so the same bound certifies the sign. That determinant is
+/// ((b − a) × (c − a)) · (d − a) = −orient3d(a, b, c, d); when the bound does not certify it, the
+/// crate's exact `orient3d` decides.
+#[derive(Clone, Copy)]
+pub(super) struct Plane {
+    a: [f64; 3],
+    b: [f64; 3],
+    c: [f64; 3],
+    /// The 2×2 minors of b − a and c − a (the normal), and the sums of their products' magnitudes.
+    minor: [f64; 3],
+    size: [f64; 3],
+}
+
+impl Plane {
+    pub(super) fn new(t: &Corners) -> Plane {
+        let [a, b, c] = *t;
+        // Shewchuk's names on the transposed matrix: (adx, ady, adz) = (b − a)ₓ, (c − a)ₓ,
+        // (d − a)ₓ, and so on for y (bd…) and z (cd…).
+        let (adx, ady) = (b[0] - a[0], c[0] - a[0]);
+        let (bdx, bdy) = (b[1] - a[1], c[1] - a[1]);
+        let (cdx, cdy) = (b[2] - a[2], c[2] - a[2]);
+        let (bdxcdy, cdxbdy) = (bdx * cdy, cdx * bdy);
+        let (cdxady, adxcdy) = (cdx * ady, adx * cdy);
+        let (adxbdy, bdxady) = (adx * bdy, bdx * ady);
+        Plane {
+            a,
+            b,
+            c,
+            minor: [bdxcdy - cdxbdy, cdxady - adxcdy, adxbdy - bdxady],
+            size: [
+                bdxcdy.abs() + cdxbdy.abs(),
+                cdxady.abs() + adxcdy.abs(),
+                adxbdy.abs() + bdxady.abs(),
+            ],
+        }
+    }
+
+    /// A value with the sign of `orient3d(a, b, c, d)` (zero exactly when `d` is in the plane).
+    #[inline(always)] // a few flops run for every pair of neighbouring triangles
+    pub(super) fn side(&self, d: [f64; 3]) -> f64 {
+        let (adz, bdz, cdz) = (d[0] - self.a[0], d[1] - self.a[1], d[2] - self.a[2]);
+        let det = adz * self.minor[0] + bdz * self.minor[1] + cdz * self.minor[2];
+        let permanent = self.size[0] * adz.abs() + self.size[1] * bdz.abs() + self.size[2] * cdz.abs();
+        let errbound = O3DERRBOUND_A * permanent;
+        if det > errbound || -det > errbound {
+            return -det;
+        }
+        robust::orient3d(c3(self.a), c3(self.b), c3(self.c), c3(d))
+    }
+}
+
 /// The segment `s e` at the triangle `t`, exactly.
 fn crossing(s: [f64; 3], e: [f64; 3], t: &Corners) -> Crossing {
     let (a, b, c) = (c3(t[0]), c3(t[1]), c3(t[2]));
@@ -310,6 +369,41 @@ mod tests {
             let ours = orient3d(c3(a), c3(b), c3(c), c3(d));
             let theirs = robust::orient3d(c3(a), c3(b), c3(c), c3(d));
             assert_eq!(ours.to_bits(), theirs.to_bits(), "{a:?} {b:?} {c:?} {d:?}");
+        }
+    }
+
+    /// The plane's side has `robust::orient3d`'s sign (and zero exactly where it is zero), also for
+    /// points on the plane up to rounding and for flat or degenerate triangles.
+    #[test]
+    fn plane_side_is_orient3ds_sign() {
+        let mut state = 0x2545_F491_4F6C_DD1D_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for i in 0..30_000 {
+            let [a, mut b, mut c] = [0; 3].map(|_| [next(), next(), next()]);
+            if i % 7 == 0 {
+                // Collinear corners: every point is on the (undefined) plane.
+                c = [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
+            }
+            if i % 11 == 0 {
+                b = a;
+            }
+            let d = match i % 4 {
+                0 => [next(), next(), next()],
+                1 => {
+                    let (s, t) = (next(), next());
+                    [0, 1, 2].map(|k| a[k] + s * (b[k] - a[k]) + t * (c[k] - a[k]))
+                }
+                2 => [0, 1, 2].map(|k| 0.5 * (b[k] + c[k])),
+                _ => [a, b, c][i % 3],
+            };
+            let ours = Plane::new(&[a, b, c]).side(d);
+            let theirs = robust::orient3d(c3(a), c3(b), c3(c), c3(d));
+            assert_eq!(ours.partial_cmp(&0.0), theirs.partial_cmp(&0.0), "{a:?} {b:?} {c:?} {d:?}");
         }
     }
 

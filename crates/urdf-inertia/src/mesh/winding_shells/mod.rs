@@ -105,7 +105,7 @@ struct Shell {
 /// back (`stored.copies`: the winding number of the file's surface counts them), and where their
 /// edges balance only so, with the faces the ladder turned round turned back (`stored.faces`).
 pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> ShellOutcome {
-    let shells = shells(vertices, faces);
+    let (shells, uses) = shells(vertices, faces);
     let unchanged = |undecided_pairs, overlap_bound| ShellOutcome {
         faces: faces.clone(),
         undecided_pairs,
@@ -140,7 +140,7 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
     // A pair with an undecided side is bounded whatever the other side's classification, unless
     // its cluster is a closed cycle, or both shells are: then it is decided face by face (the open
     // shells around sealed ones keep their pairs' bounds).
-    let (clusters, flip, welded) = clusters(vertices, faces, stored, &shells, &pairs, &decided);
+    let (clusters, flip, welded) = clusters(vertices, faces, stored, &shells, (&pairs, &decided), &uses);
     let mut relevant = clusters.relevant.clone();
     for &(a, b) in &pairs {
         if decided[a] && decided[b] {
@@ -202,30 +202,32 @@ pub struct AsStored {
 
 /// [`resolvable`] on the faces as given (and the stored orientation of those `flip` marks), then,
 /// when a cluster does not balance so, on welded corners: clusters left open by cracks alone
-/// balance once welded, and are decided on welded corners (then returned too).
+/// balance once welded, and are decided on welded corners (then returned too). `uses`: the faces'
+/// edge uses ([`edge_uses`]).
 fn clusters(
     vertices: &[[f64; 3]],
     faces: &Polygons,
     stored: &AsStored,
     shells: &[Shell],
-    pairs: &[(usize, usize)],
-    decided: &[bool],
+    pairs: (&[(usize, usize)], &[bool]),
+    uses: &[EdgeUse],
 ) -> (Clusters, Vec<bool>, Option<Vec<u32>>) {
     let flip = turned_round(faces, &stored.faces);
     let copies = (&stored.copies, &flip[..]);
-    let mut clusters = resolvable(faces, copies, shells, pairs, decided, None);
+    let mut clusters = resolvable(faces, copies, shells, pairs, (uses, None));
     let welded = clusters
         .unbalanced
         .then(|| cracks::representatives(vertices));
     if let Some(rep) = &welded {
-        clusters = resolvable(faces, copies, shells, pairs, decided, Some(rep));
+        let uses = edge_uses(vertices.len(), &numbered(faces), Some(rep));
+        clusters = resolvable(faces, copies, shells, pairs, (&uses, Some(rep)));
     }
     (clusters, flip, welded)
 }
 
-/// Per edge: the first shell using it, and its uses one way less the other, with the faces as
+/// Per edge: the shell of its first use, and its uses one way less the other, with the faces as
 /// classified and as stored.
-type EdgeUses = FxHashMap<(u32, u32), (u32, i64, i64)>;
+type EdgeSums = (u32, i64, i64);
 
 /// Which shells [`resolvable`] gives to the face-by-face decision.
 struct Clusters {
@@ -242,19 +244,17 @@ struct Clusters {
 /// they share where the surface is non-manifold) that hold an undecided pair and whose edges all
 /// balance (as many uses each way: a closed cycle, whose winding number is an integer everywhere and
 /// is counted exactly by a ray's crossings), counting the extra `copies` of faces and taking
-/// vertices as their representatives `rep` when given. A cluster balances with its faces as
-/// classified (the ladder's repairs kept), or else in their stored orientation (the faces marked in
-/// `flip` turned back: a re-orientation that broke a closed cycle of the file is undone).
+/// vertices as their representatives `rep` when given (`uses`: the edge uses on them). A cluster
+/// balances with its faces as classified (the ladder's repairs kept), or else in their stored
+/// orientation (the faces marked in `flip` turned back: a re-orientation that broke a closed
+/// cycle of the file is undone).
 fn resolvable(
     faces: &Polygons,
     (copies, flip): (&Polygons, &[bool]),
     shells: &[Shell],
-    pairs: &[(usize, usize)],
-    decided: &[bool],
-    rep: Option<&[u32]>,
+    (pairs, decided): (&[(usize, usize)], &[bool]),
+    (uses, rep): (&[EdgeUse], Option<&[u32]>),
 ) -> Clusters {
-    let at = |v: u32| rep.map_or(v, |r| r[v as usize]);
-    let key = |u: u32, v: u32| (u.min(v), u.max(v));
     let mut shell_of = vec![0u32; faces.len()];
     for (i, s) in shells.iter().enumerate() {
         s.faces.iter().for_each(|&f| shell_of[f as usize] = i as u32);
@@ -263,37 +263,30 @@ fn resolvable(
     for &(a, b) in pairs {
         join(&mut parent, a as u32, b as u32);
     }
-    let mut edges = EdgeUses::default();
-    let count = |edges: &mut EdgeUses, parent: &mut Vec<u32>, face: &[u32], shell: u32, turned: bool| {
-        for k in 0..face.len() {
-            let (u, v) = (at(face[k]), at(face[(k + 1) % face.len()]));
-            if u != v {
-                let e = edges.entry(key(u, v)).or_insert((shell, 0, 0));
-                let d = if u < v { 1 } else { -1 };
-                e.1 += d;
-                e.2 += if turned { -d } else { d };
-                join(parent, e.0, shell);
-            }
+    // The faces' edges, in order (each with the shell of its first use in face order), then the
+    // edges that only copies use.
+    let mut edges: Vec<(u64, EdgeSums)> = Vec::new();
+    for group in uses.chunk_by(|x, y| x.key == y.key) {
+        if group[0].key >> 32 == group[0].key & 0xFFFF_FFFF {
+            continue;
         }
-    };
-    for (i, face) in faces.iter().enumerate() {
-        count(&mut edges, &mut parent, face, shell_of[i], flip[i]);
-    }
-    let mut copy_shell = Vec::with_capacity(copies.len());
-    for face in copies.iter() {
-        let (u, v) = (at(face[0]), at(face[1]));
-        let shell = edges.get(&key(u, v)).map(|e| e.0);
-        if let Some(s) = shell {
-            count(&mut edges, &mut parent, face, s, false);
+        let first = shell_of[group[0].face as usize];
+        let (mut net, mut as_stored) = (0, 0);
+        for e in group {
+            let d = if e.forward { 1 } else { -1 };
+            net += d;
+            as_stored += if flip[e.face as usize] { -d } else { d };
+            join(&mut parent, first, shell_of[e.face as usize]);
         }
-        copy_shell.push(shell.map(|s| s as usize));
+        edges.push((group[0].key, (first, net, as_stored)));
     }
+    let (copy_shell, extra) = copied_edges(copies, rep, &mut edges, &mut parent);
     // Per cluster: open as classified, open as stored.
     let mut open = vec![(false, false); shells.len()];
-    for &(s, net, stored) in edges.values() {
+    for &(s, net, as_stored) in edges.iter().map(|e| &e.1).chain(extra.values()) {
         let r = root(&mut parent, s) as usize;
         open[r].0 |= net != 0;
-        open[r].1 |= stored != 0;
+        open[r].1 |= as_stored != 0;
     }
     let mut wanted = vec![false; shells.len()];
     for &(a, b) in pairs {
@@ -310,6 +303,45 @@ fn resolvable(
         unbalanced: (0..shells.len()).any(|r| wanted[r] && open[r].0 && open[r].1),
         copy_shell,
     }
+}
+
+/// The extra copies of faces counted in the faces' `edges` (sorted by edge), in order: each joins
+/// the shell of the first use of its first edge (by a face, or by an earlier copy), when there is
+/// one. Per copy, that shell; and the edges only copies use.
+fn copied_edges(
+    copies: &Polygons,
+    rep: Option<&[u32]>,
+    edges: &mut [(u64, EdgeSums)],
+    parent: &mut [u32],
+) -> (Vec<Option<usize>>, FxHashMap<u64, EdgeSums>) {
+    let at = |v: u32| rep.map_or(v, |r| r[v as usize]);
+    let mut extra: FxHashMap<u64, EdgeSums> = FxHashMap::default();
+    let mut copy_shell = Vec::with_capacity(copies.len());
+    for face in copies.iter() {
+        let key = edge_key(at(face[0]), at(face[1]));
+        let shell = match edges.binary_search_by_key(&key, |e| e.0) {
+            Ok(i) => Some(edges[i].1 .0),
+            Err(_) => extra.get(&key).map(|e| e.0),
+        };
+        copy_shell.push(shell.map(|s| s as usize));
+        let Some(shell) = shell else { continue };
+        for k in 0..face.len() {
+            let (u, v) = (at(face[k]), at(face[(k + 1) % face.len()]));
+            if u == v {
+                continue;
+            }
+            let key = edge_key(u, v);
+            let e = match edges.binary_search_by_key(&key, |e| e.0) {
+                Ok(i) => &mut edges[i].1,
+                Err(_) => extra.entry(key).or_insert((shell, 0, 0)),
+            };
+            let d = if u < v { 1 } else { -1 };
+            e.1 += d;
+            e.2 += d;
+            join(parent, e.0, shell);
+        }
+    }
+    (copy_shell, extra)
 }
 
 fn join(parent: &mut [u32], a: u32, b: u32) {
@@ -477,36 +509,29 @@ fn rebuilt(faces: &Polygons, keep: &[bool], turn: &[bool]) -> Polygons {
 }
 
 /// Shells: components over edges that exactly two faces share with opposite directions; a shell is
-/// closed when every edge of its faces is such an edge.
-fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
-    let mut by_edge: FxHashMap<(u32, u32), Vec<(u32, bool)>> = FxHashMap::default();
-    for (i, face) in faces.iter().enumerate() {
-        for k in 0..face.len() {
-            let (u, v) = (face[k], face[(k + 1) % face.len()]);
-            let key = (u.min(v), u.max(v));
-            by_edge.entry(key).or_default().push((i as u32, u < v));
-        }
-    }
+/// closed when every edge of its faces is such an edge. Also the faces' edge uses ([`edge_uses`]).
+fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> (Vec<Shell>, Vec<EdgeUse>) {
     let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
     let mut open_face = vec![false; faces.len()];
-    for users in by_edge.values() {
-        if users.len() == 2 && users[0].1 != users[1].1 {
-            let (a, b) = (root(&mut parent, users[0].0), root(&mut parent, users[1].0));
+    let uses = edge_uses(vertices.len(), &numbered(faces), None);
+    for users in uses.chunk_by(|x, y| x.key == y.key) {
+        if users.len() == 2 && users[0].forward != users[1].forward {
+            let (a, b) = (root(&mut parent, users[0].face), root(&mut parent, users[1].face));
             parent[a.max(b) as usize] = a.min(b);
         } else {
-            for &(f, _) in users {
-                open_face[f as usize] = true;
+            for e in users {
+                open_face[e.face as usize] = true;
             }
         }
     }
     let centre = crate::mass::integrals::bounding_box_centre(vertices);
-    let mut index: FxHashMap<u32, usize> = FxHashMap::default();
+    // Per root (its component's lowest face): its shell.
+    let mut index = vec![u32::MAX; faces.len()];
     let mut out: Vec<Shell> = Vec::new();
     for (i, face) in faces.iter().enumerate() {
-        let r = root(&mut parent, i as u32);
-        let n = out.len();
-        let at = *index.entry(r).or_insert(n);
-        if at == n {
+        let r = root(&mut parent, i as u32) as usize;
+        if index[r] == u32::MAX {
+            index[r] = out.len() as u32;
             out.push(Shell {
                 faces: Vec::new(),
                 closed: true,
@@ -517,7 +542,7 @@ fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
                 bounds: Aabb::EMPTY,
             });
         }
-        let s = &mut out[at];
+        let s = &mut out[index[r] as usize];
         s.faces.push(i as u32);
         s.closed &= !open_face[i];
         let a = sub(vertices[face[0] as usize], centre);
@@ -540,7 +565,71 @@ fn shells(vertices: &[[f64; 3]], faces: &Polygons) -> Vec<Shell> {
             s.closed = s.motion <= NEARLY_CLOSED * s.volume6.abs() / 6.0;
         }
     }
-    out
+    (out, uses)
+}
+
+/// One use of an edge by a face.
+#[derive(Clone, Copy)]
+pub(super) struct EdgeUse {
+    /// The edge ([`edge_key`]).
+    pub(super) key: u64,
+    pub(super) face: u32,
+    /// Whether the face runs along it from its lower corner.
+    pub(super) forward: bool,
+}
+
+/// Every use of an edge by the `faces` (numbered) on `n` vertices, on the vertices'
+/// representatives `rep` when given, sorted by edge and, along one edge, by face. A counting sort
+/// by the lower corner, then a sort of each corner's few edges: no map of lists, and no sort of
+/// the whole, on every face of a surface of several shells.
+pub(super) fn edge_uses<'a, F>(n: usize, faces: &F, rep: Option<&[u32]>) -> Vec<EdgeUse>
+where
+    F: Iterator<Item = (u32, &'a [u32])> + Clone,
+{
+    let at = |v: u32| rep.map_or(v, |r| r[v as usize]);
+    let each = |f: &mut dyn FnMut(u32, u32, u32)| {
+        for (i, face) in faces.clone() {
+            for k in 0..face.len() {
+                f(i, at(face[k]), at(face[(k + 1) % face.len()]));
+            }
+        }
+    };
+    let mut start = vec![0u32; n + 1];
+    each(&mut |_, u, v| start[u.min(v) as usize + 1] += 1);
+    for k in 0..n {
+        start[k + 1] += start[k];
+    }
+    let blank = EdgeUse {
+        key: 0,
+        face: 0,
+        forward: false,
+    };
+    let mut uses = vec![blank; start[n] as usize];
+    let mut fill = start.clone();
+    each(&mut |i, u, v| {
+        let at = &mut fill[u.min(v) as usize];
+        uses[*at as usize] = EdgeUse {
+            key: edge_key(u, v),
+            face: i,
+            forward: u < v,
+        };
+        *at += 1;
+    });
+    // Each corner's uses are in face order: a stable sort by edge keeps them so along each edge.
+    for k in 0..n {
+        uses[start[k] as usize..start[k + 1] as usize].sort_by_key(|e| e.key);
+    }
+    uses
+}
+
+/// The faces with their numbers, for [`edge_uses`].
+fn numbered(faces: &Polygons) -> impl Iterator<Item = (u32, &[u32])> + Clone {
+    (0..faces.len()).map(|i| (i as u32, faces.face(i)))
+}
+
+/// An undirected edge as one word, its lower corner first.
+pub(super) fn edge_key(u: u32, v: u32) -> u64 {
+    (u64::from(u.min(v)) << 32) | u64::from(u.max(v))
 }
 
 pub(super) fn root(parent: &mut [u32], mut x: u32) -> u32 {
