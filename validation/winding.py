@@ -85,9 +85,8 @@ def ours(binary, path, scale, extra=()):
     return json.loads(proc.stdout), None
 
 
-def measure(binary, robots, robot, path, scale, rng, points):
+def measure(binary, name, path, scale, rng, points):
     """One row, or None for a mesh the ladder does not repair."""
-    name = str(path.relative_to(robots)) if path.is_relative_to(robots) else str(path)
     data, err = ours(binary, path, scale)
     refused = False
     if data is None and "UI108" in err:
@@ -181,7 +180,8 @@ def main():
     for robot, path, scale in collision_meshes(robots, share):
         if args.only and args.only not in str(path):
             continue
-        row = measure(args.binary, robots, robot, path, scale, rng, args.points)
+        name = str(path.relative_to(robots)) if path.is_relative_to(robots) else str(path)
+        row = measure(args.binary, name, path, scale, rng, args.points)
         if row is not None:
             rows.append(row)
     lines, failed = report(rows, args.points)
