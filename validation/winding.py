@@ -85,8 +85,9 @@ def ours(binary, path, scale, extra=()):
     return json.loads(proc.stdout), None
 
 
-def measure(binary, name, path, scale, rng, points):
-    """One row, or None for a mesh the ladder does not repair."""
+def measure(binary, name, path, scale, rng, points, reader=triangles):
+    """One row, or None for a mesh the ladder does not repair. `reader(path, scale)` gives the reference's
+    triangles (default: as coal reads them)."""
     data, err = ours(binary, path, scale)
     refused = False
     if data is None and "UI108" in err:
@@ -96,7 +97,7 @@ def measure(binary, name, path, scale, rng, points):
         return {"name": name, "scale": scale, "error": err}
     if data["provenance"] in ("exact", "welded"):
         return None
-    v, f = triangles(path, scale)
+    v, f = reader(path, scale)
     start = time.perf_counter()
     ref, sigma = solid_volume(v, f, rng=rng, points=points)
     seconds = time.perf_counter() - start

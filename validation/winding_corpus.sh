@@ -7,7 +7,7 @@
 #   OUT.md defaults to a file in the work directory, so the tree stays clean; the figures in docs/accuracy.md
 #   are regenerated on purpose from that report.
 # Environment: WINDING_WORK (work directory, default a new temp dir; the wheels are downloaded there and
-# removed at the end), WINDING_VENV (default validation/.venv-winding), WINDING_POINTS (samples per mesh),
+# removed at the end), WINDING_VENV (default validation/.venv-winding, which winding.sh shares), WINDING_POINTS (samples per mesh),
 # WINDING_JOBS (meshes measured at once, default 1; the figures do not depend on it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,7 +20,7 @@ trap 'rm -rf "$work/extract" "$work/wheels"' EXIT
 if [ ! -x "$venv/bin/python" ]; then
   python3 -m venv "$venv"
 fi
-"$venv/bin/python" -m pip install --quiet --disable-pip-version-check -r validation/winding-requirements.txt
+"$venv/bin/python" -m pip install --quiet --disable-pip-version-check -r validation/winding-corpus-requirements.txt
 # --platform/--python-version: pybullet is the one binary wheel; the others are py3-none-any (as corpus.sh).
 "$venv/bin/python" -m pip download --quiet --disable-pip-version-check --no-deps --only-binary=:all: \
   --platform manylinux2014_x86_64 --python-version 3.11 --implementation cp --abi cp311 \
