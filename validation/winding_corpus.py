@@ -102,7 +102,7 @@ def measure_package(args, name, version, meshes_only, work):
 def table(packages, rows):
     """The per-package summary lines."""
     lines = [
-        "| package | collision meshes | repaired by default | pass | within 1% (+3 sigma) | refused (UI108) | "
+        "| package | unique meshes | repaired by default | pass | within 1% (+3 sigma) | refused (UI108) | "
         "refused: estimate bounds the difference | other errors |",
         "|---|---|---|---|---|---|---|---|",
     ]
