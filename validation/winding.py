@@ -85,9 +85,9 @@ def ours(binary, path, scale, extra=()):
     return json.loads(proc.stdout), None
 
 
-def measure(binary, robots, robot, path, scale, rng, points):
-    """One row, or None for a mesh the ladder does not repair."""
-    name = str(path.relative_to(robots)) if path.is_relative_to(robots) else str(path)
+def measure(binary, name, path, scale, rng, points, reader=triangles):
+    """One row, or None for a mesh the ladder does not repair. `reader(path, scale)` gives the reference's
+    triangles (default: as coal reads them)."""
     data, err = ours(binary, path, scale)
     refused = False
     if data is None and "UI108" in err:
@@ -97,7 +97,7 @@ def measure(binary, robots, robot, path, scale, rng, points):
         return {"name": name, "scale": scale, "error": err}
     if data["provenance"] in ("exact", "welded"):
         return None
-    v, f = triangles(path, scale)
+    v, f = reader(path, scale)
     start = time.perf_counter()
     ref, sigma = solid_volume(v, f, rng=rng, points=points)
     seconds = time.perf_counter() - start
@@ -181,7 +181,8 @@ def main():
     for robot, path, scale in collision_meshes(robots, share):
         if args.only and args.only not in str(path):
             continue
-        row = measure(args.binary, robots, robot, path, scale, rng, args.points)
+        name = str(path.relative_to(robots)) if path.is_relative_to(robots) else str(path)
+        row = measure(args.binary, name, path, scale, rng, args.points)
         if row is not None:
             rows.append(row)
     lines, failed = report(rows, args.points)

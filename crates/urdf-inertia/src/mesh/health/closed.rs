@@ -1,7 +1,7 @@
 //! The closed rungs: as stored, welded, inverted or re-oriented component by component.
 
 use super::geometry::{
-    bbox, component_boxes, component_volumes, vector_area,
+    bbox, component_boxes, component_volumes, vector_area, Aabb,
 };
 use super::ladder::Ladder;
 use super::closed_consistent;
@@ -191,7 +191,7 @@ pub(super) fn reoriented(
         flipped,
         nested,
         flip_volume,
-    } = outward(&w.vertices, &w.kept, o);
+    } = outward(&w.vertices, &w.kept, o, &te.pairs);
     let mut faces = w.kept.clone();
     apply(&mut faces, &reversed);
     ladder.strict(&format!(
@@ -218,7 +218,8 @@ pub(super) fn reoriented(
 }
 
 /// Each face's reversal under an orientation that turns every component outward by its own signed
-/// volume, how many faces that flips, and the volume of components lying inside another one's
+/// volume (a closed cavity inside another component's box stays inward: [`turned_components`]), how
+/// many faces that flips, and the volume of components lying inside another one's
 /// bounding box (counted twice: a cavity turned outward adds its volume instead of removing it).
 /// `flip_volume` is what the faces flipped against the rest of their component change ([`flip_change`]).
 pub(super) struct Outward {
@@ -262,17 +263,24 @@ pub(super) fn flip_change(vertices: &[[f64; 3]], faces: &Polygons, o: &Orientati
         .sum()
 }
 
-pub(super) fn outward(vertices: &[[f64; 3]], faces: &Polygons, o: &Orientation) -> Outward {
+pub(super) fn outward(
+    vertices: &[[f64; 3]],
+    faces: &Polygons,
+    o: &Orientation,
+    pairs: &[(u32, u32, bool)],
+) -> Outward {
     let mut trial = faces.clone();
     apply(&mut trial, &o.flip);
     let vol = component_volumes(vertices, &trial, &o.comp, o.ncomp);
+    let boxes = (o.ncomp > 1).then(|| component_boxes(vertices, faces, &o.comp, o.ncomp));
+    let closed = closed_components(faces, o, pairs);
+    let turn = turned_components(&vol, &closed, boxes.as_deref());
     let reversed: Vec<bool> = (0..faces.len())
-        .map(|i| o.flip[i] ^ (vol[o.comp[i] as usize] < 0.0))
+        .map(|i| o.flip[i] ^ turn[o.comp[i] as usize])
         .collect();
     let flipped = reversed.iter().filter(|r| **r).count();
     let mut nested = 0.0;
-    if o.ncomp > 1 {
-        let boxes = component_boxes(vertices, faces, &o.comp, o.ncomp);
+    if let Some(boxes) = &boxes {
         for c in 0..o.ncomp {
             if (0..o.ncomp).any(|d| d != c && boxes[d].contains(&boxes[c])) {
                 nested += 2.0 * vol[c].abs() / 6.0;
@@ -286,6 +294,47 @@ pub(super) fn outward(vertices: &[[f64; 3]], faces: &Polygons, o: &Orientation) 
         nested,
         flip_volume,
     }
+}
+
+/// Whether each component is closed: every edge of its faces shared with one other face (`pairs`
+/// holds the manifold edges).
+fn closed_components(faces: &Polygons, o: &Orientation, pairs: &[(u32, u32, bool)]) -> Vec<bool> {
+    let mut shared = vec![0usize; faces.len()];
+    for &(a, b, _) in pairs {
+        shared[a as usize] += 1;
+        shared[b as usize] += 1;
+    }
+    let mut closed = vec![true; o.ncomp];
+    for (i, face) in faces.iter().enumerate() {
+        if shared[i] < face.len() {
+            closed[o.comp[i] as usize] = false;
+        }
+    }
+    closed
+}
+
+/// Which components to turn round (given each one's signed volume, consistently wound, whether it
+/// is closed, and their boxes): the whole surface when it is wound inward in all (which leaves
+/// {|w| >= 1/2} as it is), then each component wound inward, except a closed one at an odd nesting
+/// depth, as [`misoriented`] decides for closed meshes: that is a cavity, and turned outward the
+/// winding number inside it would be 2 instead of 0, so the solid would fill it. An open
+/// component's sign depends on where it is measured from; it is turned as before. Beyond
+/// [`NESTING_CHECK`] components, every component wound inward is turned.
+fn turned_components(vol: &[f64], closed: &[bool], boxes: Option<&[Aabb]>) -> Vec<bool> {
+    let inward = vol.iter().sum::<f64>() < 0.0;
+    let n = vol.len();
+    (0..n)
+        .map(|c| {
+            let own = if inward { -vol[c] } else { vol[c] };
+            let depth = match boxes {
+                Some(b) if closed[c] && n <= NESTING_CHECK => (0..n)
+                    .filter(|&d| d != c && vol[d].abs() > vol[c].abs() && b[d].contains(&b[c]))
+                    .count(),
+                _ => 0,
+            };
+            inward ^ (own < 0.0 && depth % 2 == 0)
+        })
+        .collect()
 }
 
 /// Reverses the faces marked.

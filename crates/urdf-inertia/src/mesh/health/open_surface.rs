@@ -43,7 +43,7 @@ impl Winding {
 pub(super) fn windings(w: &Welding, te: &Edges) -> Vec<Winding> {
     let mut out = Vec::new();
     if let Some(o) = orient(w.topology.len(), &te.pairs) {
-        let turned = outward(&w.vertices, &w.kept, &o);
+        let turned = outward(&w.vertices, &w.kept, &o, &te.pairs);
         if turned.flipped > 0 {
             let mut faces = w.kept.clone();
             apply(&mut faces, &turned.reversed);
