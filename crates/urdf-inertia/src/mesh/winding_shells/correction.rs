@@ -10,11 +10,13 @@
 //! the cone it spans from the surface's box centre (the volume a wrong orientation can change) to
 //! the bound, twice when it may count twice.
 
-use super::grid::{orient3d, Corners, Grid, Plane, Seen};
-use super::{c3, edge_meets, triangles_touch};
+use super::grid::{Corners, Grid, Plane, Seen};
+use super::{edge_meets, triangles_touch};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
 use crate::mass::Polygons;
 use robust::{orient2d, Coord};
+use rustc_hash::FxHashMap;
+use std::cell::RefCell;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
@@ -93,6 +95,10 @@ struct Faces<'a> {
     centre: [f64; 3],
     /// Distances below this are not trusted to f64 plane tests.
     margin: f64,
+    /// Whether a blocker `u` lies exactly in triangle `t`'s plane, per (t, u) once: the pieces of
+    /// one triangle ask it again for each blocker (14 times per pair on a real gripper with
+    /// coincident shells), and an exact zero is orient3d's most expensive answer.
+    in_plane: RefCell<FxHashMap<(u32, u32), bool>>,
 }
 
 /// Decides the triangles `tris` (closed shells whose pairs the classification left open; `sign` per
@@ -121,6 +127,7 @@ pub(super) fn resolve(
         grid,
         centre,
         margin,
+        in_plane: RefCell::default(),
     };
     let mut seen = Seen::new(tris.len());
     let blockers = f.all_blockers(&boxes, &mut seen);
@@ -469,7 +476,8 @@ impl Faces<'_> {
     /// planes into convex cells that no triangle meets any more, each decided by a ray, or bounded
     /// when it is a sliver the plane tests cannot tell from a cut. Whether it did so.
     fn cut(&self, piece: &Corners, t: u32, blockers: &[u32], seen: &mut Seen, out: &mut Resolved) -> bool {
-        let [p, q, r] = self.corners[t as usize].map(c3);
+        let tc = self.corners[t as usize];
+        let plane = &self.planes[t as usize];
         let nt = {
             let c = self.corners[t as usize];
             cross(sub(c[1], c[0]), sub(c[2], c[0]))
@@ -484,7 +492,10 @@ impl Faces<'_> {
                 .iter()
                 .map(|x| dot(n, sub(*x, a)).abs() / norm(n))
                 .fold(0.0, f64::max);
-            let exact = [a, b, c].iter().all(|&x| orient3d(p, q, r, c3(x)) == 0.0);
+            // In t's plane exactly: a corner of t is, without a predicate; the others by orient3d.
+            let exact = *self.in_plane.borrow_mut().entry((t, u)).or_insert_with(|| {
+                [a, b, c].iter().all(|&x| tc.contains(&x) || plane.side(x) == 0.0)
+            });
             if exact || gap <= NEAR * self.grid.bounds.diagonal() {
                 // Nearly in t's plane: taken as in it, which moves the solid by at most the slab
                 // between the two over the piece (on both sides).
