@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The winding-number validation on meshes it was not tuned on: every collision mesh of the PyPI robot wheels
 # pinned in validation/corpus-requirements.txt (example-robot-data aside: validation/winding.sh) that the
-# health ladder repairs, against libigl's fast winding number (validation/winding_corpus.py). Not run by
-# .ci/run: it samples about 340 meshes (docs/accuracy.md, "Open and overlapping meshes", gives its cost).
+# health ladder repairs, against libigl's fast winding number (validation/winding_corpus.py). .ci/run runs
+# it with WINDING_JOBS=2: about 340 meshes (docs/accuracy.md, "Open and overlapping meshes", gives its cost).
 # Usage: bash validation/winding_corpus.sh [OUT.md]
 #   OUT.md defaults to a file in the work directory, so the tree stays clean; the figures in docs/accuracy.md
 #   are regenerated on purpose from that report.
