@@ -126,6 +126,30 @@ def fmt_scale(scale):
     return "" if all(s == 1.0 for s in scale) else " ×" + ",".join(f"{s:g}" for s in scale)
 
 
+def mesh_rows(rows, known, errors_heading, shorten):
+    """The per-mesh table, then the meshes urdf-inertia refuses (`errors_heading`, each error through
+    `shorten`) and the `known` failures with their reasons."""
+    measured = [r for r in rows if "error" not in r]
+    lines = [
+        "| mesh | rung | faces | ours (m³) | reference (m³) | difference (rel.) | estimate (rel.) | 3 sigma (rel.) | pass |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in sorted(measured, key=lambda r: (r["refused"], r["pass"], r["name"])):
+        rel = r["diff"] / r["ref"] if r["ref"] > 0 else float("inf")
+        mark = "yes" if r["pass"] else ("known" if r["name"] in known else "NO")
+        lines.append(
+            f"| {r['name']}{fmt_scale(r['scale'])} | {r['rung']} | {r['faces']} | {r['ours']:.4e} | {r['ref']:.4e} | "
+            f"{rel:.1e} | {r['estimate']:.1e} | {3 * r['sigma'] / max(r['ref'], 1e-300):.1e} | {mark} |"
+        )
+    errors = [r for r in rows if "error" in r]
+    if errors:
+        lines += ["", f"## {errors_heading}", ""]
+        lines += [f"- {r['name']}{fmt_scale(r['scale'])}: {shorten(r['error'])}" for r in errors]
+    if known:
+        lines += ["", "## Known and explained", ""] + [f"- {k}: {v}" for k, v in sorted(known.items())]
+    return lines
+
+
 def report(rows, points):
     measured = [r for r in rows if "error" not in r]
     by_default = [r for r in measured if not r["refused"]]
@@ -145,22 +169,8 @@ def report(rows, points):
         f"{len(within)} within 1% (+3 sigma). Refused by default (UI108), measured under `--open-mesh caps`: "
         f"{len(refused)} meshes, {sum(r['pass'] for r in refused)} of whose estimates bound the difference.",
         "",
-        "| mesh | rung | faces | ours (m³) | reference (m³) | difference (rel.) | estimate (rel.) | 3 sigma (rel.) | pass |",
-        "|---|---|---|---|---|---|---|---|---|",
     ]
-    for r in sorted(measured, key=lambda r: (r["refused"], r["pass"], r["name"])):
-        rel = r["diff"] / r["ref"] if r["ref"] > 0 else float("inf")
-        mark = "yes" if r["pass"] else ("known" if r["name"] in KNOWN else "NO")
-        lines.append(
-            f"| {r['name']}{fmt_scale(r['scale'])} | {r['rung']} | {r['faces']} | {r['ours']:.4e} | {r['ref']:.4e} | "
-            f"{rel:.1e} | {r['estimate']:.1e} | {3 * r['sigma'] / max(r['ref'], 1e-300):.1e} | {mark} |"
-        )
-    errors = [r for r in rows if "error" in r]
-    if errors:
-        lines += ["", "## Meshes that fail in urdf-inertia", ""]
-        lines += [f"- {r['name']}{fmt_scale(r['scale'])}: {r['error']}" for r in errors]
-    if KNOWN:
-        lines += ["", "## Known and explained", ""] + [f"- {k}: {v}" for k, v in sorted(KNOWN.items())]
+    lines += mesh_rows(rows, KNOWN, "Meshes that fail in urdf-inertia", lambda e: e)
     seconds = sum(r["seconds"] for r in measured)
     lines += ["", f"Sampling took {seconds:.0f} s in all."]
     return lines, failed

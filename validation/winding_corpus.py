@@ -27,7 +27,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from corpus import Package, collision_meshes, find_wheel, norm, parse_requirements, read_text  # noqa: E402
-from winding import POINTS, fmt_scale, measure, triangles  # noqa: E402
+from winding import POINTS, fmt_scale, measure, mesh_rows, triangles  # noqa: E402
 
 # Meshes (package/relative path) whose estimate is known to be below the reference's difference, each with
 # the reason. Keep short: every entry is a number printed without an honest bound.
@@ -140,24 +140,12 @@ def report(packages, rows, points):
         "",
     ]
     lines += table(packages, rows)
-    lines += [
-        "",
-        "| mesh | rung | faces | ours (m³) | reference (m³) | difference (rel.) | estimate (rel.) | 3 sigma (rel.) | pass |",
-        "|---|---|---|---|---|---|---|---|---|",
-    ]
-    for r in sorted(measured, key=lambda r: (r["refused"], r["pass"], r["name"])):
-        rel = r["diff"] / r["ref"] if r["ref"] > 0 else float("inf")
-        mark = "yes" if r["pass"] else ("known" if r["name"] in KNOWN else "NO")
-        lines.append(
-            f"| {r['name']}{fmt_scale(r['scale'])} | {r['rung']} | {r['faces']} | {r['ours']:.4e} | {r['ref']:.4e} | "
-            f"{rel:.1e} | {r['estimate']:.1e} | {3 * r['sigma'] / max(r['ref'], 1e-300):.1e} | {mark} |"
-        )
-    errors = [r for r in rows if "error" in r]
-    if errors:
-        lines += ["", "## Meshes urdf-inertia refuses for another reason (explained in validation/CORPUS.md)", ""]
-        lines += [f"- {r['name']}{fmt_scale(r['scale'])}: {' '.join(r['error'].split())[:300]}" for r in errors]
-    if KNOWN:
-        lines += ["", "## Known and explained", ""] + [f"- {k}: {v}" for k, v in sorted(KNOWN.items())]
+    lines += [""] + mesh_rows(
+        rows,
+        KNOWN,
+        "Meshes urdf-inertia refuses for another reason (explained in validation/CORPUS.md)",
+        lambda e: " ".join(e.split())[:300],
+    )
     seconds = sum(r["seconds"] for r in measured)
     lines += ["", f"Sampling took {seconds:.0f} s in all."]
     return lines, failed
