@@ -161,15 +161,15 @@ pub(super) fn misoriented(vertices: &[[f64; 3]], faces: &Polygons, comp: &[u32],
     }
     let boxes = component_boxes(vertices, faces, comp, ncomp);
     (0..ncomp)
-        .map(|c| {
-            let depth = (0..ncomp)
-                .filter(|&d| {
-                    d != c && vol[d].abs() > vol[c].abs() && boxes[d].contains(&boxes[c])
-                })
-                .count();
-            vol[c] < 0.0 && depth % 2 == 0
-        })
+        .map(|c| vol[c] < 0.0 && nesting_depth(c, &vol, &boxes) % 2 == 0)
         .collect()
+}
+
+/// How many components hold component `c`: larger in volume, their boxes containing its box.
+fn nesting_depth(c: usize, vol: &[f64], boxes: &[Aabb]) -> usize {
+    (0..vol.len())
+        .filter(|&d| d != c && vol[d].abs() > vol[c].abs() && boxes[d].contains(&boxes[c]))
+        .count()
 }
 
 /// The volume that moves with the reference point, over reference points in the bounding box, for a
@@ -327,9 +327,7 @@ fn turned_components(vol: &[f64], closed: &[bool], boxes: Option<&[Aabb]>) -> Ve
         .map(|c| {
             let own = if inward { -vol[c] } else { vol[c] };
             let depth = match boxes {
-                Some(b) if closed[c] && n <= NESTING_CHECK => (0..n)
-                    .filter(|&d| d != c && vol[d].abs() > vol[c].abs() && b[d].contains(&b[c]))
-                    .count(),
+                Some(b) if closed[c] && n <= NESTING_CHECK => nesting_depth(c, vol, b),
                 _ => 0,
             };
             inward ^ (own < 0.0 && depth % 2 == 0)
