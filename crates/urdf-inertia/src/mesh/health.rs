@@ -345,6 +345,7 @@ pub fn heal(
     ladder.as_stored = winding_shells::AsStored {
         faces: w.kept.clone(),
         copies: std::mem::take(&mut w.copies),
+        precision: Some(precision),
     };
     // Nothing merged or dropped: the topology is the exact weld's faces, which just failed the proof.
     let unchanged =

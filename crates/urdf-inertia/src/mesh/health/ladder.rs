@@ -99,10 +99,16 @@ impl<'a> Ladder<'a> {
                 model.source = ModelError::Overlap;
             }
             model.terms.push((s.overlap_bound, Lever::Anywhere));
-            self.warn(HealthKind::Repaired, format!(
-                "{} pair(s) of shells touch or cut each other (or are open) where their boxes overlap: the volume they may count twice, at most {:.2e} m³ (their boxes' intersections), is in the error estimate",
-                s.undecided_pairs, s.overlap_bound
-            ));
+            // Shells closed up to cracks add the volume their cracks leave undefined; with no
+            // undecided pair that is all the bound is.
+            let text = if s.undecided_pairs > 0 {
+                format!("{} pair(s) of shells touch or cut each other (or are open) where their boxes overlap: the volume they may count twice, at most {:.2e} m³ (their boxes' intersections), is in the error estimate",
+                    s.undecided_pairs, s.overlap_bound)
+            } else {
+                format!("shells closed up to cracks were classified as closed: the volume their cracks leave undefined, at most {:.2e} m³, is in the error estimate",
+                    s.overlap_bound)
+            };
+            self.warn(HealthKind::Repaired, text);
         }
         if !s.changed {
             return faces;

@@ -8,10 +8,11 @@
 use crate::geometry::{dot, sub};
 use crate::mesh::weld;
 
-/// Each vertex's representative under the tolerant weld the ladder uses (tolerance from the stored
-/// precision, as far as the coordinates tell it).
-pub(super) fn representatives(vertices: &[[f64; 3]]) -> Vec<u32> {
-    let tol = weld::tolerance(vertices, weld::Precision::of(vertices));
+/// Each vertex's representative under the tolerant weld the ladder uses: the tolerance from the
+/// file's `precision` when known, else as far as the coordinates tell it.
+pub(super) fn representatives(vertices: &[[f64; 3]], precision: Option<weld::Precision>) -> Vec<u32> {
+    let precision = precision.unwrap_or_else(|| weld::Precision::of(vertices));
+    let tol = weld::tolerance(vertices, precision);
     weld::tolerant(vertices, tol).representative
 }
 

@@ -25,6 +25,7 @@ mod grid;
 
 use crate::geometry::{cross, dot, norm, solid_angle, sub, Aabb};
 use crate::mass::Polygons;
+use crate::mesh::weld;
 use grid::orient3d;
 use robust::Coord3D;
 use rustc_hash::FxHashMap;
@@ -198,6 +199,10 @@ pub struct AsStored {
     pub faces: Polygons,
     /// Extra copies of faces, in their stored orientation, that welding dropped as duplicates.
     pub copies: Polygons,
+    /// The precision of the file's own numbers, which set the ladder's tolerant weld; cracks are
+    /// welded with the same tolerance. Taken from the vertices when not given: of scaled
+    /// coordinates (f32 times 0.001) that says f64, a tolerance far below the file's cracks.
+    pub precision: Option<weld::Precision>,
 }
 
 /// [`resolvable`] on the faces as given (and the stored orientation of those `flip` marks), then,
@@ -217,7 +222,7 @@ fn clusters(
     let mut clusters = resolvable(faces, copies, shells, pairs, (uses, None));
     let welded = clusters
         .unbalanced
-        .then(|| cracks::representatives(vertices));
+        .then(|| cracks::representatives(vertices, stored.precision));
     if let Some(rep) = &welded {
         let uses = edge_uses(vertices.len(), &numbered(faces), Some(rep));
         clusters = resolvable(faces, copies, shells, pairs, (&uses, Some(rep)));
