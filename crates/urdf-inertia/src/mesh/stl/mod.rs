@@ -208,7 +208,7 @@ fn truncated(path: &Path, n: usize, read: usize, e: &std::io::Error) -> MeshErro
 /// be [`parse`]'s, bit for bit.
 #[doc(hidden)]
 pub fn read_split(
-    mut source: impl std::io::Read,
+    mut source: impl std::io::Read + Send,
     len: u64,
     path: &Path,
     chunk: usize,
