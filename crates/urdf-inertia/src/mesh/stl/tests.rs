@@ -262,7 +262,8 @@ fn check(bytes: &[u8], what: &str) {
             &format!("{what}, chunks of {chunk}"),
         );
         let head = bytes[..bytes.len().min(5)].to_vec();
-        let streamed = ascii_stream(head, &bytes[bytes.len().min(5)..], path, piece, chunk);
+        let rest = &bytes[bytes.len().min(5)..];
+        let streamed = ascii_stream(head, rest, bytes.len() as u64, path, piece, chunk);
         same(
             &reference,
             &streamed,
@@ -452,13 +453,14 @@ fn streamed_ascii_read_error_while_parsing() {
     let path = Path::new("t.stl");
     for (piece, chunk) in [(300, 100), (1000, 200)] {
         let source = FailingAfter { bytes: &text.as_bytes()[5..] };
-        let read = ascii_stream(text.as_bytes()[..5].to_vec(), source, path, piece, chunk);
+        let len = text.len() as u64;
+        let read = ascii_stream(text.as_bytes()[..5].to_vec(), source, len, path, piece, chunk);
         let err = read.expect_err("the read fails");
         assert!(matches!(err.kind, MeshErrorKind::Io(_)), "{err:?}");
         let mut bad = text.clone().into_bytes();
         bad[40] = 0xff;
         let source = FailingAfter { bytes: &bad[5..] };
-        let read = ascii_stream(bad[..5].to_vec(), source, path, piece, chunk);
+        let read = ascii_stream(bad[..5].to_vec(), source, len, path, piece, chunk);
         let err = read.expect_err("not UTF-8");
         assert!(
             format!("{err}").contains("not valid UTF-8 at byte 40"),
