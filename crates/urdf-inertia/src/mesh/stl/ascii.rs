@@ -18,48 +18,71 @@ pub(super) fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
     reader.finish()
 }
 
-/// Reads ASCII STL from `head` (the bytes already read) and then `source`, in pieces of `piece`
-/// bytes ([`ASCII_PIECE`]; chunks of `chunk`, [`ASCII_CHUNK`]): memory is the mesh and one piece (a
-/// line longer than a piece is held whole), not the file. The result, errors included, is
-/// [`ascii`]'s on the whole text.
+/// Reads ASCII STL from `head` (the bytes already read) and then `source`, `len` bytes in all, in
+/// pieces of `piece` bytes ([`ASCII_PIECE`]; chunks of `chunk`, [`ASCII_CHUNK`]): memory is the
+/// mesh and two pieces (a line longer than a piece is held whole), not the file. The next piece is read while the chunks
+/// of the one before are parsed (`rayon::join`), so that on two threads the kernel's copy of the
+/// file is not a serial stretch. The result, errors included, is [`ascii`]'s on the whole text.
 pub(super) fn ascii_stream(
     head: Vec<u8>,
-    mut source: impl std::io::Read,
+    mut source: impl std::io::Read + Send,
+    len: u64,
     path: &Path,
     piece: usize,
     chunk: usize,
 ) -> Result<RawMesh, MeshError> {
     let mut reader = Ascii::new(path, chunk);
+    reader.reserve(usize::try_from(len).unwrap_or(usize::MAX));
+    // Both buffers at their size from the start: growing them by doubling would copy and fault in
+    // every smaller size on the way.
     let mut buf = head;
+    buf.reserve(piece.saturating_sub(buf.len()));
+    let mut next = Vec::with_capacity(piece);
+    let mut end = top_up(&mut buf, &mut source, piece, path)?;
     loop {
-        // Top the piece up to its size (twice what is held when one line is longer).
-        let want = piece.max(2 * buf.len());
-        let before = buf.len();
-        (&mut source)
-            .take((want - before) as u64)
-            .read_to_end(&mut buf)
-            .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e.to_string())))?;
-        let end = buf.len() == before;
         if end {
             reader.feed(&buf);
             return reader.finish();
         }
         // Whole chunks only, the last one cut at a `facet` line; the rest waits for the next piece,
         // so that no chunk begins inside a facet (to be parsed again from the state before it).
-        let Some(lines) = memchr::memrchr(b'\n', &buf).map(|i| i + 1) else {
+        let lines = memchr::memrchr(b'\n', &buf).map(|i| i + 1);
+        let mut chunks = lines.map_or_else(Vec::new, |l| facet_chunks(&buf[..l], reader.chunk));
+        let rest = chunks.pop().filter(|_| !chunks.is_empty());
+        let (Some(lines), Some(rest)) = (lines, rest) else {
+            end = top_up(&mut buf, &mut source, piece, path)?;
             continue;
         };
-        let mut chunks = facet_chunks(&buf[..lines], reader.chunk);
-        let Some(rest) = chunks.pop().filter(|_| !chunks.is_empty()) else {
-            continue;
-        };
-        let cut = lines - rest.len();
-        reader.feed_chunks(&chunks);
+        // The next piece begins with the rest of this one, and is read while this one is parsed.
+        next.clear();
+        next.extend_from_slice(&buf[lines - rest.len()..]);
+        let ((), read) = rayon::join(
+            || reader.feed_chunks(&chunks),
+            || top_up(&mut next, &mut source, piece, path),
+        );
         if reader.utf8.is_some() {
             return reader.finish();
         }
-        buf.drain(..cut);
+        end = read?;
+        std::mem::swap(&mut buf, &mut next);
     }
+}
+
+/// Reads from `source` onto `buf` up to `piece` bytes (twice what it holds when one line is
+/// longer); whether nothing more came (the end of the text).
+fn top_up(
+    buf: &mut Vec<u8>,
+    source: &mut impl std::io::Read,
+    piece: usize,
+    path: &Path,
+) -> Result<bool, MeshError> {
+    let want = piece.max(2 * buf.len());
+    let before = buf.len();
+    source
+        .take((want - before) as u64)
+        .read_to_end(buf)
+        .map_err(|e| MeshError::new(path, None, MeshErrorKind::Io(e.to_string())))?;
+    Ok(buf.len() == before)
 }
 
 /// Bytes of ASCII STL read at a time by [`ascii_stream`].
@@ -110,13 +133,16 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
         utf8: None,
     };
     let mut out = empty(AsciiState::default());
-    // About 250 bytes a facet, half a new vertex a facet.
+    // About 250 bytes a facet, half a new vertex a facet, and the vertices a chunk shares with the
+    // one before parsed again in it (a third more on a closed mesh written row by row): a vertex
+    // for every 320 bytes holds them all without growing the lists (a copy of each on every chunk
+    // at 400) and takes as many slots (4 Ki for a 512 KiB chunk).
     out.indices.reserve(text.len() / 80);
     out.sizes.reserve(text.len() / 240);
     let mut p = ChunkParse {
         out,
-        table: VertexTable::with_capacity(text.len() / 400 + 16),
-        seen: SeenLines::with_capacity(text.len() / 400 + 16),
+        table: VertexTable::with_capacity(text.len() / 320 + 16),
+        seen: SeenLines::with_capacity(text.len() / 320 + 16),
         in_loop: start.in_loop,
         current: start.current.clone(),
         base,
@@ -486,6 +512,18 @@ impl<'p> Ascii<'p> {
             error: None,
             utf8: None,
         }
+    }
+
+    /// Makes room in the mesh's lists for the facets of a text of `len` bytes, as exporters write
+    /// it (about 250 bytes a facet, half a vertex a facet; room is made for twice that): grown by
+    /// doubling instead, the lists were copied at every size and each copy's pages faulted in
+    /// afresh. Room never written is never faulted in, so a text of shorter facets costs no memory
+    /// for it (and grows its lists as before past it).
+    fn reserve(&mut self, len: usize) {
+        let facets = len / 128;
+        self.indices.reserve(3 * facets);
+        self.starts.reserve(facets);
+        self.vertices.reserve(facets);
     }
 
     pub(super) fn feed(&mut self, text: &[u8]) {

@@ -208,7 +208,7 @@ fn truncated(path: &Path, n: usize, read: usize, e: &std::io::Error) -> MeshErro
 /// be [`parse`]'s, bit for bit.
 #[doc(hidden)]
 pub fn read_split(
-    mut source: impl std::io::Read,
+    mut source: impl std::io::Read + Send,
     len: u64,
     path: &Path,
     chunk: usize,
@@ -234,7 +234,7 @@ pub fn read_split(
             .map_err(|e| io(e.to_string()))?;
         if looks_ascii(&head) && is_text(&head) {
             let rest = source.take(len.saturating_sub(head.len() as u64));
-            return ascii_stream(head, rest, path, ASCII_PIECE, ASCII_CHUNK);
+            return ascii_stream(head, rest, len, path, ASCII_PIECE, ASCII_CHUNK);
         }
         // No more than the length checked when the file was opened.
         let rest = source.take(len.saturating_sub(head.len() as u64));

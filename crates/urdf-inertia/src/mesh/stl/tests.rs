@@ -262,7 +262,8 @@ fn check(bytes: &[u8], what: &str) {
             &format!("{what}, chunks of {chunk}"),
         );
         let head = bytes[..bytes.len().min(5)].to_vec();
-        let streamed = ascii_stream(head, &bytes[bytes.len().min(5)..], path, piece, chunk);
+        let rest = &bytes[bytes.len().min(5)..];
+        let streamed = ascii_stream(head, rest, bytes.len() as u64, path, piece, chunk);
         same(
             &reference,
             &streamed,
@@ -422,4 +423,48 @@ fn streamed_ascii_fast_path_is_the_whole_text_parse() {
     check(&bad, "not UTF-8 in a facet normal");
     let e = ascii(&bad, Path::new("t")).expect_err("not UTF-8");
     assert!(e.to_string().contains(&format!("not valid UTF-8 at byte {at}")), "{e}");
+}
+
+/// A source that gives `bytes` and then fails, as a file on a failing disk or a network share
+/// that drops does.
+struct FailingAfter<'a> {
+    bytes: &'a [u8],
+}
+
+impl std::io::Read for FailingAfter<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        if self.bytes.is_empty() {
+            return Err(std::io::Error::other("the disk went away"));
+        }
+        let n = buf.len().min(self.bytes.len());
+        buf[..n].copy_from_slice(&self.bytes[..n]);
+        self.bytes = &self.bytes[n..];
+        Ok(n)
+    }
+}
+
+/// The next piece is read while the one before is parsed: a read that fails is still reported as
+/// the read error (not as the text cut short), and text that is not UTF-8 before it still wins, as
+/// when the pieces were read one after the other.
+#[test]
+fn streamed_ascii_read_error_while_parsing() {
+    let facet = "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n";
+    let text = format!("solid a\n{}", facet.repeat(50));
+    let path = Path::new("t.stl");
+    for (piece, chunk) in [(300, 100), (1000, 200)] {
+        let source = FailingAfter { bytes: &text.as_bytes()[5..] };
+        let len = text.len() as u64;
+        let read = ascii_stream(text.as_bytes()[..5].to_vec(), source, len, path, piece, chunk);
+        let err = read.expect_err("the read fails");
+        assert!(matches!(err.kind, MeshErrorKind::Io(_)), "{err:?}");
+        let mut bad = text.clone().into_bytes();
+        bad[40] = 0xff;
+        let source = FailingAfter { bytes: &bad[5..] };
+        let read = ascii_stream(bad[..5].to_vec(), source, len, path, piece, chunk);
+        let err = read.expect_err("not UTF-8");
+        assert!(
+            format!("{err}").contains("not valid UTF-8 at byte 40"),
+            "{err}"
+        );
+    }
 }
