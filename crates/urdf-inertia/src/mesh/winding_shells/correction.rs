@@ -425,7 +425,7 @@ impl Faces<'_> {
                 }
                 let ray = |k: usize, seen: &mut Seen| {
                     self.grid
-                        .winding(&self.corners, p, k, n[k].signum(), &skip, seen)
+                        .winding((&self.corners, &self.planes), p, k, n[k].signum(), &skip, seen)
                 };
                 let mut rest = axes.iter().filter(|&&k| n[k] != 0.0);
                 let front = rest.by_ref().find_map(|&k| ray(k, seen))?;
