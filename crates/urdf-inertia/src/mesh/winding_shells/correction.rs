@@ -11,7 +11,7 @@
 //! the bound, twice when it may count twice.
 
 use super::grid::{Corners, Grid, Plane, Seen};
-use super::{edge_meets, triangles_touch};
+use super::{edge_meets, triangles_touch, EdgeUse};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
 use crate::mass::Polygons;
 use robust::{orient2d, Coord};
@@ -123,7 +123,9 @@ pub(super) fn resolve(
     let grid = Grid::new(&boxes);
     let margin = 1e-12 * grid.bounds.diagonal();
     let planes = corners.iter().map(Plane::new).collect();
-    let closed = balanced(vertices.len(), tris);
+    let numbered = (0..tris.len()).map(|i| (i as u32, &tris[i][..]));
+    let uses = super::edge_uses(vertices.len(), &numbered, None);
+    let closed = balanced(&uses);
     let f = Faces {
         vertices,
         tris,
@@ -147,7 +149,7 @@ pub(super) fn resolve(
         changed: false,
     };
     let mut heap = BinaryHeap::new();
-    f.patches(&blockers, &mut seen, &mut out, &mut heap);
+    f.patches((&blockers, &uses), &mut seen, &mut out, &mut heap);
     for (t, b) in blockers.into_iter().enumerate() {
         if !b.is_empty() && !f.cut(&f.corners[t], t as u32, &b, &mut seen, &mut out) {
             heap.push(f.piece(f.corners[t], t as u32, b));
@@ -292,19 +294,24 @@ impl Faces<'_> {
 
     /// Uncut triangles joined across the edges they share, each patch decided by one ray; the
     /// patches no ray decides go to `heap` whole.
-    fn patches(&self, blockers: &[Vec<u32>], seen: &mut Seen, out: &mut Resolved, heap: &mut BinaryHeap<Piece>) {
+    /// `uses`: the edge uses of all the triangles ([`super::edge_uses`]), of which those of uncut
+    /// ones join them.
+    fn patches(
+        &self,
+        (blockers, uses): (&[Vec<u32>], &[EdgeUse]),
+        seen: &mut Seen,
+        out: &mut Resolved,
+        heap: &mut BinaryHeap<Piece>,
+    ) {
         let n = self.tris.len();
-        let uncut = (0..n).filter(|&i| blockers[i].is_empty());
-        let faces = uncut.map(|i| (i as u32, &self.tris[i][..]));
-        let uses = super::edge_uses(self.vertices.len(), &faces, None);
         let mut parent: Vec<u32> = (0..n as u32).collect();
         for users in uses.chunk_by(|x, y| x.key == y.key) {
-            if users.len() == 2 && users[0].forward != users[1].forward {
-                let (a, b) = (
-                    super::root(&mut parent, users[0].face),
-                    super::root(&mut parent, users[1].face),
-                );
-                parent[a.max(b) as usize] = a.min(b);
+            let mut uncut = users.iter().filter(|e| blockers[e.face as usize].is_empty());
+            if let (Some(x), Some(y), None) = (uncut.next(), uncut.next(), uncut.next()) {
+                if x.forward != y.forward {
+                    let (a, b) = (super::root(&mut parent, x.face), super::root(&mut parent, y.face));
+                    parent[a.max(b) as usize] = a.min(b);
+                }
             }
         }
         // (patch root, triangle), sorted: the patches in the order of their roots (each root is
@@ -619,11 +626,9 @@ struct Origin {
     axes: [Option<usize>; 2],
 }
 
-/// Whether every edge of the triangles `tris` on `n` vertices is used as often one way as the
-/// other.
-fn balanced(n: usize, tris: &[[u32; 3]]) -> bool {
-    let faces = (0..tris.len()).map(|i| (i as u32, &tris[i][..]));
-    let uses = super::edge_uses(n, &faces, None);
+/// Whether every edge of the triangles whose edge `uses` these are is used as often one way as
+/// the other.
+fn balanced(uses: &[EdgeUse]) -> bool {
     uses.chunk_by(|x, y| x.key == y.key)
         .all(|g| g.iter().map(|e| if e.forward { 1i64 } else { -1 }).sum::<i64>() == 0)
 }
