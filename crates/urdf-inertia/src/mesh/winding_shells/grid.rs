@@ -302,12 +302,13 @@ impl Plane {
 /// The segment `s e`, parallel to axis `axis`, at the triangle `t` (whose plane is `plane`), exactly.
 ///
 /// Whether the segment's line passes through the triangle is read in the projection along `axis`:
-/// `e` is `s` with one coordinate changed, so e − s = L·e_axis exactly and orient3d(s, e, a, b) =
-/// ±L · orient2d(a′, b′, s′) exactly (a′ the projection of a, one sign for all three edges). The
-/// three signs are thus orient3d's up to one common factor, which the tests below (mixed signs, a
-/// zero) do not see, and two-dimensional ones cost less and reject most triangles (those coplanar
-/// with the face the ray starts from, whose sides of the start are zero, included) before the
-/// sides of their planes are asked. The answer is the one the two conditions give in either order.
+/// `e` is `s` with one coordinate changed, so e − s is L times the unit vector of `axis` exactly
+/// and orient3d(s, e, a, b) = ±L · orient2d(a′, b′, s′) exactly (a′ the projection of a, one sign
+/// for all three edges). The three signs are thus orient3d's up to one common factor, which the
+/// tests below (mixed signs, a zero) do not see, and two-dimensional ones cost less and reject
+/// most triangles (those coplanar with the face the ray starts from, whose sides of the start are
+/// zero, included) before the sides of their planes are asked. The answer is the one the two
+/// conditions give in either order.
 fn crossing(s: [f64; 3], e: [f64; 3], axis: usize, t: &Corners, plane: &Plane) -> Crossing {
     let (j, l) = ((axis + 1) % 3, (axis + 2) % 3);
     let p2 = |x: [f64; 3]| Coord { x: x[j], y: x[l] };
