@@ -10,6 +10,7 @@
 //! the cone it spans from the surface's box centre (the volume a wrong orientation can change) to
 //! the bound, twice when it may count twice.
 
+use super::cells::{area, cells, centroid, split};
 use super::grid::{Corners, Grid, Plane, Seen};
 use super::{edge_meets, triangles_touch, EdgeUse};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
@@ -30,9 +31,6 @@ const MAX_CUTS: usize = 40;
 /// A triangle whose plane is within this share of the diagonal of a piece everywhere on it is taken
 /// as lying in the piece's plane.
 const NEAR: f64 = 1e-7;
-
-/// Cells beyond which a piece is split in four rather than cut.
-const MAX_CELLS: usize = 256;
 
 /// Rays tried on a patch of uncut faces before it is split like a cut one.
 const MAX_TRIES: usize = 8;
@@ -721,109 +719,6 @@ fn c2(p: [f64; 3], drop: usize) -> Coord<f64> {
         x: p[(drop + 1) % 3],
         y: p[(drop + 2) % 3],
     }
-}
-
-/// A cutting plane: a point on it, its normal, and the margin within which a corner counts as on it.
-type CutPlane = ([f64; 3], [f64; 3], f64);
-
-/// Convex polygons in one buffer (the cut used a `Vec` per cell and per plane, whose allocations
-/// cost more than the clipping): their corners in order, and where each polygon ends.
-#[derive(Default)]
-struct Cells {
-    corners: Vec<[f64; 3]>,
-    ends: Vec<usize>,
-}
-
-impl Cells {
-    fn len(&self) -> usize {
-        self.ends.len()
-    }
-
-    fn iter(&self) -> impl Iterator<Item = &[[f64; 3]]> {
-        let starts = std::iter::once(0).chain(self.ends.iter().copied());
-        starts.zip(&self.ends).map(|(s, &e)| &self.corners[s..e])
-    }
-
-    fn clear(&mut self) {
-        self.corners.clear();
-        self.ends.clear();
-    }
-
-    /// Ends the polygon whose corners were pushed since the last one ended.
-    fn close(&mut self) {
-        self.ends.push(self.corners.len());
-    }
-}
-
-/// `piece` cut along the `planes` in turn into convex cells, in order; `None` when they are more
-/// than [`MAX_CELLS`].
-fn cells(piece: &Corners, planes: &[CutPlane]) -> Option<Cells> {
-    let mut cells = Cells::default();
-    cells.corners.extend_from_slice(piece);
-    cells.close();
-    let mut next = Cells::default();
-    let mut d = Vec::new();
-    for &(a, n, m) in planes {
-        next.clear();
-        for cell in cells.iter() {
-            d.clear();
-            d.extend(cell.iter().map(|x| dot(n, sub(*x, a))));
-            // A plane along the cell's side (one cut already, or a shared edge) leaves it whole.
-            if d.iter().all(|&x| x >= -m) || d.iter().all(|&x| x <= m) {
-                next.corners.extend_from_slice(cell);
-                next.close();
-                continue;
-            }
-            for side in [1.0, -1.0] {
-                let start = next.corners.len();
-                clip(cell, &d, side, &mut next.corners);
-                if next.corners.len() - start >= 3 {
-                    next.close();
-                } else {
-                    next.corners.truncate(start);
-                }
-            }
-        }
-        std::mem::swap(&mut cells, &mut next);
-        if cells.len() > MAX_CELLS {
-            return None;
-        }
-    }
-    Some(cells)
-}
-
-/// Appends to `out` the part of a convex polygon on one side (`side` = ±1) of a plane, given its
-/// corners' signed distances `d` (corners on the plane belong to both sides).
-fn clip(poly: &[[f64; 3]], d: &[f64], side: f64, out: &mut Vec<[f64; 3]>) {
-    for i in 0..poly.len() {
-        let j = (i + 1) % poly.len();
-        let (di, dj) = (d[i] * side, d[j] * side);
-        if di >= 0.0 {
-            out.push(poly[i]);
-        }
-        if (di > 0.0 && dj < 0.0) || (di < 0.0 && dj > 0.0) {
-            let s = di / (di - dj);
-            out.push([0, 1, 2].map(|k| poly[i][k] + s * (poly[j][k] - poly[i][k])));
-        }
-    }
-}
-
-fn area(poly: &[[f64; 3]]) -> f64 {
-    (1..poly.len() - 1)
-        .map(|k| norm(cross(sub(poly[k], poly[0]), sub(poly[k + 1], poly[0]))) / 2.0)
-        .sum()
-}
-
-fn centroid(poly: &[[f64; 3]]) -> [f64; 3] {
-    let n = poly.len() as f64;
-    [0, 1, 2].map(|k| poly.iter().map(|p| p[k]).sum::<f64>() / n)
-}
-
-/// The four halves-of-edges triangles of a triangle.
-fn split(t: Corners) -> [Corners; 4] {
-    let mid = |a: [f64; 3], b: [f64; 3]| [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
-    let (ab, bc, ca) = (mid(t[0], t[1]), mid(t[1], t[2]), mid(t[2], t[0]));
-    [[t[0], ab, ca], [ab, t[1], bc], [ca, bc, t[2]], [ab, bc, ca]]
 }
 
 fn inflated(b: Aabb, m: f64) -> Aabb {
