@@ -10,8 +10,9 @@
 //! the cone it spans from the surface's box centre (the volume a wrong orientation can change) to
 //! the bound, twice when it may count twice.
 
+use super::cells::{area, cells, centroid, split};
 use super::grid::{Corners, Grid, Plane, Seen};
-use super::{edge_meets, triangles_touch};
+use super::{edge_meets, triangles_touch, EdgeUse};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
 use crate::mass::Polygons;
 use robust::{orient2d, Coord};
@@ -30,9 +31,6 @@ const MAX_CUTS: usize = 40;
 /// A triangle whose plane is within this share of the diagonal of a piece everywhere on it is taken
 /// as lying in the piece's plane.
 const NEAR: f64 = 1e-7;
-
-/// Cells beyond which a piece is split in four rather than cut.
-const MAX_CELLS: usize = 256;
 
 /// Rays tried on a patch of uncut faces before it is split like a cut one.
 const MAX_TRIES: usize = 8;
@@ -99,6 +97,11 @@ struct Faces<'a> {
     /// one triangle ask it again for each blocker (14 times per pair on a real gripper with
     /// coincident shells), and an exact zero is orient3d's most expensive answer.
     in_plane: RefCell<FxHashMap<(u32, u32), bool>>,
+    /// Per triangle: the last of its pieces decided at the first try, and how ([`Faces::decide_linked`]).
+    origins: RefCell<Vec<Option<(Origin, i64)>>>,
+    /// Whether every edge of the triangles is used as often one way as the other: a closed
+    /// cycle, on which [`Faces::joined`] holds.
+    closed: bool,
 }
 
 /// Decides the triangles `tris` (closed shells whose pairs the classification left open; `sign` per
@@ -118,6 +121,9 @@ pub(super) fn resolve(
     let grid = Grid::new(&boxes);
     let margin = 1e-12 * grid.bounds.diagonal();
     let planes = corners.iter().map(Plane::new).collect();
+    let numbered = (0..tris.len()).map(|i| (i as u32, &tris[i][..]));
+    let uses = super::edge_uses(vertices.len(), &numbered, None);
+    let closed = balanced(&uses);
     let f = Faces {
         vertices,
         tris,
@@ -128,6 +134,8 @@ pub(super) fn resolve(
         centre,
         margin,
         in_plane: RefCell::default(),
+        origins: RefCell::new(vec![None; tris.len()]),
+        closed,
     };
     let mut seen = Seen::new(tris.len());
     let blockers = f.all_blockers(&boxes, &mut seen);
@@ -139,7 +147,7 @@ pub(super) fn resolve(
         changed: false,
     };
     let mut heap = BinaryHeap::new();
-    f.patches(&blockers, &mut seen, &mut out, &mut heap);
+    f.patches((&blockers, &uses), &mut seen, &mut out, &mut heap);
     for (t, b) in blockers.into_iter().enumerate() {
         if !b.is_empty() && !f.cut(&f.corners[t], t as u32, &b, &mut seen, &mut out) {
             heap.push(f.piece(f.corners[t], t as u32, b));
@@ -284,19 +292,24 @@ impl Faces<'_> {
 
     /// Uncut triangles joined across the edges they share, each patch decided by one ray; the
     /// patches no ray decides go to `heap` whole.
-    fn patches(&self, blockers: &[Vec<u32>], seen: &mut Seen, out: &mut Resolved, heap: &mut BinaryHeap<Piece>) {
+    /// `uses`: the edge uses of all the triangles ([`super::edge_uses`]), of which those of uncut
+    /// ones join them.
+    fn patches(
+        &self,
+        (blockers, uses): (&[Vec<u32>], &[EdgeUse]),
+        seen: &mut Seen,
+        out: &mut Resolved,
+        heap: &mut BinaryHeap<Piece>,
+    ) {
         let n = self.tris.len();
-        let uncut = (0..n).filter(|&i| blockers[i].is_empty());
-        let faces = uncut.map(|i| (i as u32, &self.tris[i][..]));
-        let uses = super::edge_uses(self.vertices.len(), &faces, None);
         let mut parent: Vec<u32> = (0..n as u32).collect();
         for users in uses.chunk_by(|x, y| x.key == y.key) {
-            if users.len() == 2 && users[0].forward != users[1].forward {
-                let (a, b) = (
-                    super::root(&mut parent, users[0].face),
-                    super::root(&mut parent, users[1].face),
-                );
-                parent[a.max(b) as usize] = a.min(b);
+            let mut uncut = users.iter().filter(|e| blockers[e.face as usize].is_empty());
+            if let (Some(x), Some(y), None) = (uncut.next(), uncut.next(), uncut.next()) {
+                if x.forward != y.forward {
+                    let (a, b) = (super::root(&mut parent, x.face), super::root(&mut parent, y.face));
+                    parent[a.max(b) as usize] = a.min(b);
+                }
             }
         }
         // (patch root, triangle), sorted: the patches in the order of their roots (each root is
@@ -339,7 +352,7 @@ impl Faces<'_> {
                     .filter(|&u| overlap(&b, &Aabb::of(self.corners[u as usize])) && self.may_meet(&child, u))
                     .collect();
                 if blockers.is_empty() {
-                    if let Some(k) = self.decide(&child, p.t, seen) {
+                    if let Some(k) = self.decide_linked(&child, p.t, seen, |_| true, &[]) {
                         self.emit(&child, k, out);
                         continue;
                     }
@@ -391,7 +404,7 @@ impl Faces<'_> {
     /// How a piece of triangle `t` no other triangle meets bounds Ω: 1 outward, −1 inward, 0 not
     /// at all; `None` when no ray from its centre counts exactly.
     fn decide(&self, piece: &[[f64; 3]], t: u32, seen: &mut Seen) -> Option<i64> {
-        self.decide_where(piece, t, seen, |_| true, &[])
+        self.decide_where(piece, t, seen, |_| true, &[]).map(|d| d.kappa)
     }
 
     /// [`Faces::decide`] from the first of a few points inside the piece that `usable` accepts and
@@ -405,7 +418,7 @@ impl Faces<'_> {
         seen: &mut Seen,
         usable: impl Fn([f64; 3]) -> bool,
         coplanar: &[Coplanar],
-    ) -> Option<i64> {
+    ) -> Option<Decided> {
         let c = self.corners[t as usize];
         let n = cross(sub(c[1], c[0]), sub(c[2], c[0]));
         let mut axes = [0, 1, 2];
@@ -413,39 +426,107 @@ impl Faces<'_> {
         let mid = centroid(piece);
         let inner = piece.iter().map(|v| [0, 1, 2].map(|k| (3.0 * mid[k] + v[k]) / 4.0));
         let mut skip = vec![t];
-        let (jump, front) = std::iter::once(mid)
-            .chain(inner)
-            .filter(|&p| usable(p))
-            .find_map(|p| {
-                skip.truncate(1);
-                let mut jump = 1;
-                for cp in coplanar.iter().filter(|cp| cp.covers(p)) {
-                    skip.push(cp.u);
-                    jump += if cp.same { 1 } else { -1 };
-                }
-                let ray = |k: usize, seen: &mut Seen| {
-                    self.grid
-                        .winding(&self.corners, p, k, n[k].signum(), &skip, seen)
-                };
-                let mut rest = axes.iter().filter(|&&k| n[k] != 0.0);
-                let front = rest.by_ref().find_map(|&k| ray(k, seen))?;
-                // A second ray, where one leaves the face steeply enough, must count the same:
-                // on a surface that is not watertight near `p` (a cap's crack, a sliver whose
-                // centre rounds a few ulps behind a neighbour) rays disagree, and the piece is
-                // left undecided, so it enters the bound.
-                let again = rest
-                    .filter(|&&k| n[k].abs() >= SECOND_RAY * norm(n))
-                    .find_map(|&k| ray(k, seen));
-                if again.is_some_and(|w| w != front) {
-                    return None;
-                }
-                Some((jump, front))
-            })?;
-        if skip.iter().any(|&u| u < t) {
-            return Some(0);
+        // Whether no point and no ray was refused before the one that decides.
+        let mut first = true;
+        for p in std::iter::once(mid).chain(inner) {
+            if !usable(p) {
+                first = false;
+                continue;
+            }
+            skip.truncate(1);
+            let mut jump = 1;
+            for cp in coplanar.iter().filter(|cp| cp.covers(p)) {
+                skip.push(cp.u);
+                jump += if cp.same { 1 } else { -1 };
+            }
+            let mut ray = |k: usize| {
+                let w = self.grid.winding((&self.corners, &self.planes), p, k, n[k].signum(), &skip, seen);
+                first &= w.is_some();
+                w.map(|w| (k, w))
+            };
+            let mut rest = axes.iter().filter(|&&k| n[k] != 0.0);
+            let Some((k, front)) = rest.by_ref().find_map(|&k| ray(k)) else {
+                continue;
+            };
+            // A second ray, where one leaves the face steeply enough, must count the same:
+            // on a surface that is not watertight near `p` (a cap's crack, a sliver whose
+            // centre rounds a few ulps behind a neighbour) rays disagree, and the piece is
+            // left undecided, so it enters the bound.
+            let again = rest
+                .filter(|&&k| n[k].abs() >= SECOND_RAY * norm(n))
+                .find_map(|&k| ray(k));
+            if again.is_some_and(|(_, w)| w != front) {
+                first = false;
+                continue;
+            }
+            if skip.iter().any(|&u| u < t) {
+                return Some(Decided { kappa: 0, from: None });
+            }
+            let solid = |w: i64| i64::from(w.abs() >= 1);
+            let from = (first && skip.len() == 1).then_some(Origin {
+                p,
+                axes: [Some(k), again.map(|(k, _)| k)],
+            });
+            return Some(Decided {
+                kappa: solid(front + jump) - solid(front),
+                from,
+            });
         }
-        let solid = |w: i64| i64::from(w.abs() >= 1);
-        Some(solid(front + jump) - solid(front))
+        None
+    }
+
+    /// [`Faces::decide_where`], or the decision of the last piece of `t` decided at the first try
+    /// when the piece's centre is [`Faces::joined`] to it (no coplanar triangle in the way: their
+    /// jumps depend on the point). Every piece of a triangle cut into many asks rays otherwise,
+    /// most of them counting what its neighbour's counted.
+    fn decide_linked(
+        &self,
+        piece: &[[f64; 3]],
+        t: u32,
+        seen: &mut Seen,
+        usable: impl Fn([f64; 3]) -> bool,
+        coplanar: &[Coplanar],
+    ) -> Option<i64> {
+        let mid = centroid(piece);
+        let last = self.origins.borrow()[t as usize];
+        if let Some((from, kappa)) = last {
+            if self.closed && coplanar.is_empty() && usable(mid) && self.joined(t, &from, mid, seen) {
+                return Some(kappa);
+            }
+        }
+        let d = self.decide_where(piece, t, seen, usable, coplanar)?;
+        if let Some(from) = d.from {
+            self.origins.borrow_mut()[t as usize] = Some((from, d.kappa));
+        }
+        Some(d.kappa)
+    }
+
+    /// Whether the piece of triangle `t` around `q` is decided as the one whose rays counted
+    /// `from` (see [`Origin`]): the rays from `q` along the same axes would count the same.
+    ///
+    /// A ray's count from a point x (all triangles but `t`) changes as x moves only where x
+    /// passes through a triangle other than `t`, or where the ray sweeps across an edge that does
+    /// not balance: the surface decided here is a closed cycle, whose only such edges, once `t`
+    /// is left out, are `t`'s own. So the count is the same from both ends of a segment that no
+    /// other triangle meets (exact, and conservative: a triangle in the segment's plane meets
+    /// it) and whose ends lie strictly inside `t` seen along the ray (exact `orient2d`, which
+    /// keeps the swept strip off `t`'s edges).
+    fn joined(&self, t: u32, from: &Origin, q: [f64; 3], seen: &mut Seen) -> bool {
+        let c = self.corners[t as usize];
+        let inside = |x: [f64; 3], k: usize| {
+            let s = [0, 1, 2].map(|i| orient2d(c2(c[i], k), c2(c[(i + 1) % 3], k), c2(x, k)));
+            s.iter().all(|&v| v > 0.0) || s.iter().all(|&v| v < 0.0)
+        };
+        let p = from.p;
+        if !from.axes.iter().flatten().all(|&k| inside(p, k) && inside(q, k)) {
+            return false;
+        }
+        let mut near = Vec::new();
+        self.grid.overlapping(&Aabb::of([p, q]), None, seen, &mut near);
+        near.iter().all(|&u| {
+            let plane = &self.planes[u as usize];
+            u == t || !edge_meets(p, q, plane.side(p), plane.side(q), self.corners[u as usize])
+        })
     }
 
     fn emit_whole(&self, t: u32, kappa: i64, out: &mut Resolved) {
@@ -512,39 +593,42 @@ impl Faces<'_> {
         if planes.len() > MAX_CUTS {
             return false;
         }
-        let mut cells = vec![piece.to_vec()];
-        for &(a, n, m) in &planes {
-            let mut next = Vec::with_capacity(2 * cells.len());
-            for cell in &cells {
-                let d: Vec<f64> = cell.iter().map(|x| dot(n, sub(*x, a))).collect();
-                // A plane along the cell's side (one cut already, or a shared edge) leaves it whole.
-                if d.iter().all(|&x| x >= -m) || d.iter().all(|&x| x <= m) {
-                    next.push(cell.clone());
-                    continue;
-                }
-                for side in [1.0, -1.0] {
-                    let part = clip(cell, &d, side);
-                    if part.len() >= 3 {
-                        next.push(part);
-                    }
-                }
-            }
-            cells = next;
-            if cells.len() > MAX_CELLS {
-                return false;
-            }
-        }
+        let Some(cells) = cells(piece, &planes) else {
+            return false;
+        };
         let apart = |x: [f64; 3]| planes.iter().all(|&(a, n, m)| dot(n, sub(x, a)).abs() > m);
-        for cell in cells {
-            if let Some(k) = self.decide_where(&cell, t, seen, apart, &coplanar) {
-                self.emit(&cell, k, out);
+        for cell in cells.iter() {
+            if let Some(k) = self.decide_linked(cell, t, seen, apart, &coplanar) {
+                self.emit(cell, k, out);
             } else {
-                out.bound += self.delta(&cell, t);
-                self.emit(&cell, self.sign[t as usize], out);
+                out.bound += self.delta(cell, t);
+                self.emit(cell, self.sign[t as usize], out);
             }
         }
         true
     }
+}
+
+/// How a piece bounds Ω (1 outward, −1 inward, 0 not at all), and where its rays started when
+/// they decided it at the first try.
+struct Decided {
+    kappa: i64,
+    from: Option<Origin>,
+}
+
+/// The point whose rays decided a piece at the first try (its centre, no ray refused, no
+/// coplanar triangle covering it), and their axes: the first and, when there is one, the second.
+#[derive(Clone, Copy)]
+struct Origin {
+    p: [f64; 3],
+    axes: [Option<usize>; 2],
+}
+
+/// Whether every edge of the triangles whose edge `uses` these are is used as often one way as
+/// the other.
+fn balanced(uses: &[EdgeUse]) -> bool {
+    uses.chunk_by(|x, y| x.key == y.key)
+        .all(|g| g.iter().map(|e| if e.forward { 1i64 } else { -1 }).sum::<i64>() == 0)
 }
 
 /// A triangle in the plane of the one being decided: its edges as planes across that plane (normals
@@ -635,42 +719,6 @@ fn c2(p: [f64; 3], drop: usize) -> Coord<f64> {
         x: p[(drop + 1) % 3],
         y: p[(drop + 2) % 3],
     }
-}
-
-/// The part of a convex polygon on one side (`side` = ±1) of a plane, given its corners' signed
-/// distances `d` (corners on the plane belong to both sides).
-fn clip(poly: &[[f64; 3]], d: &[f64], side: f64) -> Vec<[f64; 3]> {
-    let mut out = Vec::with_capacity(poly.len() + 1);
-    for i in 0..poly.len() {
-        let j = (i + 1) % poly.len();
-        let (di, dj) = (d[i] * side, d[j] * side);
-        if di >= 0.0 {
-            out.push(poly[i]);
-        }
-        if (di > 0.0 && dj < 0.0) || (di < 0.0 && dj > 0.0) {
-            let s = di / (di - dj);
-            out.push([0, 1, 2].map(|k| poly[i][k] + s * (poly[j][k] - poly[i][k])));
-        }
-    }
-    out
-}
-
-fn area(poly: &[[f64; 3]]) -> f64 {
-    (1..poly.len() - 1)
-        .map(|k| norm(cross(sub(poly[k], poly[0]), sub(poly[k + 1], poly[0]))) / 2.0)
-        .sum()
-}
-
-fn centroid(poly: &[[f64; 3]]) -> [f64; 3] {
-    let n = poly.len() as f64;
-    [0, 1, 2].map(|k| poly.iter().map(|p| p[k]).sum::<f64>() / n)
-}
-
-/// The four halves-of-edges triangles of a triangle.
-fn split(t: Corners) -> [Corners; 4] {
-    let mid = |a: [f64; 3], b: [f64; 3]| [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
-    let (ab, bc, ca) = (mid(t[0], t[1]), mid(t[1], t[2]), mid(t[2], t[0]));
-    [[t[0], ab, ca], [ab, t[1], bc], [ca, bc, t[2]], [ab, bc, ca]]
 }
 
 fn inflated(b: Aabb, m: f64) -> Aabb {

@@ -2,7 +2,7 @@
 //! point on a face, counted by exact crossings (`orient3d`) of an axis-parallel ray.
 
 use crate::geometry::Aabb;
-use robust::Coord3D;
+use robust::{orient2d, Coord, Coord3D};
 
 use super::c3;
 
@@ -158,7 +158,7 @@ impl Grid {
     /// vertex or a plane of one of them.
     pub(super) fn winding(
         &self,
-        corners: &[Corners],
+        (corners, planes): (&[Corners], &[Plane]),
         p: [f64; 3],
         axis: usize,
         sign: f64,
@@ -202,7 +202,7 @@ impl Grid {
                 if skip.contains(&i) || !seen.first(i) {
                     continue;
                 }
-                match crossing(p, end, &corners[i as usize]) {
+                match crossing(p, end, axis, &corners[i as usize], &planes[i as usize]) {
                     Crossing::Miss => {}
                     Crossing::Through(d) => w += d,
                     Crossing::Degenerate => return None,
@@ -299,20 +299,26 @@ impl Plane {
     }
 }
 
-/// The segment `s e` at the triangle `t`, exactly.
-fn crossing(s: [f64; 3], e: [f64; 3], t: &Corners) -> Crossing {
-    let (a, b, c) = (c3(t[0]), c3(t[1]), c3(t[2]));
-    let (os, oe) = (orient3d(a, b, c, c3(s)), orient3d(a, b, c, c3(e)));
-    if (os > 0.0 && oe > 0.0) || (os < 0.0 && oe < 0.0) {
+/// The segment `s e`, parallel to axis `axis`, at the triangle `t` (whose plane is `plane`), exactly.
+///
+/// Whether the segment's line passes through the triangle is read in the projection along `axis`:
+/// `e` is `s` with one coordinate changed, so e − s is L times the unit vector of `axis` exactly
+/// and orient3d(s, e, a, b) = ±L · orient2d(a′, b′, s′) exactly (a′ the projection of a, one sign
+/// for all three edges). The three signs are thus orient3d's up to one common factor, which the
+/// tests below (mixed signs, a zero) do not see, and two-dimensional ones cost less and reject
+/// most triangles (those coplanar with the face the ray starts from, whose sides of the start are
+/// zero, included) before the sides of their planes are asked. The answer is the one the two
+/// conditions give in either order.
+fn crossing(s: [f64; 3], e: [f64; 3], axis: usize, t: &Corners, plane: &Plane) -> Crossing {
+    let (j, l) = ((axis + 1) % 3, (axis + 2) % 3);
+    let p2 = |x: [f64; 3]| Coord { x: x[j], y: x[l] };
+    let (a, b, c, sp) = (p2(t[0]), p2(t[1]), p2(t[2]), p2(s));
+    let q = [orient2d(a, b, sp), orient2d(b, c, sp), orient2d(c, a, sp)];
+    if q.iter().any(|x| *x > 0.0) && q.iter().any(|x| *x < 0.0) {
         return Crossing::Miss;
     }
-    let (cs, ce) = (c3(s), c3(e));
-    let q = [
-        orient3d(cs, ce, a, b),
-        orient3d(cs, ce, b, c),
-        orient3d(cs, ce, c, a),
-    ];
-    if q.iter().any(|x| *x > 0.0) && q.iter().any(|x| *x < 0.0) {
+    let (os, oe) = (plane.side(s), plane.side(e));
+    if (os > 0.0 && oe > 0.0) || (os < 0.0 && oe < 0.0) {
         return Crossing::Miss;
     }
     if os == 0.0 || oe == 0.0 || q.contains(&0.0) {
@@ -407,23 +413,102 @@ mod tests {
         }
     }
 
+    /// The crossing as orient3d alone decides it: the segment's sides of the plane, then the sides
+    /// of the segment's line of the three edges.
+    fn crossing_by_orient3d(s: [f64; 3], e: [f64; 3], t: &Corners) -> Crossing {
+        let (a, b, c) = (c3(t[0]), c3(t[1]), c3(t[2]));
+        let (os, oe) = (orient3d(a, b, c, c3(s)), orient3d(a, b, c, c3(e)));
+        if (os > 0.0 && oe > 0.0) || (os < 0.0 && oe < 0.0) {
+            return Crossing::Miss;
+        }
+        let (cs, ce) = (c3(s), c3(e));
+        let q = [
+            orient3d(cs, ce, a, b),
+            orient3d(cs, ce, b, c),
+            orient3d(cs, ce, c, a),
+        ];
+        if q.iter().any(|x| *x > 0.0) && q.iter().any(|x| *x < 0.0) {
+            return Crossing::Miss;
+        }
+        if os == 0.0 || oe == 0.0 || q.contains(&0.0) {
+            return Crossing::Degenerate;
+        }
+        Crossing::Through(if os > 0.0 { 1 } else { -1 })
+    }
+
+    fn same(x: &Crossing, y: &Crossing) -> bool {
+        match (x, y) {
+            (Crossing::Miss, Crossing::Miss) | (Crossing::Degenerate, Crossing::Degenerate) => true,
+            (Crossing::Through(a), Crossing::Through(b)) => a == b,
+            _ => false,
+        }
+    }
+
+    /// The projected edge tests give orient3d's answer for axis-parallel segments: random ones,
+    /// segments through corners, along edges, starting in the plane, and coplanar triangles.
+    #[test]
+    fn crossing_is_orient3ds() {
+        let mut state = 0x5851_F42D_4C95_7F2D_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let (mut through, mut degenerate) = (0, 0);
+        for i in 0..40_000 {
+            let [a, b, mut c] = [0; 3].map(|_| [next(), next(), next()]);
+            let axis = i % 3;
+            if i % 13 == 0 {
+                // Parallel to the axis.
+                c = b;
+                c[axis] += 0.25;
+            }
+            let t = [a, b, c];
+            let mut s = match (i / 3) % 5 {
+                0 | 1 => [next(), next(), next()],
+                // In the plane, up to the rounding of the combination.
+                2 => {
+                    let (u, v) = (next() + 0.5, next() + 0.5);
+                    [0, 1, 2].map(|k| a[k] + u * (b[k] - a[k]) + v * (c[k] - a[k]))
+                }
+                // On an edge's line (projected) or at a corner.
+                3 => [0, 1, 2].map(|k| 0.5 * (a[k] + b[k])),
+                _ => t[i % 3],
+            };
+            if (i / 3) % 5 >= 3 {
+                s[axis] += next();
+            }
+            let mut e = s;
+            e[axis] = if i % 2 == 0 { 2.0 } else { -2.0 };
+            let ours = crossing(s, e, axis, &t, &Plane::new(&t));
+            let theirs = crossing_by_orient3d(s, e, &t);
+            through += usize::from(matches!(ours, Crossing::Through(_)));
+            degenerate += usize::from(matches!(ours, Crossing::Degenerate));
+            assert!(same(&ours, &theirs), "{t:?} {s:?} {e:?}");
+        }
+        assert!(through > 1000 && degenerate > 100, "{through} {degenerate}");
+    }
+
     #[test]
     fn winding_inside_and_outside_a_cube() {
         let corners = cube();
         let boxes: Vec<Aabb> = corners.iter().map(|t| Aabb::of(*t)).collect();
         let grid = Grid::new(&boxes);
+        let planes: Vec<Plane> = corners.iter().map(Plane::new).collect();
+        let tris = (&corners[..], &planes[..]);
         let mut seen = Seen::new(corners.len());
         let inside = [0.3, 0.4, 0.45];
         for axis in 0..3 {
             for sign in [1.0, -1.0] {
-                let w = grid.winding(&corners, inside, axis, sign, &[], &mut seen);
+                let w = grid.winding(tris, inside, axis, sign, &[], &mut seen);
                 assert_eq!(w, Some(1));
-                let w = grid.winding(&corners, [1.5, 0.3, 0.4], axis, sign, &[], &mut seen);
+                let w = grid.winding(tris, [1.5, 0.3, 0.4], axis, sign, &[], &mut seen);
                 assert_eq!(w, Some(0));
             }
         }
         // Through the diagonal of a face: degenerate.
-        let w = grid.winding(&corners, [0.5, 0.5, 0.5], 2, 1.0, &[], &mut seen);
+        let w = grid.winding(tris, [0.5, 0.5, 0.5], 2, 1.0, &[], &mut seen);
         assert_eq!(w, None);
     }
 }

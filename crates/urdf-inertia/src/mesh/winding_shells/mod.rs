@@ -19,6 +19,7 @@
 //! their bounding boxes (a closed shell's winding number is 0 outside its box), whose volume enters
 //! the error estimate.
 
+mod cells;
 mod correction;
 mod cracks;
 mod grid;

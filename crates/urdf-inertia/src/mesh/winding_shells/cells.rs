@@ -1,0 +1,138 @@
+//! Convex pieces of a triangle: cut along planes into cells, split in four, their area and centre
+//! (plain f64 geometry: which pieces are decided, and how, is [`super::correction`]'s).
+
+use super::grid::Corners;
+use crate::geometry::{cross, dot, norm, sub};
+
+/// Cells beyond which a piece is split in four rather than cut.
+const MAX_CELLS: usize = 256;
+
+/// A cutting plane: a point on it, its normal, and the margin within which a corner counts as on it.
+pub(super) type CutPlane = ([f64; 3], [f64; 3], f64);
+
+/// Convex polygons in one buffer (the cut used a `Vec` per cell and per plane, whose allocations
+/// cost more than the clipping): their corners in order, and where each polygon ends.
+#[derive(Default)]
+pub(super) struct Cells {
+    corners: Vec<[f64; 3]>,
+    ends: Vec<usize>,
+}
+
+impl Cells {
+    pub(super) fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    pub(super) fn iter(&self) -> impl Iterator<Item = &[[f64; 3]]> {
+        let starts = std::iter::once(0).chain(self.ends.iter().copied());
+        starts.zip(&self.ends).map(|(s, &e)| &self.corners[s..e])
+    }
+
+    fn clear(&mut self) {
+        self.corners.clear();
+        self.ends.clear();
+    }
+
+    /// Ends the polygon whose corners were pushed since the last one ended.
+    fn close(&mut self) {
+        self.ends.push(self.corners.len());
+    }
+}
+
+/// `piece` cut along the `planes` in turn into convex cells, in order; `None` when they are more
+/// than [`MAX_CELLS`].
+pub(super) fn cells(piece: &Corners, planes: &[CutPlane]) -> Option<Cells> {
+    let mut cells = Cells::default();
+    cells.corners.extend_from_slice(piece);
+    cells.close();
+    let mut next = Cells::default();
+    let mut d = Vec::new();
+    for &(a, n, m) in planes {
+        next.clear();
+        for cell in cells.iter() {
+            d.clear();
+            d.extend(cell.iter().map(|x| dot(n, sub(*x, a))));
+            // A plane along the cell's side (one cut already, or a shared edge) leaves it whole.
+            if d.iter().all(|&x| x >= -m) || d.iter().all(|&x| x <= m) {
+                next.corners.extend_from_slice(cell);
+                next.close();
+                continue;
+            }
+            for side in [1.0, -1.0] {
+                let start = next.corners.len();
+                clip(cell, &d, side, &mut next.corners);
+                if next.corners.len() - start >= 3 {
+                    next.close();
+                } else {
+                    next.corners.truncate(start);
+                }
+            }
+        }
+        std::mem::swap(&mut cells, &mut next);
+        if cells.len() > MAX_CELLS {
+            return None;
+        }
+    }
+    Some(cells)
+}
+
+/// Appends to `out` the part of a convex polygon on one side (`side` = ±1) of a plane, given its
+/// corners' signed distances `d` (corners on the plane belong to both sides).
+fn clip(poly: &[[f64; 3]], d: &[f64], side: f64, out: &mut Vec<[f64; 3]>) {
+    for i in 0..poly.len() {
+        let j = (i + 1) % poly.len();
+        let (di, dj) = (d[i] * side, d[j] * side);
+        if di >= 0.0 {
+            out.push(poly[i]);
+        }
+        if (di > 0.0 && dj < 0.0) || (di < 0.0 && dj > 0.0) {
+            let s = di / (di - dj);
+            out.push([0, 1, 2].map(|k| poly[i][k] + s * (poly[j][k] - poly[i][k])));
+        }
+    }
+}
+
+pub(super) fn area(poly: &[[f64; 3]]) -> f64 {
+    (1..poly.len() - 1)
+        .map(|k| norm(cross(sub(poly[k], poly[0]), sub(poly[k + 1], poly[0]))) / 2.0)
+        .sum()
+}
+
+pub(super) fn centroid(poly: &[[f64; 3]]) -> [f64; 3] {
+    let n = poly.len() as f64;
+    [0, 1, 2].map(|k| poly.iter().map(|p| p[k]).sum::<f64>() / n)
+}
+
+/// The four halves-of-edges triangles of a triangle.
+pub(super) fn split(t: Corners) -> [Corners; 4] {
+    let mid = |a: [f64; 3], b: [f64; 3]| [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
+    let (ab, bc, ca) = (mid(t[0], t[1]), mid(t[1], t[2]), mid(t[2], t[0]));
+    [[t[0], ab, ca], [ab, t[1], bc], [ca, bc, t[2]], [ab, bc, ca]]
+}
+
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two planes across a right triangle of legs 2 (x = ½, y = ½) cut it into four cells, in the
+    /// order of the cuts (x ≥ ½ first, each side's y ≥ ½ first), whose areas are, by hand,
+    /// ½ (legs 1), 9/8 − ½, then ∫₀^½ (3/2 − x) dx = 5/8 and 7/8 − 5/8; a plane along a side
+    /// (y = 0) leaves the cells whole, and they stay in the triangle's plane.
+    #[test]
+    fn cells_cut_along_planes_in_order() {
+        let t = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]];
+        let planes = [
+            ([0.5, 0.0, 0.0], [1.0, 0.0, 0.0], 1e-12),
+            ([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 1e-12),
+            ([0.0, 0.5, 0.0], [0.0, 1.0, 0.0], 1e-12),
+        ];
+        let c = cells(&t, &planes).expect("few cells");
+        assert_eq!(c.len(), 4);
+        let areas: Vec<f64> = c.iter().map(area).collect();
+        assert_eq!(areas, vec![0.5, 0.625, 0.625, 0.25]);
+        assert_eq!(areas.iter().sum::<f64>(), 2.0);
+        assert!(c.iter().flatten().all(|p| p[2] == 0.0));
+        assert_eq!(centroid(&t), [2.0 / 3.0, 2.0 / 3.0, 0.0]);
+    }
+}
