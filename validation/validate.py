@@ -162,7 +162,15 @@ def reason_for(parts, urdf_text):
             reasons.append(f"{Path(p['geometry']).name}: non-manifold closed mesh, integrated about its bounding-box centre (coal: about the origin)")
         elif prov in ("reoriented", "inverted"):
             reasons.append(f"{Path(p['geometry']).name}: {prov} winding fixed (coal integrates it as wound)")
+        elif classified(p):
+            reasons.append(f"{Path(p['geometry']).name}: closed shells that overlap, a region two of them enclose counted once (coal counts it twice)")
     return reasons
+
+
+def classified(part):
+    """Whether urdf-inertia classified the shells of a closed mesh (components that nest or cut each other):
+    its messages say so; its volume is then Omega's, not the stored integral coal gives."""
+    return any("shells" in m["message"] for m in part.get("warnings", []) + part.get("notes", []))
 
 
 def main():

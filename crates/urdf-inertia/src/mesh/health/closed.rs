@@ -104,6 +104,14 @@ pub(super) fn consistent_closed(
             });
         }
     }
+    // Closed components whose boxes overlap may enclose a region twice (one inside the other, or
+    // two bodies of an assembly cutting each other): the stored integral counts it twice while Ω
+    // = {|w| ≥ ½} counts it once, so the shells are classified ([`Ladder::shells`]). A mesh of one
+    // component, or of components apart, pays one pass for the boxes at most.
+    if ncomp > 1 && ncomp <= NESTING_CHECK {
+        let boxes = component_boxes(&vertices, topology_faces, &comp, ncomp);
+        ladder.overlapping_components = any_overlap(&boxes);
+    }
     if let Rung::Welded {
         merged_vertices,
         widest_crack,
@@ -163,6 +171,18 @@ pub(super) fn misoriented(vertices: &[[f64; 3]], faces: &Polygons, comp: &[u32],
     (0..ncomp)
         .map(|c| vol[c] < 0.0 && nesting_depth(c, &vol, &boxes) % 2 == 0)
         .collect()
+}
+
+/// Whether two of the boxes overlap in a positive volume (a sweep along x).
+fn any_overlap(boxes: &[Aabb]) -> bool {
+    let mut order: Vec<usize> = (0..boxes.len()).collect();
+    order.sort_by(|&a, &b| boxes[a].lo[0].total_cmp(&boxes[b].lo[0]));
+    order.iter().enumerate().any(|(i, &a)| {
+        order[i + 1..]
+            .iter()
+            .take_while(|&&b| boxes[b].lo[0] < boxes[a].hi[0])
+            .any(|&b| (1..3).all(|k| boxes[a].lo[k].max(boxes[b].lo[k]) < boxes[a].hi[k].min(boxes[b].hi[k])))
+    })
 }
 
 /// How many components hold component `c`: larger in volume, their boxes containing its box.

@@ -24,6 +24,9 @@ pub(super) struct Ladder<'a> {
     /// The faces as stored, where welding and the rungs changed them (whose winding number defines
     /// the solid where shells overlap).
     pub(super) as_stored: winding_shells::AsStored,
+    /// A closed surface of several components whose boxes overlap: its shells are classified like
+    /// the repaired rungs' (a region two of them enclose counts once).
+    pub(super) overlapping_components: bool,
 }
 
 impl<'a> Ladder<'a> {
@@ -45,6 +48,7 @@ impl<'a> Ladder<'a> {
             faces_read: mesh.faces.len(),
             known: None,
             as_stored: winding_shells::AsStored::default(),
+            overlapping_components: false,
         }
     }
 
@@ -78,10 +82,12 @@ impl<'a> Ladder<'a> {
         rung: &Rung,
         model: &mut Model,
     ) -> Polygons {
-        if !matches!(
-            rung,
-            Rung::Capped { .. } | Rung::NonManifold { .. } | Rung::Reoriented { .. }
-        ) {
+        if !self.overlapping_components
+            && !matches!(
+                rung,
+                Rung::Capped { .. } | Rung::NonManifold { .. } | Rung::Reoriented { .. }
+            )
+        {
             return faces;
         }
         let mut s = winding_shells::classify(vertices, &faces, &self.as_stored);

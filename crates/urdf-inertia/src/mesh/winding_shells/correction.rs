@@ -590,10 +590,24 @@ impl Faces<'_> {
                 planes.push((a, cross(ab, ac), self.margin * norm(ab) * norm(ac)));
             }
         }
-        if planes.len() > MAX_CUTS {
+        // Only planes that cross the piece can cut it (its cells lie inside it): those along its
+        // sides or beyond it leave every cell whole, so they neither count against the limit nor
+        // are tried. Under coincident shells most of a piece's coplanar neighbours are such (a
+        // fan's edges meet at a shared corner); counted, they sent it to be split in four again
+        // and again until the work ran out, and the pieces left entered the bound. `apart` still
+        // keeps the decision's points off every plane.
+        let crossing: Vec<_> = planes
+            .iter()
+            .copied()
+            .filter(|&(a, n, m)| {
+                let d = piece.map(|x| dot(n, sub(x, a)));
+                !(d.iter().all(|&x| x >= -m) || d.iter().all(|&x| x <= m))
+            })
+            .collect();
+        if crossing.len() > MAX_CUTS {
             return false;
         }
-        let Some(cells) = cells(piece, &planes) else {
+        let Some(cells) = cells(piece, &crossing) else {
             return false;
         };
         let apart = |x: [f64; 3]| planes.iter().all(|&(a, n, m)| dot(n, sub(x, a)).abs() > m);
