@@ -86,7 +86,7 @@ def measure_package(args, name, version, meshes_only, work):
         if args.only and args.only not in label:
             return None
         rng = np.random.default_rng(zlib.crc32(f"{label}{fmt_scale(scale)}".encode()))
-        row = measure(args.binary, label, Path(key), scale, rng, args.points, reference_triangles)
+        row = measure(args.binary, label, Path(key), scale, rng, args.points, reference_triangles, args.all)
         if row is not None:
             row["package"] = name
             if "error" in row:
@@ -162,6 +162,8 @@ def main():
     ap.add_argument("--points", type=int, default=POINTS)
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--only", default="", help="substring of the mesh paths (package/path) to measure")
+    ap.add_argument("--all", action="store_true",
+                    help="every mesh, the clean (exact, welded) ones too: a screen for wrong closed meshes, not run by CI")
     args = ap.parse_args()
     args.binary = str(Path(args.binary).resolve())
     work = Path(args.work).resolve()
