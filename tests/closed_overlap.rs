@@ -100,3 +100,42 @@ fn coaxial_cylinders_with_coplanar_fan_caps() {
     assert!(error <= 1e-8, "{error:e} {:?}", s.warnings);
     assert_small(&s);
 }
+
+/// More closed components than the nesting check looks at (2,000): a grid of 2,100 small boxes, one
+/// of them with a box inside it. The overlap check has no limit on the components, so the inner box
+/// still counts once.
+#[test]
+fn a_box_inside_one_of_many_components_counts_once() {
+    let mut boxes: Vec<Mesh> = (0..2_100)
+        .map(|i| {
+            let (x, y) = (f64::from(i % 50) * 2.0, f64::from(i / 50) * 2.0);
+            common::box_at([x, y, 0.0], [x + 1.0, y + 1.0, 1.0])
+        })
+        .collect();
+    let inner = common::box_at([0.25, 0.25, 0.25], [0.75, 0.5, 0.75]);
+    boxes.push(inner);
+    let parts: Vec<(&Mesh, bool)> = boxes.iter().map(|m| (m, false)).collect();
+    let s = solid(&together(&parts));
+    let terms: Vec<(i32, &Mesh)> = boxes[..2_100].iter().map(|m| (1, m)).collect();
+    let error = within_estimate("many components", &s, &exact_sum(&terms));
+    assert!(error <= 1e-12, "{error:e} {:?}", s.warnings);
+    assert_small(&s);
+}
+
+/// Slices of one long part: 300 boxes that all overlap along x and none in y, more box tests than
+/// the overlap check's budget. It stops and classifies, which finds nothing to change.
+#[test]
+fn slices_beyond_the_overlap_budget_are_classified_and_unchanged() {
+    let boxes: Vec<Mesh> = (0..300)
+        .map(|i| {
+            let y = f64::from(i) * 2.0;
+            common::box_at([0.0, y, 0.0], [10.0, y + 1.0, 1.0])
+        })
+        .collect();
+    let parts: Vec<(&Mesh, bool)> = boxes.iter().map(|m| (m, false)).collect();
+    let s = solid(&together(&parts));
+    let terms: Vec<(i32, &Mesh)> = boxes.iter().map(|m| (1, m)).collect();
+    let error = within_estimate("slices", &s, &exact_sum(&terms));
+    assert!(error <= 1e-12, "{error:e} {:?}", s.warnings);
+    assert_small(&s);
+}

@@ -36,16 +36,29 @@ KNOWN = {}
 
 # Points per mesh (the cells of the stratified grid number half as many): about 1 s per mesh.
 POINTS = 100_000
+# A mesh beyond its estimate plus 3 sigma is sampled again with this many times the points (measure).
+RESAMPLE = 10
 
 
 def triangles(path, scale):
-    """Vertices (float64) and triangles as coal's MeshLoader (assimp) reads them."""
+    """Vertices (float64) and triangles as coal's MeshLoader (assimp) reads them, except an OBJ that coal
+    reads with vertices no triangle uses: trimesh reads those. assimp splits an OBJ with several materials
+    into several meshes, and coal 3.0.3 indexes the second and later ones without their vertex offset (as
+    for glTF primitives, validation/gltf_coal.py), so their triangles land on the first mesh's vertices:
+    robosuite's schunk_svh_hand `d13.obj` (two materials) has 2.3e-6 m³ as coal reads it and 6.2e-6 as
+    trimesh, libigl and urdf-inertia read it."""
     model = coal.MeshLoader().load(str(path), np.array(scale, dtype=float))
     v = np.array(model.vertices(), dtype=np.float64).reshape(-1, 3)
     f = np.empty((model.num_tris, 3), dtype=np.int64)
     for i in range(model.num_tris):
         t = model.tri_indices(i)
         f[i] = (t[0], t[1], t[2])
+    if Path(path).suffix.lower() == ".obj" and len(np.unique(f)) < len(v):
+        import trimesh
+
+        mesh = trimesh.load(str(path), force="mesh", process=False)
+        v = np.asarray(mesh.vertices, dtype=np.float64) * np.asarray(scale, dtype=np.float64)
+        f = np.asarray(mesh.faces, dtype=np.int64)
     return v, f
 
 
@@ -85,9 +98,9 @@ def ours(binary, path, scale, extra=()):
     return json.loads(proc.stdout), None
 
 
-def measure(binary, name, path, scale, rng, points, reader=triangles):
-    """One row, or None for a mesh the ladder does not repair. `reader(path, scale)` gives the reference's
-    triangles (default: as coal reads them)."""
+def measure(binary, name, path, scale, rng, points, reader=triangles, everything=False):
+    """One row, or None for a mesh the ladder does not repair (unless `everything`: clean meshes too).
+    `reader(path, scale)` gives the reference's triangles (default: as coal reads them)."""
     data, err = ours(binary, path, scale)
     refused = False
     if data is None and "UI108" in err:
@@ -98,7 +111,11 @@ def measure(binary, name, path, scale, rng, points, reader=triangles):
     # A closed mesh is measured too when its shells were classified (components that nest or cut each
     # other): its volume is then Omega's, not the stored integral.
     messages = data.get("warnings", []) + data.get("notes", [])
-    if data["provenance"] in ("exact", "welded") and not any("shells" in m["message"] for m in messages):
+    if (
+        not everything
+        and data["provenance"] in ("exact", "welded")
+        and not any("shells" in m["message"] for m in messages)
+    ):
         return None
     v, f = reader(path, scale)
     start = time.perf_counter()
@@ -109,6 +126,18 @@ def measure(binary, name, path, scale, rng, points, reader=triangles):
     est = data["error_estimate"] if data["error_estimate"] is not None else float("inf")
     diff = abs(vol - ref)
     allowed = est * vol + 3 * sigma
+    first = None
+    if diff > allowed:
+        # A second, independent sample, RESAMPLE times larger (sigma about a third): of some 450 meshes
+        # with honest estimates about one is beyond 3 sigma by chance (0.27% each), and the streams are
+        # seeded, so CI would fail on it every time. A wrong estimate fails again, against a smaller sigma;
+        # the first sample stays in the report.
+        first = (diff, sigma)
+        start = time.perf_counter()
+        ref, sigma = solid_volume(v, f, rng=rng, points=RESAMPLE * points)
+        seconds += time.perf_counter() - start
+        diff = abs(vol - ref)
+        allowed = est * vol + 3 * sigma
     return {
         "name": name,
         "scale": scale,
@@ -122,6 +151,7 @@ def measure(binary, name, path, scale, rng, points, reader=triangles):
         "pass": diff <= allowed,
         "faces": len(f),
         "seconds": seconds,
+        "first": first,
     }
 
 
@@ -144,6 +174,16 @@ def mesh_rows(rows, known, errors_heading, shorten):
             f"| {r['name']}{fmt_scale(r['scale'])} | {r['rung']} | {r['faces']} | {r['ours']:.4e} | {r['ref']:.4e} | "
             f"{rel:.1e} | {r['estimate']:.1e} | {3 * r['sigma'] / max(r['ref'], 1e-300):.1e} | {mark} |"
         )
+    again = [r for r in measured if r.get("first")]
+    if again:
+        lines += ["", "## Sampled again", "",
+                  f"Beyond the estimate plus 3 sigma at the first sample, so sampled again with {RESAMPLE} times the "
+                  "points (the table gives the second sample):", ""]
+        lines += [
+            f"- {r['name']}{fmt_scale(r['scale'])}: first difference {r['first'][0] / r['ref']:.1e}, 3 sigma "
+            f"{3 * r['first'][1] / r['ref']:.1e}; second {r['diff'] / r['ref']:.1e}, 3 sigma {3 * r['sigma'] / r['ref']:.1e}"
+            for r in sorted(again, key=lambda r: r["name"])
+        ]
     errors = [r for r in rows if "error" in r]
     if errors:
         lines += ["", f"## {errors_heading}", ""]
@@ -165,7 +205,8 @@ def report(rows, points):
         f"Generated by `bash validation/winding.sh`. Every (file, scale) used by a `<collision>` whose rung is not exact "
         f"or welded, or whose shells were classified (closed, components that nest or cut each other); reference: the volume of {{x : |w(x)| >= 1/2}}, w libigl's fast winding number on the triangles "
         f"coal (assimp) reads, by stratified sampling in the bounding box (about {points:,} points per mesh, two per "
-        "cell; sigma its standard error). Pass: |ours - reference| <= estimate x ours + 3 sigma.",
+        "cell; sigma its standard error). Pass: |ours - reference| <= estimate x ours + 3 sigma, at the first "
+        f"sample or at a second one with {RESAMPLE} times the points.",
         "",
         f"Repaired by default: {len(by_default)} meshes, {sum(r['pass'] for r in by_default)} pass, "
         f"{len(by_default) - sum(r['pass'] for r in by_default)} do not ({len(failed)} not listed as known); "
@@ -186,6 +227,8 @@ def main():
     ap.add_argument("--out", required=True)
     ap.add_argument("--points", type=int, default=POINTS)
     ap.add_argument("--only", default="", help="substring of the mesh paths to measure")
+    ap.add_argument("--all", action="store_true",
+                    help="every mesh, the clean (exact, welded) ones too: a screen for wrong closed meshes, not run by CI")
     args = ap.parse_args()
     share = Path(args.share)
     robots = share / "example-robot-data" / "robots"
@@ -195,7 +238,7 @@ def main():
         if args.only and args.only not in str(path):
             continue
         name = str(path.relative_to(robots)) if path.is_relative_to(robots) else str(path)
-        row = measure(args.binary, name, path, scale, rng, args.points)
+        row = measure(args.binary, name, path, scale, rng, args.points, everything=args.all)
         if row is not None:
             rows.append(row)
     lines, failed = report(rows, args.points)

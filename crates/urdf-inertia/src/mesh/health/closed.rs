@@ -107,8 +107,10 @@ pub(super) fn consistent_closed(
     // Closed components whose boxes overlap may enclose a region twice (one inside the other, or
     // two bodies of an assembly cutting each other): the stored integral counts it twice while Ω
     // = {|w| ≥ ½} counts it once, so the shells are classified ([`Ladder::shells`]). A mesh of one
-    // component, or of components apart, pays one pass for the boxes at most.
-    if ncomp > 1 && ncomp <= NESTING_CHECK {
+    // component, or of components apart, pays one pass for the boxes at most. There is no limit on
+    // the components: the sweep's work is capped, and a sweep that reaches its cap classifies (the
+    // classification has caps of its own, whose bounds enter the estimate).
+    if ncomp > 1 {
         let boxes = component_boxes(&vertices, topology_faces, &comp, ncomp);
         ladder.overlapping_components = any_overlap(&boxes);
     }
@@ -173,16 +175,31 @@ pub(super) fn misoriented(vertices: &[[f64; 3]], faces: &Polygons, comp: &[u32],
         .collect()
 }
 
-/// Whether two of the boxes overlap in a positive volume (a sweep along x).
+/// Box tests per box beyond which [`any_overlap`] stops and answers yes: boxes that overlap along x
+/// but not in y or z (slices of one long part) would otherwise make the sweep quadratic.
+const OVERLAP_TESTS_PER_BOX: usize = 64;
+
+/// Whether two of the boxes overlap in a positive volume (a sweep along x), or whether the sweep ran
+/// out of its budget of tests before it could say they do not.
 fn any_overlap(boxes: &[Aabb]) -> bool {
     let mut order: Vec<usize> = (0..boxes.len()).collect();
     order.sort_by(|&a, &b| boxes[a].lo[0].total_cmp(&boxes[b].lo[0]));
-    order.iter().enumerate().any(|(i, &a)| {
-        order[i + 1..]
-            .iter()
-            .take_while(|&&b| boxes[b].lo[0] < boxes[a].hi[0])
-            .any(|&b| (1..3).all(|k| boxes[a].lo[k].max(boxes[b].lo[k]) < boxes[a].hi[k].min(boxes[b].hi[k])))
-    })
+    let mut budget = OVERLAP_TESTS_PER_BOX * boxes.len();
+    for (i, &a) in order.iter().enumerate() {
+        for &b in &order[i + 1..] {
+            if boxes[b].lo[0] >= boxes[a].hi[0] {
+                break;
+            }
+            if budget == 0 {
+                return true;
+            }
+            budget -= 1;
+            if (1..3).all(|k| boxes[a].lo[k].max(boxes[b].lo[k]) < boxes[a].hi[k].min(boxes[b].hi[k])) {
+                return true;
+            }
+        }
+    }
+    false
 }
 
 /// How many components hold component `c`: larger in volume, their boxes containing its box.
