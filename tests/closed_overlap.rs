@@ -10,7 +10,7 @@
 #[path = "../crates/urdf-inertia/tests/common/mod.rs"]
 mod common;
 
-use common::shells::{exact_sum, solid_with, together, within_estimate};
+use common::shells::{assert_estimate_at_most, exact_sum, solid_with, together, within_estimate};
 use common::Mesh;
 use urdf_inertia::mesh::health::{HealthOptions, Solid};
 
@@ -19,12 +19,7 @@ fn solid(mesh: &Mesh) -> Solid {
 }
 
 fn assert_small(s: &Solid) {
-    assert!(
-        s.error_estimate <= 1e-6,
-        "{:e} {:?}",
-        s.error_estimate,
-        s.warnings
-    );
+    assert_estimate_at_most(s, 1e-6);
 }
 
 /// Two closed boxes that cut each other, both outward: the union, box + box − their intersection.

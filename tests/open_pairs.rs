@@ -9,7 +9,9 @@
 #[path = "../crates/urdf-inertia/tests/common/mod.rs"]
 mod common;
 
-use common::shells::{exact_sum, open_top, solid_with, together, within_estimate};
+use common::shells::{
+    assert_estimate_at_most, exact_sum, open_top, solid_with, together, within_estimate,
+};
 use common::winding::omega_volume;
 use common::Mesh;
 use urdf_inertia::mesh::health::{HealthOptions, Solid};
@@ -47,12 +49,7 @@ fn a_cracked_box_through_a_wall_counts_the_intersection_once() {
     let exact = exact_sum(&[(1, &a), (1, &b), (-1, &both)]);
     let error = within_estimate("cracked box", &s, &exact);
     assert!(error <= 1e-8, "{error:e}");
-    assert!(
-        s.error_estimate <= 1e-6,
-        "{:e} {:?}",
-        s.error_estimate,
-        s.warnings
-    );
+    assert_estimate_at_most(&s, 1e-6);
 }
 
 /// The same with the crack inside the open box (where w decides whether the faces count).
@@ -66,12 +63,7 @@ fn a_crack_inside_the_other_shell() {
     let exact = exact_sum(&[(1, &a), (1, &b), (-1, &both)]);
     let error = within_estimate("crack inside", &s, &exact);
     assert!(error <= 1e-8, "{error:e}");
-    assert!(
-        s.error_estimate <= 1e-6,
-        "{:e} {:?}",
-        s.error_estimate,
-        s.warnings
-    );
+    assert_estimate_at_most(&s, 1e-6);
 }
 
 /// The first test's surface as a CAD export stores it: millimetres in f32, the crack one f32 unit in
@@ -114,12 +106,7 @@ fn a_cracked_box_in_millimetres_is_welded_at_the_files_precision() {
     let exact = exact_sum(&[(1, &scaled(&a)), (1, &scaled(&b)), (-1, &scaled(&both))]);
     let error = within_estimate("cracked box in mm", &s, &exact);
     assert!(error <= 1e-8, "{error:e} {:?}", s.warnings);
-    assert!(
-        s.error_estimate <= 1e-6,
-        "{:e} {:?}",
-        s.error_estimate,
-        s.warnings
-    );
+    assert_estimate_at_most(&s, 1e-6);
 }
 
 /// A tetrahedron with outward faces, on corners `p`.
@@ -148,12 +135,7 @@ fn a_face_stored_twice_for_two_shells_counts_once() {
     let error = within_estimate("face twice", &s, &exact);
     assert!(error <= 1e-8, "{error:e} {:?}", s.warnings);
     // Every face decided on the surface as stored: the rung's terms for the copy it dropped go.
-    assert!(
-        s.error_estimate <= 1e-6,
-        "{:e} {:?}",
-        s.error_estimate,
-        s.warnings
-    );
+    assert_estimate_at_most(&s, 1e-6);
     // The sampled winding number of the mesh as stored agrees (Ω is the taller tetrahedron).
     assert!(
         (s.unit.mass - sampled).abs() <= 4.0 * sigma + 1e-3,
@@ -190,12 +172,7 @@ fn a_face_the_ladder_turns_round_is_decided_as_stored() {
     let exact = exact_sum(&[(1, &tall), (1, &far)]);
     let error = within_estimate("turned round", &s, &exact);
     assert!(error <= 1e-8, "{error:e} {:?}", s.warnings);
-    assert!(
-        s.error_estimate <= 1e-6,
-        "{:e} {:?}",
-        s.error_estimate,
-        s.warnings
-    );
+    assert_estimate_at_most(&s, 1e-6);
     let said = |what: &str| s.warnings.iter().any(|w| w.text.contains(what));
     assert!(
         said("1 re-oriented faces as stored") && said("1 face copies put back"),

@@ -74,3 +74,14 @@ pub fn within_estimate(name: &str, s: &Solid, exact: &ExactMass) -> f64 {
     );
     volume.max(inertia)
 }
+
+/// Asserts that `s`'s estimate is at most `bound`: the classification decided the shells, not their
+/// boxes' bound.
+pub fn assert_estimate_at_most(s: &Solid, bound: f64) {
+    assert!(
+        s.error_estimate <= bound,
+        "estimate {:e} above {bound:e}: {:?}",
+        s.error_estimate,
+        s.warnings
+    );
+}
