@@ -122,6 +122,27 @@ impl Aabb {
     }
 }
 
+/// Each pair of `boxes` whose ranges along x overlap (the second starts before the first ends),
+/// found by a sweep along x: `visit(a, b)` with `a` the box that starts first, until it breaks.
+/// The pairs the overlap checks of components and of shells go through; each applies its own test
+/// and its own limit.
+pub(crate) fn x_sweep(
+    boxes: &[Aabb],
+    mut visit: impl FnMut(usize, usize) -> std::ops::ControlFlow<()>,
+) -> std::ops::ControlFlow<()> {
+    let mut order: Vec<usize> = (0..boxes.len()).collect();
+    order.sort_by(|&a, &b| boxes[a].lo[0].total_cmp(&boxes[b].lo[0]));
+    for (i, &a) in order.iter().enumerate() {
+        for &b in &order[i + 1..] {
+            if boxes[b].lo[0] >= boxes[a].hi[0] {
+                break;
+            }
+            visit(a, b)?;
+        }
+    }
+    std::ops::ControlFlow::Continue(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::Aabb;

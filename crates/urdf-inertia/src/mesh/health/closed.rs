@@ -8,10 +8,11 @@ use super::closed_consistent;
 use super::topology::{closed_consistent_split, Edges, Orientation};
 use super::welding::Welding;
 use super::{HealthKind, ModelError, Rung, Solid};
-use crate::geometry::{cross, dot, sub};
+use crate::geometry::{cross, dot, sub, x_sweep};
 use crate::mass::integrals::{bounding_box_centre, volume_integrals, VolumeIntegrals};
 use crate::mass::{IntegrationOptions, Polygons};
 use crate::mesh::MeshError;
+use std::ops::ControlFlow;
 
 /// [`closed_consistent`] on `faces`, and beside it, when the pool has more than one thread, the
 /// integrals of `faces` as stored that [`consistent_closed`] starts from.
@@ -182,24 +183,16 @@ const OVERLAP_TESTS_PER_BOX: usize = 64;
 /// Whether two of the boxes overlap in a positive volume (a sweep along x), or whether the sweep ran
 /// out of its budget of tests before it could say they do not.
 fn any_overlap(boxes: &[Aabb]) -> bool {
-    let mut order: Vec<usize> = (0..boxes.len()).collect();
-    order.sort_by(|&a, &b| boxes[a].lo[0].total_cmp(&boxes[b].lo[0]));
     let mut budget = OVERLAP_TESTS_PER_BOX * boxes.len();
-    for (i, &a) in order.iter().enumerate() {
-        for &b in &order[i + 1..] {
-            if boxes[b].lo[0] >= boxes[a].hi[0] {
-                break;
-            }
-            if budget == 0 {
-                return true;
-            }
-            budget -= 1;
-            if (1..3).all(|k| boxes[a].lo[k].max(boxes[b].lo[k]) < boxes[a].hi[k].min(boxes[b].hi[k])) {
-                return true;
-            }
+    let overlap = |a: &Aabb, b: &Aabb| (1..3).all(|k| a.lo[k].max(b.lo[k]) < a.hi[k].min(b.hi[k]));
+    x_sweep(boxes, |a, b| {
+        if budget == 0 || overlap(&boxes[a], &boxes[b]) {
+            return ControlFlow::Break(());
         }
-    }
-    false
+        budget -= 1;
+        ControlFlow::Continue(())
+    })
+    .is_break()
 }
 
 /// How many components hold component `c`: larger in volume, their boxes containing its box.

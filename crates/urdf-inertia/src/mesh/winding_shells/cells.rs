@@ -39,6 +39,12 @@ impl Cells {
     }
 }
 
+/// Whether a plane leaves a convex polygon whole: its corners' signed distances `d` from the plane
+/// are all at least −`m` or all at most `m` (the polygon lies on one side, up to the margin).
+pub(super) fn leaves_whole(d: &[f64], m: f64) -> bool {
+    d.iter().all(|&x| x >= -m) || d.iter().all(|&x| x <= m)
+}
+
 /// `piece` cut along the `planes` in turn into convex cells, in order; `None` when they are more
 /// than [`MAX_CELLS`].
 pub(super) fn cells(piece: &Corners, planes: &[CutPlane]) -> Option<Cells> {
@@ -53,7 +59,7 @@ pub(super) fn cells(piece: &Corners, planes: &[CutPlane]) -> Option<Cells> {
             d.clear();
             d.extend(cell.iter().map(|x| dot(n, sub(*x, a))));
             // A plane along the cell's side (one cut already, or a shared edge) leaves it whole.
-            if d.iter().all(|&x| x >= -m) || d.iter().all(|&x| x <= m) {
+            if leaves_whole(&d, m) {
                 next.corners.extend_from_slice(cell);
                 next.close();
                 continue;

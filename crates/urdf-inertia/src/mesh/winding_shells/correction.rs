@@ -10,7 +10,7 @@
 //! the cone it spans from the surface's box centre (the volume a wrong orientation can change) to
 //! the bound, twice when it may count twice.
 
-use super::cells::{area, cells, centroid, split};
+use super::cells::{area, cells, centroid, leaves_whole, split};
 use super::grid::{Corners, Grid, Plane, Seen};
 use super::{edge_meets, triangles_touch, EdgeUse};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
@@ -590,7 +590,8 @@ impl Faces<'_> {
                 planes.push((a, cross(ab, ac), self.margin * norm(ab) * norm(ac)));
             }
         }
-        // Only planes that cross the piece can cut it (its cells lie inside it): those along its
+        // Only planes that cross the piece can cut it (its cells lie inside it, so a plane that
+        // leaves the piece whole leaves each of its cells whole in `cells`): those along its
         // sides or beyond it leave every cell whole, so they neither count against the limit nor
         // are tried. Under coincident shells most of a piece's coplanar neighbours are such (a
         // fan's edges meet at a shared corner); counted, they sent it to be split in four again
@@ -599,10 +600,7 @@ impl Faces<'_> {
         let crossing: Vec<_> = planes
             .iter()
             .copied()
-            .filter(|&(a, n, m)| {
-                let d = piece.map(|x| dot(n, sub(x, a)));
-                !(d.iter().all(|&x| x >= -m) || d.iter().all(|&x| x <= m))
-            })
+            .filter(|&(a, n, m)| !leaves_whole(&piece.map(|x| dot(n, sub(x, a))), m))
             .collect();
         if crossing.len() > MAX_CUTS {
             return false;

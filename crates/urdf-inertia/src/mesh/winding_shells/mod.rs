@@ -24,12 +24,13 @@ mod correction;
 mod cracks;
 mod grid;
 
-use crate::geometry::{cross, dot, norm, solid_angle, sub, Aabb};
+use crate::geometry::{cross, dot, norm, solid_angle, sub, x_sweep, Aabb};
 use crate::mass::Polygons;
 use crate::mesh::weld;
 use grid::orient3d;
 use robust::Coord3D;
 use rustc_hash::FxHashMap;
+use std::ops::ControlFlow;
 
 /// Pairs of shells with overlapping boxes beyond this many are not decided one by one: all are bounded.
 const MAX_PAIRS: usize = 20_000;
@@ -649,22 +650,18 @@ pub(super) fn root(parent: &mut [u32], mut x: u32) -> u32 {
 
 /// Pairs of shells whose boxes overlap in a region of positive volume (sweep along x).
 fn overlapping_pairs(shells: &[Shell]) -> Vec<(usize, usize)> {
-    let mut order: Vec<usize> = (0..shells.len()).collect();
-    order.sort_by(|&a, &b| shells[a].bounds.lo[0].total_cmp(&shells[b].bounds.lo[0]));
+    let boxes: Vec<Aabb> = shells.iter().map(|s| s.bounds).collect();
     let mut pairs = Vec::new();
-    for (i, &a) in order.iter().enumerate() {
-        for &b in &order[i + 1..] {
-            if shells[b].bounds.lo[0] >= shells[a].bounds.hi[0] {
-                break;
-            }
-            if box_overlap(&shells[a], &shells[b]) > 0.0 {
-                pairs.push((a.min(b), a.max(b)));
-            }
-            if pairs.len() > MAX_PAIRS {
-                return pairs;
-            }
+    let _ = x_sweep(&boxes, |a, b| {
+        if box_overlap(&shells[a], &shells[b]) > 0.0 {
+            pairs.push((a.min(b), a.max(b)));
         }
-    }
+        if pairs.len() > MAX_PAIRS {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    });
     pairs
 }
 
