@@ -140,10 +140,24 @@ pub(super) fn check_volume(
 /// (products by positive factors round monotonically), so a volume outside the floors of the area
 /// ± `slack` is decided as the sequential sum decides it; only a volume inside that band, which a
 /// solid is not, sums again in order.
+///
+/// Most solids are decided before any sum, by a bound on the area: `diagonal` is that of a box
+/// holding every vertex, so each side of a fan triangle is at most D = `diagonal` long and its area at
+/// most D²/2, and a face of k corners has k − 2 of them. The sequential sum as computed is within a
+/// factor (1 + n·u)(1 + c·k·u) of the exact sum (n faces, u the unit round-off), well below 2, so it is at most (corners) · D²: a
+/// volume above the floor of that bound is above the floor of the sum (the floor grows with the
+/// area, as above), which is what the sum would decide. The floor is 1e-13 of the area times D, so
+/// only meshes thin next to their number of faces (a 1.3 M-face torus would need a volume below
+/// 2e-5 of D³) go on to the sums. This skips a pass over every face and its corners (77
+/// instructions a face of 1,302 on a 1.3 M-face binary STL; docs/benchmarks.md, round seven).
 fn empty(vertices: &[[f64; 3]], faces: &Polygons, diagonal: f64, volume: f64) -> bool {
     let floor = |area: f64| ZERO_VOLUME_ROUNDOFFS * f64::EPSILON * area * diagonal;
     if volume.is_nan() {
         return true;
+    }
+    let area_bound = faces.indices.len() as f64 * diagonal * diagonal;
+    if volume > floor(area_bound) {
+        return false;
     }
     if let Some(area) = chunked_area(vertices, faces) {
         let slack = 4.0 * faces.len() as f64 * f64::EPSILON;
@@ -189,7 +203,52 @@ fn chunked_area(vertices: &[[f64; 3]], faces: &Polygons) -> Option<f64> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::geometry::bbox;
     use super::*;
+
+    /// The area bound decides only volumes the sum decides the same way: the faces' area as
+    /// [`empty`] sums it stays below corners × D² for faces as large as the box allows (triangles on
+    /// three corners of the box, a polygon of 1,000 corners around it), and volumes just above and
+    /// below each floor are decided as the sequential sum decides them.
+    #[test]
+    fn the_area_bound_decides_as_the_sequential_floor() {
+        let (lo, hi) = ([-1.0, -2.0, -0.5], [3.0, 0.5, 2.5]);
+        let mut vertices: Vec<[f64; 3]> = (0..8)
+            .map(|i| [0, 1, 2].map(|k| if i >> k & 1 == 1 { hi[k] } else { lo[k] }))
+            .collect();
+        let mut triangles = Vec::new();
+        for a in 0..8u32 {
+            for b in a + 1..8 {
+                for c in b + 1..8 {
+                    triangles.push([a, b, c]);
+                }
+            }
+        }
+        let mut faces = Polygons::from_triangles(&triangles);
+        let ring = vertices.len() as u32;
+        for i in 0..1000 {
+            let t = f64::from(i) * std::f64::consts::TAU / 1000.0;
+            vertices.push([1.0 + 2.0 * t.cos(), -0.75 + 1.25 * t.sin(), 1.0 + 1.5 * (3.0 * t).sin()]);
+        }
+        faces.push(&(ring..ring + 1000).collect::<Vec<_>>());
+        let diagonal = bbox(&vertices).diagonal();
+        let area: f64 = faces.iter().map(|f| polygon_area(&vertices, f)).sum();
+        let bound = faces.indices.len() as f64 * diagonal * diagonal;
+        assert!(2.0 * area <= bound, "{area} {bound}");
+        let floor = |a: f64| ZERO_VOLUME_ROUNDOFFS * f64::EPSILON * a * diagonal;
+        let step = |x: f64, d: i64| f64::from_bits((x.to_bits() as i64 + d) as u64);
+        for volume in [
+            floor(area),
+            step(floor(area), 1),
+            step(floor(area), -1),
+            floor(bound),
+            step(floor(bound), 1),
+            step(floor(bound), -1),
+            1.0,
+        ] {
+            assert_eq!(empty(&vertices, &faces, diagonal, volume), volume <= floor(area), "{volume}");
+        }
+    }
 
     /// On more than one thread, the chunked area decides as the sequential floor does, also for
     /// volumes on, just above and just below that floor (where it falls back to the sequential sum).
