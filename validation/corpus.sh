@@ -28,5 +28,5 @@ fi
   -d "$work/wheels" -r validation/corpus-requirements.txt
 cargo build --release --quiet
 echo "== corpus: work directory $work, report $out"
-"$venv/bin/python" validation/corpus.py --binary target/release/urdf-inertia --wheels "$work/wheels" \
+"$venv/bin/python" validation/corpus.py --binary "${CARGO_TARGET_DIR:-target}/release/urdf-inertia" --wheels "$work/wheels" \
   --requirements validation/corpus-requirements.txt --work "$work" --out "$out" --timings "$work/timings.tsv"

@@ -8,9 +8,9 @@ venv="${VALIDATION_VENV:-validation/.venv}"
 if [ ! -x "$venv/bin/python" ]; then
   python3 -m venv "$venv"
 fi
-"$venv/bin/python" -m pip install --quiet --disable-pip-version-check pin==4.1.0 example-robot-data==6.0.0 mujoco==3.3.7 drake==1.51.1
+"$venv/bin/python" -m pip install --quiet --disable-pip-version-check -r validation/requirements.txt
 share="$("$venv/bin/python" -c 'import sysconfig, pathlib; print(pathlib.Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share")')"
 cargo build --release --quiet
-"$venv/bin/python" validation/meshes.py --binary target/release/urdf-inertia --share "$share" --out "$(dirname "$out")/MESHES.md"
-"$venv/bin/python" validation/gltf_coal.py --binary target/release/urdf-inertia
-"$venv/bin/python" validation/validate.py --binary target/release/urdf-inertia --share "$share" --out "$out" --work validation/work
+"$venv/bin/python" validation/meshes.py --binary "${CARGO_TARGET_DIR:-target}/release/urdf-inertia" --share "$share" --out "$(dirname "$out")/MESHES.md"
+"$venv/bin/python" validation/gltf_coal.py --binary "${CARGO_TARGET_DIR:-target}/release/urdf-inertia"
+"$venv/bin/python" validation/validate.py --binary "${CARGO_TARGET_DIR:-target}/release/urdf-inertia" --share "$share" --out "$out" --work validation/work
