@@ -8,8 +8,8 @@
 //! * `weld-soup`: the health step's exact weld of a triangle soup (three vertices per face, what a
 //!   reader that does not weld delivers; a welded STL skips this step);
 //! * `edges`: the proof that the surface is closed and consistently wound, with its components;
-//! * `integrate`: one integration of the ten volume integrals (a clean mesh takes two: the value,
-//!   and the round-off estimate about a second reference point);
+//! * `integrate`: one integration of the ten volume integrals (a clean mesh takes two, in one pass
+//!   over its faces: the value, and the round-off estimate about a second reference point);
 //! * `heal`: `make_solid`, everything after reading: edge analysis, ladder and integrations;
 //! * `end-to-end`: read + heal, what `urdf-inertia mesh` does after the file is in memory.
 

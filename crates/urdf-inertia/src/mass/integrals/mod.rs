@@ -250,7 +250,7 @@ pub fn volume_integrals(
         // Fixed chunks, whatever the number of threads, each summed with compensation and combined
         // in chunk order as double-doubles: the same bits for any thread count.
         use rayon::prelude::*;
-        let chunks: Vec<([f64; 10], [f64; 10])> = crate::threads::install(|| {
+        let chunks: Vec<RawSums> = crate::threads::install(|| {
             (0..n.div_ceil(CHUNK))
                 .into_par_iter()
                 .map(|c| {
@@ -259,20 +259,72 @@ pub fn volume_integrals(
                 })
                 .collect()
         });
-        let mut hi = [0.0; 10];
-        let mut lo = [0.0; 10];
-        for (h, l) in chunks {
-            for k in 0..10 {
-                let (s, e) = two_sum(hi[k], h[k]);
-                hi[k] = s;
-                lo[k] += e + l[k];
-            }
-        }
-        (hi, lo)
+        combine(chunks.iter())
     } else {
         fan_sums(vertices, faces.iter(), reference, options)
     };
     finish(raw, reference, [6.0, 24.0, 120.0, 120.0])
+}
+
+/// The chunks' double-double sums combined in order.
+fn combine<'a>(chunks: impl Iterator<Item = &'a RawSums>) -> RawSums {
+    let mut hi = [0.0; 10];
+    let mut lo = [0.0; 10];
+    for (h, l) in chunks {
+        for k in 0..10 {
+            let (s, e) = two_sum(hi[k], h[k]);
+            hi[k] = s;
+            lo[k] += e + l[k];
+        }
+    }
+    (hi, lo)
+}
+
+/// [`volume_integrals`] about the options' reference point and about `second`, in one pass over
+/// the faces: each triangle's corners are gathered once and fed to two kernels, each summing what
+/// it would sum alone, in the same order and the same chunks, so each result is, bit for bit, that
+/// of [`volume_integrals`] with its reference point. The gather (a random access per corner) is
+/// what a second pass would repeat: the health ladder's round-off estimate integrates about the
+/// box's corner as well as its centre (docs/benchmarks.md, "Round seven").
+pub fn volume_integrals_about_two(
+    vertices: &[[f64; 3]],
+    faces: &Polygons,
+    options: &IntegrationOptions,
+    second: [f64; 3],
+) -> (VolumeIntegrals, VolumeIntegrals) {
+    let reference = options.reference_for(vertices);
+    let other = IntegrationOptions {
+        reference: Some(second),
+        ..*options
+    };
+    let two = |faces| {
+        run_kernel(FanLoopTwo {
+            vertices,
+            faces,
+            references: [reference, second],
+            options: [options, &other],
+        })
+    };
+    let n = faces.len();
+    let (a, b) = if options.summation == Summation::Compensated && n > CHUNK {
+        use rayon::prelude::*;
+        let chunks: Vec<(RawSums, RawSums)> = crate::threads::install(|| {
+            (0..n.div_ceil(CHUNK))
+                .into_par_iter()
+                .map(|c| two((c * CHUNK..((c + 1) * CHUNK).min(n)).map(|i| faces.face(i))))
+                .collect()
+        });
+        (combine(chunks.iter().map(|c| &c.0)), combine(chunks.iter().map(|c| &c.1)))
+    } else {
+        run_kernel(FanLoopTwo {
+            vertices,
+            faces: faces.iter(),
+            references: [reference, second],
+            options: [options, &other],
+        })
+    };
+    let divisors = [6.0, 24.0, 120.0, 120.0];
+    (finish(a, reference, divisors), finish(b, second, divisors))
 }
 
 /// Faces per chunk of a parallel integration (meshes up to this size are summed in one sequence).
@@ -302,6 +354,8 @@ struct FanLoop<'a, I> {
 }
 
 impl<'f, I: Iterator<Item = &'f [u32]>> KernelLoop for FanLoop<'_, I> {
+    type Output = RawSums;
+
     #[inline(always)]
     fn sums<const FMA: bool>(self) -> RawSums {
         let (vertices, reference) = (self.vertices, self.reference);
@@ -320,6 +374,43 @@ impl<'f, I: Iterator<Item = &'f [u32]>> KernelLoop for FanLoop<'_, I> {
             }
         }
         batch.finish::<FMA>(acc, accurate)
+    }
+}
+
+/// [`volume_integrals_about_two`]'s loop: [`FanLoop`] feeding two batches, each with its own
+/// reference point, from one gather of the corners.
+struct FanLoopTwo<'a, I> {
+    vertices: &'a [[f64; 3]],
+    faces: I,
+    references: [[f64; 3]; 2],
+    options: [&'a IntegrationOptions; 2],
+}
+
+impl<'f, I: Iterator<Item = &'f [u32]>> KernelLoop for FanLoopTwo<'_, I> {
+    type Output = (RawSums, RawSums);
+
+    #[inline(always)]
+    fn sums<const FMA: bool>(self) -> (RawSums, RawSums) {
+        let (vertices, [r0, r1]) = (self.vertices, self.references);
+        let accurate = self.options.map(|o| o.accurate_faces);
+        let mut acc = self.options.map(|o| Accumulator::new(o.summation));
+        let mut batch = [Batch::new(), Batch::new()];
+        for face in self.faces {
+            if face.len() < 3 {
+                continue;
+            }
+            let a = vertices[face[0] as usize];
+            let (a0, a1) = (sub(a, r0), sub(a, r1));
+            for k in 1..face.len() - 1 {
+                let b = vertices[face[k] as usize];
+                let c = vertices[face[k + 1] as usize];
+                batch[0].add::<FMA>(a0, sub(b, r0), sub(c, r0), &mut acc[0], accurate[0]);
+                batch[1].add::<FMA>(a1, sub(b, r1), sub(c, r1), &mut acc[1], accurate[1]);
+            }
+        }
+        let [a0, a1] = acc;
+        let [b0, b1] = batch;
+        (b0.finish::<FMA>(a0, accurate[0]), b1.finish::<FMA>(a1, accurate[1]))
     }
 }
 
@@ -424,6 +515,42 @@ mod tests {
             f.push(&q);
         }
         (v, f)
+    }
+
+    /// [`volume_integrals_about_two`] gives, bit for bit, what [`volume_integrals`] gives about each
+    /// reference point: on polygons (fans) and on a mesh of more than two chunks (the chunked sums),
+    /// with plain and compensated sums, on one thread and on three.
+    #[test]
+    fn two_references_in_one_pass_are_two_passes() {
+        let (v, f) = cube_quads(0.37);
+        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || (crate::xorshift(&mut rng) >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+        let n = 3 * CHUNK + 11;
+        let big_v: Vec<[f64; 3]> = (0..n + 2).map(|_| [next(), 1e3 * next(), next() + 7.0]).collect();
+        let tris: Vec<[u32; 3]> = (0..n as u32).map(|i| [i, i + 1, i + 2]).collect();
+        let big_f = Polygons::from_triangles(&tris);
+        let bits = |t: &VolumeIntegrals| (t.to_array().map(f64::to_bits), t.low.map(f64::to_bits), t.reference.map(f64::to_bits));
+        for threads in [1, 3] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
+            pool.install(|| {
+                for (v, f) in [(&v, &f), (&big_v, &big_f)] {
+                    for summation in [Summation::Compensated, Summation::Plain] {
+                        let opts = IntegrationOptions {
+                            summation,
+                            ..IntegrationOptions::accurate()
+                        };
+                        let second = [-0.4, 3.0e-3, 9.5];
+                        let (a, b) = volume_integrals_about_two(v, f, &opts, second);
+                        let other = IntegrationOptions {
+                            reference: Some(second),
+                            ..opts
+                        };
+                        assert_eq!(bits(&a), bits(&volume_integrals(v, f, &opts)));
+                        assert_eq!(bits(&b), bits(&volume_integrals(v, f, &other)));
+                    }
+                }
+            });
+        }
     }
 
     #[test]

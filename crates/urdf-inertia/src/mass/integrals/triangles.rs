@@ -32,8 +32,10 @@ pub(super) type RawSums = ([f64; 10], [f64; 10]);
 
 /// A loop over triangles feeding [`Batch`]es, compiled for the build's CPU and for x86-64-v3.
 pub(super) trait KernelLoop {
+    /// [`RawSums`], or several of them for a loop that feeds several batches.
+    type Output;
     /// The sums; `FMA`: compiled where hardware FMA is enabled (selects [`two_prod_in`]).
-    fn sums<const FMA: bool>(self) -> RawSums;
+    fn sums<const FMA: bool>(self) -> Self::Output;
 }
 
 /// Runs a kernel loop in the best instruction set the CPU has, detected at run time (the binary
@@ -43,7 +45,7 @@ pub(super) trait KernelLoop {
 /// (`kernel_paths_agree` checks it). The dispatch takes a third fewer instructions per face than
 /// the SSE2 build (figures: docs/benchmarks.md, "Figures behind choices in the code").
 #[inline(always)]
-pub(super) fn run_kernel<L: KernelLoop>(kernel: L) -> RawSums {
+pub(super) fn run_kernel<L: KernelLoop>(kernel: L) -> L::Output {
     #[cfg(target_arch = "x86_64")]
     if let Some(v3) = pulp::x86::V3::try_new() {
         return v3.vectorize(WithFma(kernel));
@@ -55,11 +57,11 @@ pub(super) fn run_kernel<L: KernelLoop>(kernel: L) -> RawSums {
 struct WithFma<L>(L);
 
 impl<L: KernelLoop> pulp::NullaryFnOnce for WithFma<L> {
-    type Output = RawSums;
+    type Output = L::Output;
 
     // Inlined into pulp's `#[target_feature]` function, so that the whole loop is compiled with it.
     #[inline(always)]
-    fn call(self) -> RawSums {
+    fn call(self) -> L::Output {
         self.0.sums::<true>()
     }
 }
@@ -72,6 +74,8 @@ pub(super) struct TriangleLoop<'a> {
 }
 
 impl KernelLoop for TriangleLoop<'_> {
+    type Output = RawSums;
+
     #[inline(always)]
     fn sums<const FMA: bool>(self) -> RawSums {
         let (shifted, accurate) = (self.shifted, self.options.accurate_faces);

@@ -3,14 +3,14 @@
 use super::geometry::{
     bbox, component_boxes, component_volumes, vector_area, Aabb,
 };
-use super::ladder::Ladder;
+use super::ladder::{Known, Ladder};
 use super::closed_consistent;
 use super::topology::{closed_consistent_split, Edges, Orientation};
 use super::welding::Welding;
 use super::{HealthKind, ModelError, Rung, Solid};
 use crate::geometry::{cross, dot, sub, x_sweep};
-use crate::mass::integrals::{bounding_box_centre, volume_integrals, VolumeIntegrals};
-use crate::mass::{IntegrationOptions, Polygons};
+use crate::mass::integrals::bounding_box_centre;
+use crate::mass::Polygons;
 use crate::mesh::MeshError;
 use std::ops::ControlFlow;
 
@@ -27,7 +27,7 @@ use std::ops::ControlFlow;
 pub(super) fn prove(
     vertices: &[[f64; 3]],
     faces: &Polygons,
-) -> (Option<(Vec<u32>, usize)>, Option<VolumeIntegrals>) {
+) -> (Option<(Vec<u32>, usize)>, Option<Known>) {
     // Below two of the kernel's chunks the integral is one sequence anyway.
     if faces.len() < 1 << 16 {
         return (closed_consistent(faces), None);
@@ -38,7 +38,7 @@ pub(super) fn prove(
         }
         let (proof, t) = rayon::join(
             || closed_consistent_split(faces, vertices.len()),
-            || volume_integrals(vertices, faces, &IntegrationOptions::accurate()),
+            || Known::both(vertices, faces),
         );
         (proof, Some(t))
     })
@@ -52,15 +52,14 @@ pub(super) fn prove(
 pub(super) fn consistent_closed(
     mut ladder: Ladder<'_>,
     vertices: Vec<[f64; 3]>,
-    (stored, known): (Polygons, Option<VolumeIntegrals>),
+    (stored, known): (Polygons, Option<Known>),
     kept: Option<Polygons>,
     (comp, ncomp): (Vec<u32>, usize),
     rung: Rung,
 ) -> Result<Solid, MeshError> {
     // Closed only once welded within tolerance: the stored surface's vector area is not exactly 0.
     let welded = kept.is_some();
-    let t = known
-        .unwrap_or_else(|| volume_integrals(&vertices, &stored, &IntegrationOptions::accurate()));
+    let Known { integrals: t, corner } = known.unwrap_or_else(|| Known::both(&vertices, &stored));
     let inverted = t.t1 < 0.0;
     let mut faces = stored;
     let mut kept = kept;
@@ -130,8 +129,13 @@ pub(super) fn consistent_closed(
     } else {
         0.0
     };
-    // The faces are the stored ones, or all of them reversed: their integrals are known.
-    ladder.known = Some(if inverted { t.negated() } else { t });
+    // The faces are the stored ones, or all of them reversed: their integrals are known (about the
+    // corner, reversed faces are integrated again: fanned from another corner, their round-off
+    // differs from the negated sums').
+    ladder.known = Some(Known {
+        integrals: if inverted { t.negated() } else { t },
+        corner: corner.filter(|_| !inverted),
+    });
     ladder.finish(
         vertices,
         faces,
@@ -148,9 +152,16 @@ pub(super) fn welded_closed(
     w: Welding,
     components: (Vec<u32>, usize),
     rung: Rung,
-    known: Option<VolumeIntegrals>,
+    known: Option<Known>,
 ) -> Result<Solid, MeshError> {
-    let known = known.filter(|_| w.duplicates == 0 && w.cancelled == 0);
+    // The integrals about the centre stand for the welded faces; the round-off estimate integrates
+    // the welded vertices about their own box's corner.
+    let known = known
+        .filter(|_| w.duplicates == 0 && w.cancelled == 0)
+        .map(|k| Known {
+            corner: None,
+            ..k
+        });
     consistent_closed(ladder, w.vertices, (w.stored, known), Some(w.kept), components, rung)
 }
 

@@ -2,13 +2,46 @@
 //! shells' classification and the last step (integrate, check the volume, estimate the error).
 
 use super::geometry::{bbox, unit_props};
-use super::model::{check_volume, reach, round_off, Lever, Model};
+use super::model::{check_volume, reach, round_off, round_off_against, Lever, Model};
 use super::{ErrorEstimate, HealthKind, HealthMessage, HealthOptions, ModelError, Rung, Solid};
 use crate::geometry::dot;
-use crate::mass::integrals::VolumeIntegrals;
-use crate::mass::{MassProperties, Polygons};
+use crate::geometry::Aabb;
+use crate::mass::integrals::{volume_integrals_about_two, VolumeIntegrals};
+use crate::mass::{IntegrationOptions, MassProperties, Polygons};
 use crate::mesh::{winding_shells, MeshError, MeshErrorKind, RawMesh};
 use std::path::Path;
+
+/// Integrals of the faces and vertices [`Ladder::finish`] gets, computed before it: about the box's
+/// centre, and, when they came from the same pass ([`volume_integrals_about_two`]), the vertices'
+/// box with the integrals about its lowest corner, which the round-off estimate compares them with.
+#[derive(Clone)]
+pub(super) struct Known {
+    pub(super) integrals: VolumeIntegrals,
+    pub(super) corner: Option<(Aabb, VolumeIntegrals)>,
+}
+
+impl Known {
+    /// The integrals about the box's centre and lowest corner, in one pass over the faces. The box
+    /// is found once, on the pool: its centre is
+    /// [`crate::mass::integrals::bounding_box_centre`]'s (a serial pass of its own
+    /// otherwise) whenever no side of it is at a zero coordinate; minimum and maximum are then the
+    /// same bits whatever the order of the vertices, while a box with a side at 0.0 or −0.0 may
+    /// differ from it in the sign of that zero, and keeps the serial pass.
+    pub(super) fn both(vertices: &[[f64; 3]], faces: &Polygons) -> Known {
+        let bounds = bbox(vertices);
+        let (lo, hi) = (bounds.lo, bounds.hi);
+        let plain = lo.iter().chain(&hi).all(|x| x.is_finite() && *x != 0.0);
+        let options = IntegrationOptions {
+            reference: plain.then(|| [0, 1, 2].map(|k| lo[k] + 0.5 * (hi[k] - lo[k]))),
+            ..IntegrationOptions::accurate()
+        };
+        let (integrals, corner) = volume_integrals_about_two(vertices, faces, &options, lo);
+        Known {
+            integrals,
+            corner: Some((bounds, corner)),
+        }
+    }
+}
 
 /// Shared by the rungs: where the mesh came from and what has been said about it.
 #[derive(Clone)]
@@ -19,8 +52,8 @@ pub(super) struct Ladder<'a> {
     pub(super) notes: Vec<HealthMessage>,
     pub(super) faces_read: usize,
     /// The integrals of the faces `finish` gets, when a rung already has them (a clean mesh is then
-    /// integrated twice, not three times: once here, once about a second reference point).
-    pub(super) known: Option<VolumeIntegrals>,
+    /// integrated once, about both reference points, not three times).
+    pub(super) known: Option<Known>,
     /// The faces as stored, where welding and the rungs changed them (whose winding number defines
     /// the solid where shells overlap).
     pub(super) as_stored: winding_shells::AsStored,
@@ -208,14 +241,17 @@ impl<'a> Ladder<'a> {
         let mut model = model.into();
         let mut vertices = vertices;
         let faces = self.shells(&mut vertices, faces, &rung, &mut model);
-        let unit = match self.known.take() {
-            Some(t) => MassProperties::from_integrals(&t, 1.0),
-            None => unit_props(&vertices, &faces, None),
+        let (unit, corner) = match self.known.take() {
+            Some(k) => (MassProperties::from_integrals(&k.integrals, 1.0), k.corner),
+            None => (unit_props(&vertices, &faces, None), None),
         };
-        // One pass for the box both checks use.
-        let bounds = bbox(&vertices);
+        // One pass for the box both checks use, unless the integrals came with it.
+        let bounds = corner.as_ref().map_or_else(|| bbox(&vertices), |c| c.0);
         check_volume(&vertices, &faces, bounds, unit.mass, self.path)?;
-        let round_off = round_off(&vertices, &faces, bounds.lo, &unit);
+        let round_off = match corner {
+            Some((_, t)) => round_off_against(&MassProperties::from_integrals(&t, 1.0), &unit),
+            None => round_off(&vertices, &faces, bounds.lo, &unit),
+        };
         let source = model.source;
         let bound = model.bound(&unit, &vertices);
         let model_error = bound.relative;
@@ -255,5 +291,62 @@ impl<'a> Ladder<'a> {
             error,
             faces_read: self.faces_read,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mass::integrals::volume_integrals;
+
+    /// [`Known::both`] gives the bits of the two separate integrations it replaces, about
+    /// [`crate::mass::integrals::bounding_box_centre`] and about the box's lowest corner: on a box
+    /// with no side at zero (the centre from the pooled box), with sides at 0.0 and at −0.0 (the
+    /// serial centre), and on a mesh of more than two of the kernel's chunks.
+    #[test]
+    fn both_integrals_are_the_separate_passes() {
+        let cube = |lo: [f64; 3], hi: [f64; 3]| {
+            let v: Vec<[f64; 3]> = (0..8)
+                .map(|i| [0, 1, 2].map(|k| if i >> k & 1 == 1 { hi[k] } else { lo[k] }))
+                .collect();
+            let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+            let mut f = Polygons::new();
+            for q in &quads {
+                f.push(q);
+            }
+            (v, f)
+        };
+        let (mut torus_v, mut torus_f) = (Vec::new(), Vec::new());
+        let (m, n) = (400u32, 200u32);
+        for i in 0..m {
+            for j in 0..n {
+                let (u, w) = (f64::from(i) * 0.0157, f64::from(j) * 0.0314);
+                torus_v.push([(1.0 + 0.3 * w.cos()) * u.cos() + 2.5, (1.0 + 0.3 * w.cos()) * u.sin() - 4.0, 0.3 * w.sin() + 0.5]);
+                let (a, b) = (i * n + j, ((i + 1) % m) * n + j);
+                let (c, d) = (i * n + (j + 1) % n, ((i + 1) % m) * n + (j + 1) % n);
+                torus_f.extend([[a, b, d], [a, d, c]]);
+            }
+        }
+        let torus = (torus_v, Polygons::from_triangles(&torus_f));
+        let bits = |t: &VolumeIntegrals| {
+            (t.to_array().map(f64::to_bits), t.low.map(f64::to_bits), t.reference.map(f64::to_bits))
+        };
+        for (v, f) in [
+            cube([0.25, -3.0, 1.5], [2.0, -0.5, 4.0]),
+            cube([0.0, -1.0, 1.0], [2.0, 3.0, 4.0]),
+            cube([-2.0, -1.0, -0.0], [2.0, 0.0, 4.0]),
+            torus,
+        ] {
+            let k = Known::both(&v, &f);
+            let (b, corner) = k.corner.expect("both");
+            assert_eq!(b, bbox(&v));
+            let accurate = IntegrationOptions::accurate();
+            let about_lo = IntegrationOptions {
+                reference: Some(b.lo),
+                ..accurate
+            };
+            assert_eq!(bits(&k.integrals), bits(&volume_integrals(&v, &f, &accurate)));
+            assert_eq!(bits(&corner), bits(&volume_integrals(&v, &f, &about_lo)));
+        }
     }
 }

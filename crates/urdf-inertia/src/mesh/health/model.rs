@@ -93,7 +93,11 @@ pub(super) fn reach(unit: &MassProperties, vertices: &[[f64; 3]]) -> f64 {
 /// The round-off estimate: the relative disagreement of volume and central inertia integrated about
 /// two reference points (bounding-box centre and corner), never below [`ROUND_OFF_FLOOR`].
 pub(super) fn round_off(vertices: &[[f64; 3]], faces: &Polygons, lo: [f64; 3], base: &MassProperties) -> f64 {
-    let other = unit_props(vertices, faces, Some(lo));
+    round_off_against(&unit_props(vertices, faces, Some(lo)), base)
+}
+
+/// [`round_off`] from the properties integrated about the second reference point, `other`.
+pub(super) fn round_off_against(other: &MassProperties, base: &MassProperties) -> f64 {
     let mut d = [[0.0; 3]; 3];
     for i in 0..3 {
         for j in 0..3 {
