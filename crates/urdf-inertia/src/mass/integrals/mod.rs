@@ -195,6 +195,11 @@ pub fn bounding_box_centre(vertices: &[[f64; 3]]) -> [f64; 3] {
             hi[k] = hi[k].max(v[k]);
         }
     }
+    box_centre(lo, hi)
+}
+
+/// The centre of the box from `lo` to `hi`, as [`bounding_box_centre`] takes it.
+pub(crate) fn box_centre(lo: [f64; 3], hi: [f64; 3]) -> [f64; 3] {
     // lo + (hi - lo)/2 stays inside [lo, hi] without overflow; the centre only has to be near the mesh.
     [0, 1, 2].map(|k| lo[k] + 0.5 * (hi[k] - lo[k]))
 }
@@ -297,31 +302,22 @@ pub fn volume_integrals_about_two(
         reference: Some(second),
         ..*options
     };
-    let two = |faces| {
-        run_kernel(FanLoopTwo {
-            vertices,
-            faces,
-            references: [reference, second],
-            options: [options, &other],
-        })
-    };
+    let (references, both) = ([reference, second], [options, &other]);
     let n = faces.len();
     let (a, b) = if options.summation == Summation::Compensated && n > CHUNK {
         use rayon::prelude::*;
         let chunks: Vec<(RawSums, RawSums)> = crate::threads::install(|| {
             (0..n.div_ceil(CHUNK))
                 .into_par_iter()
-                .map(|c| two((c * CHUNK..((c + 1) * CHUNK).min(n)).map(|i| faces.face(i))))
+                .map(|c| {
+                    let range = c * CHUNK..((c + 1) * CHUNK).min(n);
+                    fan_sums_two(vertices, range.map(|i| faces.face(i)), references, both)
+                })
                 .collect()
         });
         (combine(chunks.iter().map(|c| &c.0)), combine(chunks.iter().map(|c| &c.1)))
     } else {
-        run_kernel(FanLoopTwo {
-            vertices,
-            faces: faces.iter(),
-            references: [reference, second],
-            options: [options, &other],
-        })
+        fan_sums_two(vertices, faces.iter(), references, both)
     };
     let divisors = [6.0, 24.0, 120.0, 120.0];
     (finish(a, reference, divisors), finish(b, second, divisors))
@@ -341,6 +337,21 @@ fn fan_sums<'a>(
         vertices,
         faces,
         reference,
+        options,
+    })
+}
+
+/// [`fan_sums`] about two reference points at once, each with its options.
+fn fan_sums_two<'a>(
+    vertices: &[[f64; 3]],
+    faces: impl Iterator<Item = &'a [u32]>,
+    references: [[f64; 3]; 2],
+    options: [&IntegrationOptions; 2],
+) -> (RawSums, RawSums) {
+    run_kernel(FanLoopTwo {
+        vertices,
+        faces,
+        references,
         options,
     })
 }

@@ -6,7 +6,7 @@ use super::model::{check_volume, reach, round_off, round_off_against, Lever, Mod
 use super::{ErrorEstimate, HealthKind, HealthMessage, HealthOptions, ModelError, Rung, Solid};
 use crate::geometry::dot;
 use crate::geometry::Aabb;
-use crate::mass::integrals::{volume_integrals_about_two, VolumeIntegrals};
+use crate::mass::integrals::{box_centre, volume_integrals_about_two, VolumeIntegrals};
 use crate::mass::{IntegrationOptions, MassProperties, Polygons};
 use crate::mesh::{winding_shells, MeshError, MeshErrorKind, RawMesh};
 use std::path::Path;
@@ -32,7 +32,7 @@ impl Known {
         let (lo, hi) = (bounds.lo, bounds.hi);
         let plain = lo.iter().chain(&hi).all(|x| x.is_finite() && *x != 0.0);
         let options = IntegrationOptions {
-            reference: plain.then(|| [0, 1, 2].map(|k| lo[k] + 0.5 * (hi[k] - lo[k]))),
+            reference: plain.then(|| box_centre(lo, hi)),
             ..IntegrationOptions::accurate()
         };
         let (integrals, corner) = volume_integrals_about_two(vertices, faces, &options, lo);
@@ -339,7 +339,12 @@ mod tests {
         ] {
             let k = Known::both(&v, &f);
             let (b, corner) = k.corner.expect("both");
-            assert_eq!(b, bbox(&v));
+            // The box it carries, against the coordinates' own extremes.
+            for k in 0..3 {
+                let c = || v.iter().map(|p| p[k]);
+                assert_eq!(b.lo[k], c().fold(f64::INFINITY, f64::min), "axis {k}");
+                assert_eq!(b.hi[k], c().fold(f64::NEG_INFINITY, f64::max), "axis {k}");
+            }
             let accurate = IntegrationOptions::accurate();
             let about_lo = IntegrationOptions {
                 reference: Some(b.lo),
