@@ -32,6 +32,9 @@ const MAX_CUTS: usize = 40;
 /// as lying in the piece's plane.
 const NEAR: f64 = 1e-7;
 
+/// Seeds of the weights of the last points [`Faces::decide_where`] tries in a piece.
+const GENERIC: [f64; 2] = [0.137, 0.571];
+
 /// Rays tried on a patch of uncut faces before it is split like a cut one.
 const MAX_TRIES: usize = 8;
 
@@ -425,10 +428,19 @@ impl Faces<'_> {
         axes.sort_by(|&a, &b| n[b].abs().total_cmp(&n[a].abs()));
         let mid = centroid(piece);
         let inner = piece.iter().map(|v| [0, 1, 2].map(|k| (3.0 * mid[k] + v[k]) / 4.0));
+        // Then points of no regular position: a cell that spans seams ([`Faces::seams`]) of two
+        // regular triangulations can have its centre and the points above on one of them.
+        let generic = GENERIC.iter().map(|&seed| {
+            let w: Vec<f64> = (0..piece.len())
+                .map(|i| 1.0 + (seed + 0.618_033_988_749_895 * i as f64).fract())
+                .collect();
+            let sum: f64 = w.iter().sum();
+            [0, 1, 2].map(|k| piece.iter().zip(&w).map(|(v, w)| v[k] * w).sum::<f64>() / sum)
+        });
         let mut skip = vec![t];
         // Whether no point and no ray was refused before the one that decides.
         let mut first = true;
-        for p in std::iter::once(mid).chain(inner) {
+        for p in std::iter::once(mid).chain(inner).chain(generic) {
             if !usable(p) {
                 first = false;
                 continue;
@@ -529,6 +541,50 @@ impl Faces<'_> {
         })
     }
 
+    /// The edges (coplanar triangle, its edge) along which a piece of `t` need not be cut, where
+    /// two coplanar triangles tile the plane on either side (two triangulations of one face, as
+    /// coincident shells have). Each is used by exactly two of the `coplanar` triangles, both
+    /// exactly in the plane, one each way, that face the same way relative to `t` (exact
+    /// `orient2d` in projection, neither degenerate) and are both numbered below `t` or both above
+    /// it. The two then lie on its two sides (a triangle lies to the left of its edges seen from
+    /// its own normal), so crossing it one of them stops covering a point and the other starts:
+    /// the jumps covering a point add up the same on both sides, and whether a lower-numbered
+    /// triangle covers it does not change. In front of the piece nothing changes either: a
+    /// triangle leaving the plane along the edge would meet `t`'s interior, a blocker whose plane
+    /// still cuts there. So a cell may span a seam and one decision holds on all of it; its
+    /// decision's point still keeps off the seam (`apart`), where covering is not clear.
+    fn seams(&self, t: u32, coplanar: &[Coplanar]) -> Vec<(usize, usize)> {
+        let k = normal_axis(self.corners[t as usize]);
+        let turn = |c: Corners| orient2d(c2(c[0], k), c2(c[1], k), c2(c[2], k));
+        let facing = turn(self.corners[t as usize]);
+        // Per exact coplanar triangle whose orientation is certain: its edges' uses.
+        let mut uses = Vec::new();
+        for (i, cp) in coplanar.iter().enumerate().filter(|(_, cp)| cp.exact) {
+            let s = turn(self.corners[cp.u as usize]) * facing;
+            if s == 0.0 || (s > 0.0) != cp.same {
+                continue;
+            }
+            let v = self.tris[cp.u as usize];
+            for e in 0..3 {
+                let (a, b) = (v[e], v[NEXT[e]]);
+                if a != b {
+                    uses.push(((a.min(b), a.max(b)), a < b, i, e));
+                }
+            }
+        }
+        uses.sort_unstable();
+        let mut seams = Vec::new();
+        for g in uses.chunk_by(|x, y| x.0 == y.0) {
+            if let [x, y] = g {
+                let (cx, cy) = (&coplanar[x.2], &coplanar[y.2]);
+                if x.1 != y.1 && cx.same == cy.same && (cx.u < t) == (cy.u < t) {
+                    seams.extend([(x.2, x.3), (y.2, y.3)]);
+                }
+            }
+        }
+        seams
+    }
+
     fn emit_whole(&self, t: u32, kappa: i64, out: &mut Resolved) {
         let tri = self.tris[t as usize];
         out.changed |= kappa != self.sign[t as usize];
@@ -557,8 +613,6 @@ impl Faces<'_> {
     /// planes into convex cells that no triangle meets any more, each decided by a ray, or bounded
     /// when it is a sliver the plane tests cannot tell from a cut. Whether it did so.
     fn cut(&self, piece: &Corners, t: u32, blockers: &[u32], seen: &mut Seen, out: &mut Resolved) -> bool {
-        let tc = self.corners[t as usize];
-        let plane = &self.planes[t as usize];
         let nt = {
             let c = self.corners[t as usize];
             cross(sub(c[1], c[0]), sub(c[2], c[0]))
@@ -575,6 +629,7 @@ impl Faces<'_> {
                 .fold(0.0, f64::max);
             // In t's plane exactly: a corner of t is, without a predicate; the others by orient3d.
             let exact = *self.in_plane.borrow_mut().entry((t, u)).or_insert_with(|| {
+                let (tc, plane) = (self.corners[t as usize], &self.planes[t as usize]);
                 [a, b, c].iter().all(|&x| tc.contains(&x) || plane.side(x) == 0.0)
             });
             if exact || gap <= NEAR * self.grid.bounds.diagonal() {
@@ -583,12 +638,17 @@ impl Faces<'_> {
                 if !exact {
                     out.bound += 2.0 * area(piece) * gap;
                 }
-                let cp = Coplanar::new(u, [a, b, c], nt, self.margin);
-                planes.extend_from_slice(&cp.edges);
-                coplanar.push(cp);
+                coplanar.push(Coplanar::new(u, [a, b, c], nt, self.margin, exact));
             } else {
                 planes.push((a, cross(ab, ac), self.margin * norm(ab) * norm(ac)));
             }
+        }
+        // Whether each plane cuts: all but the seams between coplanar triangles.
+        let mut cuts = vec![true; planes.len()];
+        let seams = self.seams(t, &coplanar);
+        for (i, cp) in coplanar.iter().enumerate() {
+            planes.extend_from_slice(&cp.edges);
+            cuts.extend((0..3).map(|k| !seams.contains(&(i, k))));
         }
         // Only planes that cross the piece can cut it (its cells lie inside it, so a plane that
         // leaves the piece whole leaves each of its cells whole in `cells`): those along its
@@ -599,8 +659,9 @@ impl Faces<'_> {
         // keeps the decision's points off every plane.
         let crossing: Vec<_> = planes
             .iter()
-            .copied()
-            .filter(|&(a, n, m)| !leaves_whole(&piece.map(|x| dot(n, sub(x, a))), m))
+            .zip(&cuts)
+            .filter(|&(&(a, n, m), &cuts)| cuts && !leaves_whole(&piece.map(|x| dot(n, sub(x, a))), m))
+            .map(|(&plane, _)| plane)
             .collect();
         if crossing.len() > MAX_CUTS {
             return false;
@@ -649,10 +710,12 @@ struct Coplanar {
     u: u32,
     edges: [([f64; 3], [f64; 3], f64); 3],
     same: bool,
+    /// Exactly in the plane (not only within [`NEAR`] of it).
+    exact: bool,
 }
 
 impl Coplanar {
-    fn new(u: u32, c: Corners, nt: [f64; 3], margin: f64) -> Coplanar {
+    fn new(u: u32, c: Corners, nt: [f64; 3], margin: f64, exact: bool) -> Coplanar {
         let nu = cross(sub(c[1], c[0]), sub(c[2], c[0]));
         let edges = [0, 1, 2].map(|k| {
             let (a, b, o) = (c[k], c[(k + 1) % 3], c[(k + 2) % 3]);
@@ -666,6 +729,7 @@ impl Coplanar {
             u,
             edges,
             same: dot(nu, nt) > 0.0,
+            exact,
         }
     }
 

@@ -263,6 +263,12 @@ pub(super) struct Plane {
     /// The 2×2 minors of b − a and c − a (the normal), and the sums of their products' magnitudes.
     minor: [f64; 3],
     size: [f64; 3],
+    /// An axis along which the three corners have one coordinate, and that coordinate: the plane
+    /// is perpendicular to it, and a point with that coordinate lies in it (orient3d is exactly
+    /// zero), which the filter cannot certify and the adaptive stages find at their dearest.
+    /// Flat faces of CAD parts often are so (coincident shells: every corner of the other shell's
+    /// triangles in the face asks).
+    level: Option<(usize, f64)>,
 }
 
 impl Plane {
@@ -276,10 +282,12 @@ impl Plane {
         let (bdxcdy, cdxbdy) = (bdx * cdy, cdx * bdy);
         let (cdxady, adxcdy) = (cdx * ady, adx * cdy);
         let (adxbdy, bdxady) = (adx * bdy, bdx * ady);
+        let level = (0..3).find(|&k| a[k] == b[k] && b[k] == c[k]).map(|k| (k, a[k]));
         Plane {
             a,
             b,
             c,
+            level,
             minor: [bdxcdy - cdxbdy, cdxady - adxcdy, adxbdy - bdxady],
             size: [
                 bdxcdy.abs() + cdxbdy.abs(),
@@ -292,6 +300,11 @@ impl Plane {
     /// A value with the sign of `orient3d(a, b, c, d)` (zero exactly when `d` is in the plane).
     #[inline(always)] // a few flops run for every pair of neighbouring triangles
     pub(super) fn side(&self, d: [f64; 3]) -> f64 {
+        if let Some((k, x)) = self.level {
+            if d[k] == x {
+                return 0.0;
+            }
+        }
         let (adz, bdz, cdz) = (d[0] - self.a[0], d[1] - self.a[1], d[2] - self.a[2]);
         let det = adz * self.minor[0] + bdz * self.minor[1] + cdz * self.minor[2];
         let permanent = self.size[0] * adz.abs() + self.size[1] * bdz.abs() + self.size[2] * cdz.abs();
@@ -415,6 +428,48 @@ mod tests {
             let theirs = robust::orient3d(c3(a), c3(b), c3(c), c3(d));
             assert_eq!(ours.partial_cmp(&0.0), theirs.partial_cmp(&0.0), "{a:?} {b:?} {c:?} {d:?}");
         }
+    }
+
+    /// A triangle perpendicular to an axis (its corners share that coordinate exactly, as on the
+    /// flat faces of CAD parts): its side of points at that coordinate is zero without the
+    /// adaptive stages, and of every other point `robust::orient3d`'s sign; also for collinear
+    /// corners and coordinates of no exact binary value.
+    #[test]
+    fn a_level_plane_side_is_orient3ds_sign() {
+        let mut state = 0x1405_7B7E_F767_814F_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let mut zeros = 0;
+        for i in 0..30_000 {
+            let k = i % 3;
+            let level = [0.3, -1.0 / 3.0, 1e-7, 0.0][i % 4];
+            let mut t = [0; 3].map(|_| [next(), next(), next()]);
+            for c in &mut t {
+                c[k] = level;
+            }
+            if i % 9 == 0 {
+                t[2] = [0, 1, 2].map(|j| 0.5 * (t[0][j] + t[1][j]));
+            }
+            let plane = Plane::new(&t);
+            assert_eq!(plane.level, Some((k, level)));
+            let mut d = [next(), next(), next()];
+            match i % 5 {
+                0 | 1 => d[k] = level,
+                2 => d[k] = level + f64::EPSILON * next(),
+                _ => {}
+            }
+            let ours = plane.side(d);
+            let theirs = robust::orient3d(c3(t[0]), c3(t[1]), c3(t[2]), c3(d));
+            zeros += usize::from(ours == 0.0);
+            assert_eq!(ours.partial_cmp(&0.0), theirs.partial_cmp(&0.0), "{t:?} {d:?}");
+        }
+        assert!(zeros > 10_000, "{zeros}");
+        // Corners that share no coordinate: no level.
+        assert_eq!(Plane::new(&[[0.0, 0.0, 0.0], [1.0, 0.5, 0.2], [0.3, 1.0, 0.7]]).level, None);
     }
 
     /// The crossing as orient3d alone decides it: the segment's sides of the plane, then the sides
