@@ -349,6 +349,16 @@ fn crossing(s: [f64; 3], e: [f64; 3], axis: usize, t: &Corners, plane: &Plane) -
 mod tests {
     use super::*;
 
+    /// Xorshift numbers uniform in [−½, ½) from `state`.
+    fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        }
+    }
+
     /// The unit cube's twelve triangles, outward.
     fn cube() -> Vec<Corners> {
         let p = |i: usize| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64];
@@ -370,13 +380,7 @@ mod tests {
     /// over to the adaptive stages (points on or within rounding of the plane).
     #[test]
     fn orient3d_is_robusts() {
-        let mut state = 0x9E37_79B9_7F4A_7C15_u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut next = uniform(0x9E37_79B9_7F4A_7C15_u64);
         for i in 0..20_000 {
             let [a, b, c] = [0; 3].map(|_| [next(), next(), next()]);
             let d = match i % 3 {
@@ -399,13 +403,7 @@ mod tests {
     /// points on the plane up to rounding and for flat or degenerate triangles.
     #[test]
     fn plane_side_is_orient3ds_sign() {
-        let mut state = 0x2545_F491_4F6C_DD1D_u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut next = uniform(0x2545_F491_4F6C_DD1D_u64);
         for i in 0..30_000 {
             let [a, mut b, mut c] = [0; 3].map(|_| [next(), next(), next()]);
             if i % 7 == 0 {
@@ -436,13 +434,7 @@ mod tests {
     /// corners and coordinates of no exact binary value.
     #[test]
     fn a_level_plane_side_is_orient3ds_sign() {
-        let mut state = 0x1405_7B7E_F767_814F_u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut next = uniform(0x1405_7B7E_F767_814F_u64);
         let mut zeros = 0;
         for i in 0..30_000 {
             let k = i % 3;
@@ -507,13 +499,7 @@ mod tests {
     /// segments through corners, along edges, starting in the plane, and coplanar triangles.
     #[test]
     fn crossing_is_orient3ds() {
-        let mut state = 0x5851_F42D_4C95_7F2D_u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut next = uniform(0x5851_F42D_4C95_7F2D_u64);
         let (mut through, mut degenerate) = (0, 0);
         for i in 0..40_000 {
             let [a, b, mut c] = [0; 3].map(|_| [next(), next(), next()]);
