@@ -135,52 +135,6 @@ fn slices_beyond_the_overlap_budget_are_classified_and_unchanged() {
     assert_small(&s);
 }
 
-/// A box from `lo` to `hi` whose every face is an `n` × `n` grid of squares, each two triangles
-/// (outward): the same solid as [`common::box_at`], triangulated otherwise.
-fn grid_box(lo: [f64; 3], hi: [f64; 3], n: u32) -> Mesh {
-    // The last line at `hi` itself (lo + (hi − lo) need not round to it: the faces would not meet).
-    let at = |k: usize, i: u32| {
-        if i == n {
-            hi[k]
-        } else {
-            lo[k] + (hi[k] - lo[k]) * f64::from(i) / f64::from(n)
-        }
-    };
-    let (mut v, mut f) = (Vec::new(), Vec::new());
-    // Each face: the axis it is perpendicular to, its side, and two in-plane axes in the order
-    // that makes the grid's squares turn outward.
-    for (k, top) in [
-        (0, false),
-        (0, true),
-        (1, false),
-        (1, true),
-        (2, false),
-        (2, true),
-    ] {
-        let (mut a, mut b) = ((k + 1) % 3, (k + 2) % 3);
-        if !top {
-            std::mem::swap(&mut a, &mut b);
-        }
-        let base = v.len() as u32;
-        for i in 0..=n {
-            for j in 0..=n {
-                let mut p = [0.0; 3];
-                p[k] = if top { hi[k] } else { lo[k] };
-                (p[a], p[b]) = (at(a, i), at(b, j));
-                v.push(p);
-            }
-        }
-        let id = |i: u32, j: u32| base + i * (n + 1) + j;
-        for i in 0..n {
-            for j in 0..n {
-                let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
-                f.extend([[q[0], q[1], q[2]], [q[0], q[2], q[3]]]);
-            }
-        }
-    }
-    (v, f)
-}
-
 /// Two boxes stacked on a face that each triangulates its own way (a 3 × 3 and a 4 × 4 grid), as
 /// two bodies of an assembly exported as one mesh: the faces where they touch bound nothing (both
 /// sides are inside), the solid is both boxes, and each of those triangles, cut by a dozen of the
@@ -188,8 +142,8 @@ fn grid_box(lo: [f64; 3], hi: [f64; 3], n: u32) -> Mesh {
 #[test]
 fn boxes_stacked_on_a_face_triangulated_twice() {
     let (lo, mid, hi) = ([0.0, 0.0, 0.0], [1.0, 0.7, 0.3], [1.0, 0.7, 0.9]);
-    let a = grid_box(lo, mid, 3);
-    let b = grid_box([0.0, 0.0, 0.3], hi, 4);
+    let a = common::grid_box(lo, mid, 3);
+    let b = common::grid_box([0.0, 0.0, 0.3], hi, 4);
     let s = solid(&together(&[(&a, false), (&b, false)]));
     let exact = exact_sum(&[
         (1, &common::box_at(lo, mid)),
@@ -208,7 +162,10 @@ fn boxes_stacked_on_a_face_triangulated_twice() {
 #[test]
 fn a_box_stored_twice_triangulated_two_ways() {
     let (lo, hi) = ([0.1, 0.2, 0.3], [1.1, 0.9, 0.7]);
-    let (v, f) = together(&[(&grid_box(lo, hi, 3), false), (&grid_box(lo, hi, 5), false)]);
+    let (v, f) = together(&[
+        (&common::grid_box(lo, hi, 3), false),
+        (&common::grid_box(lo, hi, 5), false),
+    ]);
     let exact = exact_sum(&[(1, &common::box_at(lo, hi))]);
     // Every 7th face to the front, in turn: a fixed permutation that mixes the copies.
     let mut mixed = Vec::with_capacity(f.len());

@@ -10,7 +10,7 @@
 //! other (exact segment–triangle tests where their boxes overlap, one winding number each way), or
 //! of deciding their faces piece by piece where they touch or cut each other (`crossing`: two
 //! shells touching inside; `cutting`: three, 61,439 faces, two of which cut the third along
-//! circles).
+//! circles; `coincident`: one box stored twice, triangulated as two grids, 51,852 faces).
 //!
 //! `cargo bench --bench open_mesh`. The figures go to docs/benchmarks.md.
 
@@ -73,10 +73,26 @@ fn bench(c: &mut Criterion) {
     // removed (a planar hole: exact caps) around a second one at half the radius (doubly enclosed:
     // dropped), or moved half a radius so that the two touch inside (decided face by face), or two
     // at 0.6 of the radius moved 0.7 each way, which cut the outer one (decided face by face).
+    // And coincident shells as CAD assemblies export them: one box stored twice, its faces a 36 × 36
+    // and a 55 × 55 grid (each triangle of one under a dozen of the other's).
+    let twice = {
+        let (lo, hi) = ([0.0; 3], [1.0; 3]);
+        let (mut v, mut f) = common::grid_box(lo, hi, 36);
+        let (v2, f2) = common::grid_box(lo, hi, 55);
+        let n = v.len() as u32;
+        v.extend(v2);
+        f.extend(f2.iter().map(|t| t.map(|i| i + n)));
+        RawMesh {
+            vertices: v,
+            faces: Polygons::from_triangles(&f),
+            ..RawMesh::default()
+        }
+    };
     let meshes = [
         ("nested", spheres(&[(0.0, 0.5)])),
         ("crossing", spheres(&[(0.5, 0.5)])),
         ("cutting", spheres(&[(-0.7, 0.6), (0.7, 0.6)])),
+        ("coincident", twice),
     ];
     for (name, mesh) in meshes {
         let faces = mesh.faces.len();

@@ -333,6 +333,52 @@ pub fn box_at(lo: [f64; 3], hi: [f64; 3]) -> Mesh {
     (v, f)
 }
 
+/// A box from `lo` to `hi` whose every face is an `n` × `n` grid of squares, each two triangles
+/// (outward): the same solid as [`box_at`], triangulated otherwise.
+pub fn grid_box(lo: [f64; 3], hi: [f64; 3], n: u32) -> Mesh {
+    // The last line at `hi` itself (lo + (hi − lo) need not round to it: the faces would not meet).
+    let at = |k: usize, i: u32| {
+        if i == n {
+            hi[k]
+        } else {
+            lo[k] + (hi[k] - lo[k]) * f64::from(i) / f64::from(n)
+        }
+    };
+    let (mut v, mut f) = (Vec::new(), Vec::new());
+    // Each face: the axis it is perpendicular to, its side, and two in-plane axes in the order
+    // that makes the grid's squares turn outward.
+    for (k, top) in [
+        (0, false),
+        (0, true),
+        (1, false),
+        (1, true),
+        (2, false),
+        (2, true),
+    ] {
+        let (mut a, mut b) = ((k + 1) % 3, (k + 2) % 3);
+        if !top {
+            std::mem::swap(&mut a, &mut b);
+        }
+        let base = v.len() as u32;
+        for i in 0..=n {
+            for j in 0..=n {
+                let mut p = [0.0; 3];
+                p[k] = if top { hi[k] } else { lo[k] };
+                (p[a], p[b]) = (at(a, i), at(b, j));
+                v.push(p);
+            }
+        }
+        let id = |i: u32, j: u32| base + i * (n + 1) + j;
+        for i in 0..n {
+            for j in 0..n {
+                let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+                f.extend([[q[0], q[1], q[2]], [q[0], q[2], q[3]]]);
+            }
+        }
+    }
+    (v, f)
+}
+
 /// A closed cylinder along Z with `n` segments (outward triangles).
 pub fn cylinder_mesh(r: f64, l: f64, n: u32) -> Mesh {
     let mut v = vec![[0.0, 0.0, -l / 2.0], [0.0, 0.0, l / 2.0]];
