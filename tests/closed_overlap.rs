@@ -156,9 +156,10 @@ fn boxes_stacked_on_a_face_triangulated_twice() {
 
 /// One box stored twice, triangulated two ways: w is 2 inside, Ω the box once; each face of one
 /// copy lies on the other's, facing the same way, and where they coincide the lower-numbered
-/// triangle carries both. Also with the faces of the two copies interleaved in the file, so that
-/// the triangles on either side of a seam of one copy are numbered on both sides of a triangle of
-/// the other: which one carries then changes across the seam, which must cut there.
+/// triangle carries both. Also with the faces of the two copies shuffled in the file, so that the
+/// triangles on either side of a seam of one copy may be numbered on both sides of a triangle of
+/// the other. (This does not pin the seams' numbering condition: the result stays exact without
+/// it too; the condition is kept for the argument in `Faces::seams`.)
 #[test]
 fn a_box_stored_twice_triangulated_two_ways() {
     let (lo, hi) = ([0.1, 0.2, 0.3], [1.1, 0.9, 0.7]);

@@ -77,11 +77,10 @@ fn bench(c: &mut Criterion) {
     // and a 55 × 55 grid (each triangle of one under a dozen of the other's).
     let twice = {
         let (lo, hi) = ([0.0; 3], [1.0; 3]);
-        let (mut v, mut f) = common::grid_box(lo, hi, 36);
-        let (v2, f2) = common::grid_box(lo, hi, 55);
-        let n = v.len() as u32;
-        v.extend(v2);
-        f.extend(f2.iter().map(|t| t.map(|i| i + n)));
+        let (v, f) = common::shells::together(&[
+            (&common::grid_box(lo, hi, 36), false),
+            (&common::grid_box(lo, hi, 55), false),
+        ]);
         RawMesh {
             vertices: v,
             faces: Polygons::from_triangles(&f),

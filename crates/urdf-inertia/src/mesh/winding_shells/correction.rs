@@ -541,7 +541,7 @@ impl Faces<'_> {
         })
     }
 
-    /// The edges (coplanar triangle, its edge) along which a piece of `t` need not be cut, where
+    /// Per coplanar triangle, which of its edges a piece of `t` need not be cut along, where
     /// two coplanar triangles tile the plane on either side (two triangulations of one face, as
     /// coincident shells have). Each is used by exactly two of the `coplanar` triangles, both
     /// exactly in the plane, one each way, that face the same way relative to `t` (exact
@@ -553,7 +553,7 @@ impl Faces<'_> {
     /// triangle leaving the plane along the edge would meet `t`'s interior, a blocker whose plane
     /// still cuts there. So a cell may span a seam and one decision holds on all of it; its
     /// decision's point still keeps off the seam (`apart`), where covering is not clear.
-    fn seams(&self, t: u32, coplanar: &[Coplanar]) -> Vec<(usize, usize)> {
+    fn seams(&self, t: u32, coplanar: &[Coplanar]) -> Vec<[bool; 3]> {
         let k = normal_axis(self.corners[t as usize]);
         let turn = |c: Corners| orient2d(c2(c[0], k), c2(c[1], k), c2(c[2], k));
         let facing = turn(self.corners[t as usize]);
@@ -573,12 +573,13 @@ impl Faces<'_> {
             }
         }
         uses.sort_unstable();
-        let mut seams = Vec::new();
+        let mut seams = vec![[false; 3]; coplanar.len()];
         for g in uses.chunk_by(|x, y| x.0 == y.0) {
             if let [x, y] = g {
                 let (cx, cy) = (&coplanar[x.2], &coplanar[y.2]);
                 if x.1 != y.1 && cx.same == cy.same && (cx.u < t) == (cy.u < t) {
-                    seams.extend([(x.2, x.3), (y.2, y.3)]);
+                    seams[x.2][x.3] = true;
+                    seams[y.2][y.3] = true;
                 }
             }
         }
@@ -645,10 +646,9 @@ impl Faces<'_> {
         }
         // Whether each plane cuts: all but the seams between coplanar triangles.
         let mut cuts = vec![true; planes.len()];
-        let seams = self.seams(t, &coplanar);
-        for (i, cp) in coplanar.iter().enumerate() {
+        for (cp, seams) in coplanar.iter().zip(self.seams(t, &coplanar)) {
             planes.extend_from_slice(&cp.edges);
-            cuts.extend((0..3).map(|k| !seams.contains(&(i, k))));
+            cuts.extend(seams.map(|seam| !seam));
         }
         // Only planes that cross the piece can cut it (its cells lie inside it, so a plane that
         // leaves the piece whole leaves each of its cells whole in `cells`): those along its
