@@ -180,3 +180,46 @@ fn a_box_stored_twice_triangulated_two_ways() {
         assert_estimate_at_most(&s, 1e-12);
     }
 }
+
+/// Faces that coincide on part of their plane only: a box standing on part of another's top
+/// (the faces touching bound nothing), and one sunk into it up to that top (the same top plane,
+/// facing the same way, covered in part twice). The edges of the covering faces end inside the
+/// triangles below them (the boxes' sides are off every grid line), so each such triangle is cut
+/// along those edges and decided cell by cell, while the lines of the edges beyond their ends
+/// cut nothing: a cut there, or none where the edge runs, would show in the exact volume.
+#[test]
+fn boxes_covering_part_of_a_face() {
+    let (lo, hi) = ([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let base = common::grid_box(lo, hi, 3);
+    let (x, y) = ([0.45, 1.37], [0.21, 0.83]);
+    let standing = ([x[0], y[0], 1.0], [x[1], y[1], 1.5]);
+    let sunk = ([x[0], y[0], 0.6], [x[1], y[1], 1.0]);
+    let inside = ([x[0], y[0], 0.6], [1.0, y[1], 1.0]);
+    for (name, other, exact) in [
+        (
+            "standing on part of the top",
+            standing,
+            exact_sum(&[
+                (1, &common::box_at(lo, hi)),
+                (1, &common::box_at(standing.0, standing.1)),
+            ]),
+        ),
+        (
+            "sunk up to the top",
+            sunk,
+            exact_sum(&[
+                (1, &common::box_at(lo, hi)),
+                (1, &common::box_at(sunk.0, sunk.1)),
+                (-1, &common::box_at(inside.0, inside.1)),
+            ]),
+        ),
+    ] {
+        let s = solid(&together(&[
+            (&base, false),
+            (&common::grid_box(other.0, other.1, 4), false),
+        ]));
+        let error = within_estimate(name, &s, &exact);
+        assert!(error <= 1e-12, "{name}: {error:e} {:?}", s.warnings);
+        assert_estimate_at_most(&s, 1e-12);
+    }
+}

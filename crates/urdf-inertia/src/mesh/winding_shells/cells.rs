@@ -45,21 +45,57 @@ pub(super) fn leaves_whole(d: &[f64], m: f64) -> bool {
     d.iter().all(|&x| x >= -m) || d.iter().all(|&x| x <= m)
 }
 
-/// `piece` cut along the `planes` in turn into convex cells, in order; `None` when they are more
-/// than [`MAX_CELLS`].
-pub(super) fn cells(piece: &Corners, planes: &[CutPlane]) -> Option<Cells> {
+/// A cut: the plane, and the corners of what lies along it in the piece's plane (a blocker's
+/// three corners, or a coplanar triangle's edge with its end repeated), if any. A cell that these
+/// corners lie beyond is left whole by the cut, even where the plane crosses it: what the plane
+/// stands for does not reach the cell. Without a reach, the plane cuts wherever it crosses.
+pub(super) struct Cut {
+    pub(super) plane: CutPlane,
+    pub(super) reach: Option<[[f64; 3]; 3]>,
+}
+
+impl Cut {
+    /// Whether the cut's reach lies [`beyond`] the polygon.
+    pub(super) fn misses(&self, poly: &[[f64; 3]], nt: [f64; 3], margin: f64) -> bool {
+        self.reach.as_ref().is_some_and(|r| beyond(poly, nt, r, margin))
+    }
+}
+
+/// Whether a cut's `reach` lies beyond one side of a polygon in the plane of normal `nt`, by more
+/// than `margin` (a distance): the side's line, across that plane, leaves every corner of the
+/// polygon on one side (up to the margin) and every point of the reach beyond the margin on the
+/// other, so what the cut stands for cannot meet the polygon. Both are checked, not assumed: a
+/// side a few ulps long (two corners that clipping made almost one) points anywhere.
+pub(super) fn beyond(poly: &[[f64; 3]], nt: [f64; 3], reach: &[[f64; 3]; 3], margin: f64) -> bool {
+    let n = poly.len();
+    (0..n).any(|i| {
+        let (p, q) = (poly[i], poly[(i + 1) % n]);
+        let out = cross(sub(q, p), nt);
+        let m = margin * norm(out);
+        m > 0.0
+            && reach.iter().all(|x| dot(out, sub(*x, p)) > m)
+            && poly.iter().all(|x| dot(out, sub(*x, p)) <= m)
+    })
+}
+
+/// `piece` (in the plane of normal `nt`) cut along the `cuts` in turn into convex cells, in order,
+/// each cell cut only where the cut's reach is not [`beyond`] it (`margin`, a distance); `None`
+/// when they are more than [`MAX_CELLS`].
+pub(super) fn cells(piece: &Corners, cuts: &[&Cut], nt: [f64; 3], margin: f64) -> Option<Cells> {
     let mut cells = Cells::default();
     cells.corners.extend_from_slice(piece);
     cells.close();
     let mut next = Cells::default();
     let mut d = Vec::new();
-    for &(a, n, m) in planes {
+    for cut in cuts {
+        let (a, n, m) = cut.plane;
         next.clear();
         for cell in cells.iter() {
             d.clear();
             d.extend(cell.iter().map(|x| dot(n, sub(*x, a))));
-            // A plane along the cell's side (one cut already, or a shared edge) leaves it whole.
-            if leaves_whole(&d, m) {
+            // A plane along the cell's side (one cut already, or a shared edge), or one whose
+            // reach ends before the cell, leaves it whole.
+            if leaves_whole(&d, m) || cut.misses(cell, nt, margin) {
                 next.corners.extend_from_slice(cell);
                 next.close();
                 continue;
@@ -128,17 +164,54 @@ mod tests {
     #[test]
     fn cells_cut_along_planes_in_order() {
         let t = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]];
+        let far = [[9.0, 9.0, 0.0]; 3];
+        let line = |a, n| Cut {
+            plane: (a, n, 1e-12),
+            reach: Some([[-9.0, -9.0, 0.0], far[0], far[0]]),
+        };
         let planes = [
-            ([0.5, 0.0, 0.0], [1.0, 0.0, 0.0], 1e-12),
-            ([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 1e-12),
-            ([0.0, 0.5, 0.0], [0.0, 1.0, 0.0], 1e-12),
+            line([0.5, 0.0, 0.0], [1.0, 0.0, 0.0]),
+            line([0.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+            line([0.0, 0.5, 0.0], [0.0, 1.0, 0.0]),
         ];
-        let c = cells(&t, &planes).expect("few cells");
+        let c = cells(&t, &planes.iter().collect::<Vec<_>>(), [0.0, 0.0, 1.0], 1e-12).expect("few cells");
         assert_eq!(c.len(), 4);
         let areas: Vec<f64> = c.iter().map(area).collect();
         assert_eq!(areas, vec![0.5, 0.625, 0.625, 0.25]);
         assert_eq!(areas.iter().sum::<f64>(), 2.0);
         assert!(c.iter().flatten().all(|p| p[2] == 0.0));
         assert_eq!(centroid(&t), [2.0 / 3.0, 2.0 / 3.0, 0.0]);
+    }
+
+    /// A cut's reach lies beyond a unit square (turning about +z) when one of its sides' lines
+    /// separates them: a segment to its right, one on the extension of its diagonal past a
+    /// corner, a triangle above it. A segment crossing it, or one ending on its side, is not.
+    /// Nor is any reach seen from the square turned the other way, whose sides' outward normals
+    /// point in: the check finds the corners on the wrong side. A side of no length (two corners
+    /// a few ulps apart, as clipping makes them) separates nothing whichever way it points; a
+    /// square flattened to a segment still lies apart from what is away from it.
+    #[test]
+    fn reach_beyond_a_cell_by_its_sides() {
+        let square = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+        let up = [0.0, 0.0, 1.0];
+        let seg = |a: [f64; 3], b: [f64; 3]| [a, b, b];
+        let m = 1e-12;
+        assert!(beyond(&square, up, &seg([2.0, -5.0, 0.0], [2.0, 5.0, 0.0]), m));
+        assert!(beyond(&square, up, &seg([1.5, 1.5, 0.0], [3.0, 3.0, 0.0]), m));
+        assert!(beyond(&square, up, &[[0.0, 2.0, -1.0], [1.0, 2.0, 1.0], [0.5, 3.0, 0.0]], m));
+        assert!(!beyond(&square, up, &seg([0.5, -5.0, 0.0], [0.5, 5.0, 0.0]), m));
+        assert!(!beyond(&square, up, &seg([1.0, 0.5, 0.0], [3.0, 0.5, 0.0]), m));
+        assert!(!beyond(&square, up, &seg([-1.0, 0.5, 0.0], [3.0, 0.5, 0.0]), m));
+        let mut turned = square;
+        turned.reverse();
+        assert!(!beyond(&turned, up, &seg([2.0, -5.0, 0.0], [2.0, 5.0, 0.0]), m));
+        // The square with its corner (1, 1) doubled one ulp away: that side points into the
+        // square, so what lies inside is beyond it.
+        let ulp = [1.0 + f64::EPSILON, 1.0 - f64::EPSILON / 2.0, 0.0];
+        let near = [square[0], square[1], square[2], ulp, square[3]];
+        assert!(!beyond(&near, up, &seg([0.5, 0.2, 0.0], [0.2, 0.5, 0.0]), m));
+        let flat = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
+        assert!(beyond(&flat, up, &seg([0.5, 3.0, 0.0], [0.5, 5.0, 0.0]), m));
+        assert!(!beyond(&flat, up, &seg([0.5, -1.0, 0.0], [0.5, 1.0, 0.0]), m));
     }
 }
