@@ -843,7 +843,6 @@ fn overlap(a: &Aabb, b: &Aabb) -> bool {
     (0..3).all(|k| a.lo[k] <= b.hi[k] && b.lo[k] <= a.hi[k])
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -866,10 +865,10 @@ mod tests {
         sum
     }
 
-    /// A triangle of area 8 with a smaller one turned the other way lying in its plane (area ½,
-    /// off its edges and of no regular position): where the small one covers it the two cancel
-    /// and the big one carries nothing, elsewhere it bounds alone. So the faces emitted add up to
-    /// 7.5 along +z, exactly as the small one's edges cut the big one: a cut along an edge's line
+    /// A triangle of area 8 with a smaller one turned the other way lying in its plane (area
+    /// 0.53, off its edges and of no regular position): where the small one covers it the two
+    /// cancel and the big one carries nothing, elsewhere it bounds alone. So the faces emitted add
+    /// up to 8 − 0.53 along +z, exactly as the small one's edges cut the big one: a cut along an edge's line
     /// beyond the edge's end would be harmless, none where the edge runs would decide a cell on
     /// both sides of it from one point. Also moved elsewhere inside, and across the big one's
     /// long edge (there, outside it, the small one bounds alone, facing −z).
