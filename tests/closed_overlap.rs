@@ -182,11 +182,13 @@ fn a_box_stored_twice_triangulated_two_ways() {
 }
 
 /// Faces that coincide on part of their plane only: a box standing on part of another's top
-/// (the faces touching bound nothing), and one sunk into it up to that top (the same top plane,
-/// facing the same way, covered in part twice). The edges of the covering faces end inside the
+/// (the faces touching bound nothing), and one sunk up to that top, part of it outside (the same
+/// top plane, facing the same way, covered in part twice). The covering faces end inside the
 /// triangles below them (the boxes' sides are off every grid line), so each such triangle is cut
-/// along those edges and decided cell by cell, while the lines of the edges beyond their ends
-/// cut nothing: a cut there, or none where the edge runs, would show in the exact volume.
+/// where the other box's side faces meet it and decided cell by cell: a side face whose reach
+/// were taken too short would leave a cell on both sides of it and show in the exact volume.
+/// (Its coplanar edges' reach is pinned by `correction::tests`: on closed shells a side face
+/// cuts along the same line.)
 #[test]
 fn boxes_covering_part_of_a_face() {
     let (lo, hi) = ([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
