@@ -722,10 +722,19 @@ fn nesting(
     if ta.len().saturating_mul(tb.len()) > MAX_TESTS {
         return None;
     }
-    if ta
-        .iter()
-        .any(|x| tb.iter().any(|y| triangles_touch(vertices, x, y)))
-    {
+    let boxes = |ts: &[[u32; 3]]| -> Vec<Aabb> {
+        ts.iter()
+            .map(|t| Aabb::of(t.map(|i| vertices[i as usize])))
+            .collect()
+    };
+    let touch = closed_boxes_meeting(&boxes(&ta), &boxes(&tb), |x, y| {
+        if triangles_touch(vertices, &ta[x], &tb[y]) {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    });
+    if touch.is_break() {
         return None;
     }
     let wa = integer(winding(
@@ -739,6 +748,45 @@ fn nesting(
         vertices[tris[b][0][0] as usize],
     ))?;
     Some((wa, wb))
+}
+
+/// Each pair of a box of `a` and a box of `b` that meet as closed boxes (touching counts), found
+/// by a sweep along x: `visit(i, j)` with `i` in `a` and `j` in `b`, until it breaks. Every such
+/// pair is visited once (from the box that starts first, or comes first in the sort at a tie), so
+/// a test that holds for some pair finds one, as the loop over all pairs did, in time linear in
+/// the pairs whose x ranges meet rather than in all |a|·|b|.
+fn closed_boxes_meeting(
+    a: &[Aabb],
+    b: &[Aabb],
+    mut visit: impl FnMut(usize, usize) -> ControlFlow<()>,
+) -> ControlFlow<()> {
+    let all: Vec<(&Aabb, usize, bool)> = a
+        .iter()
+        .enumerate()
+        .map(|(i, x)| (x, i, false))
+        .chain(b.iter().enumerate().map(|(j, y)| (y, j, true)))
+        .collect();
+    let mut order: Vec<usize> = (0..all.len()).collect();
+    order.sort_by(|&p, &q| all[p].0.lo[0].total_cmp(&all[q].0.lo[0]));
+    for (n, &p) in order.iter().enumerate() {
+        let (bp, ip, in_b) = all[p];
+        for &q in &order[n + 1..] {
+            let (bq, iq, other) = all[q];
+            // Sorted by the start along x: every later box starts at or after this one.
+            if bq.lo[0] > bp.hi[0] {
+                break;
+            }
+            let meet = (1..3).all(|k| bp.lo[k] <= bq.hi[k] && bq.lo[k] <= bp.hi[k]);
+            if other != in_b && meet {
+                if in_b {
+                    visit(iq, ip)?;
+                } else {
+                    visit(ip, iq)?;
+                }
+            }
+        }
+    }
+    ControlFlow::Continue(())
 }
 
 fn integer(w: f64) -> Option<i64> {
@@ -818,4 +866,60 @@ fn winding(vertices: &[[f64; 3]], tris: &[[u32; 3]], p: [f64; 3]) -> f64 {
         total += solid_angle(a, b, c, norm(a), norm(b), norm(c));
     }
     total / (4.0 * std::f64::consts::PI)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sweep visits exactly the pairs (one box of each list) that meet as closed boxes, each
+    /// once: boxes on a coarse lattice, so that many touch at a face, an edge or a corner only.
+    #[test]
+    fn the_sweep_visits_each_meeting_pair_once() {
+        let mut state = 0x2545_F491_4F6C_DD1D_u64;
+        let mut next = |n: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % n) as f64
+        };
+        let mut boxes = |count: usize| -> Vec<Aabb> {
+            (0..count)
+                .map(|_| {
+                    let lo = [next(6), next(6), next(6)];
+                    let size = [next(3), next(3), next(3)];
+                    Aabb::new(lo, [0, 1, 2].map(|k| lo[k] + size[k]))
+                })
+                .collect()
+        };
+        for (na, nb) in [(0, 5), (7, 0), (40, 30), (120, 90)] {
+            let (a, b) = (boxes(na), boxes(nb));
+            let mut want = Vec::new();
+            for (i, x) in a.iter().enumerate() {
+                for (j, y) in b.iter().enumerate() {
+                    if (0..3).all(|k| x.lo[k] <= y.hi[k] && y.lo[k] <= x.hi[k]) {
+                        want.push((i, j));
+                    }
+                }
+            }
+            let mut got = Vec::new();
+            let all = closed_boxes_meeting(&a, &b, |i, j| {
+                got.push((i, j));
+                ControlFlow::Continue(())
+            });
+            assert!(all.is_continue());
+            got.sort_unstable();
+            assert_eq!(got, want, "{na} × {nb}");
+            assert!(na * nb < 1000 || want.len() > 100, "{}", want.len());
+            // A visit that breaks stops the sweep.
+            if let Some(&first) = want.first() {
+                let mut seen = 0;
+                let stop = closed_boxes_meeting(&a, &b, |_, _| {
+                    seen += 1;
+                    ControlFlow::Break(())
+                });
+                assert!(stop.is_break() && seen == 1, "{first:?}");
+            }
+        }
+    }
 }
