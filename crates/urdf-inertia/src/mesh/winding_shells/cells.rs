@@ -82,10 +82,15 @@ pub(super) fn beyond(poly: &[[f64; 3]], nt: [f64; 3], reach: &[[f64; 3]; 3], mar
 /// each cell cut only where the cut's reach is not [`beyond`] it (`margin`, a distance); `None`
 /// when they are more than [`MAX_CELLS`].
 pub(super) fn cells(piece: &Corners, cuts: &[&Cut], nt: [f64; 3], margin: f64) -> Option<Cells> {
-    let mut cells = Cells::default();
+    // Room for a few dozen cells of a few corners each: the lists do not grow in the common case.
+    let room = || Cells {
+        corners: Vec::with_capacity(256),
+        ends: Vec::with_capacity(48),
+    };
+    let mut cells = room();
     cells.corners.extend_from_slice(piece);
     cells.close();
-    let mut next = Cells::default();
+    let mut next = room();
     let mut d = Vec::new();
     for cut in cuts {
         let (a, n, m) = cut.plane;

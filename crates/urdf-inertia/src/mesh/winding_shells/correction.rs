@@ -623,7 +623,8 @@ impl Faces<'_> {
             let c = self.corners[t as usize];
             cross(sub(c[1], c[0]), sub(c[2], c[0]))
         };
-        let mut planes = Vec::with_capacity(blockers.len());
+        // A blocker is one plane, or a coplanar triangle's three edges: room for all without growing.
+        let mut planes = Vec::with_capacity(3 * blockers.len());
         let mut coplanar = Vec::new();
         for &u in blockers {
             let [a, b, c] = self.corners[u as usize];
@@ -653,7 +654,8 @@ impl Faces<'_> {
             }
         }
         // Whether each plane cuts: all but the seams between coplanar triangles.
-        let mut cuts = vec![true; planes.len()];
+        let mut cuts = Vec::with_capacity(planes.capacity());
+        cuts.resize(planes.len(), true);
         for (cp, seams) in coplanar.iter().zip(self.seams(t, &coplanar)) {
             planes.extend(cp.cuts());
             cuts.extend(seams.map(|seam| !seam));
