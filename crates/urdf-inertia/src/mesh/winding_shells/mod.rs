@@ -727,13 +727,18 @@ fn nesting(
             .map(|t| Aabb::of(t.map(|i| vertices[i as usize])))
             .collect()
     };
-    let touch = closed_boxes_meeting(&boxes(&ta), &boxes(&tb), |x, y| {
+    // A shell with no triangle in the other's box cannot touch it (nested shells, most often).
+    let touch = if ta.is_empty() || tb.is_empty() {
+        ControlFlow::Continue(())
+    } else {
+        closed_boxes_meeting(&boxes(&ta), &boxes(&tb), |x, y| {
         if triangles_touch(vertices, &ta[x], &tb[y]) {
             ControlFlow::Break(())
         } else {
             ControlFlow::Continue(())
         }
-    });
+    })
+    };
     if touch.is_break() {
         return None;
     }
@@ -751,39 +756,44 @@ fn nesting(
 }
 
 /// Each pair of a box of `a` and a box of `b` that meet as closed boxes (touching counts), found
-/// by a sweep along x: `visit(i, j)` with `i` in `a` and `j` in `b`, until it breaks. Every such
-/// pair is visited once (from the box that starts first, or comes first in the sort at a tie), so
-/// a test that holds for some pair finds one, as the loop over all pairs did, in time linear in
-/// the pairs whose x ranges meet rather than in all |a|·|b|.
+/// by a sweep along x over the two lists, each sorted by where its boxes start: `visit(i, j)` with
+/// `i` in `a` and `j` in `b`, until it breaks. Every such pair is visited once (from the box that
+/// starts first, the one of `a` at a tie), so a test that holds for some pair finds one, as the loop
+/// over all pairs did, in time linear in the pairs whose x ranges meet rather than in all |a|·|b|;
+/// pairs within one list are never looked at (an empty list costs nothing).
 fn closed_boxes_meeting(
     a: &[Aabb],
     b: &[Aabb],
     mut visit: impl FnMut(usize, usize) -> ControlFlow<()>,
 ) -> ControlFlow<()> {
-    let all: Vec<(&Aabb, usize, bool)> = a
-        .iter()
-        .enumerate()
-        .map(|(i, x)| (x, i, false))
-        .chain(b.iter().enumerate().map(|(j, y)| (y, j, true)))
-        .collect();
-    let mut order: Vec<usize> = (0..all.len()).collect();
-    order.sort_by(|&p, &q| all[p].0.lo[0].total_cmp(&all[q].0.lo[0]));
-    for (n, &p) in order.iter().enumerate() {
-        let (bp, ip, in_b) = all[p];
-        for &q in &order[n + 1..] {
-            let (bq, iq, other) = all[q];
-            // Sorted by the start along x: every later box starts at or after this one.
-            if bq.lo[0] > bp.hi[0] {
-                break;
-            }
-            let meet = (1..3).all(|k| bp.lo[k] <= bq.hi[k] && bq.lo[k] <= bp.hi[k]);
-            if other != in_b && meet {
-                if in_b {
-                    visit(iq, ip)?;
-                } else {
-                    visit(ip, iq)?;
+    if a.is_empty() || b.is_empty() {
+        return ControlFlow::Continue(());
+    }
+    let sorted = |boxes: &[Aabb]| {
+        let mut order: Vec<usize> = (0..boxes.len()).collect();
+        order.sort_by(|&p, &q| boxes[p].lo[0].total_cmp(&boxes[q].lo[0]));
+        order
+    };
+    let (oa, ob) = (sorted(a), sorted(b));
+    let meet = |x: &Aabb, y: &Aabb| (1..3).all(|k| x.lo[k] <= y.hi[k] && y.lo[k] <= x.hi[k]);
+    let (mut i, mut j) = (0, 0);
+    while i < oa.len() && j < ob.len() {
+        let (x, y) = (&a[oa[i]], &b[ob[j]]);
+        if x.lo[0] <= y.lo[0] {
+            // x starts first: the boxes of b from y on that start within x's range along x.
+            for &q in ob[j..].iter().take_while(|&&q| b[q].lo[0] <= x.hi[0]) {
+                if meet(x, &b[q]) {
+                    visit(oa[i], q)?;
                 }
             }
+            i += 1;
+        } else {
+            for &p in oa[i..].iter().take_while(|&&p| a[p].lo[0] <= y.hi[0]) {
+                if meet(&a[p], y) {
+                    visit(p, ob[j])?;
+                }
+            }
+            j += 1;
         }
     }
     ControlFlow::Continue(())
