@@ -281,7 +281,8 @@ pub(super) fn orient3d(pa: Coord3D<f64>, pb: Coord3D<f64>, pc: Coord3D<f64>, pd:
 /// or all four have the same x, the same y or the same z. Their orientation is then exactly zero,
 /// the answer the adaptive stages reach at their dearest. Shells that share vertices, or lie on
 /// one face of a CAD part (coincident shells), ask it of most pairs of triangles that touch: on
-/// centauro's wheel (81 pairs of touching shells) the adaptive stages were 13% of the run.
+/// centauro's wheel (81 pairs of touching shells) the adaptive stages were 13% of the
+/// instructions.
 fn plainly_flat(p: [Coord3D<f64>; 4]) -> bool {
     let same = |a: &Coord3D<f64>, b: &Coord3D<f64>| a.x == b.x && a.y == b.y && a.z == b.z;
     let level = |k: fn(&Coord3D<f64>) -> f64| p.iter().all(|q| k(q) == k(&p[0]));

@@ -727,19 +727,18 @@ fn nesting(
             .map(|t| Aabb::of(t.map(|i| vertices[i as usize])))
             .collect()
     };
-    // A shell with no triangle in the other's box cannot touch it (nested shells, most often).
-    let touch = if ta.is_empty() || tb.is_empty() {
-        ControlFlow::Continue(())
-    } else {
-        closed_boxes_meeting(&boxes(&ta), &boxes(&tb), |x, y| {
+    let touch = |x: usize, y: usize| {
         if triangles_touch(vertices, &ta[x], &tb[y]) {
             ControlFlow::Break(())
         } else {
             ControlFlow::Continue(())
         }
-    })
     };
-    if touch.is_break() {
+    // A shell with no triangle in the other's box cannot touch it (nested shells, most often).
+    let touching = !ta.is_empty()
+        && !tb.is_empty()
+        && closed_boxes_meeting(&boxes(&ta), &boxes(&tb), touch).is_break();
+    if touching {
         return None;
     }
     let wa = integer(winding(
