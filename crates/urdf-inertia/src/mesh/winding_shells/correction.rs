@@ -12,7 +12,7 @@
 
 use super::cells::{area, cells, centroid, leaves_whole, split, Cut};
 use super::grid::{Corners, Grid, Plane, Seen};
-use super::{edge_meets, triangles_touch, EdgeUse};
+use super::{edge_meets, overlap, triangles_touch, EdgeUse};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
 use crate::mass::Polygons;
 use robust::{orient2d, Coord};
@@ -843,10 +843,6 @@ fn c2(p: [f64; 3], drop: usize) -> Coord<f64> {
 
 fn inflated(b: Aabb, m: f64) -> Aabb {
     Aabb::new(b.lo.map(|x| x - m), b.hi.map(|x| x + m))
-}
-
-fn overlap(a: &Aabb, b: &Aabb) -> bool {
-    (0..3).all(|k| a.lo[k] <= b.hi[k] && b.lo[k] <= a.hi[k])
 }
 
 #[cfg(test)]

@@ -149,8 +149,7 @@ impl Grid {
                 if u64::from(i) < after {
                     continue;
                 }
-                let meets = (0..3).all(|k| b.lo[k] <= x.hi[k] && x.lo[k] <= b.hi[k]);
-                if meets && seen.first(i) {
+                if super::overlap(b, x) && seen.first(i) {
                     out.push(i);
                 }
             }

@@ -703,30 +703,18 @@ fn nesting(
     if !sa.closed || !sb.closed {
         return None;
     }
-    let Aabb { lo, hi } = sa.bounds.intersection(sb.bounds);
-    let near = |t: &[u32; 3]| {
-        (0..3).all(|k| {
-            let (tl, th) = t
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
-                    (
-                        l.min(vertices[v as usize][k]),
-                        h.max(vertices[v as usize][k]),
-                    )
-                });
-            tl <= hi[k] && th >= lo[k]
-        })
+    // The triangles whose boxes meet the two shells' common box, with their boxes.
+    let common = sa.bounds.intersection(sb.bounds);
+    let near = |ts: &[[u32; 3]]| -> (Vec<[u32; 3]>, Vec<Aabb>) {
+        ts.iter()
+            .map(|t| (*t, Aabb::of(t.map(|i| vertices[i as usize]))))
+            .filter(|(_, b)| overlap(b, &common))
+            .unzip()
     };
-    let ta: Vec<[u32; 3]> = tris[a].iter().filter(|t| near(t)).copied().collect();
-    let tb: Vec<[u32; 3]> = tris[b].iter().filter(|t| near(t)).copied().collect();
+    let ((ta, boxes_a), (tb, boxes_b)) = (near(&tris[a]), near(&tris[b]));
     if ta.len().saturating_mul(tb.len()) > MAX_TESTS {
         return None;
     }
-    let boxes = |ts: &[[u32; 3]]| -> Vec<Aabb> {
-        ts.iter()
-            .map(|t| Aabb::of(t.map(|i| vertices[i as usize])))
-            .collect()
-    };
     let touch = |x: usize, y: usize| {
         if triangles_touch(vertices, &ta[x], &tb[y]) {
             ControlFlow::Break(())
@@ -737,7 +725,7 @@ fn nesting(
     // A shell with no triangle in the other's box cannot touch it (nested shells, most often).
     let touching = !ta.is_empty()
         && !tb.is_empty()
-        && closed_boxes_meeting(&boxes(&ta), &boxes(&tb), touch).is_break();
+        && closed_boxes_meeting(&boxes_a, &boxes_b, touch).is_break();
     if touching {
         return None;
     }
@@ -774,21 +762,20 @@ fn closed_boxes_meeting(
         order
     };
     let (oa, ob) = (sorted(a), sorted(b));
-    let meet = |x: &Aabb, y: &Aabb| (1..3).all(|k| x.lo[k] <= y.hi[k] && y.lo[k] <= x.hi[k]);
     let (mut i, mut j) = (0, 0);
     while i < oa.len() && j < ob.len() {
         let (x, y) = (&a[oa[i]], &b[ob[j]]);
         if x.lo[0] <= y.lo[0] {
             // x starts first: the boxes of b from y on that start within x's range along x.
             for &q in ob[j..].iter().take_while(|&&q| b[q].lo[0] <= x.hi[0]) {
-                if meet(x, &b[q]) {
+                if overlap(x, &b[q]) {
                     visit(oa[i], q)?;
                 }
             }
             i += 1;
         } else {
             for &p in oa[i..].iter().take_while(|&&p| a[p].lo[0] <= y.hi[0]) {
-                if meet(&a[p], y) {
+                if overlap(&a[p], y) {
                     visit(p, ob[j])?;
                 }
             }
@@ -796,6 +783,11 @@ fn closed_boxes_meeting(
         }
     }
     ControlFlow::Continue(())
+}
+
+/// Whether two boxes meet as closed boxes (touching counts).
+pub(super) fn overlap(a: &Aabb, b: &Aabb) -> bool {
+    (0..3).all(|k| a.lo[k] <= b.hi[k] && b.lo[k] <= a.hi[k])
 }
 
 fn integer(w: f64) -> Option<i64> {
