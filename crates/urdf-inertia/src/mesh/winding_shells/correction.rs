@@ -16,7 +16,6 @@ use super::{edge_meets, overlap, triangles_touch, EdgeUse};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
 use crate::mass::Polygons;
 use robust::{orient2d, Coord};
-use rustc_hash::FxHashMap;
 use std::cell::RefCell;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -63,7 +62,18 @@ struct Piece {
     delta: f64,
     corners: Corners,
     t: u32,
-    blockers: Vec<u32>,
+    blockers: Vec<Blocker>,
+}
+
+/// A triangle that may meet a piece of triangle `t`, and whether it lies exactly in `t`'s plane:
+/// found by the first cut that asks (an exact zero is orient3d's most expensive answer) and carried
+/// by the pieces split from that piece, which ask again for each blocker (14 times per pair on a
+/// real gripper with coincident shells). A table of the pairs, asked once per pair, cost the cut a
+/// cache miss per blocker: 20–26% of the wheel's time in the cut, about a third of it the table's.
+#[derive(Clone, Copy)]
+struct Blocker {
+    u: u32,
+    in_plane: Option<bool>,
 }
 
 impl PartialEq for Piece {
@@ -96,10 +106,6 @@ struct Faces<'a> {
     centre: [f64; 3],
     /// Distances below this are not trusted to f64 plane tests.
     margin: f64,
-    /// Whether a blocker `u` lies exactly in triangle `t`'s plane, per (t, u) once: the pieces of
-    /// one triangle ask it again for each blocker (14 times per pair on a real gripper with
-    /// coincident shells), and an exact zero is orient3d's most expensive answer.
-    in_plane: RefCell<FxHashMap<(u32, u32), bool>>,
     /// Per triangle: the last of its pieces decided at the first try, and how ([`Faces::decide_linked`]).
     origins: RefCell<Vec<Option<(Origin, i64)>>>,
     /// Whether every edge of the triangles is used as often one way as the other: a closed
@@ -136,7 +142,6 @@ pub(super) fn resolve(
         grid,
         centre,
         margin,
-        in_plane: RefCell::default(),
         origins: RefCell::new(vec![None; tris.len()]),
         closed,
     };
@@ -152,7 +157,11 @@ pub(super) fn resolve(
     let mut heap = BinaryHeap::new();
     f.patches((&blockers, &uses), &mut seen, &mut out, &mut heap);
     for (t, b) in blockers.into_iter().enumerate() {
-        if !b.is_empty() && !f.cut(&f.corners[t], t as u32, &b, &mut seen, &mut out) {
+        if b.is_empty() {
+            continue;
+        }
+        let mut b: Vec<Blocker> = b.into_iter().map(|u| Blocker { u, in_plane: None }).collect();
+        if !f.cut(&f.corners[t], t as u32, &mut b, &mut seen, &mut out) {
             heap.push(f.piece(f.corners[t], t as u32, b));
         }
     }
@@ -348,18 +357,18 @@ impl Faces<'_> {
             splits += 1;
             for child in split(p.corners) {
                 let b = inflated(Aabb::of(child), self.margin);
-                let blockers: Vec<u32> = p
+                let mut blockers: Vec<Blocker> = p
                     .blockers
                     .iter()
                     .copied()
-                    .filter(|&u| overlap(&b, &Aabb::of(self.corners[u as usize])) && self.may_meet(&child, u))
+                    .filter(|x| overlap(&b, &Aabb::of(self.corners[x.u as usize])) && self.may_meet(&child, x.u))
                     .collect();
                 if blockers.is_empty() {
                     if let Some(k) = self.decide_linked(&child, p.t, seen, |_| true, &[]) {
                         self.emit(&child, k, out);
                         continue;
                     }
-                } else if self.cut(&child, p.t, &blockers, seen, out) {
+                } else if self.cut(&child, p.t, &mut blockers, seen, out) {
                     continue;
                 }
                 let piece = self.piece(child, p.t, blockers);
@@ -373,7 +382,7 @@ impl Faces<'_> {
         }
     }
 
-    fn piece(&self, corners: Corners, t: u32, blockers: Vec<u32>) -> Piece {
+    fn piece(&self, corners: Corners, t: u32, blockers: Vec<Blocker>) -> Piece {
         Piece {
             delta: self.delta(&corners, t),
             corners,
@@ -618,7 +627,7 @@ impl Faces<'_> {
     /// When no blocker lies in `t`'s plane (and they are few): the piece cut along the blockers'
     /// planes into convex cells that no triangle meets any more, each decided by a ray, or bounded
     /// when it is a sliver the plane tests cannot tell from a cut. Whether it did so.
-    fn cut(&self, piece: &Corners, t: u32, blockers: &[u32], seen: &mut Seen, out: &mut Resolved) -> bool {
+    fn cut(&self, piece: &Corners, t: u32, blockers: &mut [Blocker], seen: &mut Seen, out: &mut Resolved) -> bool {
         let nt = {
             let c = self.corners[t as usize];
             cross(sub(c[1], c[0]), sub(c[2], c[0]))
@@ -626,7 +635,8 @@ impl Faces<'_> {
         // A blocker is one plane, or a coplanar triangle's three edges: room for all without growing.
         let mut planes = Vec::with_capacity(3 * blockers.len());
         let mut coplanar = Vec::new();
-        for &u in blockers {
+        for blocker in blockers.iter_mut() {
+            let u = blocker.u;
             let [a, b, c] = self.corners[u as usize];
             let (ab, ac) = (sub(b, a), sub(c, a));
             let n = cross(ab, ac);
@@ -635,7 +645,7 @@ impl Faces<'_> {
                 .map(|x| dot(n, sub(*x, a)).abs() / norm(n))
                 .fold(0.0, f64::max);
             // In t's plane exactly: a corner of t is, without a predicate; the others by orient3d.
-            let exact = *self.in_plane.borrow_mut().entry((t, u)).or_insert_with(|| {
+            let exact = *blocker.in_plane.get_or_insert_with(|| {
                 let (tc, plane) = (self.corners[t as usize], &self.planes[t as usize]);
                 [a, b, c].iter().all(|&x| tc.contains(&x) || plane.side(x) == 0.0)
             });
