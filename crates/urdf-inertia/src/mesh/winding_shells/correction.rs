@@ -174,8 +174,9 @@ impl Faces<'_> {
     /// shared corner: those whose boxes meet its box grown by the margin, in the order of the
     /// grid's cells over that box. Each pair of triangles is found once, from the lower-numbered
     /// one's query over a box grown enough to hold both conditions (the margin twice, and the
-    /// rounding of the coordinates), and each condition is then checked as stated; the few lists
-    /// of two or more are put back in the grid's order.
+    /// rounding of the coordinates), and each condition is then checked as stated; the lists of
+    /// two or more are put back in the order of the grid's query over `t`'s grown box (sorted by
+    /// [`Grid::first_shared_cell`], not asked again).
     fn all_blockers(&self, boxes: &[Aabb], seen: &mut Seen) -> Vec<Vec<u32>> {
         let n = self.tris.len();
         let grown: Vec<Aabb> = boxes.iter().map(|b| inflated(*b, self.margin)).collect();
@@ -199,11 +200,14 @@ impl Faces<'_> {
                 }
             }
         }
+        let mut keyed = Vec::new();
         for (t, list) in out.iter_mut().enumerate() {
             if list.len() > 1 {
-                self.grid.overlapping(&grown[t], None, seen, &mut near);
-                near.retain(|u| list.contains(u));
-                list.clone_from(&near);
+                keyed.clear();
+                keyed.extend(list.iter().map(|&u| (self.grid.first_shared_cell(&grown[t], &boxes[u as usize]), u)));
+                keyed.sort_unstable();
+                list.clear();
+                list.extend(keyed.iter().map(|&(_, u)| u));
             }
         }
         out

@@ -156,10 +156,35 @@ impl Grid {
         });
     }
 
+    /// Where [`Grid::overlapping`] of `query` finds a triangle whose box `b` meets it (closed
+    /// boxes): the first cell it visits that holds the triangle, the corner of the two boxes'
+    /// ranges of cells lowest on every axis (the cells are visited in order of their number, and a
+    /// cell's entries in order of theirs). Sorting by (this, number) puts triangles in its order
+    /// without a second query.
+    pub(super) fn first_shared_cell(&self, query: &Aabb, b: &Aabb) -> usize {
+        let idx = [0, 1, 2].map(|k| self.index(k, query.lo[k]).max(self.index(k, b.lo[k])));
+        (idx[0] * self.dims[1] + idx[1]) * self.dims[2] + idx[2]
+    }
+
     /// How many entries the ray of [`Grid::winding`] from `p` along `sign`·e_`axis` reads: those of
     /// the row of cells from `p`'s to the grid's end. A ray may leave a face on either side (the
     /// count behind it is the count in front plus its jump), and one way is often much shorter.
     pub(super) fn row_entries(&self, p: [f64; 3], axis: usize, sign: f64) -> usize {
+        let (first, stride, cells) = self.row(p, axis, sign);
+        if stride == 1 {
+            return (self.start[first + cells.end] - self.start[first + cells.start]) as usize;
+        }
+        cells
+            .map(|i| {
+                let c = first + i * stride;
+                (self.start[c + 1] - self.start[c]) as usize
+            })
+            .sum()
+    }
+
+    /// The cells a ray from `p` along `sign`·e_`axis` passes, from `p`'s to the grid's end: cell
+    /// `first + i · stride` for each `i` of the range.
+    fn row(&self, p: [f64; 3], axis: usize, sign: f64) -> (usize, usize, std::ops::Range<usize>) {
         let idx = [0, 1, 2].map(|k| self.index(k, p[k]));
         let stride = match axis {
             0 => self.dims[1] * self.dims[2],
@@ -167,20 +192,12 @@ impl Grid {
             _ => 1,
         };
         let first = ((idx[0] * self.dims[1] + idx[1]) * self.dims[2] + idx[2]) - idx[axis] * stride;
-        let (lo, hi) = if sign > 0.0 {
-            (idx[axis], self.dims[axis])
+        let cells = if sign > 0.0 {
+            idx[axis]..self.dims[axis]
         } else {
-            (0, idx[axis] + 1)
+            0..idx[axis] + 1
         };
-        if stride == 1 {
-            return (self.start[first + hi] - self.start[first + lo]) as usize;
-        }
-        (lo..hi)
-            .map(|i| {
-                let c = first + i * stride;
-                (self.start[c + 1] - self.start[c]) as usize
-            })
-            .sum()
+        (first, stride, cells)
     }
 
     /// The winding number of the triangles (all but those in `skip`) at `p`, counted along the ray from `p`
@@ -203,30 +220,23 @@ impl Grid {
             self.bounds.lo[axis].min(p[axis]) - margin
         };
         seen.next();
-        let (j, l) = ((axis + 1) % 3, (axis + 2) % 3);
-        let (cj, cl) = (self.index(j, p[j]), self.index(l, p[l]));
-        let from = self.index(axis, p[axis]);
-        let row: Box<dyn Iterator<Item = usize>> = if sign > 0.0 {
-            Box::new(from..self.dims[axis])
+        // The ray's box: its start's point on the other two axes, from its start on along `axis`.
+        let (mut lo, mut hi) = (p, p);
+        if sign > 0.0 {
+            hi[axis] = f64::INFINITY;
         } else {
-            Box::new((0..=from).rev())
-        };
+            lo[axis] = f64::NEG_INFINITY;
+        }
+        // The row of cells from the start's on, in either order: which triangles the ray meets,
+        // and whether one of them only touches it, do not depend on the order.
+        let (first, stride, cells) = self.row(p, axis, sign);
         let mut w = 0;
-        for ck in row {
-            let mut idx = [0; 3];
-            (idx[axis], idx[j], idx[l]) = (ck, cj, cl);
-            let c = (idx[0] * self.dims[1] + idx[1]) * self.dims[2] + idx[2];
-            let (items, boxes) = self.cell_items(c);
+        for ck in cells {
+            let (items, boxes) = self.cell_items(first + ck * stride);
             for (&i, b) in items.iter().zip(boxes) {
-                // The segment varies along `axis` only: a triangle whose box misses its line, or
-                // lies wholly behind its start, is missed (exact comparisons).
-                let outside = |k: usize| b.hi[k] < p[k] || b.lo[k] > p[k];
-                let behind = if sign > 0.0 {
-                    b.hi[axis] < p[axis]
-                } else {
-                    b.lo[axis] > p[axis]
-                };
-                if outside(j) || outside(l) || behind {
+                // A triangle whose box misses the ray's line, or lies wholly behind its start, is
+                // missed (exact comparisons; a NaN corner is not rejected here).
+                if (0..3).any(|k| b.hi[k] < lo[k] || b.lo[k] > hi[k]) {
                     continue;
                 }
                 if skip.contains(&i) || !seen.first(i) {
@@ -639,6 +649,39 @@ mod tests {
         // Through the diagonal of a face: degenerate.
         let w = grid.winding(tris, [0.5, 0.5, 0.5], 2, 1.0, &[], &mut seen);
         assert_eq!(w, None);
+    }
+
+    /// Sorting what a box query finds by (first shared cell, number) is the query's own order.
+    #[test]
+    fn first_shared_cells_give_the_query_order() {
+        let mut next = uniform(11);
+        let boxes: Vec<Aabb> = (0..600)
+            .map(|_| {
+                let lo = [next() * 3.0, next() * 2.0, next()];
+                let size = 0.5 * next() * next();
+                Aabb::of([lo, lo.map(|x| x + size * 1.5)])
+            })
+            .collect();
+        let grid = Grid::new(&boxes);
+        assert!(grid.dims.iter().all(|&d| d > 2), "{:?}", grid.dims);
+        let mut seen = Seen::new(boxes.len());
+        let (mut found, mut several) = (Vec::new(), 0);
+        for q in 0..300 {
+            // Query boxes of the triangles themselves (as `all_blockers` asks) and others.
+            let query = if q % 2 == 0 {
+                boxes[q]
+            } else {
+                let lo = [next() * 3.0, next() * 2.0, next()];
+                Aabb::of([lo, lo.map(|x| x + next())])
+            };
+            grid.overlapping(&query, None, &mut seen, &mut found);
+            let mut sorted = found.clone();
+            sorted.reverse();
+            sorted.sort_unstable_by_key(|&u| (grid.first_shared_cell(&query, &boxes[u as usize]), u));
+            assert_eq!(sorted, found, "query {q}");
+            several += usize::from(found.len() > 1);
+        }
+        assert!(several > 50, "{several}");
     }
 
     #[test]
