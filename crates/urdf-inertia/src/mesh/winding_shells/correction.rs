@@ -750,6 +750,9 @@ fn balanced(uses: &[EdgeUse]) -> bool {
 struct Coplanar {
     u: u32,
     corners: Corners,
+    /// The corners' box: a point strictly inside the triangle seen along an axis is strictly
+    /// inside it on the other two (most points a piece asks about are not).
+    bounds: Aabb,
     edges: [([f64; 3], [f64; 3], f64); 3],
     same: bool,
     /// Exactly in the plane (not only within [`NEAR`] of it).
@@ -770,6 +773,7 @@ impl Coplanar {
         Coplanar {
             u,
             corners: c,
+            bounds: Aabb::of(c),
             edges,
             same: dot(nu, nt) > 0.0,
             exact,
@@ -791,6 +795,11 @@ impl Coplanar {
     /// off the edges that come near its cell; an edge's line beyond the edge may pass close by,
     /// where a rounded side would not do.
     fn covers(&self, p: [f64; 3], k: usize) -> bool {
+        let b = &self.bounds;
+        let within = |i: usize| p[i] > b.lo[i] && p[i] < b.hi[i];
+        if !within((k + 1) % 3) || !within((k + 2) % 3) {
+            return false;
+        }
         let c = self.corners;
         let s = [0, 1, 2].map(|i| orient2d(c2(c[i], k), c2(c[(i + 1) % 3], k), c2(p, k)));
         s.iter().all(|&v| v > 0.0) || s.iter().all(|&v| v < 0.0)
