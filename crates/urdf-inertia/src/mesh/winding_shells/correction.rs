@@ -203,8 +203,9 @@ impl Faces<'_> {
         let mut keyed = Vec::new();
         for (t, list) in out.iter_mut().enumerate() {
             if list.len() > 1 {
+                let corner = self.grid.cell_of(grown[t].lo);
                 keyed.clear();
-                keyed.extend(list.iter().map(|&u| (self.grid.first_shared_cell(&grown[t], &boxes[u as usize]), u)));
+                keyed.extend(list.iter().map(|&u| (self.grid.first_shared_cell(corner, &boxes[u as usize]), u)));
                 keyed.sort_unstable();
                 list.clear();
                 list.extend(keyed.iter().map(|&(_, u)| u));

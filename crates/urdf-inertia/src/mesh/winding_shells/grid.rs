@@ -156,13 +156,18 @@ impl Grid {
         });
     }
 
-    /// Where [`Grid::overlapping`] of `query` finds a triangle whose box `b` meets it (closed
-    /// boxes): the first cell it visits that holds the triangle, the corner of the two boxes'
-    /// ranges of cells lowest on every axis (the cells are visited in order of their number, and a
-    /// cell's entries in order of theirs). Sorting by (this, number) puts triangles in its order
-    /// without a second query.
-    pub(super) fn first_shared_cell(&self, query: &Aabb, b: &Aabb) -> usize {
-        let idx = [0, 1, 2].map(|k| self.index(k, query.lo[k]).max(self.index(k, b.lo[k])));
+    /// The cell of a point, per axis (clamped to the grid).
+    pub(super) fn cell_of(&self, p: [f64; 3]) -> [usize; 3] {
+        [0, 1, 2].map(|k| self.index(k, p[k]))
+    }
+
+    /// Where [`Grid::overlapping`] of a query box whose lowest corner is in cell `query`
+    /// ([`Grid::cell_of`]) finds a triangle whose box `b` meets it (closed boxes): the first cell
+    /// it visits that holds the triangle, the corner of the two boxes' ranges of cells lowest on
+    /// every axis (the cells are visited in order of their number, and a cell's entries in order
+    /// of theirs). Sorting by (this, number) puts triangles in its order without a second query.
+    pub(super) fn first_shared_cell(&self, query: [usize; 3], b: &Aabb) -> usize {
+        let idx = [0, 1, 2].map(|k| query[k].max(self.index(k, b.lo[k])));
         (idx[0] * self.dims[1] + idx[1]) * self.dims[2] + idx[2]
     }
 
@@ -677,7 +682,8 @@ mod tests {
             grid.overlapping(&query, None, &mut seen, &mut found);
             let mut sorted = found.clone();
             sorted.reverse();
-            sorted.sort_unstable_by_key(|&u| (grid.first_shared_cell(&query, &boxes[u as usize]), u));
+            let corner = grid.cell_of(query.lo);
+            sorted.sort_unstable_by_key(|&u| (grid.first_shared_cell(corner, &boxes[u as usize]), u));
             assert_eq!(sorted, found, "query {q}");
             several += usize::from(found.len() > 1);
         }
