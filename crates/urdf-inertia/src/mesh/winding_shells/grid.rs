@@ -656,17 +656,24 @@ mod tests {
         assert_eq!(w, None);
     }
 
+    /// `n` cubes scattered over a region of 3 × 2 × 1, of many sizes up to a quarter of `size` (the
+    /// product of two uniform numbers: mostly small), so that a grid over them has cells of several
+    /// entries and empty ones.
+    fn scattered_boxes(next: &mut impl FnMut() -> f64, n: usize, size: f64) -> Vec<Aabb> {
+        (0..n)
+            .map(|_| {
+                let lo = [next() * 3.0, next() * 2.0, next()];
+                let s = size * next() * next();
+                Aabb::of([lo, lo.map(|x| x + s)])
+            })
+            .collect()
+    }
+
     /// Sorting what a box query finds by (first shared cell, number) is the query's own order.
     #[test]
     fn first_shared_cells_give_the_query_order() {
         let mut next = uniform(11);
-        let boxes: Vec<Aabb> = (0..600)
-            .map(|_| {
-                let lo = [next() * 3.0, next() * 2.0, next()];
-                let size = 0.5 * next() * next();
-                Aabb::of([lo, lo.map(|x| x + size * 1.5)])
-            })
-            .collect();
+        let boxes = scattered_boxes(&mut next, 600, 0.75);
         let grid = Grid::new(&boxes);
         assert!(grid.dims.iter().all(|&d| d > 2), "{:?}", grid.dims);
         let mut seen = Seen::new(boxes.len());
@@ -692,15 +699,8 @@ mod tests {
 
     #[test]
     fn row_entries_count_the_cells_a_ray_reads() {
-        // Boxes of many sizes, so that the grid has cells of several entries and empty ones.
         let mut next = uniform(7);
-        let boxes: Vec<Aabb> = (0..400)
-            .map(|_| {
-                let lo = [next() * 3.0, next() * 2.0, next()];
-                let size = 0.4 * next() * next();
-                Aabb::of([lo, lo.map(|x| x + size)])
-            })
-            .collect();
+        let boxes = scattered_boxes(&mut next, 400, 0.4);
         let grid = Grid::new(&boxes);
         assert!(grid.dims.iter().all(|&d| d > 2), "{:?}", grid.dims);
         for _ in 0..200 {
