@@ -14,7 +14,7 @@ mod cli;
 /// (cargo feature `no_thp` off) are faster in back-to-back runs, but not in a virtual machine that
 /// hands freed memory back to its host (virtio-balloon free page reporting, order 9 and up: whole
 /// huge pages). On such a 2-core VM (1.3 M faces, one thread, interleaved): back to back, median
-/// 146 ms against 190 ms, but 16 of 100 runs took 1.4 to 3× the median (none without them); with
+/// 146 ms against 190 ms, but 16 of 100 runs took 1.4 to 3× the median (1 of 100 with small pages); with
 /// 3 s between runs, as a user runs it, 319 ms against 196 ms (189 ms of system time: the host
 /// faults each huge page in again). The kernel's compaction stalled none of them (`compact_stall`
 /// unchanged), as an earlier note here had guessed. Small pages cost the same either way.

@@ -722,11 +722,9 @@ fn nesting(
             ControlFlow::Continue(())
         }
     };
-    // A shell with no triangle in the other's box cannot touch it (nested shells, most often).
-    let touching = !ta.is_empty()
-        && !tb.is_empty()
-        && closed_boxes_meeting(&boxes_a, &boxes_b, touch).is_break();
-    if touching {
+    // A shell with no triangle in the other's box cannot touch it (nested shells, most often):
+    // the sweep then looks at nothing.
+    if closed_boxes_meeting(&boxes_a, &boxes_b, touch).is_break() {
         return None;
     }
     let wa = integer(winding(
