@@ -156,6 +156,11 @@ impl Grid {
         });
     }
 
+    /// How many cells [`Grid::overlapping`] visits for a query box `b`.
+    pub(super) fn cells_in(&self, b: &Aabb) -> usize {
+        (0..3).map(|k| self.index(k, b.hi[k]) - self.index(k, b.lo[k]) + 1).product()
+    }
+
     /// The cell of a point, per axis (clamped to the grid).
     pub(super) fn cell_of(&self, p: [f64; 3]) -> [usize; 3] {
         [0, 1, 2].map(|k| self.index(k, p[k]))
