@@ -598,12 +598,8 @@ impl Faces<'_> {
     /// keeps the swept strip off `t`'s edges).
     fn joined(&self, t: u32, from: &Origin, q: [f64; 3], seen: &mut Seen) -> bool {
         let c = self.corners[t as usize];
-        let inside = |x: [f64; 3], k: usize| {
-            let s = [0, 1, 2].map(|i| orient2d(c2(c[i], k), c2(c[(i + 1) % 3], k), c2(x, k)));
-            s.iter().all(|&v| v > 0.0) || s.iter().all(|&v| v < 0.0)
-        };
         let p = from.p;
-        if !from.axes.iter().flatten().all(|&k| inside(p, k) && inside(q, k)) {
+        if !from.axes.iter().flatten().all(|&k| strictly_inside(c, p, k) && strictly_inside(c, q, k)) {
             return false;
         }
         self.segment_clear(p, q, [t, t], seen)
@@ -650,10 +646,6 @@ impl Faces<'_> {
         };
         let d = cu[i];
         let p = from.p;
-        let strictly_inside = |tri: Corners, x: [f64; 3], k: usize| {
-            let s = [0, 1, 2].map(|i| orient2d(c2(tri[i], k), c2(tri[(i + 1) % 3], k), c2(x, k)));
-            s.iter().all(|&v| v > 0.0) || s.iter().all(|&v| v < 0.0)
-        };
         let fits = |k: usize| {
             let (a2, b2) = (c2(a, k), c2(b, k));
             let (p2, q2) = (c2(p, k), c2(q, k));
@@ -928,10 +920,14 @@ impl Coplanar {
         if !within((k + 1) % 3) || !within((k + 2) % 3) {
             return false;
         }
-        let c = self.corners;
-        let s = [0, 1, 2].map(|i| orient2d(c2(c[i], k), c2(c[(i + 1) % 3], k), c2(p, k)));
-        s.iter().all(|&v| v > 0.0) || s.iter().all(|&v| v < 0.0)
+        strictly_inside(self.corners, p, k)
     }
+}
+
+/// Whether `x` lies strictly inside triangle `c` seen along axis `k` (exact `orient2d`).
+fn strictly_inside(c: Corners, x: [f64; 3], k: usize) -> bool {
+    let s = [0, 1, 2].map(|i| orient2d(c2(c[i], k), c2(c[(i + 1) % 3], k), c2(x, k)));
+    s.iter().all(|&v| v > 0.0) || s.iter().all(|&v| v < 0.0)
 }
 
 /// Two triangles `[v, …]` sharing their first corner: whether they may meet elsewhere (exact,
