@@ -212,7 +212,8 @@ impl Grid {
 
     /// The winding number of the triangles (all but those in `skip`) at `p`, counted along the ray from `p`
     /// in direction `sign`·e_`axis` to beyond the grid; `None` when the ray touches an edge, a
-    /// vertex or a plane of one of them.
+    /// vertex or a plane of one of them. With `near`, the triangles it passes through whose boxes
+    /// begin (seen from `p`) no further along `axis` than `near`'s coordinate are listed there.
     pub(super) fn winding(
         &self,
         (corners, planes): (&[Corners], &[Plane]),
@@ -221,6 +222,7 @@ impl Grid {
         sign: f64,
         skip: &[u32],
         seen: &mut Seen,
+        mut near: Option<(f64, &mut Vec<u32>)>,
     ) -> Option<i64> {
         let mut end = p;
         let margin = self.cell[axis];
@@ -254,7 +256,14 @@ impl Grid {
                 }
                 match crossing(p, end, axis, &corners[i as usize], &planes[i as usize]) {
                     Crossing::Miss => {}
-                    Crossing::Through(d) => w += d,
+                    Crossing::Through(d) => {
+                        w += d;
+                        if let Some((reach, list)) = near.as_mut() {
+                            if (sign > 0.0 && b.lo[axis] <= *reach) || (sign < 0.0 && b.hi[axis] >= *reach) {
+                                list.push(i);
+                            }
+                        }
+                    }
                     Crossing::Degenerate => return None,
                 }
             }
@@ -364,6 +373,11 @@ impl Plane {
 
     /// A value with the sign of `orient3d(a, b, c, d)` (zero exactly when `d` is in the plane).
     #[inline(always)] // a few flops run for every pair of neighbouring triangles
+    /// (b − a) × (c − a), the same bits as `geometry::cross` of the two gives (its minors).
+    pub(super) fn normal(&self) -> [f64; 3] {
+        self.minor
+    }
+
     pub(super) fn side(&self, d: [f64; 3]) -> f64 {
         if let Some((k, x)) = self.level {
             if d[k] == x {
@@ -650,14 +664,14 @@ mod tests {
         let inside = [0.3, 0.4, 0.45];
         for axis in 0..3 {
             for sign in [1.0, -1.0] {
-                let w = grid.winding(tris, inside, axis, sign, &[], &mut seen);
+                let w = grid.winding(tris, inside, axis, sign, &[], &mut seen, None);
                 assert_eq!(w, Some(1));
-                let w = grid.winding(tris, [1.5, 0.3, 0.4], axis, sign, &[], &mut seen);
+                let w = grid.winding(tris, [1.5, 0.3, 0.4], axis, sign, &[], &mut seen, None);
                 assert_eq!(w, Some(0));
             }
         }
         // Through the diagonal of a face: degenerate.
-        let w = grid.winding(tris, [0.5, 0.5, 0.5], 2, 1.0, &[], &mut seen);
+        let w = grid.winding(tris, [0.5, 0.5, 0.5], 2, 1.0, &[], &mut seen, None);
         assert_eq!(w, None);
     }
 

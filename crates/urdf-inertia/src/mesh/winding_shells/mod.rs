@@ -22,6 +22,7 @@
 mod cells;
 mod correction;
 mod cracks;
+mod exact;
 mod grid;
 
 use crate::geometry::{cross, dot, norm, solid_angle, sub, x_sweep, Aabb};
