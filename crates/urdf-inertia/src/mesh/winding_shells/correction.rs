@@ -10,7 +10,7 @@
 //! the cone it spans from the surface's box centre (the volume a wrong orientation can change) to
 //! the bound, twice when it may count twice.
 
-use super::cells::{area, cells, centroid, leaves_whole, split, Cut};
+use super::cells::{area, cells, centroid, leaves_whole, split, Cut, CutPlane};
 use super::grid::{Corners, Grid, Plane, Seen};
 use super::{edge_meets, overlap, triangles_touch, EdgeUse};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
@@ -871,7 +871,7 @@ impl Faces<'_> {
                 coplanar.push(Coplanar::new(u, [a, b, c], nt, self.margin, exact));
             } else {
                 planes.push(Cut {
-                    plane: (a, n, self.margin * norm(ab) * norm(ac)),
+                    plane: blocker_plane([a, b, c], n, nt, self.margin),
                     reach: Some([a, b, c]),
                 });
             }
@@ -1094,6 +1094,40 @@ fn coplanar_apart(t: Corners, u: Corners) -> bool {
     apart(t, u) || apart(u, t)
 }
 
+/// The plane along which a blocker `c` (normal `n`, not in the plane of normal `nt` of the piece it
+/// blocks) cuts that piece, and its margin: points within the margin of the plane may lie on the
+/// blocker. Its own plane, with the margin `margin · |ab| · |ac|` that covers the normal's
+/// rounding, is a band of width `margin / sin θ` (θ its angle at `a`): for a sliver (corners a
+/// rounding from one line, as exporters leave along seams) that band holds the whole piece, so no
+/// point of it could be decided (laikago's `chassis.obj`: a sliver of float area 0 across a
+/// face left 1.4e-3 of the volume undecided). A sliver lies within its height `h` of the line of
+/// its longest edge, so within `h` of the plane through that line across the piece's plane;
+/// that plane is taken when its band is the narrower. `h` is bounded from the float normal and
+/// the rounding of the differences and products (each component within `6 ε |ab| |ac|`, the
+/// norm within `16 ε |ab| |ac|`).
+fn blocker_plane(c: Corners, n: [f64; 3], nt: [f64; 3], margin: f64) -> CutPlane {
+    let [a, b, cc] = c;
+    let (ab, ac) = (sub(b, a), sub(cc, a));
+    let own = (a, n, margin * norm(ab) * norm(ac));
+    let own_band = own.2 / norm(n);
+    let edges = [(a, b), (b, cc), (cc, a)];
+    let (p, q) = edges
+        .into_iter()
+        .max_by(|x, y| norm(sub(x.1, x.0)).total_cmp(&norm(sub(y.1, y.0))))
+        .unwrap_or((a, b));
+    let e = sub(q, p);
+    let len = norm(e);
+    let h = (norm(n) + 16.0 * f64::EPSILON * norm(ab) * norm(ac)) / len;
+    let across = cross(e, nt);
+    let m = (margin + h) * len * norm(nt);
+    let band = m / norm(across);
+    if band < own_band {
+        (p, across, m)
+    } else {
+        own
+    }
+}
+
 /// Whether the corners lie on one line, exactly: the normal's three components, which are the
 /// corners' `orient2d` seen along each axis, are all zero.
 fn collinear(c: Corners) -> bool {
@@ -1228,6 +1262,26 @@ mod tests {
         let signs = vec![1; tris.len()];
         let r = resolve(&vertices, &tris, &signs, [0.5; 3], 0.0);
         assert_eq!(r.bound, 0.0);
+        let got = enclosed(&vertices, &r);
+        assert!((got - 1.0).abs() < 1e-15, "{got}");
+    }
+
+    /// A sliver through a box's bottom: corners 2⁻⁵⁰ from one line, so its own plane's band
+    /// (the margin over the sine of its angle, about 1e3 here) holds the whole bottom. Cut along
+    /// the plane through its longest edge across the bottom instead, the bottom is two cells,
+    /// each decided: the box, with nothing undecided but the sliver's own pieces (area 1e-16).
+    #[test]
+    fn a_sliver_cuts_along_its_longest_edge() {
+        let mut vertices = Vec::new();
+        let mut tris = Vec::new();
+        push_box(&mut vertices, &mut tris, [0.0; 3], [1.0; 3]);
+        let base = vertices.len() as u32;
+        let off = 0.5 + 2f64.powi(-50);
+        vertices.extend([[0.25, 0.5, -0.25], [0.75, 0.5, 0.25], [0.5, off, 0.0]]);
+        tris.push([base, base + 1, base + 2]);
+        let signs = vec![1; tris.len()];
+        let r = resolve(&vertices, &tris, &signs, [0.5; 3], 0.0);
+        assert!(r.bound < 1e-15, "{}", r.bound);
         let got = enclosed(&vertices, &r);
         assert!((got - 1.0).abs() < 1e-15, "{got}");
     }
