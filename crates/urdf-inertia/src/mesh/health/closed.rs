@@ -320,9 +320,21 @@ pub(super) fn outward(
         .map(|i| o.flip[i] ^ turn[o.comp[i] as usize])
         .collect();
     let flipped = reversed.iter().filter(|r| **r).count();
+    // Per component, faces reversed against the file and kept: a component that ends mostly
+    // reversed was turned round as a whole (up to the faces [`flip_change`] counts).
+    let mut count = vec![[0usize; 2]; o.ncomp];
+    for (i, r) in reversed.iter().enumerate() {
+        count[o.comp[i] as usize][usize::from(*r)] += 1;
+    }
     let mut nested = 0.0;
     if let Some(boxes) = &boxes {
         for c in 0..o.ncomp {
+            // Only a component turned against the file can make the solid differ from Ω of the
+            // file's surface there: one kept as stored (a cavity left inward, a solid outward) is
+            // what the file's winding number says it is, and nesting is decided by it.
+            if count[c][1] <= count[c][0] {
+                continue;
+            }
             if (0..o.ncomp).any(|d| d != c && boxes[d].contains(&boxes[c])) {
                 nested += 2.0 * vol[c].abs() / 6.0;
             }
