@@ -1253,17 +1253,23 @@ mod tests {
     /// in it) kept every point of the bottom too near to be decided.
     #[test]
     fn a_triangle_of_collinear_corners_cuts_nothing() {
+        let (r, got) = unit_box_and([[0.25, 0.5, -0.25], [0.5, 0.5, 0.0], [0.75, 0.5, 0.25]]);
+        assert_eq!(r.bound, 0.0);
+        assert!((got - 1.0).abs() < 1e-15, "{got}");
+    }
+
+    /// The unit box and one more triangle, resolved: what was decided and the volume it encloses.
+    fn unit_box_and(triangle: Corners) -> (Resolved, f64) {
         let mut vertices = Vec::new();
         let mut tris = Vec::new();
         push_box(&mut vertices, &mut tris, [0.0; 3], [1.0; 3]);
         let base = vertices.len() as u32;
-        vertices.extend([[0.25, 0.5, -0.25], [0.5, 0.5, 0.0], [0.75, 0.5, 0.25]]);
+        vertices.extend(triangle);
         tris.push([base, base + 1, base + 2]);
         let signs = vec![1; tris.len()];
         let r = resolve(&vertices, &tris, &signs, [0.5; 3], 0.0);
-        assert_eq!(r.bound, 0.0);
         let got = enclosed(&vertices, &r);
-        assert!((got - 1.0).abs() < 1e-15, "{got}");
+        (r, got)
     }
 
     /// A sliver through a box's bottom: corners 2⁻⁵⁰ from one line, so its own plane's band
@@ -1272,17 +1278,9 @@ mod tests {
     /// each decided: the box, with nothing undecided but the sliver's own pieces (area 1e-16).
     #[test]
     fn a_sliver_cuts_along_its_longest_edge() {
-        let mut vertices = Vec::new();
-        let mut tris = Vec::new();
-        push_box(&mut vertices, &mut tris, [0.0; 3], [1.0; 3]);
-        let base = vertices.len() as u32;
         let off = 0.5 + 2f64.powi(-50);
-        vertices.extend([[0.25, 0.5, -0.25], [0.75, 0.5, 0.25], [0.5, off, 0.0]]);
-        tris.push([base, base + 1, base + 2]);
-        let signs = vec![1; tris.len()];
-        let r = resolve(&vertices, &tris, &signs, [0.5; 3], 0.0);
+        let (r, got) = unit_box_and([[0.25, 0.5, -0.25], [0.75, 0.5, 0.25], [0.5, off, 0.0]]);
         assert!(r.bound < 1e-15, "{}", r.bound);
-        let got = enclosed(&vertices, &r);
         assert!((got - 1.0).abs() < 1e-15, "{got}");
     }
 
