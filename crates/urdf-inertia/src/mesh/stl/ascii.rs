@@ -4,7 +4,9 @@ use super::Keyword;
 use crate::mass::Polygons;
 use crate::mesh::weld::VertexTable;
 use crate::mesh::{parse_f64, short_decimal, MeshError, MeshErrorKind, RawMesh};
-use scan::{coordinates, is_word, line_hash, load, newline, text_to_newline, HIGHS, SPACES};
+use scan::{
+    coordinates, is_word, line_hash, load, newline, text_to_newline, FixedLine, HIGHS, SPACES,
+};
 use std::io::Read as _;
 use std::path::Path;
 
@@ -146,6 +148,9 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
         in_loop: start.in_loop,
         current: start.current.clone(),
         base,
+        outer_line: FixedLine::NONE,
+        endloop_line: FixedLine::NONE,
+        endfacet_line: FixedLine::NONE,
     };
     // The bitwise or of the words the fast path loaded ([`HIGHS`] after a line of the general path).
     let mut bytes = 0;
@@ -199,6 +204,12 @@ struct ChunkParse<'t> {
     current: Vec<u32>,
     /// The number of the chunk's first new vertex.
     base: u32,
+    /// The last `outer`, `endloop` and `endfacet` lines the fast path took, byte for byte (with
+    /// their `\n`): the line after a `facet` line, and the two after a facet's last corner, are
+    /// compared with them whole and, when they are the same bytes, done as they were.
+    outer_line: FixedLine,
+    endloop_line: FixedLine,
+    endfacet_line: FixedLine,
 }
 
 impl<'t> ChunkParse<'t> {
@@ -269,6 +280,7 @@ impl<'t> ChunkParse<'t> {
     /// hashed on the way when it is a vertex's text.
     #[inline]
     fn fast_line(&mut self, text: &'t [u8], mut at: usize, bytes: &mut u64) -> Option<usize> {
+        let line_start = at;
         loop {
             let v = load(text, at);
             *bytes |= v;
@@ -305,34 +317,79 @@ impl<'t> ChunkParse<'t> {
                 };
                 self.out.dependent |= !self.out.outer;
                 self.current.push(self.base + i);
-                return Some(end + 1);
+                return Some(self.after_corner(text, end + 1));
             }
             b'o' if is_word(text, at, w, b"outer") => {
-                self.out.outer = true;
-                self.in_loop = true;
-                self.current.clear();
-                at += 5;
+                self.outer();
+                let end = newline(text, at + 5, bytes).map_or(text.len(), |i| i + 1);
+                self.outer_line = FixedLine::of(text, line_start, end);
+                return Some(end);
             }
             b'e' if is_word(text, at, w, b"endloop") => {
                 if self.current.len() < 3 {
                     return None;
                 }
-                self.out.dependent |= !self.out.outer;
-                self.in_loop = false;
-                self.out.indices.extend_from_slice(&self.current);
-                self.out.sizes.push(self.current.len() as u32);
-                at += 7;
+                self.end_loop();
+                let end = newline(text, at + 7, bytes).map_or(text.len(), |i| i + 1);
+                self.endloop_line = FixedLine::of(text, line_start, end);
+                return Some(end);
             }
-            b'f' if is_word(text, at, w, b"facet") => at += 5,
-            b'e' if is_word(text, at, w, b"endfacet") || is_word(text, at, w, b"endsolid") => {
-                at += 8;
+            b'f' if is_word(text, at, w, b"facet") => {
+                let end = newline(text, at + 5, bytes).map_or(text.len(), |i| i + 1);
+                if self.outer_line.at(text, end) {
+                    self.out.lines += 1;
+                    self.outer();
+                    return Some(end + self.outer_line.len());
+                }
+                return Some(end);
             }
+            b'e' if is_word(text, at, w, b"endfacet") => {
+                let end = newline(text, at + 8, bytes).map_or(text.len(), |i| i + 1);
+                self.endfacet_line = FixedLine::of(text, line_start, end);
+                return Some(end);
+            }
+            b'e' if is_word(text, at, w, b"endsolid") => at += 8,
             b's' if is_word(text, at, w, b"solid") => at += 5,
             _ => return None,
         }
         // The rest of a line other than `vertex` is not read (as `Keyword::of` decides on the
         // first word alone).
         Some(newline(text, at, bytes).map_or(text.len(), |i| i + 1))
+    }
+
+    /// `outer`: a facet's corners begin.
+    #[inline(always)]
+    fn outer(&mut self) {
+        self.out.outer = true;
+        self.in_loop = true;
+        self.current.clear();
+    }
+
+    /// `endloop` after at least three corners: the face.
+    #[inline(always)]
+    fn end_loop(&mut self) {
+        self.out.dependent |= !self.out.outer;
+        self.in_loop = false;
+        self.out.indices.extend_from_slice(&self.current);
+        self.out.sizes.push(self.current.len() as u32);
+    }
+
+    /// Where the fast path goes on after a corner's line that ends before `at`: past the next line
+    /// and the one after it when they are the last `endloop` and `endfacet` lines taken, byte for
+    /// byte (and the facet has three corners or more), done as they were; else `at`.
+    #[inline(always)]
+    fn after_corner(&mut self, text: &[u8], at: usize) -> usize {
+        if self.current.len() < 3 || !self.endloop_line.at(text, at) {
+            return at;
+        }
+        self.out.lines += 1;
+        self.end_loop();
+        let at = at + self.endloop_line.len();
+        if !self.endfacet_line.at(text, at) {
+            return at;
+        }
+        self.out.lines += 1;
+        at + self.endfacet_line.len()
     }
 }
 

@@ -425,6 +425,75 @@ fn streamed_ascii_fast_path_is_the_whole_text_parse() {
     assert!(e.to_string().contains(&format!("not valid UTF-8 at byte {at}")), "{e}");
 }
 
+/// The lines after a `facet` line and after a facet's last corner, compared whole with the last
+/// `outer`, `endloop` and `endfacet` lines taken: the same faces or errors (and lines) as the
+/// whole-text reader when they repeat byte for byte, when they differ in blanks, case or what
+/// follows the keyword, when they are longer than the 16 bytes compared, when a facet has too
+/// few corners for its `endloop`, when bytes that are not ASCII (or not UTF-8) repeat in them,
+/// and at the end of the text without a newline.
+#[test]
+fn streamed_ascii_fixed_lines_are_the_whole_text_parse() {
+    let facet = |k: usize, outer: &str, endloop: &str, endfacet: &str, corners: usize| {
+        let mut s = format!("  facet normal 0 0 1\n{outer}");
+        for c in 0..corners {
+            let _ = writeln!(s, "      vertex {}.5 {} {}", k + c, c * 2, k % 7);
+        }
+        s + endloop + endfacet
+    };
+    let (o, l, f) = ("    outer loop\n", "    endloop\n", "  endfacet\n");
+    let body = |k: usize| facet(k, o, l, f, 3);
+    let mut cases: Vec<(Vec<u8>, String)> = Vec::new();
+    let mut push = |t: String, what: &str| cases.push((t.into_bytes(), what.to_string()));
+    let plain: String = (0..30).map(body).collect();
+    push(format!("solid t\n{plain}endsolid t\n"), "plain");
+    let mut odd = String::from("solid t\n");
+    for k in 0..40 {
+        let (oo, ll, ff) = match k % 8 {
+            1 => ("   outer loop\n", "   endloop\n", " endfacet\n"),
+            2 => ("    OUTER LOOP\n", "    EndLoop\n", "  endFacet\n"),
+            3 => ("    outer loop\r\n", "    endloop\r\n", "  endfacet\r\n"),
+            4 => ("        outer loop\n", "        endloop\n", "          endfacet\n"),
+            5 => ("    outer loops\n", "\tendloop x\n", "\tendfacet\t\n"),
+            6 => ("    outer loop é\n", "    endloop é\n", "  endfacet ü\n"),
+            _ => (o, l, f),
+        };
+        odd += &facet(k, oo, ll, ff, 3 + usize::from(k % 5 == 4));
+        odd += &facet(k + 50, oo, ll, ff, 3);
+    }
+    push(odd.clone() + "endsolid t\n", "blanks, case, long lines, non-ASCII");
+    for (n, what) in [(2, "two corners"), (1, "one corner"), (0, "no corners")] {
+        let text = format!("solid t\n{plain}{}{plain}", facet(99, o, l, f, n));
+        push(text, what);
+    }
+    let words = [("    outerx loop\n", "outerx"), ("    endloops\n", "endloops"), ("  endfacets\n", "endfacets")];
+    for (bad, what) in words {
+        let text = format!("solid t\n{plain}").replacen(
+            if what == "outerx" { o } else if what == "endloops" { l } else { f },
+            bad,
+            1,
+        );
+        push(text + &plain, what);
+    }
+    let cut = format!("solid t\n{plain}");
+    for end in [1, 2, 3, 5, 12, 13] {
+        let text = cut[..cut.len() - end].to_string();
+        push(text, &format!("cut {end} bytes before the end"));
+    }
+    push(format!("solid t\n{plain}  facet normal 0 0 1\n    outer loop"), "outer without a newline");
+    for (text, what) in &cases {
+        check(text, what);
+    }
+    // Not UTF-8, repeated in a line compared whole.
+    let mut bad = b"solid t\n".to_vec();
+    for k in 0..20 {
+        let t = facet(k, o, l, f, 3).replace("    endloop\n", "    endloop \u{1}\n");
+        bad.extend_from_slice(&t.into_bytes().iter().map(|&b| if b == 1 { 0xff } else { b }).collect::<Vec<_>>());
+    }
+    check(&bad, "not UTF-8 in repeated endloop lines");
+    let e = ascii(&bad, Path::new("t")).expect_err("not UTF-8");
+    assert!(e.to_string().contains("not valid UTF-8"), "{e}");
+}
+
 /// A source that gives `bytes` and then fails, as a file on a failing disk or a network share
 /// that drops does.
 struct FailingAfter<'a> {

@@ -130,6 +130,57 @@ fn digits_value(v: u64, n: usize) -> u64 {
     ((d & 0x0000_ffff_0000_ffff).wrapping_mul((10_000 << 32) + 1)) >> 32
 }
 
+/// A line of at most 16 bytes, its `\n` included, as two words to compare the text with (what is
+/// past its end masked off), or none (no text matches it).
+#[derive(Clone, Copy)]
+pub(super) struct FixedLine {
+    words: [u64; 2],
+    masks: [u64; 2],
+    len: usize,
+}
+
+impl FixedLine {
+    pub(super) const NONE: FixedLine = FixedLine {
+        words: [1, 0],
+        masks: [0, 0],
+        len: 0,
+    };
+
+    /// The line `text[start..end]` when it ends with its `\n` and is at most 16 bytes long; else
+    /// none.
+    #[inline]
+    pub(super) fn of(text: &[u8], start: usize, end: usize) -> FixedLine {
+        let n = end - start;
+        if n == 0 || n > 16 || text[end - 1] != b'\n' {
+            return FixedLine::NONE;
+        }
+        let mask = |k: usize| if k >= 8 { u64::MAX } else { (1u64 << (8 * k)) - 1 };
+        let masks = [mask(n), mask(n.saturating_sub(8))];
+        FixedLine {
+            words: [
+                load(text, start) & masks[0],
+                load(text, start + 8) & masks[1],
+            ],
+            masks,
+            len: n,
+        }
+    }
+
+    /// The line's length (0 for none).
+    #[inline(always)]
+    pub(super) fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether the text at `at` begins with this line. The bytes compared need no or into the
+    /// UTF-8 accumulator: they are the line's, or-ed into it when it was first taken.
+    #[inline(always)]
+    pub(super) fn at(&self, text: &[u8], at: usize) -> bool {
+        load(text, at) & self.masks[0] == self.words[0]
+            && load(text, at + 8) & self.masks[1] == self.words[1]
+    }
+}
+
 /// The first `\n` at or after `from`, the words read or-ed into `bytes`.
 #[inline]
 pub(super) fn newline(text: &[u8], mut from: usize, bytes: &mut u64) -> Option<usize> {
