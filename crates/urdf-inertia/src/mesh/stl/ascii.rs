@@ -151,6 +151,7 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
         outer_line: FixedLine::NONE,
         endloop_line: FixedLine::NONE,
         endfacet_line: FixedLine::NONE,
+        vertex_start: FixedLine::NONE,
     };
     // The bitwise or of the words the fast path loaded ([`HIGHS`] after a line of the general path).
     let mut bytes = 0;
@@ -210,6 +211,10 @@ struct ChunkParse<'t> {
     outer_line: FixedLine,
     endloop_line: FixedLine,
     endfacet_line: FixedLine,
+    /// The start of the last `vertex` line the fast path took, up to the blank after the keyword:
+    /// a line inside a loop that begins with the same bytes is a `vertex` line whose text starts
+    /// at that blank.
+    vertex_start: FixedLine,
 }
 
 impl<'t> ChunkParse<'t> {
@@ -281,6 +286,9 @@ impl<'t> ChunkParse<'t> {
     #[inline]
     fn fast_line(&mut self, text: &'t [u8], mut at: usize, bytes: &mut u64) -> Option<usize> {
         let line_start = at;
+        if self.in_loop && self.vertex_start.at(text, at) {
+            return self.corner(text, at + self.vertex_start.len() - 1, bytes);
+        }
         loop {
             let v = load(text, at);
             *bytes |= v;
@@ -303,26 +311,14 @@ impl<'t> ChunkParse<'t> {
                 if !self.in_loop {
                     return None;
                 }
-                let from = at + 6;
-                let (end, h) = text_to_newline(text, from, bytes)?;
-                let key = &text[from..end];
-                let (slot, seen) = self.seen.find(key, h);
-                let i = if let Some(i) = seen {
-                    i
-                } else {
-                    let p = coordinates(text, from)?;
-                    let i = self.table.insert(p);
-                    self.seen.insert(slot, key, h, i);
-                    i
-                };
-                self.out.dependent |= !self.out.outer;
-                self.current.push(self.base + i);
-                return Some(self.after_corner(text, end + 1));
+                let next = self.corner(text, at + 6, bytes)?;
+                self.vertex_start = FixedLine::of(text, line_start, at + 7);
+                return Some(next);
             }
             b'o' if is_word(text, at, w, b"outer") => {
                 self.outer();
                 let end = newline(text, at + 5, bytes).map_or(text.len(), |i| i + 1);
-                self.outer_line = FixedLine::of(text, line_start, end);
+                self.outer_line = FixedLine::line(text, line_start, end);
                 return Some(end);
             }
             b'e' if is_word(text, at, w, b"endloop") => {
@@ -331,7 +327,7 @@ impl<'t> ChunkParse<'t> {
                 }
                 self.end_loop();
                 let end = newline(text, at + 7, bytes).map_or(text.len(), |i| i + 1);
-                self.endloop_line = FixedLine::of(text, line_start, end);
+                self.endloop_line = FixedLine::line(text, line_start, end);
                 return Some(end);
             }
             b'f' if is_word(text, at, w, b"facet") => {
@@ -345,7 +341,7 @@ impl<'t> ChunkParse<'t> {
             }
             b'e' if is_word(text, at, w, b"endfacet") => {
                 let end = newline(text, at + 8, bytes).map_or(text.len(), |i| i + 1);
-                self.endfacet_line = FixedLine::of(text, line_start, end);
+                self.endfacet_line = FixedLine::line(text, line_start, end);
                 return Some(end);
             }
             b'e' if is_word(text, at, w, b"endsolid") => at += 8,
@@ -355,6 +351,27 @@ impl<'t> ChunkParse<'t> {
         // The rest of a line other than `vertex` is not read (as `Keyword::of` decides on the
         // first word alone).
         Some(newline(text, at, bytes).map_or(text.len(), |i| i + 1))
+    }
+
+    /// A `vertex` line inside a loop whose text after the keyword starts at `from` (with the
+    /// blank after it): its corner, and where the fast path goes on ([`Self::after_corner`]);
+    /// `None`, with nothing changed, when the text is not three decimals and a newline.
+    #[inline(always)]
+    fn corner(&mut self, text: &'t [u8], from: usize, bytes: &mut u64) -> Option<usize> {
+        let (end, h) = text_to_newline(text, from, bytes)?;
+        let key = &text[from..end];
+        let (slot, seen) = self.seen.find(key, h);
+        let i = if let Some(i) = seen {
+            i
+        } else {
+            let p = coordinates(text, from)?;
+            let i = self.table.insert(p);
+            self.seen.insert(slot, key, h, i);
+            i
+        };
+        self.out.dependent |= !self.out.outer;
+        self.current.push(self.base + i);
+        Some(self.after_corner(text, end + 1))
     }
 
     /// `outer`: a facet's corners begin.

@@ -433,12 +433,17 @@ fn streamed_ascii_fast_path_is_the_whole_text_parse() {
 /// and at the end of the text without a newline.
 #[test]
 fn streamed_ascii_fixed_lines_are_the_whole_text_parse() {
-    let facet = |k: usize, outer: &str, endloop: &str, endfacet: &str, corners: usize| {
+    let corner = |k: usize, c: usize| format!("{}.5 {} {}\n", k + c, c * 2, k % 7);
+    let facet_with = |k: usize, lines: [&str; 4], corners: usize| {
+        let [outer, vertex, endloop, endfacet] = lines;
         let mut s = format!("  facet normal 0 0 1\n{outer}");
         for c in 0..corners {
-            let _ = writeln!(s, "      vertex {}.5 {} {}", k + c, c * 2, k % 7);
+            s = s + vertex + &corner(k, c);
         }
         s + endloop + endfacet
+    };
+    let facet = |k: usize, outer: &str, endloop: &str, endfacet: &str, corners: usize| {
+        facet_with(k, [outer, "      vertex ", endloop, endfacet], corners)
     };
     let (o, l, f) = ("    outer loop\n", "    endloop\n", "  endfacet\n");
     let body = |k: usize| facet(k, o, l, f, 3);
@@ -457,8 +462,16 @@ fn streamed_ascii_fixed_lines_are_the_whole_text_parse() {
             6 => ("    outer loop é\n", "    endloop é\n", "  endfacet ü\n"),
             _ => (o, l, f),
         };
-        odd += &facet(k, oo, ll, ff, 3 + usize::from(k % 5 == 4));
-        odd += &facet(k + 50, oo, ll, ff, 3);
+        let vv = match k % 6 {
+            1 => "     vertex  ",
+            2 => "      VERTEX ",
+            3 => "\t\tvertex\t",
+            4 => "vertex ",
+            5 => "              vertex ",
+            _ => "      vertex ",
+        };
+        odd += &facet_with(k, [oo, vv, ll, ff], 3 + usize::from(k % 5 == 4));
+        odd += &facet_with(k + 50, [oo, vv, ll, ff], 3);
     }
     push(odd.clone() + "endsolid t\n", "blanks, case, long lines, non-ASCII");
     for (n, what) in [(2, "two corners"), (1, "one corner"), (0, "no corners")] {
@@ -473,6 +486,15 @@ fn streamed_ascii_fixed_lines_are_the_whole_text_parse() {
             1,
         );
         push(text + &plain, what);
+    }
+    for (bad, what) in [
+        ("      vertex 1 2\n", "two coordinates after a corner"),
+        ("      vertexx 1 2 3\n", "vertexx after a corner"),
+        ("      vertex\n", "vertex without coordinates"),
+        ("      vertex 1 2 3 4\n", "four coordinates"),
+    ] {
+        let one = facet(7, o, l, f, 2).replacen("  endfacet\n", "", 1).replacen(l, "", 1);
+        push(format!("solid t\n{plain}{one}{bad}{l}{f}{plain}"), what);
     }
     let cut = format!("solid t\n{plain}");
     for end in [1, 2, 3, 5, 12, 13] {

@@ -130,8 +130,8 @@ fn digits_value(v: u64, n: usize) -> u64 {
     ((d & 0x0000_ffff_0000_ffff).wrapping_mul((10_000 << 32) + 1)) >> 32
 }
 
-/// A line of at most 16 bytes, its `\n` included, as two words to compare the text with (what is
-/// past its end masked off), or none (no text matches it).
+/// At most 16 bytes of a line (a whole line, its `\n` included, or its start), as two words to
+/// compare the text with (what is past its end masked off), or none (no text matches it).
 #[derive(Clone, Copy)]
 pub(super) struct FixedLine {
     words: [u64; 2],
@@ -149,9 +149,18 @@ impl FixedLine {
     /// The line `text[start..end]` when it ends with its `\n` and is at most 16 bytes long; else
     /// none.
     #[inline]
+    pub(super) fn line(text: &[u8], start: usize, end: usize) -> FixedLine {
+        if end == start || text[end - 1] != b'\n' {
+            return FixedLine::NONE;
+        }
+        FixedLine::of(text, start, end)
+    }
+
+    /// The bytes `text[start..end]` when there are 1 to 16 of them; else none.
+    #[inline]
     pub(super) fn of(text: &[u8], start: usize, end: usize) -> FixedLine {
         let n = end - start;
-        if n == 0 || n > 16 || text[end - 1] != b'\n' {
+        if n == 0 || n > 16 {
             return FixedLine::NONE;
         }
         let mask = |k: usize| if k >= 8 { u64::MAX } else { (1u64 << (8 * k)) - 1 };
