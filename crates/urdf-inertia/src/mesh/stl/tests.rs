@@ -425,32 +425,36 @@ fn streamed_ascii_fast_path_is_the_whole_text_parse() {
     assert!(e.to_string().contains(&format!("not valid UTF-8 at byte {at}")), "{e}");
 }
 
+/// An exporter's facet `k` with the given `outer`, `vertex` (up to its coordinates), `endloop` and
+/// `endfacet` lines, and `corners` corners.
+fn fixed_facet(k: usize, lines: [&str; 4], corners: usize) -> String {
+    let [outer, vertex, endloop, endfacet] = lines;
+    let mut s = format!("  facet normal 0 0 1\n{outer}");
+    for c in 0..corners {
+        let _ = writeln!(s, "{vertex}{}.5 {} {}", k + c, c * 2, k % 7);
+    }
+    s + endloop + endfacet
+}
+
+/// The lines of [`fixed_facet`] as exporters write them.
+const EXPORTER: [&str; 4] = ["    outer loop\n", "      vertex ", "    endloop\n", "  endfacet\n"];
+
+/// Thirty facets of [`EXPORTER`] lines.
+fn exporter_facets() -> String {
+    (0..30).map(|k| fixed_facet(k, EXPORTER, 3)).collect()
+}
+
 /// The lines after a `facet` line and after a facet's last corner, compared whole with the last
-/// `outer`, `endloop` and `endfacet` lines taken: the same faces or errors (and lines) as the
-/// whole-text reader when they repeat byte for byte, when they differ in blanks, case or what
-/// follows the keyword, when they are longer than the 16 bytes compared, when a facet has too
-/// few corners for its `endloop`, when bytes that are not ASCII (or not UTF-8) repeat in them,
-/// and at the end of the text without a newline.
+/// `outer`, `endloop` and `endfacet` lines taken, and `vertex` lines recognised by the start of
+/// the last one: the same faces or errors (and lines) as the whole-text reader when they repeat
+/// byte for byte, when they differ in blanks, case or what follows the keyword, when they are
+/// longer than the 16 bytes compared, when a facet has too few corners for its `endloop`, when a
+/// line after a corner is an error, and at the end of the text without a newline.
 #[test]
 fn streamed_ascii_fixed_lines_are_the_whole_text_parse() {
-    let corner = |k: usize, c: usize| format!("{}.5 {} {}\n", k + c, c * 2, k % 7);
-    let facet_with = |k: usize, lines: [&str; 4], corners: usize| {
-        let [outer, vertex, endloop, endfacet] = lines;
-        let mut s = format!("  facet normal 0 0 1\n{outer}");
-        for c in 0..corners {
-            s = s + vertex + &corner(k, c);
-        }
-        s + endloop + endfacet
-    };
-    let facet = |k: usize, outer: &str, endloop: &str, endfacet: &str, corners: usize| {
-        facet_with(k, [outer, "      vertex ", endloop, endfacet], corners)
-    };
-    let (o, l, f) = ("    outer loop\n", "    endloop\n", "  endfacet\n");
-    let body = |k: usize| facet(k, o, l, f, 3);
-    let mut cases: Vec<(Vec<u8>, String)> = Vec::new();
-    let mut push = |t: String, what: &str| cases.push((t.into_bytes(), what.to_string()));
-    let plain: String = (0..30).map(body).collect();
-    push(format!("solid t\n{plain}endsolid t\n"), "plain");
+    let [o, _, l, f] = EXPORTER;
+    let plain = exporter_facets();
+    let mut cases: Vec<(String, String)> = vec![(format!("solid t\n{plain}endsolid t\n"), "plain".into())];
     let mut odd = String::from("solid t\n");
     for k in 0..40 {
         let (oo, ll, ff) = match k % 8 {
@@ -470,46 +474,50 @@ fn streamed_ascii_fixed_lines_are_the_whole_text_parse() {
             5 => "              vertex ",
             _ => "      vertex ",
         };
-        odd += &facet_with(k, [oo, vv, ll, ff], 3 + usize::from(k % 5 == 4));
-        odd += &facet_with(k + 50, [oo, vv, ll, ff], 3);
+        odd += &fixed_facet(k, [oo, vv, ll, ff], 3 + usize::from(k % 5 == 4));
+        odd += &fixed_facet(k + 50, [oo, vv, ll, ff], 3);
     }
-    push(odd.clone() + "endsolid t\n", "blanks, case, long lines, non-ASCII");
+    cases.push((odd + "endsolid t\n", "blanks, case, long lines, non-ASCII".into()));
     for (n, what) in [(2, "two corners"), (1, "one corner"), (0, "no corners")] {
-        let text = format!("solid t\n{plain}{}{plain}", facet(99, o, l, f, n));
-        push(text, what);
+        let text = format!("solid t\n{plain}{}{plain}", fixed_facet(99, EXPORTER, n));
+        cases.push((text, what.into()));
     }
-    let words = [("    outerx loop\n", "outerx"), ("    endloops\n", "endloops"), ("  endfacets\n", "endfacets")];
-    for (bad, what) in words {
-        let text = format!("solid t\n{plain}").replacen(
-            if what == "outerx" { o } else if what == "endloops" { l } else { f },
-            bad,
-            1,
-        );
-        push(text + &plain, what);
+    for (line, bad) in [(o, "    outerx loop\n"), (l, "    endloops\n"), (f, "  endfacets\n")] {
+        let text = format!("solid t\n{plain}").replacen(line, bad, 1);
+        cases.push((text + &plain, bad.into()));
     }
-    for (bad, what) in [
-        ("      vertex 1 2\n", "two coordinates after a corner"),
-        ("      vertexx 1 2 3\n", "vertexx after a corner"),
-        ("      vertex\n", "vertex without coordinates"),
-        ("      vertex 1 2 3 4\n", "four coordinates"),
-    ] {
-        let one = facet(7, o, l, f, 2).replacen("  endfacet\n", "", 1).replacen(l, "", 1);
-        push(format!("solid t\n{plain}{one}{bad}{l}{f}{plain}"), what);
+    for bad in ["vertex 1 2\n", "vertexx 1 2 3\n", "vertex\n", "vertex 1 2 3 4\n"] {
+        let open = fixed_facet(7, [o, EXPORTER[1], "", ""], 2);
+        cases.push((format!("solid t\n{plain}{open}      {bad}{l}{f}{plain}"), bad.into()));
     }
     let cut = format!("solid t\n{plain}");
     for end in [1, 2, 3, 5, 12, 13] {
-        let text = cut[..cut.len() - end].to_string();
-        push(text, &format!("cut {end} bytes before the end"));
+        cases.push((cut[..cut.len() - end].to_string(), format!("cut {end} bytes before the end")));
     }
-    push(format!("solid t\n{plain}  facet normal 0 0 1\n    outer loop"), "outer without a newline");
+    let outer = format!("solid t\n{plain}  facet normal 0 0 1\n    outer loop");
+    cases.push((outer, "outer without a newline".into()));
     for (text, what) in &cases {
-        check(text, what);
+        check(text.as_bytes(), what);
     }
-    // Not UTF-8, repeated in a line compared whole.
+}
+
+/// Bytes that are not ASCII before the newline of a line scanned eight or sixteen bytes at a time
+/// (at every offset in the word), and bytes that are not UTF-8 repeated in a line compared whole:
+/// the whole-text reader's faces or error.
+#[test]
+fn streamed_ascii_fast_lines_not_ascii_are_the_whole_text_parse() {
+    let plain = exporter_facets();
+    for pad in 0..20 {
+        let blanks = " ".repeat(pad);
+        let normal = plain.replacen("normal 0 0 1\n", &format!("normal 0 0 1{blanks}é\n"), 3);
+        let corner = normal.replacen(" 0\n", &format!(" 0{blanks} ü\n"), 2);
+        check(format!("solid t\n{corner}endsolid t\n").as_bytes(), &format!("not ASCII after {pad} blanks"));
+    }
     let mut bad = b"solid t\n".to_vec();
     for k in 0..20 {
-        let t = facet(k, o, l, f, 3).replace("    endloop\n", "    endloop \u{1}\n");
-        bad.extend_from_slice(&t.into_bytes().iter().map(|&b| if b == 1 { 0xff } else { b }).collect::<Vec<_>>());
+        let [o, v, _, f] = EXPORTER;
+        let t = fixed_facet(k, [o, v, "    endloop \u{1}\n", f], 3);
+        bad.extend(t.bytes().map(|b| if b == 1 { 0xff } else { b }));
     }
     check(&bad, "not UTF-8 in repeated endloop lines");
     let e = ascii(&bad, Path::new("t")).expect_err("not UTF-8");
