@@ -152,6 +152,7 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
         endloop_line: FixedLine::NONE,
         endfacet_line: FixedLine::NONE,
         vertex_start: FixedLine::NONE,
+        facet_start: FixedLine::NONE,
     };
     // The bitwise or of the words the fast path loaded ([`HIGHS`] after a line of the general path).
     let mut bytes = 0;
@@ -215,6 +216,8 @@ struct ChunkParse<'t> {
     /// a line inside a loop that begins with the same bytes is a `vertex` line whose text starts
     /// at that blank.
     vertex_start: FixedLine,
+    /// The same for `facet` lines outside a loop.
+    facet_start: FixedLine,
 }
 
 impl<'t> ChunkParse<'t> {
@@ -286,8 +289,12 @@ impl<'t> ChunkParse<'t> {
     #[inline]
     fn fast_line(&mut self, text: &'t [u8], mut at: usize, bytes: &mut u64) -> Option<usize> {
         let line_start = at;
-        if self.in_loop && self.vertex_start.at(text, at) {
-            return self.corner(text, at + self.vertex_start.len() - 1, bytes);
+        if self.in_loop {
+            if self.vertex_start.at(text, at) {
+                return self.corner(text, at + self.vertex_start.len() - 1, bytes);
+            }
+        } else if self.facet_start.at(text, at) {
+            return Some(self.facet(text, at + self.facet_start.len() - 1, bytes));
         }
         loop {
             let v = load(text, at);
@@ -331,13 +338,8 @@ impl<'t> ChunkParse<'t> {
                 return Some(end);
             }
             b'f' if is_word(text, at, w, b"facet") => {
-                let end = newline(text, at + 5, bytes).map_or(text.len(), |i| i + 1);
-                if self.outer_line.at(text, end) {
-                    self.out.lines += 1;
-                    self.outer();
-                    return Some(end + self.outer_line.len());
-                }
-                return Some(end);
+                self.facet_start = FixedLine::of(text, line_start, at + 6);
+                return Some(self.facet(text, at + 5, bytes));
             }
             b'e' if is_word(text, at, w, b"endfacet") => {
                 let end = newline(text, at + 8, bytes).map_or(text.len(), |i| i + 1);
@@ -372,6 +374,20 @@ impl<'t> ChunkParse<'t> {
         self.out.dependent |= !self.out.outer;
         self.current.push(self.base + i);
         Some(self.after_corner(text, end + 1))
+    }
+
+    /// A `facet` line whose rest after the keyword starts at `from` (not read but for its `\n`):
+    /// where the fast path goes on, past the next line too when it is the last `outer` line taken,
+    /// byte for byte (done as it was).
+    #[inline(always)]
+    fn facet(&mut self, text: &[u8], from: usize, bytes: &mut u64) -> usize {
+        let end = newline(text, from, bytes).map_or(text.len(), |i| i + 1);
+        if self.outer_line.at(text, end) {
+            self.out.lines += 1;
+            self.outer();
+            return end + self.outer_line.len();
+        }
+        end
     }
 
     /// `outer`: a facet's corners begin.

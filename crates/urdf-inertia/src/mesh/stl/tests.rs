@@ -474,7 +474,12 @@ fn streamed_ascii_fixed_lines_are_the_whole_text_parse() {
             5 => "              vertex ",
             _ => "      vertex ",
         };
-        odd += &fixed_facet(k, [oo, vv, ll, ff], 3 + usize::from(k % 5 == 4));
+        let one = fixed_facet(k, [oo, vv, ll, ff], 3 + usize::from(k % 5 == 4));
+        odd += &match k % 7 {
+            3 => one.replace("  facet normal", "\tFacet\tnormal"),
+            5 => one.replace("  facet normal", "facet normal"),
+            _ => one,
+        };
         odd += &fixed_facet(k + 50, [oo, vv, ll, ff], 3);
     }
     cases.push((odd + "endsolid t\n", "blanks, case, long lines, non-ASCII".into()));
@@ -482,8 +487,16 @@ fn streamed_ascii_fixed_lines_are_the_whole_text_parse() {
         let text = format!("solid t\n{plain}{}{plain}", fixed_facet(99, EXPORTER, n));
         cases.push((text, what.into()));
     }
-    for (line, bad) in [(o, "    outerx loop\n"), (l, "    endloops\n"), (f, "  endfacets\n")] {
-        let text = format!("solid t\n{plain}").replacen(line, bad, 1);
+    for (line, bad) in [
+        (o, "    outerx loop\n"),
+        (l, "    endloops\n"),
+        (f, "  endfacets\n"),
+        ("  facet normal", "  facets normal"),
+    ] {
+        // The second one, after one taken.
+        let mut text = format!("solid t\n{plain}");
+        let at = text.match_indices(line).nth(1).map_or(0, |(i, _)| i);
+        text.replace_range(at..at + line.len(), bad);
         cases.push((text + &plain, bad.into()));
     }
     for bad in ["vertex 1 2\n", "vertexx 1 2 3\n", "vertex\n", "vertex 1 2 3 4\n"] {
