@@ -5,7 +5,8 @@ use crate::mass::Polygons;
 use crate::mesh::weld::VertexTable;
 use crate::mesh::{parse_f64, short_decimal, MeshError, MeshErrorKind, RawMesh};
 use scan::{
-    coordinates, is_word, line_hash, load, newline, text_to_newline, FixedLine, HIGHS, SPACES,
+    coordinates, is_word, line_hash, load, newline, plain_text, text_to_newline, FixedLine, HIGHS,
+    SPACES,
 };
 use std::io::Read as _;
 use std::path::Path;
@@ -153,6 +154,7 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
         endfacet_line: FixedLine::NONE,
         vertex_start: FixedLine::NONE,
         facet_start: FixedLine::NONE,
+        key_len: 0,
     };
     // The bitwise or of the words the fast path loaded ([`HIGHS`] after a line of the general path).
     let mut bytes = 0;
@@ -218,6 +220,8 @@ struct ChunkParse<'t> {
     vertex_start: FixedLine,
     /// The same for `facet` lines outside a loop.
     facet_start: FixedLine,
+    /// The length of the last vertex text read to its `\n`.
+    key_len: usize,
 }
 
 impl<'t> ChunkParse<'t> {
@@ -360,7 +364,27 @@ impl<'t> ChunkParse<'t> {
     /// `None`, with nothing changed, when the text is not three decimals and a newline.
     #[inline(always)]
     fn corner(&mut self, text: &'t [u8], from: usize, bytes: &mut u64) -> Option<usize> {
-        let (end, h) = text_to_newline(text, from, bytes)?;
+        // The text as long as the last one, when a `\n` ends it there and it was seen: being a text
+        // seen (whole lines, or-ed into `bytes`), it holds no `\n` and needs no or.
+        let guess = from + self.key_len;
+        let (end, h) = if text.get(guess) == Some(&b'\n') {
+            let key = &text[from..guess];
+            let h = line_hash(key);
+            if let (_, Some(i)) = self.seen.find(key, h) {
+                self.out.dependent |= !self.out.outer;
+                self.current.push(self.base + i);
+                return Some(self.after_corner(text, guess + 1));
+            }
+            // A text not seen: its hash stands when it holds no `\n` (its words or-ed).
+            if plain_text(key, bytes) {
+                (guess, h)
+            } else {
+                text_to_newline(text, from, bytes)?
+            }
+        } else {
+            text_to_newline(text, from, bytes)?
+        };
+        self.key_len = end - from;
         let key = &text[from..end];
         let (slot, seen) = self.seen.find(key, h);
         let i = if let Some(i) = seen {

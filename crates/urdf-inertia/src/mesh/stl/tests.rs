@@ -503,6 +503,22 @@ fn streamed_ascii_fixed_lines_are_the_whole_text_parse() {
         let open = fixed_facet(7, [o, EXPORTER[1], "", ""], 2);
         cases.push((format!("solid t\n{plain}{open}      {bad}{l}{f}{plain}"), bad.into()));
     }
+    // Vertex texts as long as the one before: seen, not seen, holding a newline or bytes that are
+    // not ASCII, or ending in one.
+    for corners in [
+        "1 2 3\n      vertex 1 2 3\n      vertex 4 5 6\n",
+        "1 2 3\n      vertex 4 5 6\n      vertex 1 2 3\n",
+        "1 2 3\n      vertex 1\n2 3\n      vertex 4 5 6\n",
+        "1 2 3\n      vertex 1 2\n3\n      vertex 4 5 6\n",
+        "1 2 3\n      vertex 1 é 3\n      vertex 4 5 6\n",
+        "1 2 3\n      vertex 1 2 3 é\n      vertex 1 2 3 é\n      vertex 4 5 6\n",
+        "1 2 3\n      vertex 1 2 3\r\n      vertex 4 5 6\n",
+        "1 2 3\n      vertex 1 2 3 \n      vertex 1 2\t3\n",
+        "1 2 3 4 5 6\n      vertex 1 2 3\n     \n      vertex 4 5 6\n      bogus\n",
+    ] {
+        let facet = format!("  facet normal 0 0 1\n{o}      vertex {corners}{l}{f}");
+        cases.push((format!("solid t\n{plain}{facet}{facet}{plain}"), corners.into()));
+    }
     let cut = format!("solid t\n{plain}");
     for end in [1, 2, 3, 5, 12, 13] {
         cases.push((cut[..cut.len() - end].to_string(), format!("cut {end} bytes before the end")));

@@ -261,6 +261,30 @@ pub(super) fn text_to_newline(text: &[u8], from: usize, bytes: &mut u64) -> Opti
     None
 }
 
+/// Whether `key` holds no `\n` and is ASCII, its words or-ed into `bytes` (whatever the answer).
+#[inline]
+pub(super) fn plain_text(key: &[u8], bytes: &mut u64) -> bool {
+    let mut flags = 0;
+    let mut or = 0;
+    let mut words = key.chunks_exact(8);
+    for c in &mut words {
+        let mut w = [0u8; 8];
+        w.copy_from_slice(c);
+        let w = u64::from_le_bytes(w);
+        or |= w;
+        flags |= newline_or_high(w);
+    }
+    let tail = words.remainder();
+    let mut w = [0u8; 8];
+    w[..tail.len()].copy_from_slice(tail);
+    let w = u64::from_le_bytes(w);
+    or |= w;
+    // The zero bytes past the tail are flagged: only the tail's own count.
+    let tail_flags = newline_or_high(w) & ((1u64 << (8 * tail.len())) - 1);
+    *bytes |= or;
+    (flags | tail_flags | or) & HIGHS == 0
+}
+
 /// A hash of a line's bytes, eight at a time, every bit mixed into the top (the slot) and the
 /// bottom (the tag).
 pub(super) fn line_hash(b: &[u8]) -> u64 {
