@@ -274,13 +274,10 @@ pub(super) fn plain_text(key: &[u8], bytes: &mut u64) -> bool {
         or |= w;
         flags |= newline_or_high(w);
     }
-    let tail = words.remainder();
-    let mut w = [0u8; 8];
-    w[..tail.len()].copy_from_slice(tail);
-    let w = u64::from_le_bytes(w);
+    let w = tail_word(key);
     or |= w;
     // The zero bytes past the tail are flagged: only the tail's own count.
-    let tail_flags = newline_or_high(w) & ((1u64 << (8 * tail.len())) - 1);
+    let tail_flags = newline_or_high(w) & ((1u64 << (8 * (key.len() % 8))) - 1);
     *bytes |= or;
     (flags | tail_flags | or) & HIGHS == 0
 }
@@ -295,10 +292,25 @@ pub(super) fn line_hash(b: &[u8]) -> u64 {
         w.copy_from_slice(c);
         h = hash_word(h, u64::from_le_bytes(w));
     }
-    let tail = words.remainder();
+    hash_finish(hash_word(h, tail_word(b)), b.len())
+}
+
+/// The last `b.len() % 8` bytes of `b` as a word, zeros above them: the last eight bytes loaded and
+/// shifted down when there are eight (no copy of a length known only at run time).
+#[inline(always)]
+fn tail_word(b: &[u8]) -> u64 {
+    let r = b.len() % 8;
+    if r == 0 {
+        return 0;
+    }
+    if let Some(&last) = b.last_chunk::<8>() {
+        return u64::from_le_bytes(last) >> (8 * (8 - r));
+    }
     let mut w = [0u8; 8];
-    w[..tail.len()].copy_from_slice(tail);
-    hash_finish(hash_word(h, u64::from_le_bytes(w)), b.len())
+    for (i, &c) in b.iter().enumerate().take(8) {
+        w[i] = c;
+    }
+    u64::from_le_bytes(w)
 }
 
 const HASH_K: u64 = 0x9e37_79b9_7f4a_7c15;
@@ -323,6 +335,32 @@ fn hash_finish(h: u64, len: usize) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A text read to its newline hashes as the same text hashed whole (the lookup of a text as
+    /// long as the last one relies on it), at every length and alignment, and `plain_text` finds
+    /// a newline or a byte that is not ASCII anywhere in it.
+    #[test]
+    fn text_hashes_agree() {
+        for len in 0..40 {
+            for skip in 0..9 {
+                let key: Vec<u8> = (0..len).map(|i| b'0' + (i * 7 % 10) as u8).collect();
+                let mut text = vec![b' '; skip];
+                text.extend_from_slice(&key);
+                text.extend_from_slice(b"\n        ");
+                let mut bytes = 0;
+                let read = text_to_newline(&text, skip, &mut bytes);
+                assert_eq!(read, Some((skip + len, line_hash(&key))), "{len} {skip}");
+                assert!(plain_text(&key, &mut bytes), "{len}");
+                for at in 0..len {
+                    for b in [b'\n', 0x80, 0xc3] {
+                        let mut k = key.clone();
+                        k[at] = b;
+                        assert!(!plain_text(&k, &mut bytes), "{len} {at} {b}");
+                    }
+                }
+            }
+        }
+    }
 
     /// The eight-at-a-time decimal reader gives `short_decimal`'s value and length, bit for bit, on
     /// every shape of number around its limits (digit runs of 0 to 9 before and after the point,
