@@ -366,6 +366,8 @@ fn streamed_ascii_fast_path_is_the_whole_text_parse() {
         "123456789012345678901 1 1",
         "-1.000000e+00 2.500000E-01 3.125000e+001",
         "1.2999373516471264 0.012762515138294503 0",
+        "8.572527e-17 -1e-300 4.9e-324",
+        "1e23 -1.5E+40 0.1e-22",
     ];
     let mut facets = String::new();
     for (k, c) in corners.iter().enumerate() {

@@ -2,7 +2,7 @@
 //! a time, the newline and keyword tests on them, the hash of a vertex's text, and the decimal
 //! reader of its coordinates.
 
-use crate::mesh::{exponent_suffix, short_decimal, EXACT_POWERS_OF_TEN};
+use crate::mesh::{exponent_suffix, parse_f64_bytes, short_decimal, EXACT_POWERS_OF_TEN};
 
 const ONES: u64 = 0x0101_0101_0101_0101;
 pub(super) const HIGHS: u64 = 0x8080_8080_8080_8080;
@@ -42,8 +42,9 @@ pub(super) fn is_word(text: &[u8], at: usize, w: u64, k: &[u8]) -> bool {
 }
 
 /// The three coordinates of the vertex line whose text after `vertex` starts at `from` (and ends
-/// at a `\n`), when each is a decimal [`decimal`] reads (−0.0 folded into 0.0): what
-/// [`super::AsciiWords::vertex`] gives then; `None` for anything else, which it decides.
+/// at a `\n`), when each is a decimal [`decimal`] reads or else a word [`parse_f64_bytes`] reads
+/// to a finite value (−0.0 folded into 0.0): what [`super::AsciiWords::vertex`] gives then;
+/// `None` for anything else, which it decides.
 #[inline]
 pub(super) fn coordinates(text: &[u8], mut from: usize) -> Option<[f64; 3]> {
     let mut p = [0.0; 3];
@@ -51,7 +52,16 @@ pub(super) fn coordinates(text: &[u8], mut from: usize) -> Option<[f64; 3]> {
         while let Some(b' ' | b'\t' | b'\r' | b'\x0c') = text.get(from) {
             from += 1;
         }
-        let (x, n) = decimal(text.get(from..)?)?;
+        let rest = text.get(from..)?;
+        // What the eight-byte and short readers do not take (`8.572527e-17`): the word, as the
+        // general path parses it; not finite, the general path gives the error.
+        let (x, n) = if let Some(d) = decimal(rest) {
+            d
+        } else {
+            let n = rest.iter().position(u8::is_ascii_whitespace)?;
+            let x = parse_f64_bytes(&rest[..n]).filter(|x| x.is_finite())?;
+            (x, n)
+        };
         from += n;
         if !text.get(from)?.is_ascii_whitespace() {
             return None;
