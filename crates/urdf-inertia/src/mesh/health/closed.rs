@@ -277,10 +277,7 @@ pub(super) struct Outward {
 pub(super) fn flip_change(vertices: &[[f64; 3]], faces: &Polygons, o: &Orientation, reversed: &[bool]) -> f64 {
     let centre = bounding_box_centre(vertices);
     let diag = bbox(vertices).diagonal();
-    let mut count = vec![[0usize; 2]; o.ncomp];
-    for (i, r) in reversed.iter().enumerate() {
-        count[o.comp[i] as usize][usize::from(*r)] += 1;
-    }
+    let count = reversed_counts(o, reversed);
     let mut volume6 = vec![0.0f64; o.ncomp];
     let mut area2 = vec![[0.0f64; 3]; o.ncomp];
     for (i, face) in faces.iter().enumerate() {
@@ -304,6 +301,15 @@ pub(super) fn flip_change(vertices: &[[f64; 3]], faces: &Polygons, o: &Orientati
         .sum()
 }
 
+/// Per component, its faces kept as stored and reversed against the file.
+fn reversed_counts(o: &Orientation, reversed: &[bool]) -> Vec<[usize; 2]> {
+    let mut count = vec![[0usize; 2]; o.ncomp];
+    for (i, r) in reversed.iter().enumerate() {
+        count[o.comp[i] as usize][usize::from(*r)] += 1;
+    }
+    count
+}
+
 pub(super) fn outward(
     vertices: &[[f64; 3]],
     faces: &Polygons,
@@ -320,12 +326,9 @@ pub(super) fn outward(
         .map(|i| o.flip[i] ^ turn[o.comp[i] as usize])
         .collect();
     let flipped = reversed.iter().filter(|r| **r).count();
-    // Per component, faces reversed against the file and kept: a component that ends mostly
-    // reversed was turned round as a whole (up to the faces [`flip_change`] counts).
-    let mut count = vec![[0usize; 2]; o.ncomp];
-    for (i, r) in reversed.iter().enumerate() {
-        count[o.comp[i] as usize][usize::from(*r)] += 1;
-    }
+    // A component that ends mostly reversed was turned round as a whole (up to the faces
+    // [`flip_change`] counts).
+    let count = reversed_counts(o, reversed.as_slice());
     let mut nested = 0.0;
     if let Some(boxes) = &boxes {
         for c in 0..o.ncomp {

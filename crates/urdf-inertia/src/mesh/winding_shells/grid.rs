@@ -371,13 +371,13 @@ impl Plane {
         }
     }
 
-    /// A value with the sign of `orient3d(a, b, c, d)` (zero exactly when `d` is in the plane).
-    #[inline(always)] // a few flops run for every pair of neighbouring triangles
     /// (b − a) × (c − a), the same bits as `geometry::cross` of the two gives (its minors).
     pub(super) fn normal(&self) -> [f64; 3] {
         self.minor
     }
 
+    /// A value with the sign of `orient3d(a, b, c, d)` (zero exactly when `d` is in the plane).
+    #[inline(always)] // a few flops run for every pair of neighbouring triangles
     pub(super) fn side(&self, d: [f64; 3]) -> f64 {
         if let Some((k, x)) = self.level {
             if d[k] == x {
