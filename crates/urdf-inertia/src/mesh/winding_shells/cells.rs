@@ -11,7 +11,8 @@ const MAX_CELLS: usize = 256;
 pub(super) type CutPlane = ([f64; 3], [f64; 3], f64);
 
 /// Convex polygons in one buffer (the cut used a `Vec` per cell and per plane, whose allocations
-/// cost more than the clipping): their corners in order, and where each polygon ends.
+/// cost more than the clipping): their corners in order, and where each polygon ends. Kept
+/// between cuts ([`CellWork`]), the lists grow to what the largest cut needs and stay.
 #[derive(Default)]
 pub(super) struct Cells {
     corners: Vec<[f64; 3]>,
@@ -78,21 +79,29 @@ pub(super) fn beyond(poly: &[[f64; 3]], nt: [f64; 3], reach: &[[f64; 3]; 3], mar
     })
 }
 
-/// `piece` (in the plane of normal `nt`) cut along the `cuts` in turn into convex cells, in order,
-/// each cell cut only where the cut's reach is not [`beyond`] it (`margin`, a distance); `None`
-/// when they are more than [`MAX_CELLS`].
-pub(super) fn cells(piece: &Corners, cuts: &[&Cut], nt: [f64; 3], margin: f64) -> Option<Cells> {
-    // Room for a few dozen cells of a few corners each: the lists do not grow in the common case.
-    let room = || Cells {
-        corners: Vec::with_capacity(256),
-        ends: Vec::with_capacity(48),
-    };
-    let mut cells = room();
+/// The lists [`cells`] cuts into, kept between calls (see `correction::Faces::cut_work`).
+#[derive(Default)]
+pub(super) struct CellWork {
+    cells: Cells,
+    next: Cells,
+    d: Vec<f64>,
+}
+
+/// `piece` (in the plane of normal `nt`) cut along the cuts `which` of `cuts` in turn into convex
+/// cells, in order, each cell cut only where the cut's reach is not [`beyond`] it (`margin`, a
+/// distance); `None` when they are more than [`MAX_CELLS`]. The cells are `work`'s.
+pub(super) fn cells<'w>(
+    piece: &Corners,
+    (cuts, which): (&[Cut], &[usize]),
+    nt: [f64; 3],
+    margin: f64,
+    work: &'w mut CellWork,
+) -> Option<&'w Cells> {
+    let CellWork { cells, next, d } = work;
+    cells.clear();
     cells.corners.extend_from_slice(piece);
     cells.close();
-    let mut next = room();
-    let mut d = Vec::new();
-    for cut in cuts {
+    for cut in which.iter().map(|&i| &cuts[i]) {
         let (a, n, m) = cut.plane;
         next.clear();
         for cell in cells.iter() {
@@ -100,14 +109,14 @@ pub(super) fn cells(piece: &Corners, cuts: &[&Cut], nt: [f64; 3], margin: f64) -
             d.extend(cell.iter().map(|x| dot(n, sub(*x, a))));
             // A plane along the cell's side (one cut already, or a shared edge), or one whose
             // reach ends before the cell, leaves it whole.
-            if leaves_whole(&d, m) || cut.misses(cell, nt, margin) {
+            if leaves_whole(d, m) || cut.misses(cell, nt, margin) {
                 next.corners.extend_from_slice(cell);
                 next.close();
                 continue;
             }
             for side in [1.0, -1.0] {
                 let start = next.corners.len();
-                clip(cell, &d, side, &mut next.corners);
+                clip(cell, d, side, &mut next.corners);
                 if next.corners.len() - start >= 3 {
                     next.close();
                 } else {
@@ -115,7 +124,7 @@ pub(super) fn cells(piece: &Corners, cuts: &[&Cut], nt: [f64; 3], margin: f64) -
                 }
             }
         }
-        std::mem::swap(&mut cells, &mut next);
+        std::mem::swap(cells, next);
         if cells.len() > MAX_CELLS {
             return None;
         }
@@ -178,7 +187,8 @@ mod tests {
             line([0.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
             line([0.0, 0.5, 0.0], [0.0, 1.0, 0.0]),
         ];
-        let c = cells(&t, &planes.iter().collect::<Vec<_>>(), [0.0, 0.0, 1.0], 1e-12).expect("few cells");
+        let mut work = CellWork::default();
+        let c = cells(&t, (&planes, &[0, 1, 2]), [0.0, 0.0, 1.0], 1e-12, &mut work).expect("few cells");
         assert_eq!(c.len(), 4);
         let areas: Vec<f64> = c.iter().map(area).collect();
         assert_eq!(areas, vec![0.5, 0.625, 0.625, 0.25]);
