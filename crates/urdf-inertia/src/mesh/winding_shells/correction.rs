@@ -1323,6 +1323,51 @@ mod tests {
         assert!((got - 1.0).abs() < 1e-15, "{got}");
     }
 
+    /// Two closed shells touching along an edge, a wall of no thickness between them: the unit box,
+    /// and a box from x ≈ 1 to 2 whose face at x ≈ 1 shares the unit box's edge at y = 0, x = 1
+    /// and bends by ε = 2⁻³⁰ (its corners (1 − ε, 1, 1) and (1 + ε, 1, 0)), so that it dips into
+    /// the unit box over part of its face and stays out of it over the rest. That face's triangles
+    /// lie within [`NEAR`] of the unit box's, share an edge with one of them and a corner with
+    /// the other, and cross one of them: some pairs are taken as in one plane, some decided by
+    /// rays. The decided surface closes up to the wall's thickness, and the volume is the union's
+    /// within the bound. By hand: the second box 1 + ε/6 (its face's mean depth), of which ε/4
+    /// lies inside the unit box (ε/6 under the triangle at z ≥ y, ε/12 under the other), so
+    /// 2 − ε/12.
+    #[test]
+    fn a_wall_of_no_thickness_closes_and_keeps_the_union() {
+        let e = 2f64.powi(-30);
+        let mut vertices = Vec::new();
+        let mut tris = Vec::new();
+        push_box(&mut vertices, &mut tris, [0.0; 3], [1.0; 3]);
+        // The unit box's corners (1, 0, 0) and (1, 0, 1); then the second box's own.
+        let (p0, p1) = (1, 5);
+        let base = vertices.len() as u32;
+        vertices.extend([[1.0 - e, 1.0, 1.0], [1.0 + e, 1.0, 0.0]]);
+        vertices.extend([[2.0, 0.0, 0.0], [2.0, 1.0, 0.0], [2.0, 1.0, 1.0], [2.0, 0.0, 1.0]]);
+        let (a, b, f00, f10, f11, f01) = (base, base + 1, base + 2, base + 3, base + 4, base + 5);
+        tris.extend([
+            [p0, p1, a],
+            [p0, a, b],
+            [f00, f10, f11],
+            [f00, f11, f01],
+            [p0, f00, f01],
+            [p0, f01, p1],
+            [b, a, f11],
+            [b, f11, f10],
+            [p0, b, f10],
+            [p0, f10, f00],
+            [p1, f01, f11],
+            [p1, f11, a],
+        ]);
+        let signs = vec![1; tris.len()];
+        let r = resolve(&vertices, &tris, &signs, [1.0, 0.5, 0.5], 0.0);
+        let open = norm(area_vector(&vertices, &r));
+        assert!(open < 4.0 * e, "decided surface open: vector area {open:e}");
+        let got = enclosed(&vertices, &r);
+        let want = 2.0 - e / 12.0;
+        assert!((got - want).abs() <= r.bound + 1e-15, "{got} against {want}, bound {}", r.bound);
+    }
+
     /// A sphere of `n` rings of `2n` quads (triangles at the poles), facing out: no two of its
     /// triangles lie in one plane.
     fn push_sphere(vertices: &mut Vec<[f64; 3]>, tris: &mut Vec<[u32; 3]>, centre: [f64; 3], r: f64, n: u32) {
