@@ -30,7 +30,9 @@ mod binary;
 #[cfg(test)]
 mod tests;
 
-use ascii::{ascii, ascii_stream, ASCII_CHUNK, ASCII_PIECE};
+#[cfg(test)]
+use ascii::ASCII_CHUNK;
+use ascii::{ascii, ascii_stream, stream_chunk, ASCII_PIECE};
 use binary::{binary, Binary, CHUNK, PIECE};
 
 /// Parses STL bytes (binary or ASCII). Corners with bit-identical coordinates share one vertex, in
@@ -234,7 +236,7 @@ pub fn read_split(
             .map_err(|e| io(e.to_string()))?;
         if looks_ascii(&head) && is_text(&head) {
             let rest = source.take(len.saturating_sub(head.len() as u64));
-            return ascii_stream(head, rest, len, path, ASCII_PIECE, ASCII_CHUNK);
+            return ascii_stream(head, rest, len, path, ASCII_PIECE, stream_chunk(len));
         }
         // No more than the length checked when the file was opened.
         let rest = source.take(len.saturating_sub(head.len() as u64));
