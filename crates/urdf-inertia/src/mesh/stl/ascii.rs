@@ -5,7 +5,7 @@ use crate::mass::Polygons;
 use crate::mesh::weld::VertexTable;
 use crate::mesh::{parse_f64, short_decimal, MeshError, MeshErrorKind, RawMesh};
 use scan::{
-    coordinates, is_word, line_hash, load, newline, plain_text, text_to_newline, FixedLine, HIGHS,
+    coordinates, is_word, line_hash, load, newline, newline_at, plain_text, text_to_newline, FixedLine, HIGHS,
     SPACES,
 };
 use std::io::Read as _;
@@ -177,6 +177,7 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
         vertex_start: FixedLine::NONE,
         facet_start: FixedLine::NONE,
         key_len: 0,
+        facet_len: 0,
     };
     // The bitwise or of the words the fast path loaded ([`HIGHS`] after a line of the general path).
     let mut bytes = 0;
@@ -244,6 +245,9 @@ struct ChunkParse<'t> {
     facet_start: FixedLine,
     /// The length of the last vertex text read to its `\n`.
     key_len: usize,
+    /// The length of the rest of the last `facet` line read to its `\n` (from the blank after
+    /// the keyword).
+    facet_len: usize,
 }
 
 impl<'t> ChunkParse<'t> {
@@ -427,7 +431,15 @@ impl<'t> ChunkParse<'t> {
     /// byte for byte (done as it was).
     #[inline(always)]
     fn facet(&mut self, text: &[u8], from: usize, bytes: &mut u64) -> usize {
-        let end = newline(text, from, bytes).map_or(text.len(), |i| i + 1);
+        // As long as the last `facet` line's rest, most often (exporters write the normal's three
+        // numbers in one format): checked in one pass without a branch a word.
+        let end = if let Some(i) = newline_at(text, from, self.facet_len, bytes) {
+            i + 1
+        } else {
+            let i = newline(text, from, bytes);
+            self.facet_len = i.map_or(0, |i| i - from);
+            i.map_or(text.len(), |i| i + 1)
+        };
         if self.outer_line.at(text, end) {
             self.out.lines += 1;
             self.outer();

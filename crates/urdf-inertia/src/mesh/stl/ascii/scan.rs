@@ -286,6 +286,30 @@ pub(super) fn newline(text: &[u8], mut from: usize, bytes: &mut u64) -> Option<u
     memchr::memchr(b'\n', &text[from..]).map(|i| from + i)
 }
 
+/// `from + len` when it is the first `\n` at or after `from` ([`newline`]'s answer), found by
+/// checking that one is there and none comes before it: at least eight bytes, read once, their
+/// words or-ed into `bytes` (whatever the answer); `None` otherwise.
+#[inline]
+pub(super) fn newline_at(text: &[u8], from: usize, len: usize, bytes: &mut u64) -> Option<usize> {
+    let end = from + len;
+    if len < 8 || text.get(end) != Some(&b'\n') {
+        return None;
+    }
+    let line = text.get(from..end)?;
+    let (mut or, mut flags) = (0, 0);
+    let mut words = line.chunks_exact(8);
+    for c in &mut words {
+        let mut w = [0u8; 8];
+        w.copy_from_slice(c);
+        let w = u64::from_le_bytes(w);
+        or |= w;
+        flags |= zero_bytes(w ^ NEWLINES);
+    }
+    let last = u64::from_le_bytes(*line.last_chunk::<8>()?);
+    *bytes |= or | last;
+    (flags | zero_bytes(last ^ NEWLINES) == 0).then_some(end)
+}
+
 /// The first `\n` at or after `from` and the [`line_hash`] of the text before it, read once (the
 /// words or-ed into `bytes`); `None`
 /// when no `\n` comes before the last eight bytes of `text`, or a byte that is not ASCII comes
@@ -409,6 +433,37 @@ mod tests {
                         let mut k = key.clone();
                         k[at] = b;
                         assert!(!plain_text(&k, &mut bytes), "{len} {at} {b}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// `newline_at` gives `newline`'s answer wherever it gives one, and gives it for every line
+    /// of eight bytes or more at the length asked; where it answers, a byte that is not ASCII
+    /// before the `\n` is in the or of the words it read (every length, start, position of the
+    /// `\n` and of such a byte).
+    #[test]
+    fn newline_at_is_newline() {
+        for from in 0..3usize {
+            for nl in from..44 {
+                for high in [None, Some(from), Some(from + 5), Some(nl.saturating_sub(1))] {
+                    let mut text = vec![b'7'; 52];
+                    text[nl] = b'\n';
+                    if let Some(h) = high.filter(|&h| h != nl && h >= from) {
+                        text[h] = 0xc3;
+                    }
+                    let first = newline(&text, from, &mut 0);
+                    for len in 0..48 {
+                        let mut bytes = 0;
+                        match newline_at(&text, from, len, &mut bytes) {
+                            Some(end) => {
+                                assert_eq!(Some(end), first, "{from} {nl} {len}");
+                                let ascii = text[from..end].is_ascii();
+                                assert_eq!(bytes & HIGHS == 0, ascii, "{from} {nl} {len}");
+                            }
+                            None => assert!(len < 8 || first != Some(from + len), "{from} {nl} {len}"),
+                        }
                     }
                 }
             }
