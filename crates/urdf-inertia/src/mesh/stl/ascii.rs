@@ -393,26 +393,31 @@ impl<'t> ChunkParse<'t> {
         // The text as long as the last one, when a `\n` ends it there and it was seen: being a text
         // seen (whole lines, or-ed into `bytes`), it holds no `\n` and needs no or.
         let guess = from + self.key_len;
-        let (end, h) = if text.get(guess) == Some(&b'\n') {
+        // The text, its hash, and the slot of the lookup already made with them, if one was.
+        let (end, h, looked) = if text.get(guess) == Some(&b'\n') {
             let key = &text[from..guess];
             let h = line_hash(key);
-            if let (_, Some(i)) = self.seen.find(key, h) {
+            let (slot, seen) = self.seen.find(key, h);
+            if let Some(i) = seen {
                 self.out.dependent |= !self.out.outer;
                 self.current.push(self.base + i);
                 return Some(self.after_corner(text, guess + 1));
             }
-            // A text not seen: its hash stands when it holds no `\n` (its words or-ed).
+            // A text not seen: its hash and its lookup stand when it holds no `\n` (its words
+            // or-ed).
             if plain_text(key, bytes) {
-                (guess, h)
+                (guess, h, Some(slot))
             } else {
-                text_to_newline(text, from, bytes)?
+                let (end, h) = text_to_newline(text, from, bytes)?;
+                (end, h, None)
             }
         } else {
-            text_to_newline(text, from, bytes)?
+            let (end, h) = text_to_newline(text, from, bytes)?;
+            (end, h, None)
         };
         self.key_len = end - from;
         let key = &text[from..end];
-        let (slot, seen) = self.seen.find(key, h);
+        let (slot, seen) = looked.map_or_else(|| self.seen.find(key, h), |slot| (slot, None));
         let i = if let Some(i) = seen {
             i
         } else {
