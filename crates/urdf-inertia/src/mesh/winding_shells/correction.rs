@@ -12,7 +12,7 @@
 
 use super::cells::{area, cells, centroid, leaves_whole, split, CellWork, Cut, CutPlane};
 use super::grid::{Corners, Grid, Plane, Seen};
-use super::{edge_meets, overlap, triangles_touch, EdgeUse};
+use super::{corners_touch, edge_meets, overlap, EdgeUse};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
 use crate::mass::Polygons;
 use robust::{orient2d, Coord};
@@ -296,7 +296,7 @@ impl Faces<'_> {
         match in_u.iter().filter(|&&x| x).count() {
             // Symmetric: whether an edge of either crosses the other.
             0 => {
-                let touch = triangles_touch(self.vertices, &tt, &tu);
+                let touch = self.touch(t, u);
                 (asked.0 && touch, asked.1 && touch)
             }
             1 => {
@@ -328,7 +328,7 @@ impl Faces<'_> {
         let (tt, tu) = (self.tris[t], self.tris[u]);
         let in_u = tt.map(|v| tu.contains(&v));
         match in_u.iter().filter(|&&x| x).count() {
-            0 => triangles_touch(self.vertices, &tt, &tu),
+            0 => self.touch(t, u),
             1 => {
                 let i = in_u.iter().position(|&x| x).unwrap_or(0);
                 let j = tu.iter().position(|&x| x == tt[i]).unwrap_or(0);
@@ -348,6 +348,12 @@ impl Faces<'_> {
             }
             _ => true,
         }
+    }
+
+    /// [`super::triangles_touch`] of `t` and `u`, with their planes' sides precomputed.
+    fn touch(&self, t: usize, u: usize) -> bool {
+        let (pt, pu) = (&self.planes[t], &self.planes[u]);
+        corners_touch(self.corners[t], self.corners[u], (|q| pt.side(q), |q| pu.side(q)))
     }
 
     /// [`Faces::blocks`] for triangles sharing an edge, in one plane: a blocker unless the two lie
@@ -1368,6 +1374,34 @@ mod tests {
         assert!((got - want).abs() <= r.bound + 1e-15, "{got} against {want}, bound {}", r.bound);
     }
 
+    /// The pair test with the planes' precomputed sides ([`Faces::touch`]) answers as the one with
+    /// `orient3d` ([`super::super::triangles_touch`]): on pairs of triangles whose corners lie on
+    /// a lattice of three steps of 0.1 (inexact in binary), many of them coplanar, touching along
+    /// an edge or at a corner, crossing, or degenerate.
+    #[test]
+    fn plane_sides_touch_as_orient3d_does() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            f64::from((seed >> 33) as u32 % 3) * 0.1
+        };
+        let (mut touching, mut apart) = (0, 0);
+        for _ in 0..20_000 {
+            let vertices: Vec<[f64; 3]> = (0..6).map(|_| [next(), next(), next()]).collect();
+            let (x, y) = ([0, 1, 2], [3, 4, 5]);
+            let (px, py) = (x.map(|i| vertices[i as usize]), y.map(|i| vertices[i as usize]));
+            let (plane_x, plane_y) = (Plane::new(&px), Plane::new(&py));
+            let got = corners_touch(px, py, (|q| plane_x.side(q), |q| plane_y.side(q)));
+            assert_eq!(got, super::super::triangles_touch(&vertices, &x, &y), "{vertices:?}");
+            if got {
+                touching += 1;
+            } else {
+                apart += 1;
+            }
+        }
+        assert!(touching > 1000 && apart > 1000, "{touching} {apart}");
+    }
+
     /// A sphere of `n` rings of `2n` quads (triangles at the poles), facing out: no two of its
     /// triangles lie in one plane.
     fn push_sphere(vertices: &mut Vec<[f64; 3]>, tris: &mut Vec<[u32; 3]>, centre: [f64; 3], r: f64, n: u32) {
@@ -1540,8 +1574,8 @@ mod tests {
         ];
         let (t1, t2) = ([0, 1, 2], [1, 0, 3]);
         let across = [4, 5, 6];
-        assert!(triangles_touch(&vertices, &t1, &across));
-        assert!(triangles_touch(&vertices, &t2, &across));
+        assert!(super::super::triangles_touch(&vertices, &t1, &across));
+        assert!(super::super::triangles_touch(&vertices, &t2, &across));
         // Sharing corner 0: `u` from it through the edge, its other corners on either side.
         let u = [0u32, 7, 8];
         let at = |t: [u32; 3]| t.map(|i| vertices[i as usize]);

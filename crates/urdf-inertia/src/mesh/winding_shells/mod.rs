@@ -808,6 +808,17 @@ pub(super) fn c3(p: [f64; 3]) -> Coord3D<f64> {
 pub(super) fn triangles_touch(v: &[[f64; 3]], x: &[u32; 3], y: &[u32; 3]) -> bool {
     let p = |t: &[u32; 3]| t.map(|i| v[i as usize]);
     let (px, py) = (p(x), p(y));
+    let side = |t: [[f64; 3]; 3]| move |q: [f64; 3]| orient3d(c3(t[0]), c3(t[1]), c3(t[2]), c3(q));
+    corners_touch(px, py, (side(px), side(py)))
+}
+
+/// [`triangles_touch`] of the triangles of corners `px` and `py`, given for each a function with
+/// the sign of `orient3d` of its corners and a point (a precomputed plane's side).
+pub(super) fn corners_touch(
+    px: [[f64; 3]; 3],
+    py: [[f64; 3]; 3],
+    (side_x, side_y): (impl Fn([f64; 3]) -> f64, impl Fn([f64; 3]) -> f64),
+) -> bool {
     let boxes_meet = (0..3).all(|k| {
         let (xl, xh) = px
             .iter()
@@ -825,16 +836,13 @@ pub(super) fn triangles_touch(v: &[[f64; 3]], x: &[u32; 3], y: &[u32; 3]) -> boo
         return false;
     }
     // Each corner's side of the other's plane once (both edges at a corner use it).
-    let sides = |t: [[f64; 3]; 3], q: [[f64; 3]; 3]| {
-        q.map(|x| orient3d(c3(t[0]), c3(t[1]), c3(t[2]), c3(x)))
-    };
     let edges_meet = |p: [[f64; 3]; 3], o: [f64; 3], t| {
         (0..3).any(|i| {
             let j = (i + 1) % 3;
             edge_meets(p[i], p[j], o[i], o[j], t)
         })
     };
-    edges_meet(px, sides(py, px), py) || edges_meet(py, sides(px, py), px)
+    edges_meet(px, px.map(&side_y), py) || edges_meet(py, py.map(&side_x), px)
 }
 
 /// Whether the closed segment `s e` meets the closed triangle `t` (coplanar: yes, conservatively),
