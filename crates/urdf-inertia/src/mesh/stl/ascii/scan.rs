@@ -296,15 +296,7 @@ pub(super) fn newline_at(text: &[u8], from: usize, len: usize, bytes: &mut u64) 
         return None;
     }
     let line = text.get(from..end)?;
-    let (mut or, mut flags) = (0, 0);
-    let mut words = line.chunks_exact(8);
-    for c in &mut words {
-        let mut w = [0u8; 8];
-        w.copy_from_slice(c);
-        let w = u64::from_le_bytes(w);
-        or |= w;
-        flags |= zero_bytes(w ^ NEWLINES);
-    }
+    let (or, flags) = whole_words(line, |w| zero_bytes(w ^ NEWLINES));
     let last = u64::from_le_bytes(*line.last_chunk::<8>()?);
     *bytes |= or | last;
     (flags | zero_bytes(last ^ NEWLINES) == 0).then_some(end)
@@ -338,19 +330,24 @@ pub(super) fn text_to_newline(text: &[u8], from: usize, bytes: &mut u64) -> Opti
     None
 }
 
-/// Whether `key` holds no `\n` and is ASCII, its words or-ed into `bytes` (whatever the answer).
-#[inline]
-pub(super) fn plain_text(key: &[u8], bytes: &mut u64) -> bool {
-    let mut flags = 0;
-    let mut or = 0;
-    let mut words = key.chunks_exact(8);
-    for c in &mut words {
+/// The or of the whole eight-byte words of `s` (its tail left out), and the or of `flag` of each.
+#[inline(always)]
+fn whole_words(s: &[u8], flag: impl Fn(u64) -> u64) -> (u64, u64) {
+    let (mut or, mut flags) = (0, 0);
+    for c in s.chunks_exact(8) {
         let mut w = [0u8; 8];
         w.copy_from_slice(c);
         let w = u64::from_le_bytes(w);
         or |= w;
-        flags |= newline_or_high(w);
+        flags |= flag(w);
     }
+    (or, flags)
+}
+
+/// Whether `key` holds no `\n` and is ASCII, its words or-ed into `bytes` (whatever the answer).
+#[inline]
+pub(super) fn plain_text(key: &[u8], bytes: &mut u64) -> bool {
+    let (mut or, flags) = whole_words(key, newline_or_high);
     let w = tail_word(key);
     or |= w;
     // The zero bytes past the tail are flagged: only the tail's own count.
