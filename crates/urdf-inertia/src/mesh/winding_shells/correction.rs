@@ -1097,18 +1097,51 @@ fn strict_sign(s: [f64; 3]) -> Option<f64> {
     }
 }
 
-/// Two triangles `[v, …]` sharing their first corner: whether they may meet elsewhere (exact,
-/// conservative), given the sides of `u`'s other corners of `t`'s plane (not both strictly on one
-/// side) and `u`'s plane (a turn of the corners leaves a plane's sides as they are).
+/// Two triangles `[v, …]` sharing their first corner: whether `u` may meet `t` anywhere but at
+/// `v` (exact where `u` meets `t` at `v` alone; where it runs along an edge of `t`, it is taken as
+/// meeting `t`, so that `t` is not joined across that edge: [`Faces::patches`]), given the sides
+/// of `u`'s other corners of `t`'s plane (not both strictly on one side) and `u`'s plane (a turn
+/// of the corners leaves a plane's sides as they are).
 fn shares_corner(t: Corners, u: Corners, (ub, uc): (f64, f64), plane_u: &Plane) -> bool {
     if ub == 0.0 && uc == 0.0 {
         return !coplanar_apart(t, u);
     }
+    // One other corner of `u` in `t`'s plane and the third off it: `u` meets that plane along
+    // the segment from `v` to that corner, which meets `t` beyond `v` when it points into `t`'s
+    // angle at `v` or along one of its edges.
+    if ub == 0.0 {
+        return within_angle(t, u[1]);
+    }
+    if uc == 0.0 {
+        return within_angle(t, u[2]);
+    }
+    // `u` crosses `t`'s plane along a segment from `v` (towards a point strictly between `u`'s
+    // other corners, so strictly inside `u`'s angle at `v`) on the line where the two planes meet.
+    // A corner of `t` in `u`'s plane lies on that line: the segment runs along `t`'s edge to it
+    // when that corner lies inside `u`'s angle, and away from `t` otherwise.
     let (tb, tc) = (plane_u.side(t[1]), plane_u.side(t[2]));
-    if ub == 0.0 || uc == 0.0 || tb == 0.0 || tc == 0.0 {
-        return true;
+    if tb == 0.0 {
+        return within_angle(u, t[1]);
+    }
+    if tc == 0.0 {
+        return within_angle(u, t[2]);
     }
     edge_meets(u[1], u[2], ub, uc, t) || edge_meets(t[1], t[2], tb, tc, u)
+}
+
+/// Whether the segment from `t`'s first corner to `x` (in `t`'s plane, exactly) meets `t` beyond
+/// that corner: `x` inside `t`'s angle there or on one of its two edges' rays. `true` when `t` is
+/// a segment seen along the axis of its normal (conservative).
+fn within_angle(t: Corners, x: [f64; 3]) -> bool {
+    let k = normal_axis(t);
+    let p = |x: [f64; 3]| c2(x, k);
+    let s = orient2d(p(t[0]), p(t[1]), p(t[2]));
+    if s == 0.0 {
+        return true;
+    }
+    let (a, b) = (orient2d(p(t[0]), p(t[1]), p(x)), orient2d(p(t[0]), p(x), p(t[2])));
+    let with = |o: f64| o == 0.0 || (o > 0.0) == (s > 0.0);
+    with(a) && with(b) && (a != 0.0 || b != 0.0)
 }
 
 /// The next corner of a triangle.
@@ -1400,6 +1433,124 @@ mod tests {
             }
         }
         assert!(touching > 1000 && apart > 1000, "{touching} {apart}");
+    }
+
+    /// Whether triangle `u` meets triangle `t` (integer corners, `t` not flat, `u` not in `t`'s
+    /// plane) anywhere but at `t`'s first corner, in exact rationals: `u`'s section by `t`'s plane
+    /// (a segment or a point) against the barycentric coordinates of `t`.
+    fn meets_beyond_first(t: [[i64; 3]; 3], u: [[i64; 3]; 3]) -> bool {
+        use num_rational::Ratio;
+        type Q = Ratio<i128>;
+        let d3 = |a: [i64; 3], b: [i64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        let (e1, e2) = (d3(t[1], t[0]), d3(t[2], t[0]));
+        let n = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        let dist = |p: [i64; 3]| {
+            let q = d3(p, t[0]);
+            i128::from(n[0] * q[0] + n[1] * q[1] + n[2] * q[2])
+        };
+        let q = |p: [i64; 3]| p.map(|x| Q::from_integer(i128::from(x)));
+        let mut section: Vec<[Q; 3]> = Vec::new();
+        for i in 0..3 {
+            let (a, b) = (u[i], u[(i + 1) % 3]);
+            let (da, db) = (dist(a), dist(b));
+            if da == 0 {
+                section.push(q(a));
+            }
+            if (da < 0 && db > 0) || (da > 0 && db < 0) {
+                let s = Q::new(da, da - db);
+                let (qa, qb) = (q(a), q(b));
+                section.push([0, 1, 2].map(|k| qa[k] + s * (qb[k] - qa[k])));
+            }
+        }
+        if section.is_empty() {
+            return false;
+        }
+        let k = (0..3).max_by_key(|&k| n[k].abs()).unwrap_or(2);
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        let orient = |a: &[Q; 3], b: &[Q; 3], c: &[Q; 3]| (b[i] - a[i]) * (c[j] - a[j]) - (b[j] - a[j]) * (c[i] - a[i]);
+        let tq = t.map(q);
+        let area = orient(&tq[0], &tq[1], &tq[2]);
+        // The section's ends: the two of its points farthest apart.
+        let (mut a, mut b) = (section[0], section[0]);
+        for x in &section {
+            for y in &section {
+                let len = |p: &[Q; 3], r: &[Q; 3]| (0..3).map(|k| (p[k] - r[k]) * (p[k] - r[k])).sum::<Q>();
+                if len(x, y) > len(&a, &b) {
+                    (a, b) = (*x, *y);
+                }
+            }
+        }
+        // λ_m(s) = α + β s along a + s (b − a), s in [0, 1]: in `t` where every λ_m ≥ 0, and
+        // not its first corner where λ_1 + λ_2 > 0.
+        let lambda = |m: usize, x: &[Q; 3]| orient(&tq[(m + 1) % 3], &tq[(m + 2) % 3], x) / area;
+        let zero = Q::from_integer(0);
+        let (mut lo, mut hi) = (zero, Q::from_integer(1));
+        for m in 0..3 {
+            let alpha = lambda(m, &a);
+            let beta = lambda(m, &b) - alpha;
+            if beta == zero {
+                if alpha < zero {
+                    return false;
+                }
+                continue;
+            }
+            let bound = -alpha / beta;
+            if beta > zero {
+                lo = lo.max(bound);
+            } else {
+                hi = hi.min(bound);
+            }
+        }
+        let beyond = |s: Q| {
+            let x = [0, 1, 2].map(|k| a[k] + s * (b[k] - a[k]));
+            lambda(1, &x) + lambda(2, &x) > zero
+        };
+        lo <= hi && (beyond(lo) || beyond(hi))
+    }
+
+    /// Triangles sharing a corner on a small integer lattice, one not in the other's plane:
+    /// `shares_corner` says whether one meets the other anywhere but at that corner exactly, as
+    /// exact rationals do (it was conservative where a corner of either lay in the other's plane:
+    /// it took every such pair as meeting).
+    #[test]
+    fn a_triangle_sharing_a_corner_blocks_exactly_where_it_meets_the_other_beyond_it() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            i64::from((seed >> 33) as u32 % 5) - 2
+        };
+        let (mut meet, mut apart, mut on_plane) = (0, 0, 0);
+        for _ in 0..200_000 {
+            let v = [next(), next(), next()];
+            let p: Vec<[i64; 3]> = (0..4).map(|_| [next(), next(), next()]).collect();
+            let (t, u) = ([v, p[0], p[1]], [v, p[2], p[3]]);
+            let f = |x: [[i64; 3]; 3]| x.map(|c| c.map(|a| a as f64));
+            let (ft, fu) = (f(t), f(u));
+            if collinear(ft) || collinear(fu) {
+                continue;
+            }
+            let (plane_t, plane_u) = (Plane::new(&ft), Plane::new(&fu));
+            let sides = (plane_t.side(fu[1]), plane_t.side(fu[2]));
+            if (sides.0 == 0.0 && sides.1 == 0.0) || (sides.0 > 0.0 && sides.1 > 0.0) || (sides.0 < 0.0 && sides.1 < 0.0) {
+                continue;
+            }
+            let tu = (plane_u.side(ft[1]), plane_u.side(ft[2]));
+            if sides.0 == 0.0 || sides.1 == 0.0 || tu.0 == 0.0 || tu.1 == 0.0 {
+                on_plane += 1;
+            }
+            let got = shares_corner(ft, fu, sides, &plane_u);
+            assert_eq!(got, meets_beyond_first(t, u), "{t:?} {u:?}");
+            if got {
+                meet += 1;
+            } else {
+                apart += 1;
+            }
+        }
+        assert!(meet > 1000 && apart > 1000 && on_plane > 1000, "{meet} {apart} {on_plane}");
     }
 
     /// A sphere of `n` rings of `2n` quads (triangles at the poles), facing out: no two of its
