@@ -466,7 +466,13 @@ impl<'t> ChunkParse<'t> {
     fn end_loop(&mut self) {
         self.out.dependent |= !self.out.outer;
         self.in_loop = false;
-        self.out.indices.extend_from_slice(&self.current);
+        // A triangle as three stores: `extend_from_slice` of a length known only at run time is a
+        // `memcpy` call a face.
+        if let [a, b, c] = self.current[..] {
+            self.out.indices.extend_from_slice(&[a, b, c]);
+        } else {
+            self.out.indices.extend_from_slice(&self.current);
+        }
         self.out.sizes.push(self.current.len() as u32);
     }
 
