@@ -2,7 +2,6 @@
 
 use super::Keyword;
 use crate::mass::Polygons;
-use crate::mesh::weld::VertexTable;
 use crate::mesh::{parse_f64, short_decimal, MeshError, MeshErrorKind, RawMesh};
 use scan::{
     coordinates, is_word, line_hash, load, newline, newline_at, plain_text, text_to_newline, FixedLine, HIGHS,
@@ -98,7 +97,7 @@ fn top_up(
 /// Bytes of ASCII STL read at a time by [`ascii_stream`].
 pub(super) const ASCII_PIECE: usize = 4 << 20;
 
-/// Bytes of ASCII STL parsed as one chunk (in parallel, each welded on its own, as binary records).
+/// Bytes of ASCII STL parsed as one chunk (in parallel, each on its own, as binary records).
 pub(super) const ASCII_CHUNK: usize = 512 << 10;
 
 /// Bytes a chunk of a streamed text of `len` bytes: twice [`ASCII_CHUNK`] when the text is four
@@ -123,8 +122,9 @@ struct AsciiState {
     current: Vec<u32>,
 }
 
-/// One chunk of whole lines parsed on its own: vertices welded within it in order of first
-/// appearance, faces as indices into them (plus `base`).
+/// One chunk of whole lines parsed on its own: a vertex for each distinct vertex text in order of
+/// first appearance (welded by value later, across chunks), faces as indices into them (plus
+/// `base`).
 struct AsciiChunk {
     vertices: Vec<[f64; 3]>,
     indices: Vec<u32>,
@@ -166,7 +166,7 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
     out.sizes.reserve(text.len() / 240);
     let mut p = ChunkParse {
         out,
-        table: VertexTable::with_capacity(text.len() / 320 + 16),
+        vertices: Vec::with_capacity(text.len() / 320 + 16),
         seen: SeenLines::with_capacity(text.len() / 320 + 16),
         in_loop: start.in_loop,
         current: start.current.clone(),
@@ -213,7 +213,7 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
         }
     }
     let mut out = p.out;
-    out.vertices = p.table.into_vertices();
+    out.vertices = p.vertices;
     out.end = AsciiState {
         in_loop: p.in_loop,
         current: p.current,
@@ -221,10 +221,15 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
     out
 }
 
-/// A chunk being parsed: what it has produced, its welds, and the facet it is in.
+/// A chunk being parsed: what it has produced, its vertex texts, and the facet it is in.
 struct ChunkParse<'t> {
     out: AsciiChunk,
-    table: VertexTable,
+    /// The coordinates of each distinct vertex text, in order of first appearance. Not welded
+    /// here: two texts of the same value (`1e0`, `1.000000e+00`) are two vertices until the weld
+    /// across chunks ([`crate::mesh::weld::join`], which welds every repeat, within a chunk too,
+    /// to its first copy: the same result as a table here). A table of the coordinates' bits
+    /// was 26 M of the 101.6 MB torus's 865.5 M instructions, for texts that are distinct there.
+    vertices: Vec<[f64; 3]>,
     seen: SeenLines<'t>,
     in_loop: bool,
     /// The corners since `outer`.
@@ -304,7 +309,7 @@ impl<'t> ChunkParse<'t> {
         if let Some(i) = seen {
             return Ok(i);
         }
-        let i = self.table.insert(words.vertex()?);
+        let i = self.new_vertex(words.vertex()?);
         self.seen.insert(slot, key, h, i);
         Ok(i)
     }
@@ -422,7 +427,7 @@ impl<'t> ChunkParse<'t> {
             i
         } else {
             let p = coordinates(text, from)?;
-            let i = self.table.insert(p);
+            let i = self.new_vertex(p);
             self.seen.insert(slot, key, h, i);
             i
         };
@@ -451,6 +456,13 @@ impl<'t> ChunkParse<'t> {
             return end + self.outer_line.len();
         }
         end
+    }
+
+    /// The index of a vertex text not seen before in the chunk, whose coordinates are `p`.
+    #[inline(always)]
+    fn new_vertex(&mut self, p: [f64; 3]) -> u32 {
+        self.vertices.push(p);
+        self.vertices.len() as u32 - 1
     }
 
     /// `outer`: a facet's corners begin.
@@ -497,7 +509,7 @@ impl<'t> ChunkParse<'t> {
 
 /// The vertex lines of a chunk already parsed, by their text after `vertex`, and the vertex each
 /// gave: an open-addressing table of slices of the chunk's text (the text is the key, so a hit is
-/// exactly the vertex a parse would give, and a miss parses and welds as before).
+/// exactly the vertex a parse would give, and a miss parses as before).
 struct SeenLines<'t> {
     lines: Vec<(&'t [u8], u32)>,
     /// 0: empty; else `tag << 32 | (index into lines + 1)`.
@@ -852,6 +864,17 @@ mod tests {
         assert_eq!(last_facet_line(&text[..39]), Some(8));
         assert_eq!(last_facet_line(b"facet\n"), Some(0));
         assert_eq!(last_facet_line(b"outer loop\nfacets\nendfacet\n"), None);
+    }
+
+    /// Texts of the same value in one chunk (the vertices are not welded there) are one vertex
+    /// after the weld across chunks, numbered by first appearance, as a table welding each chunk
+    /// gave: `-0` with `0` too.
+    #[test]
+    fn texts_of_one_value_are_one_vertex() {
+        let text = b"solid s\nfacet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 0 1 0\nvertex 0 0 1\nendloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 1.000000e+00 0 0\nvertex 0 1e0 -0\nvertex 0 0 10e-1\nendloop\nendfacet\nendsolid s\n";
+        let mesh = ascii(text, Path::new("t.stl")).unwrap();
+        assert_eq!(mesh.vertices, [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+        assert_eq!(mesh.faces.indices, [0, 1, 2, 0, 1, 2]);
     }
 
     /// Every line recorded is found with its vertex through the table's growth, a line never
