@@ -408,9 +408,9 @@ impl<'t> ChunkParse<'t> {
                 self.current.push(self.base + i);
                 return Some(self.after_corner(text, guess + 1));
             }
-            // A text not seen: its hash and its lookup stand when it holds no `\n` (its words
-            // or-ed).
-            if plain_text(key, bytes) {
+            // A text not seen: its hash and its lookup stand when it holds no `\n` and is ASCII
+            // (nothing for the UTF-8 accumulator).
+            if plain_text(key) {
                 (guess, h, Some(slot))
             } else {
                 let (end, h) = text_to_newline(text, from, bytes)?;
@@ -443,7 +443,7 @@ impl<'t> ChunkParse<'t> {
     fn facet(&mut self, text: &[u8], from: usize, bytes: &mut u64) -> usize {
         // As long as the last `facet` line's rest, most often (exporters write the normal's three
         // numbers in one format): checked in one pass without a branch a word.
-        let end = if let Some(i) = newline_at(text, from, self.facet_len, bytes) {
+        let end = if let Some(i) = newline_at(text, from, self.facet_len) {
             i + 1
         } else {
             let i = newline(text, from, bytes);

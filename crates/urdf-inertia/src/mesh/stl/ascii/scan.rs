@@ -288,20 +288,21 @@ pub(super) fn newline(text: &[u8], mut from: usize, bytes: &mut u64) -> Option<u
     memchr::memchr(b'\n', &text[from..]).map(|i| from + i)
 }
 
-/// `from + len` when it is the first `\n` at or after `from` ([`newline`]'s answer), found by
-/// checking that one is there and none comes before it: at least eight bytes, read once, their
-/// words or-ed into `bytes` (whatever the answer); `None` otherwise.
+/// `from + len` when it is the first `\n` at or after `from` ([`newline`]'s answer) and the bytes
+/// before it are ASCII, found by checking that one is there and none comes before it: at least
+/// eight bytes, read once; `None` otherwise (a byte that is not ASCII included: the caller's
+/// [`newline`] then reads the line and ors its words for the UTF-8 check). Being ASCII, the
+/// bytes of an answer need no or into the UTF-8 accumulator.
 #[inline]
-pub(super) fn newline_at(text: &[u8], from: usize, len: usize, bytes: &mut u64) -> Option<usize> {
+pub(super) fn newline_at(text: &[u8], from: usize, len: usize) -> Option<usize> {
     let end = from + len;
     if len < 8 || text.get(end) != Some(&b'\n') {
         return None;
     }
     let line = text.get(from..end)?;
-    let (or, flags) = whole_words(line, |w| zero_bytes(w ^ NEWLINES));
     let last = u64::from_le_bytes(*line.last_chunk::<8>()?);
-    *bytes |= or | last;
-    (flags | zero_bytes(last ^ NEWLINES) == 0).then_some(end)
+    let flags = whole_words(line, newline_or_byte_high) | newline_or_byte_high(last);
+    (flags & HIGHS == 0).then_some(end)
 }
 
 /// The first `\n` at or after `from` and the [`line_hash`] of the text before it, read once (the
@@ -332,30 +333,36 @@ pub(super) fn text_to_newline(text: &[u8], from: usize, bytes: &mut u64) -> Opti
     None
 }
 
-/// The or of the whole eight-byte words of `s` (its tail left out), and the or of `flag` of each.
+/// A top bit set in each byte of `w` that is a `\n` or not ASCII, or (after the first such byte)
+/// whatever the borrow makes of the bytes after it: none when `w` has no `\n` and is ASCII. One
+/// word holds both tests, so that a line's words need no separate or for the UTF-8 check when
+/// this finds nothing (the whole-process instructions of the 101.6 MB torus of
+/// `validation/threads.sh`: 838.3 M with the separate or, see docs/benchmarks.md round nine).
 #[inline(always)]
-fn whole_words(s: &[u8], flag: impl Fn(u64) -> u64) -> (u64, u64) {
-    let (mut or, mut flags) = (0, 0);
+fn newline_or_byte_high(w: u64) -> u64 {
+    (w ^ NEWLINES).wrapping_sub(ONES) | w
+}
+
+/// The or of `flag` of the whole eight-byte words of `s` (its tail left out).
+#[inline(always)]
+fn whole_words(s: &[u8], flag: impl Fn(u64) -> u64) -> u64 {
+    let mut flags = 0;
     for c in s.chunks_exact(8) {
         let mut w = [0u8; 8];
         w.copy_from_slice(c);
-        let w = u64::from_le_bytes(w);
-        or |= w;
-        flags |= flag(w);
+        flags |= flag(u64::from_le_bytes(w));
     }
-    (or, flags)
+    flags
 }
 
-/// Whether `key` holds no `\n` and is ASCII, its words or-ed into `bytes` (whatever the answer).
+/// Whether `key` holds no `\n` and is ASCII (then its bytes need no or into the UTF-8
+/// accumulator; otherwise the caller's [`text_to_newline`] reads and ors them).
 #[inline]
-pub(super) fn plain_text(key: &[u8], bytes: &mut u64) -> bool {
-    let (mut or, flags) = whole_words(key, newline_or_high);
+pub(super) fn plain_text(key: &[u8]) -> bool {
     let w = tail_word(key);
-    or |= w;
-    // The zero bytes past the tail are flagged: only the tail's own count.
-    let tail_flags = newline_or_high(w) & ((1u64 << (8 * (key.len() % 8))) - 1);
-    *bytes |= or;
-    (flags | tail_flags | or) & HIGHS == 0
+    // The zero bytes past the tail are not flagged, and a borrow runs past a flagged byte only.
+    let flags = whole_words(key, newline_or_byte_high) | newline_or_byte_high(w);
+    flags & HIGHS == 0
 }
 
 /// A hash of a line's bytes, eight at a time, every bit mixed into the top (the slot) and the
@@ -424,42 +431,42 @@ mod tests {
                 let mut bytes = 0;
                 let read = text_to_newline(&text, skip, &mut bytes);
                 assert_eq!(read, Some((skip + len, line_hash(&key))), "{len} {skip}");
-                assert!(plain_text(&key, &mut bytes), "{len}");
+                assert!(plain_text(&key), "{len}");
                 for at in 0..len {
-                    for b in [b'\n', 0x80, 0xc3] {
+                    for b in [b'\n', 0x80, 0xc3, 0x8a, 0xff] {
                         let mut k = key.clone();
                         k[at] = b;
-                        assert!(!plain_text(&k, &mut bytes), "{len} {at} {b}");
+                        assert!(!plain_text(&k), "{len} {at} {b}");
                     }
                 }
             }
         }
     }
 
-    /// `newline_at` gives `newline`'s answer wherever it gives one, and gives it for every line
-    /// of eight bytes or more at the length asked; where it answers, a byte that is not ASCII
-    /// before the `\n` is in the or of the words it read (every length, start, position of the
-    /// `\n` and of such a byte).
+    /// `newline_at` gives `newline`'s answer wherever it gives one, and gives it for every ASCII
+    /// line of eight bytes or more at the length asked; it answers only for an ASCII line (every
+    /// length, start, position of the `\n` and of a byte that is not ASCII).
     #[test]
     fn newline_at_is_newline() {
         for from in 0..3usize {
             for nl in from..44 {
-                for high in [None, Some(from), Some(from + 5), Some(nl.saturating_sub(1))] {
-                    let mut text = vec![b'7'; 52];
-                    text[nl] = b'\n';
-                    if let Some(h) = high.filter(|&h| h != nl && h >= from) {
-                        text[h] = 0xc3;
-                    }
-                    let first = newline(&text, from, &mut 0);
-                    for len in 0..48 {
-                        let mut bytes = 0;
-                        match newline_at(&text, from, len, &mut bytes) {
-                            Some(end) => {
-                                assert_eq!(Some(end), first, "{from} {nl} {len}");
-                                let ascii = text[from..end].is_ascii();
-                                assert_eq!(bytes & HIGHS == 0, ascii, "{from} {nl} {len}");
+                for high in [None, Some(from), Some(from + 5), Some(from + 9), Some(nl.saturating_sub(1))] {
+                    for byte in [0xc3, 0x8a, 0xff] {
+                        let mut text = vec![b'7'; 52];
+                        text[nl] = b'\n';
+                        if let Some(h) = high.filter(|&h| h != nl && h >= from) {
+                            text[h] = byte;
+                        }
+                        let first = newline(&text, from, &mut 0);
+                        for len in 0..48 {
+                            let ascii = text[from..(from + len).min(52)].is_ascii();
+                            match newline_at(&text, from, len) {
+                                Some(end) => {
+                                    assert_eq!(Some(end), first, "{from} {nl} {len}");
+                                    assert!(ascii, "{from} {nl} {len}");
+                                }
+                                None => assert!(len < 8 || first != Some(from + len) || !ascii, "{from} {nl} {len}"),
                             }
-                            None => assert!(len < 8 || first != Some(from + len), "{from} {nl} {len}"),
                         }
                     }
                 }
