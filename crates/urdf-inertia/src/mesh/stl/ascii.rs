@@ -728,14 +728,15 @@ impl<'p> Ascii<'p> {
         for (text, mut chunk) in chunks.iter().zip(parsed) {
             let here = at;
             at += text.len();
+            // What the chunk's corners need added (a chunk parsed again below numbers its own).
+            let mut rebase = 0;
             if self.error.is_none() {
                 if chunk.dependent && self.state != AsciiState::default() {
                     let start = std::mem::take(&mut self.state);
                     chunk = ascii_chunk(text, start, self.vertices.len() as u32);
                 } else {
-                    let base = self.vertices.len() as u32;
-                    chunk.indices.iter_mut().for_each(|i| *i += base);
-                    chunk.end.current.iter_mut().for_each(|i| *i += base);
+                    rebase = self.vertices.len() as u32;
+                    chunk.end.current.iter_mut().for_each(|i| *i += rebase);
                 }
             }
             if let Some(u) = chunk.utf8 {
@@ -755,7 +756,8 @@ impl<'p> Ascii<'p> {
                 s += n;
                 self.starts.push(s);
             }
-            self.indices.extend_from_slice(&chunk.indices);
+            // Rebased as they are copied: one pass, not a pass in place and a `memcpy`.
+            self.indices.extend(chunk.indices.iter().map(|&i| i + rebase));
             // A chunk that neither began a facet nor touched the state leaves it as it was.
             if chunk.outer || chunk.dependent {
                 self.state = chunk.end;
