@@ -145,7 +145,9 @@ struct AsciiChunk {
 }
 
 /// Parses whole lines of ASCII STL starting in `start`, numbering new vertices from `base`.
-fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
+/// `slots` is a table's empty slots from a chunk before, or none (see [`SeenLines::with_slots`]);
+/// this chunk's, empty again, are left in it.
+fn ascii_chunk(text: &[u8], start: AsciiState, base: u32, slots: &mut Vec<u64>) -> AsciiChunk {
     let empty = |end: AsciiState| AsciiChunk {
         vertices: Vec::new(),
         indices: Vec::new(),
@@ -167,7 +169,7 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
     let mut p = ChunkParse {
         out,
         vertices: Vec::with_capacity(text.len() / 320 + 16),
-        seen: SeenLines::with_capacity(text.len() / 320 + 16),
+        seen: SeenLines::with_slots(text.len() / 320 + 16, std::mem::take(slots)),
         in_loop: start.in_loop,
         current: start.current.clone(),
         base,
@@ -212,6 +214,7 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32) -> AsciiChunk {
             return out;
         }
     }
+    *slots = p.seen.into_slots();
     let mut out = p.out;
     out.vertices = p.vertices;
     out.end = AsciiState {
@@ -511,21 +514,48 @@ impl<'t> ChunkParse<'t> {
 /// gave: an open-addressing table of slices of the chunk's text (the text is the key, so a hit is
 /// exactly the vertex a parse would give, and a miss parses as before).
 struct SeenLines<'t> {
-    lines: Vec<(&'t [u8], u32)>,
+    /// Each text, its vertex, and the slot it was put in.
+    lines: Vec<(&'t [u8], u32, u32)>,
     /// 0: empty; else `tag << 32 | (index into lines + 1)`.
     slots: Vec<u64>,
     /// 64 − log2(slots.len()): the slot is the top bits of the hash.
     shift: u32,
+    /// The slots were made anew for more lines (the slots of `lines` are stale).
+    grown: bool,
 }
 
 impl<'t> SeenLines<'t> {
+    #[cfg(test)]
     fn with_capacity(expected: usize) -> Self {
+        Self::with_slots(expected, Vec::new())
+    }
+
+    /// A table for about `expected` lines, in `slots` when they are all empty and the size it
+    /// takes (what [`Self::into_slots`] gave back from a chunk before): a chunk's fresh slots
+    /// (64 KiB at 1 MiB chunks) were zeroed, where emptying only the slots its lines took costs a
+    /// store a line (the 101.6 MB torus of `validation/threads.sh`: 817.5 M instructions down to
+    /// 809.5 M).
+    fn with_slots(expected: usize, slots: Vec<u64>) -> Self {
         let size = (2 * expected).next_power_of_two().max(16);
+        let slots = if slots.len() == size { slots } else { vec![0; size] };
         SeenLines {
             lines: Vec::with_capacity(expected),
-            slots: vec![0; size],
+            slots,
             shift: 64 - size.trailing_zeros(),
+            grown: false,
         }
+    }
+
+    /// The slots, all empty again, for [`Self::with_slots`] (none when they grew).
+    fn into_slots(self) -> Vec<u64> {
+        if self.grown {
+            return Vec::new();
+        }
+        let mut slots = self.slots;
+        for &(_, _, s) in &self.lines {
+            slots[s as usize] = 0;
+        }
+        slots
     }
 
     /// Where `key` is (its vertex), or the empty slot where it would go; neither when the probe
@@ -541,7 +571,7 @@ impl<'t> SeenLines<'t> {
                 return (Some(s), None);
             }
             if slot & 0xffff_ffff_0000_0000 == tag {
-                let (text, vertex) = self.lines[(slot as u32 - 1) as usize];
+                let (text, vertex, _) = self.lines[(slot as u32 - 1) as usize];
                 if text == key {
                     return (Some(s), Some(vertex));
                 }
@@ -562,13 +592,14 @@ impl<'t> SeenLines<'t> {
         let Some(s) = slot else {
             return;
         };
-        self.lines.push((key, vertex));
+        self.lines.push((key, vertex, s as u32));
         self.slots[s] = (h << 32) | self.lines.len() as u64;
         if 2 * self.lines.len() > self.slots.len() {
             let size = 2 * self.slots.len();
             self.slots = vec![0; size];
             self.shift = 64 - size.trailing_zeros();
-            for (i, &(text, _)) in self.lines.iter().enumerate() {
+            self.grown = true;
+            for (i, &(text, _, _)) in self.lines.iter().enumerate() {
                 let h = line_hash(text);
                 if let (Some(s), _) = self.find(text, h) {
                     self.slots[s] = (h << 32) | (i as u64 + 1);
@@ -722,7 +753,7 @@ impl<'p> Ascii<'p> {
         }
         let parsed: Vec<AsciiChunk> = chunks
             .par_iter()
-            .map(|c| ascii_chunk(c, AsciiState::default(), 0))
+            .map_init(Vec::new, |slots, c| ascii_chunk(c, AsciiState::default(), 0, slots))
             .collect();
         let mut at = offset;
         for (text, mut chunk) in chunks.iter().zip(parsed) {
@@ -733,7 +764,7 @@ impl<'p> Ascii<'p> {
             if self.error.is_none() {
                 if chunk.dependent && self.state != AsciiState::default() {
                     let start = std::mem::take(&mut self.state);
-                    chunk = ascii_chunk(text, start, self.vertices.len() as u32);
+                    chunk = ascii_chunk(text, start, self.vertices.len() as u32, &mut Vec::new());
                 } else {
                     rebase = self.vertices.len() as u32;
                     chunk.end.current.iter_mut().for_each(|i| *i += rebase);
@@ -877,6 +908,30 @@ mod tests {
         let mesh = ascii(text, Path::new("t.stl")).unwrap();
         assert_eq!(mesh.vertices, [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
         assert_eq!(mesh.faces.indices, [0, 1, 2, 0, 1, 2]);
+    }
+
+    /// The slots given back are all empty, the table's own when it did not grow (and then taken
+    /// again as they are), none when it grew.
+    #[test]
+    fn seen_slots_come_back_empty() {
+        let texts: Vec<String> = (0..40).map(|i| format!(" {i}.5 0 0")).collect();
+        let mut slots = Vec::new();
+        for n in [40, 30, 10, 40] {
+            let mut seen = SeenLines::with_slots(n, std::mem::take(&mut slots));
+            for (i, t) in texts.iter().take(n).enumerate() {
+                let h = line_hash(t.as_bytes());
+                seen.insert(seen.find(t.as_bytes(), h).0, t.as_bytes(), h, i as u32);
+            }
+            slots = seen.into_slots();
+            assert_eq!(slots.len(), (2 * n).next_power_of_two());
+            assert!(slots.iter().all(|&s| s == 0));
+        }
+        let mut seen = SeenLines::with_slots(4, slots);
+        for (i, t) in texts.iter().enumerate() {
+            let h = line_hash(t.as_bytes());
+            seen.insert(seen.find(t.as_bytes(), h).0, t.as_bytes(), h, i as u32);
+        }
+        assert!(seen.into_slots().is_empty());
     }
 
     /// Every line recorded is found with its vertex through the table's growth, a line never
