@@ -369,11 +369,22 @@ pub(super) fn plain_text(key: &[u8]) -> bool {
 /// bottom (the tag).
 pub(super) fn line_hash(b: &[u8]) -> u64 {
     let mut h = HASH_SEED;
-    let mut words = b.chunks_exact(8);
-    for c in &mut words {
-        let mut w = [0u8; 8];
-        w.copy_from_slice(c);
-        h = hash_word(h, u64::from_le_bytes(w));
+    // The first 32 bytes in straight-line code (a text of three `%e` numbers is 39 to 42 bytes),
+    // then a word at a time: a loop unrolled four times over every length took its trip counts'
+    // arithmetic on every call (the 101.6 MB torus of `validation/threads.sh`: 809.5 M
+    // instructions against 794.8 M; the same hash).
+    let mut rest = b;
+    if let Some((first, after)) = b.split_first_chunk::<32>() {
+        for c in first.chunks_exact(8) {
+            let mut w = [0u8; 8];
+            w.copy_from_slice(c);
+            h = hash_word(h, u64::from_le_bytes(w));
+        }
+        rest = after;
+    }
+    while let Some((w, after)) = rest.split_first_chunk::<8>() {
+        h = hash_word(h, u64::from_le_bytes(*w));
+        rest = after;
     }
     hash_finish(hash_word(h, tail_word(b)), b.len())
 }
