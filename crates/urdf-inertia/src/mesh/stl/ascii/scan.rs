@@ -24,6 +24,20 @@ pub(super) fn load(text: &[u8], at: usize) -> u64 {
     }
 }
 
+/// The sixteen bytes of `text` from `at` as two words ([`load`] of `at` and of `at + 8`), with one
+/// bounds test when they are all in `text`: the whole lines compared at each line start of the
+/// fast path and the two words of a `%e` number (the 101.6 MB torus of `validation/threads.sh`:
+/// 781.7 M instructions against 767.2 M).
+#[inline(always)]
+pub(super) fn load2(text: &[u8], at: usize) -> (u64, u64) {
+    if let Some(&b) = text.get(at..).and_then(|b| b.first_chunk::<16>()) {
+        let x = u128::from_le_bytes(b);
+        (x as u64, (x >> 64) as u64)
+    } else {
+        (load(text, at), load(text, at + 8))
+    }
+}
+
 /// The bit of the first zero byte of `x` and above it (0 when none): exact for the first one.
 #[inline(always)]
 fn zero_bytes(x: u64) -> u64 {
@@ -90,7 +104,7 @@ pub(super) fn coordinates(text: &[u8], mut from: usize) -> Option<[f64; 3]> {
 fn exponent_form(text: &[u8], at: usize) -> Option<(f64, usize)> {
     let negative = text.get(at) == Some(&b'-');
     let i = at + usize::from(negative);
-    let (a, b) = (load(text, i), load(text, i + 8));
+    let (a, b) = load2(text, i);
     // The point, then eight digits with a `0` in its place.
     let digits = (a & !0xff00) | 0x3000;
     let all_digits = (digits.wrapping_add(0x4646_4646_4646_4646) | digits.wrapping_sub(0x3030_3030_3030_3030)) & HIGHS == 0;
@@ -240,8 +254,8 @@ impl FixedLine {
     /// UTF-8 accumulator: they are the line's, or-ed into it when it was first taken.
     #[inline(always)]
     pub(super) fn at(&self, text: &[u8], at: usize) -> bool {
-        load(text, at) & self.masks[0] == self.words[0]
-            && load(text, at + 8) & self.masks[1] == self.words[1]
+        let (a, b) = load2(text, at);
+        a & self.masks[0] == self.words[0] && b & self.masks[1] == self.words[1]
     }
 }
 
