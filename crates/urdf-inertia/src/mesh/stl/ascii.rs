@@ -160,6 +160,11 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32, slots: &mut Vec<u64>) 
         utf8: None,
     };
     let mut out = empty(AsciiState::default());
+    // The fast path takes a corner only inside a loop, and before the chunk's first `outer` it is
+    // in one only when it started in one: then a corner there makes the chunk dependent, and so
+    // does starting in a loop (when an `outer` comes first instead, the state it leaves is its end
+    // either way). Set here, it need not be or-ed at each corner.
+    out.dependent = start.in_loop;
     // About 250 bytes a facet, half a new vertex a facet, and the vertices a chunk shares with the
     // one before parsed again in it (a third more on a closed mesh written row by row): a vertex
     // for every 320 bytes holds them all without growing the lists (a copy of each on every chunk
@@ -407,7 +412,6 @@ impl<'t> ChunkParse<'t> {
             let h = line_hash(key);
             let (slot, seen) = self.seen.find(key, h);
             if let Some(i) = seen {
-                self.out.dependent |= !self.out.outer;
                 self.current.push(self.base + i);
                 return Some(self.after_corner(text, guess + 1));
             }
@@ -434,7 +438,6 @@ impl<'t> ChunkParse<'t> {
             self.seen.insert(slot, key, h, i);
             i
         };
-        self.out.dependent |= !self.out.outer;
         self.current.push(self.base + i);
         Some(self.after_corner(text, end + 1))
     }
