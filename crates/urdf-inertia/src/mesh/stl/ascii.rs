@@ -100,19 +100,23 @@ pub(super) const ASCII_PIECE: usize = 4 << 20;
 /// Bytes of ASCII STL parsed as one chunk (in parallel, each on its own, as binary records).
 pub(super) const ASCII_CHUNK: usize = 512 << 10;
 
-/// Bytes a chunk of a streamed text of `len` bytes: twice [`ASCII_CHUNK`] when the text is four
-/// pieces or more and a piece still gives every thread of the pool two chunks (one or two
-/// threads), else [`ASCII_CHUNK`]. Each chunk border parses again the vertex texts the chunks on
-/// both sides share, and welds them again across chunks: on the 101.6 MB torus of
-/// `validation/threads.sh`, one thread, 1 MiB chunks take 921.6 M instructions down to 887.9 M.
-/// A robot mesh of a few megabytes keeps its chunks of 512 KiB for the threads.
+/// Bytes a chunk of a streamed text of `len` bytes: when the text is four pieces or more, the
+/// largest of [`ASCII_CHUNK`], twice and four times it with which a piece still gives every thread
+/// of the pool two chunks (2 MiB on one thread, 1 MiB on two), else [`ASCII_CHUNK`]. Each chunk
+/// border parses again the vertex texts the chunks on both sides share, and welds them again
+/// across chunks: on the 101.6 MB torus of `validation/threads.sh`, one thread, 1 MiB chunks
+/// take 921.6 M instructions down to 887.9 M, and 2 MiB chunks 763.6 M down to 754.8 M. A robot
+/// mesh of a few megabytes keeps its chunks of 512 KiB for the threads.
 pub(super) fn stream_chunk(len: u64) -> usize {
     let threads = rayon::current_num_threads().max(1);
-    if len >= 4 * ASCII_PIECE as u64 && ASCII_PIECE / (2 * ASCII_CHUNK) >= 2 * threads {
-        2 * ASCII_CHUNK
-    } else {
-        ASCII_CHUNK
+    if len < 4 * ASCII_PIECE as u64 {
+        return ASCII_CHUNK;
     }
+    let mut chunk = ASCII_CHUNK;
+    while chunk < 4 * ASCII_CHUNK && ASCII_PIECE / (2 * chunk) >= 2 * threads {
+        chunk *= 2;
+    }
+    chunk
 }
 
 /// What a line left for the next: inside `outer loop` … `endloop`, and the corners since `outer`.
