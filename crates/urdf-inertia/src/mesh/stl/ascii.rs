@@ -616,6 +616,12 @@ impl<'t> SeenLines<'t> {
     }
 }
 
+thread_local! {
+    /// The emptied slots of the last chunk's [`SeenLines`] on this thread, for the next chunk it
+    /// parses, in this feed or a later one (at most 128 KiB a thread, kept after the read).
+    static SLOTS: std::cell::RefCell<Vec<u64>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
 /// Slots a lookup in [`SeenLines`] probes at most: the table is at most half full, so an honest
 /// file's probes are a few slots; a file made for its hash to collide gets its lines parsed (as
 /// without the table) instead of a lookup that grows with the chunk.
@@ -760,7 +766,7 @@ impl<'p> Ascii<'p> {
         }
         let parsed: Vec<AsciiChunk> = chunks
             .par_iter()
-            .map_init(Vec::new, |slots, c| ascii_chunk(c, AsciiState::default(), 0, slots))
+            .map(|c| SLOTS.with_borrow_mut(|slots| ascii_chunk(c, AsciiState::default(), 0, slots)))
             .collect();
         let mut at = offset;
         for (text, mut chunk) in chunks.iter().zip(parsed) {
