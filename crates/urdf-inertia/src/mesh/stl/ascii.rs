@@ -618,7 +618,9 @@ impl<'t> SeenLines<'t> {
 
 thread_local! {
     /// The emptied slots of the last chunk's [`SeenLines`] on this thread, for the next chunk it
-    /// parses, in this feed or a later one (at most 128 KiB a thread, kept after the read).
+    /// parses, in this feed or a later one (at most 128 KiB a thread, kept after the read): made
+    /// afresh for each piece's first chunk instead, the 101.6 MB torus of `validation/threads.sh`
+    /// took 754.8 M instructions on one thread, against 747.1 M.
     static SLOTS: std::cell::RefCell<Vec<u64>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 

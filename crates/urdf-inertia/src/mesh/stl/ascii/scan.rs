@@ -351,7 +351,7 @@ pub(super) fn text_to_newline(text: &[u8], from: usize, bytes: &mut u64) -> Opti
 /// whatever the borrow makes of the bytes after it: none when `w` has no `\n` and is ASCII. One
 /// word holds both tests, so that a line's words need no separate or for the UTF-8 check when
 /// this finds nothing (the whole-process instructions of the 101.6 MB torus of
-/// `validation/threads.sh`: 838.3 M with the separate or, see docs/benchmarks.md round nine).
+/// `validation/threads.sh`: 838.3 M with the separate or, 822.4 M with this).
 #[inline(always)]
 fn newline_or_byte_high(w: u64) -> u64 {
     (w ^ NEWLINES).wrapping_sub(ONES) | w
