@@ -401,27 +401,35 @@ fn newline_or_byte_high(w: u64) -> u64 {
     (w ^ NEWLINES).wrapping_sub(ONES) | w
 }
 
-/// The or of `flag` of the whole eight-byte words of `s` (its tail left out): the first 32 bytes
-/// in straight-line code (a vertex text or a `facet` line's rest is 39 to 50 bytes), then a word
-/// at a time, where a loop over all of them was vectorised with a setup longer than the loop
-/// (the 101.6 MB torus of `validation/threads.sh`: 794.8 M instructions against 781.7 M).
+/// `f` folded over the whole eight-byte words of `s` from `init` (its tail left out): the first 32
+/// bytes in straight-line code (a vertex text or a `facet` line's rest is 39 to 50 bytes), then a
+/// word at a time. A loop over all of them was vectorised with a setup longer than the loop (the
+/// or of [`newline_or_byte_high`]: 794.8 M instructions against 781.7 M on the 101.6 MB torus of
+/// `validation/threads.sh`), and unrolled four times over every length it took its trip counts'
+/// arithmetic on every call (the hash of [`line_hash`]: 809.5 M against 794.8 M).
 #[inline(always)]
-fn whole_words(s: &[u8], flag: impl Fn(u64) -> u64) -> u64 {
-    let mut flags = 0;
+fn fold_words<T>(s: &[u8], init: T, f: impl Fn(T, u64) -> T) -> T {
+    let mut acc = init;
     let mut rest = s;
     if let Some((first, after)) = s.split_first_chunk::<32>() {
         for c in first.chunks_exact(8) {
             let mut w = [0u8; 8];
             w.copy_from_slice(c);
-            flags |= flag(u64::from_le_bytes(w));
+            acc = f(acc, u64::from_le_bytes(w));
         }
         rest = after;
     }
     while let Some((w, after)) = rest.split_first_chunk::<8>() {
-        flags |= flag(u64::from_le_bytes(*w));
+        acc = f(acc, u64::from_le_bytes(*w));
         rest = after;
     }
-    flags
+    acc
+}
+
+/// The or of `flag` of the whole eight-byte words of `s` (its tail left out).
+#[inline(always)]
+fn whole_words(s: &[u8], flag: impl Fn(u64) -> u64) -> u64 {
+    fold_words(s, 0, |flags, w| flags | flag(w))
 }
 
 /// Whether `key` holds no `\n` and is ASCII (then its bytes need no or into the UTF-8
@@ -437,24 +445,8 @@ pub(super) fn plain_text(key: &[u8]) -> bool {
 /// A hash of a line's bytes, eight at a time, every bit mixed into the top (the slot) and the
 /// bottom (the tag).
 pub(super) fn line_hash(b: &[u8]) -> u64 {
-    let mut h = HASH_SEED;
-    // The first 32 bytes in straight-line code (a text of three `%e` numbers is 39 to 42 bytes),
-    // then a word at a time: a loop unrolled four times over every length took its trip counts'
-    // arithmetic on every call (the 101.6 MB torus of `validation/threads.sh`: 809.5 M
-    // instructions against 794.8 M; the same hash).
-    let mut rest = b;
-    if let Some((first, after)) = b.split_first_chunk::<32>() {
-        for c in first.chunks_exact(8) {
-            let mut w = [0u8; 8];
-            w.copy_from_slice(c);
-            h = hash_word(h, u64::from_le_bytes(w));
-        }
-        rest = after;
-    }
-    while let Some((w, after)) = rest.split_first_chunk::<8>() {
-        h = hash_word(h, u64::from_le_bytes(*w));
-        rest = after;
-    }
+    // The whole words (a text of three `%e` numbers is 39 to 42 bytes), then the tail.
+    let h = fold_words(b, HASH_SEED, hash_word);
     hash_finish(hash_word(h, tail_word(b)), b.len())
 }
 
