@@ -180,3 +180,33 @@ fn a_face_the_ladder_turns_round_is_decided_as_stored() {
         s.warnings
     );
 }
+
+/// The face the ladder turns round of the test above, with a crack in the far box (one corner stored
+/// 1e-10 apart on one face) and a second box beside it: the cracked shell is one the classification
+/// does not close or decide face by face, so the surface is not decided as the file's as a whole and
+/// the rung's model stays. Before, that model held the term for the face the ladder turned, twice its
+/// vector area times the diagonal (above the volume itself: unbounded), and cracks measured on the
+/// surface with that face turned. The shells' decision turns the face back and integrates it as
+/// stored, so that term goes and the cracks are those of the surface integrated (the far crack's).
+/// Truth: the taller tetrahedron and both boxes, exactly.
+#[test]
+fn a_face_turned_back_leaves_no_orientation_term_in_the_estimate() {
+    let base = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let tall = tetrahedron([base[0], base[1], base[2], [0.25, 0.25, 1.0]]);
+    let low = tetrahedron([base[0], base[1], base[2], [0.25, 0.25, 0.5]]);
+    let far = common::box_at([0.0, 0.0, -10.0], [0.5, 0.5, -9.5]);
+    let crack = cracked(&far, [0.5, 0.5, -9.5], 2, [1e-10, -1e-10, 0.0]);
+    let edge = common::box_at([2.0, 0.0, -10.0], [2.5, 0.5, -9.5]);
+    let mut mesh = tall.clone();
+    mesh.0.push(low.0[3]);
+    mesh.1
+        .extend(low.1.iter().map(|t| t.map(|i| if i == 3 { 4 } else { i })));
+    let mesh = together(&[(&mesh, false), (&crack, false), (&edge, false)]);
+    let s = solid(&mesh);
+    let exact = exact_sum(&[(1, &tall), (1, &far), (1, &edge)]);
+    let error = within_estimate("turned back", &s, &exact);
+    assert!(error <= 1e-8, "{error:e} {:?}", s.warnings);
+    assert_estimate_at_most(&s, 1e-6);
+    let said = |what: &str| s.warnings.iter().any(|w| w.text.contains(what));
+    assert!(said("1 re-oriented faces as stored"), "{:?}", s.warnings);
+}

@@ -4,6 +4,7 @@ use super::geometry::{
     bbox, component_boxes, component_volumes, vector_area, Aabb,
 };
 use super::ladder::{Known, Ladder};
+use super::model::Model;
 use super::closed_consistent;
 use super::topology::{closed_consistent_split, Edges, Orientation};
 use super::welding::Welding;
@@ -249,13 +250,8 @@ pub(super) fn reoriented(
         faces_flipped: flipped,
         components: o.ncomp,
     };
-    let model = open_volume(&w.vertices, &faces) + nested + flip_volume;
-    let source = if nested + flip_volume > 0.0 {
-        ModelError::Orientation
-    } else {
-        ModelError::Cracks
-    };
-    ladder.finish(w.vertices, faces, rung, (model, source), |_, _| None)
+    let model = Model::reoriented(open_volume(&w.vertices, &faces), nested + flip_volume);
+    ladder.finish(w.vertices, faces, rung, model, |_, _| None)
 }
 
 /// Each face's reversal under an orientation that turns every component outward by its own signed

@@ -1,6 +1,7 @@
 //! What every rung shares: where the mesh came from, what has been said about it, the overlapping
 //! shells' classification and the last step (integrate, check the volume, estimate the error).
 
+use super::closed::open_volume;
 use super::geometry::{bbox, unit_props};
 use super::model::{check_volume, reach, round_off, round_off_against, Lever, Model};
 use super::{ErrorEstimate, HealthKind, HealthMessage, HealthOptions, ModelError, Rung, Solid};
@@ -124,16 +125,25 @@ impl<'a> Ladder<'a> {
             return faces;
         }
         let mut s = winding_shells::classify(vertices, &faces, &self.as_stored);
+        if s.changed {
+            vertices.append(&mut s.vertices);
+        }
         if s.whole_as_stored {
             // The file's surface, every face decided by its winding number: what the rung assumed
             // about closure and orientation no longer enters the solid.
-            model.terms.clear();
+            model.clear();
+        } else if s.turned_back > 0 && s.turned_back == s.turned {
+            // Every face the rung turned round is decided in its stored orientation: what turning
+            // them could change no longer enters the solid, and the cracks are those of the
+            // surface integrated now (what else the rung assumed stays).
+            model.as_stored_orientation(open_volume(vertices, &s.faces));
         }
+
         if s.resolved_pairs > 0 {
             self.resolved(&s, model);
         }
         if s.overlap_bound > 0.0 {
-            let others: f64 = model.terms.iter().map(|t| t.0).sum();
+            let others = model.total();
             if s.overlap_bound > others {
                 model.source = ModelError::Overlap;
             }
@@ -153,7 +163,6 @@ impl<'a> Ladder<'a> {
             return faces;
         }
         self.known = None;
-        vertices.append(&mut s.vertices);
         let mut done = Vec::new();
         if s.dropped_shells > 0 {
             done.push(format!(
@@ -180,7 +189,7 @@ impl<'a> Ladder<'a> {
     /// warning.
     fn resolved(&mut self, s: &winding_shells::ShellOutcome, model: &mut Model) {
         let bound = if s.resolved_bound > 0.0 {
-            let others: f64 = model.terms.iter().map(|t| t.0).sum();
+            let others = model.total();
             if s.resolved_bound > others {
                 model.source = ModelError::Overlap;
             }

@@ -20,6 +20,14 @@ pub(super) enum Lever {
 /// it sits, and what the largest is made of.
 pub(super) struct Model {
     pub(super) terms: Vec<(f64, Lever)>,
+    /// What the rung's surface, closed only up to cracks, moves with the reference point, m³,
+    /// anywhere ([`super::closed::open_volume`] of the faces as the rung integrates them).
+    pub(super) cracks: f64,
+    /// What the rung's re-orientation of faces against the file can change, m³, anywhere: components
+    /// turned round inside another's box, and faces flipped against the rest of their component
+    /// ([`super::closed::Outward`]). Kept apart because it describes nothing once every face turned
+    /// round is integrated in its stored orientation ([`Model::as_stored_orientation`]).
+    pub(super) orientation: f64,
     pub(super) source: ModelError,
 }
 
@@ -27,6 +35,8 @@ impl From<(f64, ModelError)> for Model {
     fn from((delta, source): (f64, ModelError)) -> Model {
         Model {
             terms: vec![(delta, Lever::Anywhere)],
+            cracks: 0.0,
+            orientation: 0.0,
             source,
         }
     }
@@ -41,6 +51,47 @@ pub(super) struct Bound {
 }
 
 impl Model {
+    /// A rung that integrates the faces as it re-oriented them: `cracks`, what the surface left
+    /// open can move, and `orientation`, what the re-orientation can change; the source is the
+    /// orientation when it is in the model at all.
+    pub(super) fn reoriented(cracks: f64, orientation: f64) -> Model {
+        Model {
+            terms: Vec::new(),
+            cracks,
+            orientation,
+            source: if orientation > 0.0 {
+                ModelError::Orientation
+            } else {
+                ModelError::Cracks
+            },
+        }
+    }
+
+    /// Every face the rung turned round is integrated as stored (the shells' decision turned each
+    /// back and decided it by the winding number of the file's surface): the re-orientation no
+    /// longer enters the solid, so its term goes, and the cracks are what the surface integrated
+    /// now leaves open, `cracks` ([`super::closed::open_volume`] of it), not what the rung's
+    /// turned faces did. What else the rung assumed stays.
+    pub(super) fn as_stored_orientation(&mut self, cracks: f64) {
+        self.orientation = 0.0;
+        self.cracks = cracks;
+        if self.source == ModelError::Orientation {
+            self.source = ModelError::Cracks;
+        }
+    }
+
+    /// No term at all: the solid is Ω of the file's surface up to the bounds added later.
+    pub(super) fn clear(&mut self) {
+        self.terms.clear();
+        self.cracks = 0.0;
+        self.orientation = 0.0;
+    }
+
+    /// The sum of the terms, m³.
+    pub(super) fn total(&self) -> f64 {
+        self.terms.iter().map(|t| t.0).sum::<f64>() + self.cracks + self.orientation
+    }
+
     /// The relative error that volumes δᵢ moved, added or removed at distances up to Rᵢ from the
     /// centre of mass can cause, against the true value (at least the computed one less the change):
     /// for the volume Σδ/(V − Σδ); for the central inertia 3·Σδ·R²/(‖I‖ − 3·Σδ·R²) (a point mass δ at
@@ -49,12 +100,16 @@ impl Model {
     /// the value itself.
     pub(super) fn bound(&self, unit: &MassProperties, vertices: &[[f64; 3]]) -> Bound {
         let (mut volume, mut inertia, mut moment) = (0.0, 0.0, 0.0);
-        for (delta, lever) in &self.terms {
-            if *delta == 0.0 {
+        let rung = [(self.cracks, &Lever::Anywhere), (self.orientation, &Lever::Anywhere)];
+        let terms = self.terms.iter().map(|(d, l)| (*d, l));
+        // One pass over the vertices for every term that may sit anywhere.
+        let mut anywhere = None;
+        for (delta, lever) in terms.chain(rung) {
+            if delta == 0.0 {
                 continue;
             }
             let r = match lever {
-                Lever::Anywhere => reach(unit, vertices),
+                Lever::Anywhere => *anywhere.get_or_insert_with(|| reach(unit, vertices)),
                 Lever::Near(points) => reach(unit, points),
                 Lever::Ball(centre, radius) => dist(*centre, unit.com) + radius,
             };

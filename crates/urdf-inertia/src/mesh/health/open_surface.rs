@@ -4,7 +4,7 @@ use super::caps::{cap_holes, Caps};
 use super::closed::{apply, open_volume, outward};
 use super::geometry::{bbox, signed_volume, unit_props, vector_area};
 use super::ladder::Ladder;
-use super::model::{Lever, Model};
+use super::model::Model;
 use super::topology::{orient, Edges};
 use super::welding::Welding;
 use super::{HealthKind, ModelError, Rung, Solid, CAPPED, SLIVERS};
@@ -169,29 +169,25 @@ pub(super) fn non_manifold(
 ) -> Result<Solid, MeshError> {
     ladder.strict(&format!("mesh is {what}"))?;
     ladder.warn(HealthKind::Repaired, format!("mesh is {what} but has no holes: integrated as it is{} (shells that overlap are classified by the winding number on their sides)", winding.flips()));
-    let model = open_volume(&w.vertices, &winding.faces) + winding.nested + winding.flip_volume;
+    let model = Model::reoriented(
+        open_volume(&w.vertices, &winding.faces),
+        winding.nested + winding.flip_volume,
+    );
     let rung = Rung::NonManifold {
         nonmanifold_edges: te.nonmanifold,
         faces_flipped: winding.flipped,
     };
-    let source = if winding.nested + winding.flip_volume > 0.0 {
-        ModelError::Orientation
-    } else {
-        ModelError::Cracks
-    };
-    ladder.finish(w.vertices, winding.faces, rung, (model, source), |_, _| {
-        None
-    })
+    ladder.finish(w.vertices, winding.faces, rung, model, |_, _| None)
 }
 
 /// The model error of caps: their flatness near the loops they close, what the caps of several holes
 /// seeing each other can change near them ([`Caps::interaction`]), cracks left open and components
 /// re-oriented anywhere.
 pub(super) fn caps_model(caps: &Caps, cracks: f64, nested: f64) -> Model {
-    let mut terms = caps.terms();
-    terms.extend([(cracks, Lever::Anywhere), (nested, Lever::Anywhere)]);
     Model {
-        terms,
+        terms: caps.terms(),
+        cracks,
+        orientation: nested,
         source: ModelError::Caps,
     }
 }
@@ -251,7 +247,7 @@ pub(super) fn with_caps(
     }
     let mut model = caps_model(caps, plan.cracks, winding.nested);
     // The flips are in the estimate, not in the choice whether caps are trusted (that is about caps).
-    model.terms.push((winding.flip_volume, Lever::Anywhere));
+    model.orientation += winding.flip_volume;
     let rung = Rung::Capped {
         holes: caps.holes,
         boundary_edges: te.boundary,

@@ -70,6 +70,9 @@ pub struct ShellOutcome {
     pub copies_restored: usize,
     pub turned_back: usize,
     pub cracks_welded: bool,
+    /// Faces the ladder turned round, in all (where shells were decided face by face): when
+    /// `turned_back` is all of them, the ladder's orientation enters the solid nowhere.
+    pub turned: usize,
     /// Every face was decided face by face or lies on a sealed shell, on the surface exactly as
     /// stored (all copies put back, every face turned round turned back, no face added): the solid
     /// is Ω of the file's surface up to the bounds here, whatever the rung assumed about its
@@ -178,9 +181,10 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
         out.cracks_welded = welded.is_some();
         let (tris, turned) = as_stored(faces, &shells, &tris, &clusters.unflip, &flip);
         out.turned_back = turned;
+        out.turned = flip.iter().filter(|&&f| f).count();
         out.whole_as_stored = (shells.iter().enumerate()).all(|(i, s)| relevant[i] || s.sealed)
             && copied.len() == stored.copies.len()
-            && out.turned_back == flip.iter().filter(|&&f| f).count()
+            && out.turned_back == out.turned
             && faces.len() == stored.faces.len();
         let set = ShellSet {
             shells: &shells,
