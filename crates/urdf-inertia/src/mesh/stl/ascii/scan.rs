@@ -401,12 +401,16 @@ fn newline_or_byte_high(w: u64) -> u64 {
     (w ^ NEWLINES).wrapping_sub(ONES) | w
 }
 
-/// `f` folded over the whole eight-byte words of `s` from `init` (its tail left out): the first 32
-/// bytes in straight-line code (a vertex text or a `facet` line's rest is 39 to 50 bytes), then a
+/// `f` folded over the whole eight-byte words of `s` from `init` (its tail left out): the first 48
+/// bytes in straight-line code (a vertex text or a `facet` line's rest is 39 to 55 bytes), then a
 /// word at a time. A loop over all of them was vectorised with a setup longer than the loop (the
 /// or of [`newline_or_byte_high`]: 794.8 M instructions against 781.7 M on the 101.6 MB torus of
 /// `validation/threads.sh`), and unrolled four times over every length it took its trip counts'
-/// arithmetic on every call (the hash of [`line_hash`]: 809.5 M against 794.8 M).
+/// arithmetic on every call (the hash of [`line_hash`]: 809.5 M against 794.8 M). With 32 bytes
+/// in straight-line code, a text or rest of 40 bytes or more still paid that arithmetic for its
+/// fifth and sixth words: the second torus of docs/benchmarks.md (minus signs, every facet's
+/// normal) took 744.9 M instructions against 724.1 M with 48, the first torus 719.6 M against
+/// 714.2 M.
 #[inline(always)]
 fn fold_words<T>(s: &[u8], init: T, f: impl Fn(T, u64) -> T) -> T {
     let mut acc = init;
@@ -418,6 +422,15 @@ fn fold_words<T>(s: &[u8], init: T, f: impl Fn(T, u64) -> T) -> T {
             acc = f(acc, u64::from_le_bytes(w));
         }
         rest = after;
+        // Two more words in straight-line code too: the loop below is unrolled.
+        if let Some((w, after)) = rest.split_first_chunk::<8>() {
+            acc = f(acc, u64::from_le_bytes(*w));
+            rest = after;
+            if let Some((w, after)) = rest.split_first_chunk::<8>() {
+                acc = f(acc, u64::from_le_bytes(*w));
+                rest = after;
+            }
+        }
     }
     while let Some((w, after)) = rest.split_first_chunk::<8>() {
         acc = f(acc, u64::from_le_bytes(*w));
@@ -494,7 +507,7 @@ mod tests {
     /// a newline or a byte that is not ASCII anywhere in it.
     #[test]
     fn text_hashes_agree() {
-        for len in 0..40 {
+        for len in 0..64 {
             for skip in 0..9 {
                 let key: Vec<u8> = (0..len).map(|i| b'0' + (i * 7 % 10) as u8).collect();
                 let mut text = vec![b' '; skip];
@@ -521,17 +534,17 @@ mod tests {
     #[test]
     fn newline_at_is_newline() {
         for from in 0..3usize {
-            for nl in from..44 {
-                for high in [None, Some(from), Some(from + 5), Some(from + 9), Some(nl.saturating_sub(1))] {
+            for nl in from..68 {
+                for high in [None, Some(from), Some(from + 5), Some(from + 9), Some(from + 37), Some(from + 45), Some(nl.saturating_sub(1))] {
                     for byte in [0xc3, 0x8a, 0xff] {
-                        let mut text = vec![b'7'; 52];
+                        let mut text = vec![b'7'; 76];
                         text[nl] = b'\n';
                         if let Some(h) = high.filter(|&h| h != nl && h >= from) {
                             text[h] = byte;
                         }
                         let first = newline(&text, from, &mut 0);
-                        for len in 0..48 {
-                            let ascii = text[from..(from + len).min(52)].is_ascii();
+                        for len in 0..72 {
+                            let ascii = text[from..(from + len).min(76)].is_ascii();
                             match newline_at(&text, from, len) {
                                 Some(end) => {
                                     assert_eq!(Some(end), first, "{from} {nl} {len}");
