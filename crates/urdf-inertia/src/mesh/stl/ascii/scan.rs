@@ -210,7 +210,8 @@ fn decimal(w: &[u8]) -> Option<(f64, usize)> {
         return short_decimal(w);
     };
     let exponent = e - fraction as i32;
-    let Some(&power) = EXACT_POWERS_OF_TEN.get(exponent.unsigned_abs() as usize) else {
+    // By the signed exponent, as in [`exponent_form`] (at most three digits: no overflow).
+    let Some(&power) = SIGNED_POWERS_OF_TEN.get((exponent + 22) as usize) else {
         return short_decimal(w);
     };
     // Exact: m < 2^53.
