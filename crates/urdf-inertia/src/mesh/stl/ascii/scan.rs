@@ -406,7 +406,7 @@ fn newline_or_byte_high(w: u64) -> u64 {
 /// in straight-line code, a text or rest of 40 bytes or more still paid that arithmetic for its
 /// fifth and sixth words: the second torus of docs/benchmarks.md (minus signs, every facet's
 /// normal) took 744.9 M instructions against 724.1 M with 48, the first torus 719.6 M against
-/// 714.2 M.
+/// 714.3 M.
 #[inline(always)]
 fn fold_words<T>(s: &[u8], init: T, f: impl Fn(T, u64) -> T) -> T {
     let mut acc = init;
