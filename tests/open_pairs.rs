@@ -114,6 +114,18 @@ fn tetrahedron(p: [[f64; 3]; 4]) -> Mesh {
     (p.to_vec(), vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]])
 }
 
+/// The two tetrahedra of the tests below, in one mesh, and the taller one alone.
+fn two_tetrahedra() -> (Mesh, Mesh) {
+    let base = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let tall = tetrahedron([base[0], base[1], base[2], [0.25, 0.25, 1.0]]);
+    let low = tetrahedron([base[0], base[1], base[2], [0.25, 0.25, 0.5]]);
+    let mut mesh = tall.clone();
+    mesh.0.push(low.0[3]);
+    mesh.1
+        .extend(low.1.iter().map(|t| t.map(|i| if i == 3 { 4 } else { i })));
+    (mesh, tall)
+}
+
 /// Two tetrahedra on one base triangle, the lower inside the taller, the base stored once for each
 /// (the same face twice, the same way round). The winding number is 2 inside the lower, 1 in the
 /// rest of the taller: Ω is the taller one. Welding drops the second copy, which leaves the base's
@@ -122,13 +134,7 @@ fn tetrahedron(p: [[f64; 3]; 4]) -> Mesh {
 /// number of the mesh as stored.
 #[test]
 fn a_face_stored_twice_for_two_shells_counts_once() {
-    let base = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-    let tall = tetrahedron([base[0], base[1], base[2], [0.25, 0.25, 1.0]]);
-    let low = tetrahedron([base[0], base[1], base[2], [0.25, 0.25, 0.5]]);
-    let mut mesh = tall.clone();
-    mesh.0.push(low.0[3]);
-    mesh.1
-        .extend(low.1.iter().map(|t| t.map(|i| if i == 3 { 4 } else { i })));
+    let (mesh, tall) = two_tetrahedra();
     let (sampled, sigma) = omega_volume(&mesh.0, &mesh.1, [48, 48, 48], 3);
     let s = solid(&mesh);
     let exact = exact_sum(&[(1, &tall)]);
@@ -159,14 +165,8 @@ fn a_face_stored_twice_for_two_shells_counts_once() {
 /// cluster is decided as stored: Ω is the taller tetrahedron and the box, exactly.
 #[test]
 fn a_face_the_ladder_turns_round_is_decided_as_stored() {
-    let base = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-    let tall = tetrahedron([base[0], base[1], base[2], [0.25, 0.25, 1.0]]);
-    let low = tetrahedron([base[0], base[1], base[2], [0.25, 0.25, 0.5]]);
+    let (mesh, tall) = two_tetrahedra();
     let far = common::box_at([0.0, 0.0, -10.0], [0.5, 0.5, -9.5]);
-    let mut mesh = tall.clone();
-    mesh.0.push(low.0[3]);
-    mesh.1
-        .extend(low.1.iter().map(|t| t.map(|i| if i == 3 { 4 } else { i })));
     let mesh = together(&[(&mesh, false), (&far, false)]);
     let s = solid(&mesh);
     let exact = exact_sum(&[(1, &tall), (1, &far)]);
@@ -191,16 +191,10 @@ fn a_face_the_ladder_turns_round_is_decided_as_stored() {
 /// Truth: the taller tetrahedron and both boxes, exactly.
 #[test]
 fn a_face_turned_back_leaves_no_orientation_term_in_the_estimate() {
-    let base = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-    let tall = tetrahedron([base[0], base[1], base[2], [0.25, 0.25, 1.0]]);
-    let low = tetrahedron([base[0], base[1], base[2], [0.25, 0.25, 0.5]]);
+    let (mesh, tall) = two_tetrahedra();
     let far = common::box_at([0.0, 0.0, -10.0], [0.5, 0.5, -9.5]);
     let crack = cracked(&far, [0.5, 0.5, -9.5], 2, [1e-10, -1e-10, 0.0]);
     let edge = common::box_at([2.0, 0.0, -10.0], [2.5, 0.5, -9.5]);
-    let mut mesh = tall.clone();
-    mesh.0.push(low.0[3]);
-    mesh.1
-        .extend(low.1.iter().map(|t| t.map(|i| if i == 3 { 4 } else { i })));
     let mesh = together(&[(&mesh, false), (&crack, false), (&edge, false)]);
     let s = solid(&mesh);
     let exact = exact_sum(&[(1, &tall), (1, &far), (1, &edge)]);
