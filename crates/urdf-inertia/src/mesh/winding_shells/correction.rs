@@ -124,6 +124,12 @@ struct Faces<'a> {
     /// Per triangle and edge (corner k to the next): the triangle on the other side when exactly
     /// two use the edge, one each way ([`Faces::joined_across`]); `u32::MAX` otherwise.
     across: Vec<[u32; 3]>,
+    /// Per triangle and edge (corner k to the next): the one other triangle that uses the edge
+    /// (either way), [`ALONE`] when none does, [`SHARED`] when more do ([`Faces::seam`]); made
+    /// from `uses` when a seam is first asked (most surfaces have no coplanar triangles).
+    pairs: std::cell::OnceCell<Vec<[u32; 3]>>,
+    /// Every use of an edge by the triangles, sorted by edge ([`super::edge_uses`]).
+    uses: &'a [EdgeUse],
     /// Pieces decided by [`Faces::joined_across`].
     joins_across: std::cell::Cell<usize>,
     /// [`Faces::cut`]'s lists, kept between calls: made afresh, their allocations and growth were
@@ -136,17 +142,14 @@ struct Faces<'a> {
 #[derive(Default)]
 struct CutWork {
     planes: Vec<Cut>,
-    cuts: Vec<bool>,
     coplanar: Vec<Coplanar>,
-    seams: Vec<[bool; 3]>,
-    uses: Vec<SeamUse>,
+    /// Per coplanar triangle, whether its edges may be seams ([`Faces::seam_sides`]).
+    sides: Vec<bool>,
+    /// Per triangle, its place in `coplanar` plus one, 0 when it is not there (set during a cut).
+    slot: Vec<u32>,
     crossing: Vec<usize>,
     cells: CellWork,
 }
-
-/// An edge of a coplanar triangle as [`Faces::seams`] sorts them: its corners (lower first),
-/// whether it runs from the lower, the coplanar triangle and the edge.
-type SeamUse = ((u32, u32), bool, usize, usize);
 
 /// Decides the triangles `tris` (closed shells whose pairs the classification left open; `sign` per
 /// triangle) until the pieces left undecided change at most `target` m³, or the work is spent.
@@ -197,6 +200,8 @@ fn resolve_with(
         scratch: RefCell::new(Vec::new()),
         closed,
         across,
+        pairs: std::cell::OnceCell::new(),
+        uses: &uses,
         joins_across: std::cell::Cell::new(0),
         cut_work: RefCell::new(CutWork::default()),
     };
@@ -515,7 +520,7 @@ impl Faces<'_> {
         axes.sort_by(|&a, &b| n[b].abs().total_cmp(&n[a].abs()));
         let mid = centroid(piece);
         let inner = piece.iter().map(|v| [0, 1, 2].map(|k| (3.0 * mid[k] + v[k]) / 4.0));
-        // Then points of no regular position: a cell that spans seams ([`Faces::seams`]) of two
+        // Then points of no regular position: a cell that spans seams ([`Faces::seam`]) of two
         // regular triangulations can have its centre and the points above on one of them.
         let generic = GENERIC.iter().map(|&seed| {
             let w: Vec<f64> = (0..piece.len())
@@ -801,38 +806,83 @@ impl Faces<'_> {
     /// triangle leaving the plane along the edge would meet `t`'s interior, a blocker whose plane
     /// still cuts there. So a cell may span a seam and one decision holds on all of it; its
     /// decision's point still keeps off the seam (`apart`), where covering is not clear.
-    /// The answer is left in `seams`; `uses` is room for the edges.
-    fn seams(&self, t: u32, coplanar: &[Coplanar], uses: &mut Vec<SeamUse>, seams: &mut Vec<[bool; 3]>) {
+    ///
+    /// The edge's other use is looked up in [`Faces::pairs`] (the surface's, made once) and its
+    /// triangle in `coplanar` by `slot` (each coplanar triangle's place there plus one); only an
+    /// edge more than two triangles use is paired by a pass over `coplanar`. Sorting every
+    /// coplanar edge of every cut to pair them cost more than the rest of the cut's own work
+    /// under fans of hundreds of coplanar triangles (centauro's `mesh_wheel23.stl`: 161 M
+    /// instructions of 3,569 M). `sides`: [`Faces::seam_sides`].
+    fn seam(&self, t: u32, (coplanar, sides, slot): (&[Coplanar], &[bool], &[u32]), (i, e): (usize, usize)) -> bool {
+        if !sides[i] {
+            return false;
+        }
+        let u = coplanar[i].u;
+        let v = self.tris[u as usize];
+        let (a, b) = (v[e], v[NEXT[e]]);
+        if a == b {
+            return false;
+        }
+        let key = super::edge_key(a, b);
+        // The edge's other use among the triangles that may hold seams, when it is the only one.
+        let pairs = self.pairs.get_or_init(|| pairs(self.tris, self.uses));
+        let other = match pairs[u as usize][e] {
+            ALONE => None,
+            SHARED => {
+                // Used by more than two triangles of the surface: count its uses here.
+                let (mut count, mut other) = (0, None);
+                for (j, cp) in coplanar.iter().enumerate().filter(|&(j, _)| sides[j]) {
+                    let w = self.tris[cp.u as usize];
+                    for f in 0..3 {
+                        if w[f] != w[NEXT[f]] && super::edge_key(w[f], w[NEXT[f]]) == key {
+                            count += 1;
+                            if (j, f) != (i, e) {
+                                other = Some((j, w[f] < w[NEXT[f]]));
+                            }
+                        }
+                    }
+                }
+                other.filter(|_| count == 2)
+            }
+            p => {
+                let j = slot[p as usize];
+                if j == 0 || !sides[j as usize - 1] {
+                    return false;
+                }
+                let w = self.tris[p as usize];
+                (0..3)
+                    .find(|&f| super::edge_key(w[f], w[NEXT[f]]) == key)
+                    .map(|f| (j as usize - 1, w[f] < w[NEXT[f]]))
+            }
+        };
+        let Some((j, forward)) = other else {
+            return false;
+        };
+        let (cx, cy) = (&coplanar[i], &coplanar[j]);
+        forward != (a < b) && cx.same == cy.same && (cx.u < t) == (cy.u < t)
+    }
+
+    /// Per coplanar triangle, whether its edges may be [`Faces::seam`]s: it lies exactly in `t`'s
+    /// plane and faces, certainly, the way `same` says. And each one's place in `coplanar` plus
+    /// one in `slot` (per triangle; the cut sets it back to 0 when done).
+    fn seam_sides(&self, t: u32, coplanar: &[Coplanar], sides: &mut Vec<bool>, slot: &mut Vec<u32>) {
+        if !coplanar.is_empty() && slot.len() < self.tris.len() {
+            slot.resize(self.tris.len(), 0);
+        }
+        for (i, cp) in coplanar.iter().enumerate() {
+            slot[cp.u as usize] = i as u32 + 1;
+        }
         let k = normal_axis(self.corners[t as usize]);
         let turn = |c: Corners| orient2d(c2(c[0], k), c2(c[1], k), c2(c[2], k));
         let facing = turn(self.corners[t as usize]);
-        // Per exact coplanar triangle whose orientation is certain: its edges' uses.
-        uses.clear();
-        for (i, cp) in coplanar.iter().enumerate().filter(|(_, cp)| cp.exact) {
+        sides.clear();
+        sides.extend(coplanar.iter().map(|cp| {
+            if !cp.exact {
+                return false;
+            }
             let s = turn(self.corners[cp.u as usize]) * facing;
-            if s == 0.0 || (s > 0.0) != cp.same {
-                continue;
-            }
-            let v = self.tris[cp.u as usize];
-            for e in 0..3 {
-                let (a, b) = (v[e], v[NEXT[e]]);
-                if a != b {
-                    uses.push(((a.min(b), a.max(b)), a < b, i, e));
-                }
-            }
-        }
-        uses.sort_unstable();
-        seams.clear();
-        seams.resize(coplanar.len(), [false; 3]);
-        for g in uses.chunk_by(|x, y| x.0 == y.0) {
-            if let [x, y] = g {
-                let (cx, cy) = (&coplanar[x.2], &coplanar[y.2]);
-                if x.1 != y.1 && cx.same == cy.same && (cx.u < t) == (cy.u < t) {
-                    seams[x.2][x.3] = true;
-                    seams[y.2][y.3] = true;
-                }
-            }
-        }
+            s != 0.0 && (s > 0.0) == cp.same
+        }));
     }
 
     fn emit_whole(&self, t: u32, kappa: i64, out: &mut Resolved) {
@@ -881,10 +931,9 @@ impl Faces<'_> {
         let mut work = self.cut_work.borrow_mut();
         let CutWork {
             planes,
-            cuts,
             coplanar,
-            seams,
-            uses,
+            sides,
+            slot,
             crossing,
             cells: cell_work,
         } = &mut *work;
@@ -924,14 +973,13 @@ impl Faces<'_> {
                 });
             }
         }
-        // Whether each plane cuts: all but the seams between coplanar triangles.
-        cuts.clear();
-        cuts.resize(planes.len(), true);
-        self.seams(t, coplanar, uses, seams);
-        for (cp, seams) in coplanar.iter().zip(seams.iter()) {
+        // Every plane cuts but the seams between coplanar triangles (their edges' planes follow
+        // the blockers', three each).
+        let blocking = planes.len();
+        for cp in coplanar.iter() {
             planes.extend(cp.cuts());
-            cuts.extend(seams.map(|seam| !seam));
         }
+        self.seam_sides(t, coplanar, sides, slot);
         // Only planes that cross the piece can cut it (its cells lie inside it, so a plane that
         // leaves the piece whole leaves each of its cells whole in `cells`): those along its
         // sides or beyond it leave every cell whole, so they neither count against the limit nor
@@ -941,11 +989,15 @@ impl Faces<'_> {
         // for a plane whose reach (the blocker, or the coplanar triangle's edge) ends before the
         // piece ([`Cut`]): a fan's long edges, extended, cross every piece of the face.
         crossing.clear();
-        crossing.extend(planes.iter().zip(cuts.iter()).enumerate().filter_map(|(i, (cut, &cuts))| {
+        crossing.extend(planes.iter().enumerate().filter_map(|(i, cut)| {
             let (a, n, m) = cut.plane;
-            (cuts && !leaves_whole(&piece.map(|x| dot(n, sub(x, a))), m) && !cut.misses(piece, nt, self.margin))
+            let seam = i >= blocking && self.seam(t, (coplanar, sides, slot), ((i - blocking) / 3, (i - blocking) % 3));
+            (!seam && !leaves_whole(&piece.map(|x| dot(n, sub(x, a))), m) && !cut.misses(piece, nt, self.margin))
                 .then_some(i)
         }));
+        for cp in coplanar.iter() {
+            slot[cp.u as usize] = 0;
+        }
         if crossing.len() > MAX_CUTS {
             return false;
         }
@@ -1015,6 +1067,33 @@ fn across(tris: &[[u32; 3]], uses: &[EdgeUse]) -> Vec<[u32; 3]> {
                 if let Some(e) = (0..3).find(|&e| super::edge_key(tri[e], tri[NEXT[e]]) == x.key) {
                     out[f as usize][e] = other;
                 }
+            }
+        }
+    }
+    out
+}
+
+/// [`Faces::pairs`] of an edge no other triangle uses.
+const ALONE: u32 = u32::MAX;
+
+/// [`Faces::pairs`] of an edge that more than two triangles use (or one triangle twice).
+const SHARED: u32 = u32::MAX - 1;
+
+/// Per triangle and edge (corner k to the next): the other triangle when exactly two distinct
+/// triangles use the edge (either way), [`ALONE`] when one does, [`SHARED`] otherwise. `uses`: the
+/// triangles' edge uses, sorted by edge.
+fn pairs(tris: &[[u32; 3]], uses: &[EdgeUse]) -> Vec<[u32; 3]> {
+    let mut out = vec![[ALONE; 3]; tris.len()];
+    for g in uses.chunk_by(|x, y| x.key == y.key) {
+        let other = |f: u32| match g {
+            [_] => ALONE,
+            [x, y] if x.face != y.face => if f == x.face { y.face } else { x.face },
+            _ => SHARED,
+        };
+        for x in g {
+            let tri = tris[x.face as usize];
+            for e in (0..3).filter(|&e| super::edge_key(tri[e], tri[NEXT[e]]) == x.key) {
+                out[x.face as usize][e] = other(x.face);
             }
         }
     }
