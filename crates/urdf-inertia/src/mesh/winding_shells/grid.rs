@@ -242,13 +242,15 @@ impl Grid {
         // The row of cells from the start's on, in either order: which triangles the ray meets,
         // and whether one of them only touches it, do not depend on the order.
         let (first, stride, cells) = self.row(p, axis, sign);
+        let (j, l) = ((axis + 1) % 3, (axis + 2) % 3);
         let mut w = 0;
         for ck in cells {
             let (items, boxes) = self.cell_items(first + ck * stride);
             for (&i, b) in items.iter().zip(boxes) {
                 // A triangle whose box misses the ray's line, or lies wholly behind its start, is
-                // missed (exact comparisons; a NaN corner is not rejected here).
-                if (0..3).any(|k| b.hi[k] < lo[k] || b.lo[k] > hi[k]) {
+                // missed (exact comparisons; a NaN corner is not rejected here). The line first:
+                // most boxes of the row miss it; along `axis` only the start's side can reject.
+                if b.hi[j] < p[j] || b.lo[j] > p[j] || b.hi[l] < p[l] || b.lo[l] > p[l] || b.hi[axis] < lo[axis] || b.lo[axis] > hi[axis] {
                     continue;
                 }
                 if skip.contains(&i) || !seen.first(i) {
