@@ -860,11 +860,13 @@ pub(super) fn edge_meets(s: [f64; 3], e: [f64; 3], o1: f64, o2: f64, t: [[f64; 3
         return true;
     }
     let (cs, ce) = (c3(s), c3(e));
-    let q = [
-        orient3d(cs, ce, a, b),
-        orient3d(cs, ce, b, c),
-        orient3d(cs, ce, c, a),
-    ];
+    // The line passes beside the triangle when two of its edges see it on opposite sides: the
+    // first two often do, and the third is then not asked.
+    let (q0, q1) = (orient3d(cs, ce, a, b), orient3d(cs, ce, b, c));
+    if (q0 > 0.0 && q1 < 0.0) || (q0 < 0.0 && q1 > 0.0) {
+        return false;
+    }
+    let q = [q0, q1, orient3d(cs, ce, c, a)];
     !(q.iter().any(|x| *x > 0.0) && q.iter().any(|x| *x < 0.0))
 }
 
