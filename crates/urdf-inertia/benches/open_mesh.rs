@@ -88,9 +88,12 @@ fn bench(c: &mut Criterion) {
         }
     };
     let meshes = [
-        ("nested", spheres(&[(0.0, 0.5)])),
-        ("crossing", spheres(&[(0.5, 0.5)])),
-        ("cutting", spheres(&[(-0.7, 0.6), (0.7, 0.6)])),
+        ("nested", common::shells::spheres(&[(0.0, 0.5)])),
+        ("crossing", common::shells::spheres(&[(0.5, 0.5)])),
+        (
+            "cutting",
+            common::shells::spheres(&[(-0.7, 0.6), (0.7, 0.6)]),
+        ),
         ("coincident", twice),
     ];
     for (name, mesh) in meshes {
@@ -107,27 +110,6 @@ fn bench(c: &mut Criterion) {
         });
     }
     g.finish();
-}
-
-/// An icosphere of level 6 without its first face, and for each (offset, radius) a whole one scaled
-/// by `radius` and moved by `offset` along x.
-fn spheres(others: &[(f64, f64)]) -> RawMesh {
-    let (v, f) = common::icosphere(6);
-    let mut vertices = v.clone();
-    let mut tris: Vec<[u32; 3]> = f[1..].to_vec();
-    for &(offset, radius) in others {
-        let n = vertices.len() as u32;
-        vertices.extend(
-            v.iter()
-                .map(|p| [p[0] * radius + offset, p[1] * radius, p[2] * radius]),
-        );
-        tris.extend(f.iter().map(|t| t.map(|i| i + n)));
-    }
-    RawMesh {
-        vertices,
-        faces: Polygons::from_triangles(&tris),
-        ..RawMesh::default()
-    }
 }
 
 criterion_group!(benches, bench);

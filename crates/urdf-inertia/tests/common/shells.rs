@@ -85,3 +85,25 @@ pub fn assert_estimate_at_most(s: &Solid, bound: f64) {
         s.warnings
     );
 }
+
+/// An icosphere of level 6 without its first face (a planar hole: exact caps), and for each
+/// (offset, radius) a whole one scaled by `radius` and moved by `offset` along x: the shells rows
+/// of `benches/open_mesh.rs` and `examples/shells_once.rs`.
+pub fn spheres(others: &[(f64, f64)]) -> RawMesh {
+    let (v, f) = super::icosphere(6);
+    let mut vertices = v.clone();
+    let mut tris: Vec<[u32; 3]> = f[1..].to_vec();
+    for &(offset, radius) in others {
+        let n = vertices.len() as u32;
+        vertices.extend(
+            v.iter()
+                .map(|p| [p[0] * radius + offset, p[1] * radius, p[2] * radius]),
+        );
+        tris.extend(f.iter().map(|t| t.map(|i| i + n)));
+    }
+    RawMesh {
+        vertices,
+        faces: Polygons::from_triangles(&tris),
+        ..RawMesh::default()
+    }
+}
