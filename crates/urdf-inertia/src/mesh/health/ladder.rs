@@ -138,7 +138,6 @@ impl<'a> Ladder<'a> {
             // surface integrated now (what else the rung assumed stays).
             model.as_stored_orientation(open_volume(vertices, &s.faces));
         }
-
         if s.resolved_pairs > 0 {
             self.resolved(&s, model);
         }
