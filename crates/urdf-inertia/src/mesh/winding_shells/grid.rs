@@ -11,6 +11,7 @@ pub(super) type Corners = [[f64; 3]; 3];
 
 /// Cells per axis at most (the grid has about as many cells as triangles).
 const MAX_DIM: usize = 128;
+const _: () = assert!(MAX_DIM <= 256, "cell indices are stored as u8 in Grid::new");
 
 /// Triangles bucketed by the cells their boxes cover.
 pub(super) struct Grid {
@@ -87,8 +88,14 @@ impl Grid {
         };
         let cells = dims.iter().product::<usize>();
         let mut count = vec![0u32; cells + 1];
-        for b in boxes {
-            grid.each_cell(b, |c| count[c + 1] += 1);
+        // Each box's range of cells, found once for both passes (an index is below `MAX_DIM`).
+        let ranges: Vec<[[u8; 2]; 3]> = boxes
+            .iter()
+            .map(|b| grid.cell_range(b).map(|(a, z)| [a as u8, z as u8]))
+            .collect();
+        let range = |r: &[[u8; 2]; 3]| r.map(|[a, z]| (usize::from(a), usize::from(z)));
+        for r in &ranges {
+            grid.each_cell_in(range(r), |c| count[c + 1] += 1);
         }
         for c in 0..cells {
             count[c + 1] += count[c];
@@ -96,8 +103,8 @@ impl Grid {
         let mut fill = count.clone();
         let mut items = vec![0u32; count[cells] as usize];
         let mut item_boxes = vec![Aabb::EMPTY; count[cells] as usize];
-        for (i, b) in boxes.iter().enumerate() {
-            grid.each_cell(b, |c| {
+        for (i, (b, r)) in boxes.iter().zip(&ranges).enumerate() {
+            grid.each_cell_in(range(r), |c| {
                 items[fill[c] as usize] = i as u32;
                 item_boxes[fill[c] as usize] = *b;
                 fill[c] += 1;
@@ -119,8 +126,17 @@ impl Grid {
         }
     }
 
-    fn each_cell(&self, b: &Aabb, mut f: impl FnMut(usize)) {
-        let r = [0, 1, 2].map(|k| (self.index(k, b.lo[k]), self.index(k, b.hi[k])));
+    /// The cells a box `b` covers: per axis, the first and last index.
+    fn cell_range(&self, b: &Aabb) -> [(usize, usize); 3] {
+        [0, 1, 2].map(|k| (self.index(k, b.lo[k]), self.index(k, b.hi[k])))
+    }
+
+    fn each_cell(&self, b: &Aabb, f: impl FnMut(usize)) {
+        self.each_cell_in(self.cell_range(b), f);
+    }
+
+    /// Calls `f` on each cell of a [`Grid::cell_range`], in the order of their numbers.
+    fn each_cell_in(&self, r: [(usize, usize); 3], mut f: impl FnMut(usize)) {
         for x in r[0].0..=r[0].1 {
             for y in r[1].0..=r[1].1 {
                 for z in r[2].0..=r[2].1 {
