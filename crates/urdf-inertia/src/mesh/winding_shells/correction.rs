@@ -407,21 +407,36 @@ impl Faces<'_> {
                 }
             }
         }
-        // (patch root, triangle), sorted: the patches in the order of their roots (each root is
-        // its patch's lowest triangle), each patch's triangles in order.
-        let mut members = Vec::new();
-        for t in 0..n as u32 {
-            if blockers[t as usize].is_empty() {
-                members.push((super::root(&mut parent, t), t));
+        // The uncut triangles grouped by patch root (a counting sort): the patches in the order of
+        // their roots (each root is its patch's lowest triangle), each patch's triangles in order,
+        // as a sort of (root, triangle) pairs gives them.
+        let mut start = vec![0u32; n + 1];
+        for t in 0..n {
+            if blockers[t].is_empty() {
+                let r = super::root(&mut parent, t as u32);
+                parent[t] = r;
+                start[r as usize + 1] += 1;
             }
         }
-        members.sort_unstable();
-        for patch in members.chunk_by(|x, y| x.0 == y.0) {
+        for k in 0..n {
+            start[k + 1] += start[k];
+        }
+        let mut fill = start.clone();
+        let mut members = vec![0u32; start[n] as usize];
+        for t in 0..n {
+            if blockers[t].is_empty() {
+                let at = &mut fill[parent[t] as usize];
+                members[*at as usize] = t as u32;
+                *at += 1;
+            }
+        }
+        for w in start.windows(2).filter(|w| w[0] < w[1]) {
+            let patch = &members[w[0] as usize..w[1] as usize];
             let kappa = patch
                 .iter()
                 .take(MAX_TRIES)
-                .find_map(|&(_, t)| self.decide(&self.corners[t as usize], t, seen));
-            for &(_, t) in patch {
+                .find_map(|&t| self.decide(&self.corners[t as usize], t, seen));
+            for &t in patch {
                 match kappa {
                     Some(k) => self.emit_whole(t, k, out),
                     None => heap.push(self.piece(self.corners[t as usize], t, Vec::new())),
