@@ -309,16 +309,9 @@ impl Faces<'_> {
                 let j = tu.iter().position(|&x| x == tt[i]).unwrap_or(0);
                 let (pt, pu) = (&self.corners[t], &self.corners[u]);
                 let (plane_t, plane_u) = (&self.planes[t], &self.planes[u]);
-                let one = |p: &Corners, i: usize, q: &Corners, j: usize, plane_p: &Plane, plane_q| {
-                    let sides = (plane_p.side(q[NEXT[j]]), plane_p.side(q[NEXT[NEXT[j]]]));
-                    if (sides.0 > 0.0 && sides.1 > 0.0) || (sides.0 < 0.0 && sides.1 < 0.0) {
-                        return false;
-                    }
-                    shares_corner(rotated(p, i), rotated(q, j), sides, plane_q)
-                };
                 (
-                    asked.0 && one(pt, i, pu, j, plane_t, plane_u),
-                    asked.1 && one(pu, j, pt, i, plane_u, plane_t),
+                    asked.0 && blocks_at_corner((pt, i), (pu, j), (plane_t, plane_u)),
+                    asked.1 && blocks_at_corner((pu, j), (pt, i), (plane_u, plane_t)),
                 )
             }
             2 => (asked.0 && self.blocks(t, u), asked.1 && self.blocks(u, t)),
@@ -337,14 +330,8 @@ impl Faces<'_> {
             1 => {
                 let i = in_u.iter().position(|&x| x).unwrap_or(0);
                 let j = tu.iter().position(|&x| x == tt[i]).unwrap_or(0);
-                let pu = &self.corners[u];
-                let plane = &self.planes[t];
-                let sides = (plane.side(pu[NEXT[j]]), plane.side(pu[NEXT[NEXT[j]]]));
-                if (sides.0 > 0.0 && sides.1 > 0.0) || (sides.0 < 0.0 && sides.1 < 0.0) {
-                    return false;
-                }
-                let (pt, pu) = (rotated(&self.corners[t], i), rotated(pu, j));
-                shares_corner(pt, pu, sides, &self.planes[u])
+                let corners = ((&self.corners[t], i), (&self.corners[u], j));
+                blocks_at_corner(corners.0, corners.1, (&self.planes[t], &self.planes[u]))
             }
             2 => {
                 // `t`'s plane is that of the shared corners and its third.
@@ -1236,6 +1223,18 @@ fn within_angle(t: Corners, x: [f64; 3]) -> bool {
     let (a, b) = (orient2d(p(t[0]), p(t[1]), p(x)), orient2d(p(t[0]), p(x), p(t[2])));
     let with = |o: f64| o == 0.0 || (o > 0.0) == (s > 0.0);
     with(a) && with(b) && (a != 0.0 || b != 0.0)
+}
+
+/// [`Faces::blocks`] of a triangle with corners `p` by one with corners `q` (their planes), where
+/// the two share only the corner `p[i]` = `q[j]`: the common case (`q`'s other two corners on one
+/// side of `p`'s plane) ends before any copy. Inlined: it runs for most pairs of neighbours.
+#[inline(always)]
+fn blocks_at_corner((p, i): (&Corners, usize), (q, j): (&Corners, usize), (plane_p, plane_q): (&Plane, &Plane)) -> bool {
+    let sides = (plane_p.side(q[NEXT[j]]), plane_p.side(q[NEXT[NEXT[j]]]));
+    if (sides.0 > 0.0 && sides.1 > 0.0) || (sides.0 < 0.0 && sides.1 < 0.0) {
+        return false;
+    }
+    shares_corner(rotated(p, i), rotated(q, j), sides, plane_q)
 }
 
 /// The next corner of a triangle.
