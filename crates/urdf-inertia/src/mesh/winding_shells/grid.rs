@@ -18,6 +18,8 @@ pub(super) struct Grid {
     lo: [f64; 3],
     cell: [f64; 3],
     dims: [usize; 3],
+    /// The last index per axis (`dims` less one), as a float for [`Grid::index`].
+    last: [f64; 3],
     /// Where each cell's triangles start in `items` (one more entry than cells).
     start: Vec<u32>,
     items: Vec<u32>,
@@ -81,6 +83,7 @@ impl Grid {
             lo: bounds.lo,
             cell,
             dims,
+            last: dims.map(|d| (d - 1) as f64),
             start: Vec::new(),
             items: Vec::new(),
             item_boxes: Vec::new(),
@@ -117,18 +120,21 @@ impl Grid {
     }
 
     fn index(&self, k: usize, x: f64) -> usize {
-        // Truncation is the floor for the non-negative values that reach the cast.
+        // Truncation is the floor for the non-negative values that reach the cast; the last index
+        // is a whole number, so clamping before the cast gives the index clamping after it gave,
+        // and a cast to u32 of a value below 128 costs less than a saturating one to usize.
         let i = (x - self.lo[k]) / self.cell[k];
-        if i.is_nan() || i < 0.0 {
-            0
+        if i >= 0.0 {
+            i.min(self.last[k]) as u32 as usize
         } else {
-            (i as usize).min(self.dims[k] - 1)
+            0 // below the grid, or NaN
         }
     }
 
     /// The cells a box `b` covers: per axis, the first and last index.
     fn cell_range(&self, b: &Aabb) -> [(usize, usize); 3] {
-        [0, 1, 2].map(|k| (self.index(k, b.lo[k]), self.index(k, b.hi[k])))
+        let r = |k| (self.index(k, b.lo[k]), self.index(k, b.hi[k]));
+        [r(0), r(1), r(2)]
     }
 
     fn each_cell(&self, b: &Aabb, f: impl FnMut(usize)) {
@@ -704,6 +710,32 @@ mod tests {
                 Aabb::of([lo, lo.map(|x| x + s)])
             })
             .collect()
+    }
+
+    /// [`Grid::index`] (clamp, then a cast to u32) is the saturating cast to usize, then the clamp,
+    /// that it replaced: on points in and about the grid, far off it, at its edges, and NaN.
+    #[test]
+    fn cell_index_is_the_saturating_casts() {
+        let mut next = uniform(0x1d3c_55aa_0f0f_7e21);
+        let boxes = scattered_boxes(&mut next, 500, 0.05);
+        let grid = Grid::new(&boxes);
+        let old = |k: usize, x: f64| {
+            let i = (x - grid.lo[k]) / grid.cell[k];
+            if i.is_nan() || i < 0.0 {
+                0
+            } else {
+                (i as usize).min(grid.dims[k] - 1)
+            }
+        };
+        for k in 0..3 {
+            let (lo, hi) = (grid.bounds.lo[k], grid.bounds.hi[k]);
+            let mut xs = vec![lo, hi, -0.0, 0.0, f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300, -1e300];
+            xs.extend((0..=grid.dims[k]).map(|i| lo + i as f64 * grid.cell[k]));
+            xs.extend((0..2000).map(|_| lo + (next() * 1.5 + 0.5) * (hi - lo)));
+            for x in xs {
+                assert_eq!(grid.index(k, x), old(k, x), "axis {k}, x = {x:e}");
+            }
+        }
     }
 
     /// Sorting what a box query finds by (first shared cell, number) is the query's own order.
