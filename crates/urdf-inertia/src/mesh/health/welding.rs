@@ -34,9 +34,16 @@ pub(super) fn tolerant_welding(exact: weld::ExactWeld, precision: weld::Precisio
     let (all_topology, kept_mask) = weld::remap_faces(&exact.faces, &tolerant.representative);
     let (dropped, duplicates, cancelled, extra) = duplicate_faces(&all_topology);
     let mut copies = Polygons::new();
-    let mut stored = Polygons::new();
-    let mut kept = Polygons::new();
-    let mut topology = Polygons::new();
+    // Room for every face: most are kept, and growing three lists face by face copied them.
+    let room = || {
+        let mut starts = Vec::with_capacity(exact.faces.starts.len());
+        starts.push(0);
+        Polygons {
+            indices: Vec::with_capacity(exact.faces.indices.len()),
+            starts,
+        }
+    };
+    let (mut stored, mut kept, mut topology) = (room(), room(), room());
     let mut t = 0;
     for (i, face) in exact.faces.iter().enumerate() {
         if !kept_mask[i] {
