@@ -314,7 +314,17 @@ impl Faces<'_> {
                     asked.1 && blocks_at_corner((pu, j), (pt, i), (plane_u, plane_t)),
                 )
             }
-            2 => (asked.0 && self.blocks(t, u), asked.1 && self.blocks(u, t)),
+            // An edge shared: each is blocked when the other's third corner is in its plane
+            // ([`Faces::blocks`]), tested here with the corners found once.
+            2 => {
+                let i = in_u.iter().position(|&x| !x).unwrap_or(0);
+                let j = tu.iter().position(|x| !tt.contains(x)).unwrap_or(0);
+                let (pt, pu) = (&self.corners[t], &self.corners[u]);
+                (
+                    asked.0 && self.planes[t].side(pu[j]) == 0.0 && self.coplanar_blocks(t, u),
+                    asked.1 && self.planes[u].side(pt[i]) == 0.0 && self.coplanar_blocks(u, t),
+                )
+            }
             _ => asked,
         }
     }
