@@ -277,7 +277,8 @@ fn resolvable(
     }
     // The faces' edges, in order (each with the shell of its first use in face order), then the
     // edges that only copies use.
-    let mut edges: Vec<(u64, EdgeSums)> = Vec::new();
+    // Two uses per edge on closed shells: room for as many edges, grown where there are more.
+    let mut edges: Vec<(u64, EdgeSums)> = Vec::with_capacity(uses.len() / 2);
     for group in uses.chunk_by(|x, y| x.key == y.key) {
         if group[0].key >> 32 == group[0].key & 0xFFFF_FFFF {
             continue;
@@ -685,7 +686,7 @@ fn box_overlap(a: &Shell, b: &Shell) -> f64 {
 
 /// Triangles of the given faces (fans).
 fn fan(faces: &Polygons, which: &[u32]) -> Vec<[u32; 3]> {
-    let mut out = Vec::new();
+    let mut out = Vec::with_capacity(which.len()); // one triangle per face, more for polygons
     for &f in which {
         let face = faces.face(f as usize);
         for k in 1..face.len() - 1 {
