@@ -428,17 +428,22 @@ fn resolve_pairs(
         sign,
     } = *set;
     let own = (0..shells.len()).filter(|&i| relevant[i]).map(|i| (i, &tris[i]));
-    for (i, tris) in own.chain(copied.iter().map(|(i, t)| (*i, t))) {
-        let t = match welded {
+    let all_shells = own.chain(copied.iter().map(|(i, t)| (*i, t)));
+    // Room for every triangle (a weld may drop some), each shell's appended without a copy.
+    let room = all_shells.clone().map(|(_, t)| t.len()).sum();
+    all.reserve(room);
+    signs.reserve(room);
+    for (i, tris) in all_shells {
+        let before = all.len();
+        match welded {
             Some(rep) => {
                 let (t, s) = cracks::welded_triangles(vertices, tris, rep);
                 swept += s;
-                t
+                all.extend(t);
             }
-            None => tris.clone(),
-        };
-        signs.extend(std::iter::repeat_n(sign[i], t.len()));
-        all.extend(t);
+            None => all.extend_from_slice(tris),
+        }
+        signs.extend(std::iter::repeat_n(sign[i], all.len() - before));
     }
     let volume: f64 = shells.iter().map(|s| s.volume6.abs() / 6.0).sum();
     let bounds = Aabb::of(vertices.iter().copied());
