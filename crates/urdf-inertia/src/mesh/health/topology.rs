@@ -149,16 +149,30 @@ pub(super) fn grouped<T: Copy + Default>(
 pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
     let n = *faces.indices.iter().max()? as usize + 1;
     let h = faces.indices.len();
-    let (start, out) = half_edges(faces, n);
-    let bucket = |u: usize| {
-        let lo = if u == 0 { 0 } else { start[u - 1] as usize };
-        &out[lo..start[u] as usize]
-    };
+    let (start, mut out) = half_edges(faces, n);
     let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
+    let paired = if sort_long(&start[..n], &mut out, |&(v, f)| (v, f)) {
+        pair_twins::<true>(&start[..n], &out, &mut parent)
+    } else {
+        pair_twins::<false>(&start[..n], &out, &mut parent)
+    }?;
+    (2 * paired == h).then(|| label(parent))
+}
+
+/// The twin scan of [`closed_consistent`] (`ends`: each vertex's bucket's end in `out`): the pairs
+/// found, faces joined in `parent` as they are; `None` at the first half-edge without exactly one
+/// twin. `LONG` when some bucket is longer than [`SCAN`] (sorted): without, the scan is the one
+/// before long buckets, instruction for instruction.
+#[inline(always)]
+fn pair_twins<const LONG: bool>(ends: &[u32], out: &[(u32, u32)], parent: &mut [u32]) -> Option<usize> {
+    let bucket = |u: usize| {
+        let lo = if u == 0 { 0 } else { ends[u - 1] as usize };
+        &out[lo..ends[u] as usize]
+    };
     // Each half-edge u → v with u < v must be alone in u's list and find exactly one v → u; when
     // those pairs account for every half-edge, no half-edge v → u is left without its twin.
     let mut paired = 0usize;
-    for u in 0..n {
+    for u in 0..ends.len() {
         let mine = bucket(u);
         for (i, &(v, f)) in mine.iter().enumerate() {
             if v as usize <= u {
@@ -167,19 +181,15 @@ pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
                 }
                 continue;
             }
-            if mine[..i].iter().any(|e| e.0 == v) {
+            if seen_before::<LONG, _>(mine, i, v, |e| e.0) {
                 return None;
             }
-            let mut twins = bucket(v as usize).iter().filter(|e| e.0 as usize == u);
-            let &(_, g) = twins.next()?;
-            if twins.next().is_some() {
-                return None;
-            }
-            union(&mut parent, f, g);
+            let &(_, g) = only_twin::<LONG, _>(bucket(v as usize), u as u32, |e| e.0)?;
+            union(parent, f, g);
             paired += 1;
         }
     }
-    (2 * paired == h).then(|| label(parent))
+    Some(paired)
 }
 
 /// Half-edges bucketed by their start vertex (a counting sort), each entry holding its end and its
@@ -269,7 +279,7 @@ pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec
         *b = at + ca;
         at += ca + cb;
     }
-    let out: Vec<AtomicU64> = (0..h).into_par_iter().map(|_| AtomicU64::new(0)).collect();
+    let mut out: Vec<AtomicU64> = (0..h).into_par_iter().map(|_| AtomicU64::new(0)).collect();
     rayon::join(
         || fill(faces, 0..half, first, &out),
         || fill(faces, half..nfaces, &mut second, &out),
@@ -277,13 +287,25 @@ pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec
     parent.truncate(nfaces);
     // Filling advanced each of the second half's places to where its bucket ends: u's entries are
     // `out[second[u - 1]..second[u]]`, as after [`half_edges`].
+    let key = |e: &AtomicU64| {
+        let e = e.load(Relaxed);
+        (e as u32, (e >> 32) as u32)
+    };
+    let mid = n / 2;
+    let split = if mid == 0 { 0 } else { second[mid - 1] as usize };
+    let (low, high) = out.split_at_mut(split);
+    let long = rayon::join(
+        || sort_long(&second[..mid], low, key),
+        || sort_long_from(split, &second[mid..n], high, key),
+    );
     let buckets = (second.as_slice(), out.as_slice());
+    let scan = if long.0 || long.1 { twins::<true> } else { twins::<false> };
     let (a, b) = rayon::join(
         || {
             (parent.iter_mut().zip(0..)).for_each(|(p, f)| *p = f);
-            twins(buckets, 0..n / 2, &mut parent)
+            scan(buckets, 0..mid, &mut parent)
         },
-        || twins(buckets, n / 2..n, &mut other),
+        || scan(buckets, mid..n, &mut other),
     );
     let paired = a? + b?;
     // A forest's links span its sets: joining each face to its parent in `other` joins them all.
@@ -294,6 +316,58 @@ pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec
         }
     }
     (2 * paired == h).then(|| label(parent))
+}
+
+/// Buckets longer than this are sorted by end vertex before the twin scan, which then searches
+/// them instead of scanning them: scanned, a vertex of degree d costs d² (figures:
+/// docs/benchmarks.md, "Figures behind choices in the code"). Shorter buckets, nearly all, are
+/// scanned as before.
+const SCAN: usize = 32;
+
+/// Sorts by `key` (end vertex, then face) each bucket of [`SCAN`] entries or more: `ends` are the
+/// buckets' ends as the fill left them, the first bucket starting at 0.
+fn sort_long<T>(ends: &[u32], out: &mut [T], key: impl Fn(&T) -> (u32, u32) + Copy) -> bool {
+    sort_long_from(0, ends, out, key)
+}
+
+/// [`sort_long`] of buckets held in `out` from entry `base` on.
+fn sort_long_from<T>(base: usize, ends: &[u32], out: &mut [T], key: impl Fn(&T) -> (u32, u32) + Copy) -> bool {
+    let (mut lo, mut any) = (0, false);
+    for &end in ends {
+        let hi = end as usize - base;
+        if hi - lo > SCAN {
+            out[lo..hi].sort_unstable_by_key(key);
+            any = true;
+        }
+        lo = hi;
+    }
+    any
+}
+
+/// Whether an entry before the `i`th of `mine` ends at `v`: in a sorted (long) bucket, the one
+/// right before it.
+#[inline(always)]
+fn seen_before<const LONG: bool, T>(mine: &[T], i: usize, v: u32, end: impl Fn(&T) -> u32) -> bool {
+    if LONG && mine.len() > SCAN {
+        i > 0 && end(&mine[i - 1]) == v
+    } else {
+        mine[..i].iter().any(|e| end(e) == v)
+    }
+}
+
+/// The entry of `bucket` ending at `u` when exactly one does: in a sorted (long) bucket, found by
+/// a binary search and the entry after it.
+#[inline(always)]
+fn only_twin<const LONG: bool, T>(bucket: &[T], u: u32, end: impl Fn(&T) -> u32) -> Option<&T> {
+    let near = if LONG && bucket.len() > SCAN {
+        let i = bucket.partition_point(|e| end(e) < u);
+        &bucket[i..bucket.len().min(i + 2)]
+    } else {
+        bucket
+    };
+    let mut twins = near.iter().filter(|e| end(e) == u);
+    let t = twins.next()?;
+    twins.next().is_none().then_some(t)
 }
 
 /// A union-find forest of `n` singletons.
@@ -339,7 +413,7 @@ fn fill(faces: &Polygons, range: std::ops::Range<usize>, place: &mut [u32], out:
 /// The twin scan of [`closed_consistent_split`] over the half-edges leaving `vertices` (the buckets
 /// as its fill left them: the end of each vertex's, and the entries): the number of pairs found,
 /// faces joined in `parent` as they are; `None` at the first half-edge without exactly one twin.
-fn twins(
+fn twins<const LONG: bool>(
     (end, out): (&[u32], &[AtomicU64]),
     vertices: std::ops::Range<usize>,
     parent: &mut [u32],
@@ -363,14 +437,10 @@ fn twins(
                 }
                 continue;
             }
-            if mine[..i].iter().any(|e| target(e) == v) {
+            if seen_before::<LONG, _>(mine, i, v, target) {
                 return None;
             }
-            let mut twins = bucket(v as usize).iter().filter(|e| target(e) as usize == u);
-            let g = (twins.next()?.load(Relaxed) >> 32) as u32;
-            if twins.next().is_some() {
-                return None;
-            }
+            let g = (only_twin::<LONG, _>(bucket(v as usize), u as u32, target)?.load(Relaxed) >> 32) as u32;
             union(parent, f, g);
             paired += 1;
         }
@@ -507,6 +577,124 @@ mod tests {
 
     fn faces(v: &[Vec<u32>]) -> Polygons {
         polygons(&v.iter().map(Vec::as_slice).collect::<Vec<_>>())
+    }
+
+    /// A double cone of `n` sides: apex 0, ring 1..=n, base centre n + 1 (every edge once each
+    /// way). Apex and centre have n edges each: the apex's lead to larger vertices (its own bucket is
+    /// scanned for copies), the centre's to smaller ones (its bucket is searched for twins).
+    fn cone(n: u32) -> Vec<Vec<u32>> {
+        let ring = |i: u32| 1 + i % n;
+        (0..n)
+            .flat_map(|i| [vec![0, ring(i), ring(i + 1)], vec![n + 1, ring(i + 1), ring(i)]])
+            .collect()
+    }
+
+    /// Long buckets (a cone's apex and base centre) are searched, not scanned, and give what the
+    /// scan gives: the proof and its one component when closed, none when a face is reversed, stored
+    /// twice or missing, on one thread and split on a pool; two cones on one apex, two components.
+    /// Sides from below [`SCAN`] to far above it, faces in file order and mixed.
+    #[test]
+    fn long_buckets_give_what_the_scan_gives() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("pool");
+        for n in [3, SCAN as u32 - 1, SCAN as u32, SCAN as u32 + 1, 100, 5_000] {
+            for mixed in [false, true] {
+                let mut v = cone(n);
+                let m = v.len();
+                if mixed {
+                    v = (0..m).map(|i| v[(i * 7919) % m].clone()).collect();
+                }
+                let nv = n as usize + 2;
+                let f = faces(&v);
+                let want = Some((vec![0; m], 1));
+                assert_eq!(closed_consistent(&f), want, "{n} sides");
+                assert_eq!(pool.install(|| closed_consistent_split(&f, nv)), want, "{n} sides");
+                let mut reversed = v.clone();
+                reversed[m / 2].reverse();
+                let mut twice = v.clone();
+                twice.push(v[m / 3].clone());
+                let mut missing = v.clone();
+                missing.remove(m / 4);
+                for bad in [reversed, twice, missing] {
+                    let f = faces(&bad);
+                    assert_eq!(closed_consistent(&f), None, "{n} sides");
+                    assert_eq!(pool.install(|| closed_consistent_split(&f, nv)), None, "{n} sides");
+                }
+                // A second cone on the same apex (its ring after the first's): two components.
+                let mut two = v.clone();
+                let moved = |x: u32| if x == 0 { 0 } else { x + n + 1 };
+                two.extend(cone(n).into_iter().map(|f| f.into_iter().map(moved).collect()));
+                let ids: Vec<u32> = (0..2 * m).map(|i| u32::from(i >= m)).collect();
+                let f = faces(&two);
+                assert_eq!(closed_consistent(&f), Some((ids.clone(), 2)), "{n} sides");
+                let nv2 = 2 * n as usize + 3;
+                assert_eq!(pool.install(|| closed_consistent_split(&f, nv2)), Some((ids, 2)), "{n} sides");
+            }
+        }
+    }
+
+    /// On a sorted bucket longer than [`SCAN`], `seen_before` and `only_twin` answer what a scan of
+    /// the whole bucket answers: random buckets of ends with repeats, every entry and end asked.
+    #[test]
+    fn searched_buckets_answer_as_scanned_ones() {
+        let mut rng = 0x0b0c_4e75_u64;
+        let mut rand = |n: usize| crate::xorshift(&mut rng) as usize % n;
+        for _ in 0..300 {
+            let len = SCAN + 1 + rand(60);
+            let mut bucket: Vec<(u32, u32)> = (0..len).map(|f| (rand(len) as u32, f as u32)).collect();
+            bucket.sort_unstable();
+            for (i, &(v, _)) in bucket.iter().enumerate() {
+                assert_eq!(seen_before::<true, _>(&bucket, i, v, |e| e.0), bucket[..i].iter().any(|e| e.0 == v));
+            }
+            for u in 0..=len as u32 {
+                let scanned: Vec<_> = bucket.iter().filter(|e| e.0 == u).collect();
+                let want = (scanned.len() == 1).then(|| scanned[0]);
+                assert_eq!(only_twin::<true, _>(&bucket, u, |e| e.0), want, "{bucket:?} {u}");
+            }
+        }
+    }
+
+    /// The proof with long buckets against the full analysis (a sort of every edge's half-edges,
+    /// [`edge_analysis`]): cones of 40 and 200 sides changed at random (faces reversed, stored twice,
+    /// stored twice reversed, removed, a corner moved to another vertex), on one thread and split.
+    #[test]
+    fn long_buckets_prove_what_the_full_analysis_finds() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("pool");
+        let mut rng = 0x5ca1_ab1e_u64;
+        let mut rand = |n: usize| crate::xorshift(&mut rng) as usize % n;
+        let mut found = [0usize; 2];
+        for trial in 0..600 {
+            let n = if trial % 2 == 0 { 40 } else { 200 };
+            let mut v = cone(n);
+            let m = v.len();
+            let step = [1, 7919, 104_729][trial % 3];
+            v = (0..m).map(|i| v[(i * step) % m].clone()).collect();
+            for _ in 0..rand(4) {
+                let f = rand(v.len());
+                match rand(5) {
+                    0 => v[f].reverse(),
+                    1 => v.push(v[f].clone()),
+                    2 => v.push(v[f].iter().rev().copied().collect()),
+                    3 => drop(v.remove(f)),
+                    _ => v[f][rand(3)] = rand(n as usize + 2) as u32,
+                }
+            }
+            let f = faces(&v);
+            let full = edge_analysis(&f);
+            let want = (full.boundary == 0 && full.nonmanifold == 0 && full.inconsistent == 0)
+                .then(|| components(v.len(), &full.pairs));
+            found[usize::from(want.is_some())] += 1;
+            assert_eq!(closed_consistent(&f), want, "trial {trial}");
+            let nv = n as usize + 2;
+            assert_eq!(pool.install(|| closed_consistent_split(&f, nv)), want, "trial {trial}");
+        }
+        // Both answers were met: proofs and failures.
+        assert!(found[0] > 100 && found[1] > 100, "{found:?}");
     }
 
     #[test]
