@@ -19,6 +19,7 @@
 //! | 10 | mesh overflow and underflow reported as "flat" with `NaN` | `mesh_overflow_and_underflow_are_named`, `collada_unit_that_is_no_positive_number_is_an_error` (1e308, 1e-310) |
 //! | 11 | temp files left by catchable signals and SIGXFSZ; 250-byte names; an edit lost during `fill -i`; `-i /dev/stdin` | `every_ending_signal_removes_the_temp_file`, `temp_file_has_the_targets_mode_and_is_removed_on_sigterm`, `file_size_limit_is_a_write_error`, `unchanged_output_is_not_written_and_long_names_fill_in_place`, `edit_during_fill_in_place_is_kept`, `fill_in_place_on_stdin_is_refused` |
 //! | 12 | two `<robot>` roots; CR-only line ends; UTF-32 and mark-less UTF-16; upper-case ASCII STL | `second_robot_root_is_left_alone`, `cr_only_urdf_keeps_its_line_ends_and_lines`, `utf16_without_a_mark_is_read_and_utf32_is_named`, `upper_case_ascii_stl_is_read_as_ascii` |
+//! | later | a book of triangles on one edge made capping quadratic in its pages (36 s for 200,000) | `a_book_of_many_pages_is_refused` |
 //! | later | a vertex on many edges made the closed-surface proof quadratic in its degree (18 s for a 500k-face cone) | `a_vertex_on_many_edges_is_proven_closed` (and the library's `long_buckets_give_what_the_scan_gives`, `long_buckets_prove_what_the_full_analysis_finds`, `searched_buckets_answer_as_scanned_ones`) |
 //!
 //! Item 12's self-intersecting and nested outward shells are the winding-number work's (its tests are
@@ -1043,6 +1044,43 @@ fn a_vertex_on_many_edges_is_proven_closed() {
     }
 }
 
+/// A book of `n` triangles on one edge (pages turned about the z axis): each page's two other edges
+/// are boundary edges, and its ends are vertices on n boundary edges each.
+fn book(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let mut v = vec![[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+    for i in 0..n {
+        let a = 2.0 * std::f64::consts::PI * f64::from(i) / f64::from(n);
+        v.push([a.cos(), a.sin(), 0.5]);
+    }
+    (v, (0..n).map(|i| [0, 1, 2 + i]).collect())
+}
+
+/// Capping a book of 200,000 pages once took 36 s: walking its holes looked for a vertex's next
+/// boundary edge from the start of its list (both ends of the spine are on 200,000), and the caps'
+/// coplanar groups compared each of the 100,000 holes with every group found so far. The walk now
+/// goes on from where it stopped, and the grouping stops past the holes whose interaction is
+/// computed at all. The book encloses nothing, so the mesh is refused, by default and with caps.
+#[test]
+fn a_book_of_many_pages_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (v, f) = book(200_000);
+    let stl = tmp.path().join("book.stl");
+    std::fs::write(&stl, urdf_inertia::mesh::stl::write_binary(b"book", &v, &f)).unwrap();
+    for extra in [&[][..], &["--open-mesh", "caps"][..]] {
+        let out = bin().arg("mesh").arg(&stl).args(extra).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        let err = stderr(&out);
+        assert!(
+            err.contains("error[UI108]") && err.contains("book.stl"),
+            "{err}"
+        );
+        assert!(
+            err.contains("non-manifold (1 edges shared by 3+ faces)"),
+            "{err}"
+        );
+    }
+}
+
 /// Links are computed as soon as their own meshes are healed, on whichever thread is free, and the
 /// meshes are healed in parallel. What fill computes and writes must not depend on that: a robot of
 /// shared, scaled, mirrored, missing and broken meshes and overlapping parts gives the same report
@@ -1266,6 +1304,16 @@ fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option
     add(
         "a closed cone of 500,000 faces (apex and base centre each on 250,000 edges)",
         a(&["mesh", "cone500k.stl"]),
+        None,
+    );
+    let (bv, bf) = book(200_000);
+    write(
+        "book.stl",
+        &urdf_inertia::mesh::stl::write_binary(b"book", &bv, &bf),
+    );
+    add(
+        "a book of 200,000 triangles on one edge (100,000 holes)",
+        a(&["mesh", "book.stl"]),
         None,
     );
     write(

@@ -65,6 +65,16 @@ pub(super) struct Interaction {
     pub(super) parts: Vec<(f64, [f64; 3], f64)>,
 }
 
+/// The share of the mesh's box volume below which the certified cells are not refined further,
+/// though the flatness and interaction terms are smaller still: on a nearly flat cap the cells cannot
+/// reach those terms at any affordable work, and spent the whole budget trying (40 ms for PR2's
+/// 106-face `head_tilt_L.stl`, against 1e-6 of the box: docs/accuracy.md).
+const CERTIFIED_ENOUGH: f64 = 1e-5;
+
+/// A boundary edge out of a vertex: the other end, the edge's number, and whether the mesh directs
+/// it that way.
+type Step = (u32, usize, bool);
+
 /// Closes every boundary loop of `faces` with a fan from the loop's centroid, wound against the loop's
 /// edges so the result is consistently oriented. The volume uncertainty bound ([`Caps::certify`]):
 /// none for flat caps over one hole, [`Caps::interaction`] for several flat ones, and otherwise the
@@ -73,24 +83,21 @@ pub(super) struct Interaction {
 /// that do not close are the caller's (the capped surface's vector area).
 /// `None` when there are no boundary edges. `half` are the boundary edges as directed in their faces,
 /// in the order of [`edges`].
-/// The share of the mesh's box volume below which the certified cells are not refined further,
-/// though the flatness and interaction terms are smaller still: on a nearly flat cap the cells cannot
-/// reach those terms at any affordable work, and spent the whole budget trying (40 ms for PR2's
-/// 106-face `head_tilt_L.stl`, against 1e-6 of the box: docs/accuracy.md).
-const CERTIFIED_ENOUGH: f64 = 1e-5;
-
 pub(super) fn cap_holes(vertices: &[[f64; 3]], half: &[(u32, u32)]) -> Option<Caps> {
     if half.is_empty() {
         return None;
     }
     // Walk boundary edges as undirected (cracks and slivers often have both sides in one direction),
     // preferring the mesh's own direction; each cap triangle is wound against its own edge.
-    let mut out_of: FxHashMap<u32, Vec<(u32, usize, bool)>> = FxHashMap::default();
+    // Each vertex's boundary edges, and where in its list the unused ones start: edges are only
+    // ever marked used, so the walk's "first unused edge" is found from there, not from the list's
+    // start (which made a vertex on many boundary edges quadratic in their number).
+    let mut out_of: FxHashMap<u32, (usize, Vec<Step>)> = FxHashMap::default();
     for (i, &(u, v)) in half.iter().enumerate() {
-        out_of.entry(u).or_default().push((v, i, true));
+        out_of.entry(u).or_default().1.push((v, i, true));
     }
     for (i, &(u, v)) in half.iter().enumerate() {
-        out_of.entry(v).or_default().push((u, i, false));
+        out_of.entry(v).or_default().1.push((u, i, false));
     }
     let mut used = vec![false; half.len()];
     let base = vertices.len() as u32;
@@ -121,10 +128,12 @@ pub(super) fn cap_holes(vertices: &[[f64; 3]], half: &[(u32, u32)]) -> Option<Ca
         let mut at = half[start].1;
         let mut closed = true;
         while at != half[start].0 {
-            let Some((next, i, forward)) = out_of
-                .get(&at)
-                .and_then(|o| o.iter().find(|(_, i, _)| !used[*i]).copied())
-            else {
+            let Some((next, i, forward)) = out_of.get_mut(&at).and_then(|(from, o)| {
+                while o.get(*from).is_some_and(|e| used[e.1]) {
+                    *from += 1;
+                }
+                o.get(*from).copied()
+            }) else {
                 closed = false;
                 break;
             };
@@ -297,19 +306,18 @@ impl Caps {
     /// open band (a tube open at both ends, whose caps see each other at a large solid angle: the
     /// winding number is fractional between them) that make it large.
     pub(super) fn interaction(&self) -> Interaction {
-        let groups = self.coplanar_groups();
-        let n = groups.len();
         let mut out = Interaction {
             volume: 0.0,
             parts: Vec::new(),
         };
-        if n < 2 {
-            return out;
-        }
         // Every pair of caps is looked at: beyond this many holes, not bounded (the caps are then
         // used only if the user asks for them).
-        if n > MAX_INTERACTING {
+        let Some(groups) = self.coplanar_groups() else {
             out.volume = f64::INFINITY;
+            return out;
+        };
+        let n = groups.len();
+        if n < 2 {
             return out;
         }
         let pi = std::f64::consts::PI;
@@ -374,7 +382,10 @@ impl Caps {
     /// group is one flat region (its caps do not overlap), so its winding number is below ½ in
     /// magnitude off its plane like a single cap's: the caps of one group do not tip each other.
     /// A hole split at a pinch vertex, or several holes in one flat side, are one group.
-    fn coplanar_groups(&self) -> Vec<CapShape> {
+    /// `None` once there are more than [`MAX_INTERACTING`] groups (their number never falls as caps
+    /// are added): each cap is compared with every group, so going on would be quadratic in the
+    /// holes (figures: docs/benchmarks.md, "Figures behind choices in the code").
+    fn coplanar_groups(&self) -> Option<Vec<CapShape>> {
         let pts = |c: &CapShape| &self.loop_vertices[c.loop_points.clone()];
         // An in-plane box of a cap's loop, in the plane's basis (u, v).
         let flat_box = |c: &CapShape, u: [f64; 3], v: [f64; 3]| {
@@ -419,8 +430,11 @@ impl Caps {
                 }
                 None => groups.push((c.clone(), vec![k])),
             }
+            if groups.len() > MAX_INTERACTING {
+                return None;
+            }
         }
-        groups.into_iter().map(|g| g.0).collect()
+        Some(groups.into_iter().map(|g| g.0).collect())
     }
 
     /// One flat region made of the caps `members`, in the plane of unit normal `normal` through the
