@@ -20,6 +20,7 @@
 //! | 11 | temp files left by catchable signals and SIGXFSZ; 250-byte names; an edit lost during `fill -i`; `-i /dev/stdin` | `every_ending_signal_removes_the_temp_file`, `temp_file_has_the_targets_mode_and_is_removed_on_sigterm`, `file_size_limit_is_a_write_error`, `unchanged_output_is_not_written_and_long_names_fill_in_place`, `edit_during_fill_in_place_is_kept`, `fill_in_place_on_stdin_is_refused` |
 //! | 12 | two `<robot>` roots; CR-only line ends; UTF-32 and mark-less UTF-16; upper-case ASCII STL | `second_robot_root_is_left_alone`, `cr_only_urdf_keeps_its_line_ends_and_lines`, `utf16_without_a_mark_is_read_and_utf32_is_named`, `upper_case_ascii_stl_is_read_as_ascii` |
 //! | later | a book of triangles on one edge made capping quadratic in its pages (36 s for 200,000) | `a_book_of_many_pages_is_refused` |
+//! | later | many holes in one flat side made the caps' coplanar grouping quadratic in them (6 s for a plate with 10,000 holes through it) | `a_plate_of_many_holes_is_capped` (and the library's `merged_one_at_a_time_is_merged_in_full`) |
 //! | later | a vertex on many edges made the closed-surface proof quadratic in its degree (18 s for a 500k-face cone) | `a_vertex_on_many_edges_is_proven_closed` (and the library's `long_buckets_give_what_the_scan_gives`, `long_buckets_prove_what_the_full_analysis_finds`, `searched_buckets_answer_as_scanned_ones`) |
 //!
 //! Item 12's self-intersecting and nested outward shells are the winding-number work's (its tests are
@@ -1081,6 +1082,95 @@ fn a_book_of_many_pages_is_refused() {
     }
 }
 
+/// A slab `m` × `m` × 1 (`m` = 2⌈√k⌉ + 1 unit cells a side) pierced by `k` unit square holes that
+/// have no walls: `k` holes in its top face and `k` in its bottom one, each face one flat region.
+fn perforated_plate(k: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let m = 2 * f64::from(k).sqrt().ceil() as u32 + 1;
+    let at = |i: u32, j: u32, z: u32| z * (m + 1) * (m + 1) + i * (m + 1) + j;
+    let mut v = Vec::new();
+    for z in 0..2 {
+        for i in 0..=m {
+            for j in 0..=m {
+                v.push([f64::from(i), f64::from(j), f64::from(z)]);
+            }
+        }
+    }
+    let (mut f, mut holes) = (Vec::new(), 0);
+    for i in 0..m {
+        for j in 0..m {
+            if i % 2 == 1 && j % 2 == 1 && holes < k {
+                holes += 1;
+                continue;
+            }
+            let q = |z| {
+                [
+                    at(i, j, z),
+                    at(i + 1, j, z),
+                    at(i + 1, j + 1, z),
+                    at(i, j + 1, z),
+                ]
+            };
+            let (t, b) = (q(1), q(0));
+            f.extend([[t[0], t[1], t[2]], [t[0], t[2], t[3]]]);
+            f.extend([[b[0], b[2], b[1]], [b[0], b[3], b[2]]]);
+        }
+    }
+    for t in 0..m {
+        for (p, q) in [
+            ((t, 0), (t + 1, 0)),
+            ((m, t), (m, t + 1)),
+            ((t + 1, m), (t, m)),
+            ((0, t + 1), (0, t)),
+        ] {
+            let (a, b) = (at(p.0, p.1, 0), at(q.0, q.1, 0));
+            let (c, d) = (at(q.0, q.1, 1), at(p.0, p.1, 1));
+            f.extend([[a, b, c], [a, c, d]]);
+        }
+    }
+    (v, f)
+}
+
+/// Capping a plate with 10,000 holes through it once took 6 s: the caps of each flat side form
+/// one coplanar group, and each new hole's cap recomputed the in-plane box of every member before
+/// it, and the group's radius and deviation over every member's loop. The boxes are now kept, and
+/// the group is widened by the new member alone while its box's centre stays. The caps close the
+/// plate whole; its two sides' caps see each other, so the bound is unbounded and the mesh is
+/// refused unless caps are asked for.
+#[test]
+fn a_plate_of_many_holes_is_capped() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (v, f) = perforated_plate(10_000);
+    let stl = tmp.path().join("plate.stl");
+    std::fs::write(
+        &stl,
+        urdf_inertia::mesh::stl::write_binary(b"plate", &v, &f),
+    )
+    .unwrap();
+    let out = bin().arg("mesh").arg(&stl).output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.contains("error[UI108]") && err.contains("plate.stl"),
+        "{err}"
+    );
+    let out = (bin().arg("mesh").arg(&stl))
+        .args(["--open-mesh", "caps", "--format", "json"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["provenance"], "capped", "{j}");
+    assert_eq!(j["volume"].as_f64(), Some(201.0 * 201.0), "{j}");
+    assert_eq!(j["center_of_mass"][2].as_f64(), Some(0.5), "{j}");
+    assert!(j["error_model"].is_null(), "{j}");
+    assert!(
+        j["warnings"]
+            .to_string()
+            .contains("closed its 20000 hole(s) with flat caps"),
+        "{j}"
+    );
+}
+
 /// Links are computed as soon as their own meshes are healed, on whichever thread is free, and the
 /// meshes are healed in parallel. What fill computes and writes must not depend on that: a robot of
 /// shared, scaled, mirrored, missing and broken meshes and overlapping parts gives the same report
@@ -1314,6 +1404,16 @@ fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option
     add(
         "a book of 200,000 triangles on one edge (100,000 holes)",
         a(&["mesh", "book.stl"]),
+        None,
+    );
+    let (pv, pf) = perforated_plate(10_000);
+    write(
+        "plate.stl",
+        &urdf_inertia::mesh::stl::write_binary(b"plate", &pv, &pf),
+    );
+    add(
+        "a plate pierced by 10,000 holes (20,000 coplanar caps in two groups)",
+        a(&["mesh", "plate.stl", "--open-mesh", "caps"]),
         None,
     );
     write(

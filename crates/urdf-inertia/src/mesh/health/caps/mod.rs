@@ -396,11 +396,15 @@ impl Caps {
             }
             b
         };
-        let mut groups: Vec<(CapShape, Vec<usize>)> = Vec::new();
+        // Each group: its shape, its members, and their in-plane boxes in the group's basis (its
+        // normal never changes once the group is made, so neither do the boxes: kept, not
+        // recomputed over every member's loop for each new cap, which was quadratic in the holes
+        // of one flat side).
+        let mut groups: Vec<(CapShape, Vec<usize>, Vec<[f64; 4]>)> = Vec::new();
         for (k, c) in self.loops.iter().enumerate() {
             let joined = (c.normal != [0.0; 3])
                 .then(|| {
-                    groups.iter_mut().find(|(g, members)| {
+                    groups.iter_mut().find(|(g, _, boxes)| {
                         if g.normal == [0.0; 3] || dot(g.normal, c.normal).abs() < 1.0 - 1e-12 {
                             return false;
                         }
@@ -416,19 +420,27 @@ impl Caps {
                         let u = any_perpendicular(n);
                         let v = cross(n, u);
                         let b = flat_box(c, u, v);
-                        members.iter().all(|&m| {
-                            let o = flat_box(&self.loops[m], u, v);
+                        boxes.iter().all(|o| {
                             b[2] < o[0] || o[2] < b[0] || b[3] < o[1] || o[3] < b[1]
                         })
                     })
                 })
                 .flatten();
-            match joined {
-                Some((g, members)) => {
-                    members.push(k);
-                    *g = self.merged(g.normal, members);
-                }
-                None => groups.push((c.clone(), vec![k])),
+            if let Some((g, members, boxes)) = joined {
+                let n = g.normal;
+                let u = any_perpendicular(n);
+                boxes.push(flat_box(c, u, cross(n, u)));
+                members.push(k);
+                *g = self.merged(g, members);
+            } else {
+                // A cap without a plane joins no group: its group needs no boxes.
+                let boxes = if c.normal == [0.0; 3] {
+                    Vec::new()
+                } else {
+                    let u = any_perpendicular(c.normal);
+                    vec![flat_box(c, u, cross(c.normal, u))]
+                };
+                groups.push((c.clone(), vec![k], boxes));
             }
             if groups.len() > MAX_INTERACTING {
                 return None;
@@ -437,9 +449,38 @@ impl Caps {
         Some(groups.into_iter().map(|g| g.0).collect())
     }
 
-    /// One flat region made of the caps `members`, in the plane of unit normal `normal` through the
-    /// centre of their loops' box.
-    fn merged(&self, normal: [f64; 3], members: &[usize]) -> CapShape {
+    /// One flat region made of the caps `members`, in the plane of `group`'s unit normal through
+    /// the centre of their loops' box; `group` is the region of all of `members` but the last.
+    /// When `group` is already such a region (two members or more) and the new member leaves its
+    /// box's centre as it was (bit for bit), the radius and deviation about that centre only grow
+    /// by the new member's own points: they are widened by those alone (the same maxima of the
+    /// same numbers, without going over every member again, which was quadratic in the holes of
+    /// one flat side). The area and box are the same running sum and extremes in member order.
+    fn merged(&self, group: &CapShape, members: &[usize]) -> CapShape {
+        let normal = group.normal;
+        let c = &self.loops[*members.last().expect("a group has members")];
+        if members.len() > 2 {
+            let mut g = group.clone();
+            g.area += c.area;
+            for k in 0..3 {
+                g.lo[k] = g.lo[k].min(c.lo[k]);
+                g.hi[k] = g.hi[k].max(c.hi[k]);
+            }
+            g.centre = [0, 1, 2].map(|k| 0.5 * (g.lo[k] + g.hi[k]));
+            if g.centre.map(f64::to_bits) == group.centre.map(f64::to_bits) {
+                for p in self.loop_vertices[c.loop_points.clone()].iter().chain([&c.centre]) {
+                    g.radius = g.radius.max(norm(sub(*p, g.centre)));
+                    g.deviation = g.deviation.max(dot(sub(*p, g.centre), normal).abs());
+                }
+                g.deviation = g.deviation.max(c.deviation);
+                return g;
+            }
+        }
+        self.merged_in_full(normal, members)
+    }
+
+    /// [`Caps::merged`] computed over every member.
+    fn merged_in_full(&self, normal: [f64; 3], members: &[usize]) -> CapShape {
         let mut g = self.loops[members[0]].clone();
         for &m in &members[1..] {
             let c = &self.loops[m];
@@ -487,4 +528,66 @@ fn any_perpendicular(n: [f64; 3]) -> [f64; 3] {
 fn box_distance(alo: [f64; 3], ahi: [f64; 3], blo: [f64; 3], bhi: [f64; 3]) -> f64 {
     let gap = [0, 1, 2].map(|k| (blo[k] - ahi[k]).max(alo[k] - bhi[k]).max(0.0));
     norm(gap)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The caps of `k` square holes in the plane z = 0.25, of sides and places that vary (so the
+    /// group's box grows at some holes and not at others), in a scrambled order.
+    fn perforated(k: u32) -> Caps {
+        let (mut vertices, mut half) = (Vec::new(), Vec::new());
+        for i in 0..k {
+            let j = (i * 7919) % k;
+            let (x, y, s) = (f64::from(j % 17) * 3.0, f64::from(j / 17) * 3.0, 1.0 + 0.1 * f64::from(j % 5));
+            let n = vertices.len() as u32;
+            vertices.extend([[x, y, 0.25], [x + s, y, 0.25], [x + s, y + s, 0.25], [x, y + s, 0.25]]);
+            half.extend((0..4).map(|e| (n + e, n + (e + 1) % 4)));
+        }
+        cap_holes(&vertices, &half).unwrap()
+    }
+
+    fn same(a: &CapShape, b: &CapShape) -> bool {
+        let bits = |c: &CapShape| {
+            let mut v: Vec<u64> = [c.radius, c.area, c.deviation].map(f64::to_bits).to_vec();
+            for p in [c.centre, c.normal, c.lo, c.hi] {
+                v.extend(p.map(f64::to_bits));
+            }
+            v
+        };
+        bits(a) == bits(b) && a.loop_points == b.loop_points
+    }
+
+    /// A group widened by one member at a time is, bit for bit, the group computed over all of
+    /// them at once, whether the new member moves the box's centre or not; and the coplanar
+    /// groups of holes in one plane are the one group of them all.
+    #[test]
+    fn merged_one_at_a_time_is_merged_in_full() {
+        let caps = perforated(300);
+        assert_eq!(caps.holes, 300);
+        let normal = caps.loops[0].normal;
+        let mut g = caps.loops[0].clone();
+        let (mut moved, mut kept) = (0, 0);
+        for m in 2..=caps.loops.len() {
+            let members: Vec<usize> = (0..m).collect();
+            let next = caps.merged(&g, &members);
+            let full = caps.merged_in_full(normal, &members);
+            assert!(same(&next, &full), "{m} members");
+            if m > 2 {
+                if next.centre == g.centre {
+                    kept += 1;
+                } else {
+                    moved += 1;
+                }
+            }
+            g = next;
+        }
+        assert!(moved >= 5 && kept > 100, "{moved} {kept}");
+        let groups = caps.coplanar_groups().unwrap();
+        assert_eq!(groups.len(), 1);
+        let all: Vec<usize> = (0..caps.loops.len()).collect();
+        assert!(same(&groups[0], &caps.merged_in_full(normal, &all)));
+        assert_eq!(caps.interaction().volume, 0.0);
+    }
 }
