@@ -1018,6 +1018,13 @@ fn overlap_of_a_sliver_cone_and_a_box_has_bounded_memory() {
     assert!(grown < 1 << 30, "peak memory grew by {grown} bytes");
 }
 
+/// Writes the triangles `f` on the vertices `v` as the binary STL `name` in `dir`; its path.
+fn stl_in(dir: &Path, name: &str, v: &[[f64; 3]], f: &[[u32; 3]]) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, urdf_inertia::mesh::stl::write_binary(b"shape", v, f)).unwrap();
+    path
+}
+
 /// A vertex on many edges (a cone's apex and base centre, 250,000 edges each) once made the proof
 /// that a surface is closed quadratic in its degree (each twin found by scanning the vertex's
 /// half-edges: 18 s for this cone, 2.8 s at 100,000). Its long lists are now sorted and searched. The
@@ -1027,8 +1034,7 @@ fn overlap_of_a_sliver_cone_and_a_box_has_bounded_memory() {
 fn a_vertex_on_many_edges_is_proven_closed() {
     let tmp = tempfile::tempdir().unwrap();
     let (v, f) = cone(250_000);
-    let stl = tmp.path().join("cone.stl");
-    std::fs::write(&stl, urdf_inertia::mesh::stl::write_binary(b"cone", &v, &f)).unwrap();
+    let stl = stl_in(tmp.path(), "cone.stl", &v, &f);
     let stored: Vec<[f64; 3]> = v.iter().map(|p| p.map(|x| f64::from(x as f32))).collect();
     let exact = common::exact_mass(&common::exact_integrals(&stored, &f));
     for threads in ["1", "2"] {
@@ -1065,8 +1071,7 @@ fn book(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
 fn a_book_of_many_pages_is_refused() {
     let tmp = tempfile::tempdir().unwrap();
     let (v, f) = book(200_000);
-    let stl = tmp.path().join("book.stl");
-    std::fs::write(&stl, urdf_inertia::mesh::stl::write_binary(b"book", &v, &f)).unwrap();
+    let stl = stl_in(tmp.path(), "book.stl", &v, &f);
     for extra in [&[][..], &["--open-mesh", "caps"][..]] {
         let out = bin().arg("mesh").arg(&stl).args(extra).output().unwrap();
         assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
@@ -1140,12 +1145,7 @@ fn perforated_plate(k: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
 fn a_plate_of_many_holes_is_capped() {
     let tmp = tempfile::tempdir().unwrap();
     let (v, f) = perforated_plate(10_000);
-    let stl = tmp.path().join("plate.stl");
-    std::fs::write(
-        &stl,
-        urdf_inertia::mesh::stl::write_binary(b"plate", &v, &f),
-    )
-    .unwrap();
+    let stl = stl_in(tmp.path(), "plate.stl", &v, &f);
     let out = bin().arg("mesh").arg(&stl).output().unwrap();
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     let err = stderr(&out);
@@ -1386,36 +1386,36 @@ fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option
         a(&["mesh", "grid.stl"]),
         None,
     );
-    let (cv, cf) = cone(250_000);
-    write(
-        "cone500k.stl",
-        &urdf_inertia::mesh::stl::write_binary(b"cone", &cv, &cf),
-    );
-    add(
-        "a closed cone of 500,000 faces (apex and base centre each on 250,000 edges)",
-        a(&["mesh", "cone500k.stl"]),
-        None,
-    );
-    let (bv, bf) = book(200_000);
-    write(
-        "book.stl",
-        &urdf_inertia::mesh::stl::write_binary(b"book", &bv, &bf),
-    );
-    add(
-        "a book of 200,000 triangles on one edge (100,000 holes)",
-        a(&["mesh", "book.stl"]),
-        None,
-    );
-    let (pv, pf) = perforated_plate(10_000);
-    write(
-        "plate.stl",
-        &urdf_inertia::mesh::stl::write_binary(b"plate", &pv, &pf),
-    );
-    add(
-        "a plate pierced by 10,000 holes (20,000 coplanar caps in two groups)",
-        a(&["mesh", "plate.stl", "--open-mesh", "caps"]),
-        None,
-    );
+    // Shapes that once made healing quadratic: a vertex on many edges, many holes.
+    let shapes = [
+        (
+            "cone500k.stl",
+            cone(250_000),
+            "a closed cone of 500,000 faces (apex and base centre each on 250,000 edges)",
+            &[][..],
+        ),
+        (
+            "book.stl",
+            book(200_000),
+            "a book of 200,000 triangles on one edge (100,000 holes)",
+            &[][..],
+        ),
+        (
+            "plate.stl",
+            perforated_plate(10_000),
+            "a plate pierced by 10,000 holes (20,000 coplanar caps in two groups)",
+            &["--open-mesh", "caps"][..],
+        ),
+    ];
+    for (name, (v, f), what, extra) in shapes {
+        write(
+            name,
+            &urdf_inertia::mesh::stl::write_binary(b"shape", &v, &f),
+        );
+        let mut args = a(&["mesh", name]);
+        args.extend(a(extra));
+        add(what, args, None);
+    }
     write(
         "key.toml",
         format!(
