@@ -124,6 +124,16 @@ impl Polygons {
         }
     }
 
+    /// An empty face list with room for `faces` faces of `corners` corners in all.
+    pub fn with_capacity(faces: usize, corners: usize) -> Self {
+        let mut starts = Vec::with_capacity(faces + 1);
+        starts.push(0);
+        Self {
+            indices: Vec::with_capacity(corners),
+            starts,
+        }
+    }
+
     /// Faces all given as triangles.
     pub fn from_triangles(tris: &[[u32; 3]]) -> Self {
         let indices: Vec<u32> = tris.iter().flatten().copied().collect();

@@ -151,7 +151,7 @@ pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
     let h = faces.indices.len();
     let (start, mut out) = half_edges(faces, n);
     let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
-    let paired = if sort_long(&start[..n], &mut out, |&(v, f)| (v, f)) {
+    let paired = if sort_long(0, &start[..n], &mut out, |&(v, f)| (v, f)) {
         pair_twins::<true>(&start[..n], &out, &mut parent)
     } else {
         pair_twins::<false>(&start[..n], &out, &mut parent)
@@ -285,8 +285,6 @@ pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec
         || fill(faces, half..nfaces, &mut second, &out),
     );
     parent.truncate(nfaces);
-    // Filling advanced each of the second half's places to where its bucket ends: u's entries are
-    // `out[second[u - 1]..second[u]]`, as after [`half_edges`].
     let key = |e: &AtomicU64| {
         let e = e.load(Relaxed);
         (e as u32, (e >> 32) as u32)
@@ -295,9 +293,11 @@ pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec
     let split = if mid == 0 { 0 } else { second[mid - 1] as usize };
     let (low, high) = out.split_at_mut(split);
     let long = rayon::join(
-        || sort_long(&second[..mid], low, key),
-        || sort_long_from(split, &second[mid..n], high, key),
+        || sort_long(0, &second[..mid], low, key),
+        || sort_long(split, &second[mid..n], high, key),
     );
+    // Filling advanced each of the second half's places to where its bucket ends: u's entries are
+    // `out[second[u - 1]..second[u]]`, as after [`half_edges`].
     let buckets = (second.as_slice(), out.as_slice());
     let scan = if long.0 || long.1 { twins::<true> } else { twins::<false> };
     let (a, b) = rayon::join(
@@ -324,14 +324,10 @@ pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec
 /// scanned as before.
 const SCAN: usize = 32;
 
-/// Sorts by `key` (end vertex, then face) each bucket of [`SCAN`] entries or more: `ends` are the
-/// buckets' ends as the fill left them, the first bucket starting at 0.
-fn sort_long<T>(ends: &[u32], out: &mut [T], key: impl Fn(&T) -> (u32, u32) + Copy) -> bool {
-    sort_long_from(0, ends, out, key)
-}
-
-/// [`sort_long`] of buckets held in `out` from entry `base` on.
-fn sort_long_from<T>(base: usize, ends: &[u32], out: &mut [T], key: impl Fn(&T) -> (u32, u32) + Copy) -> bool {
+/// Sorts by `key` (end vertex, then face) each bucket of more than [`SCAN`] entries, and says
+/// whether there was one: `ends` are the buckets' ends as the fill left them, counted from entry
+/// `base` of the whole list, whose part from there on is `out`.
+fn sort_long<T>(base: usize, ends: &[u32], out: &mut [T], key: impl Fn(&T) -> (u32, u32) + Copy) -> bool {
     let (mut lo, mut any) = (0, false);
     for &end in ends {
         let hi = end as usize - base;

@@ -35,14 +35,7 @@ pub(super) fn tolerant_welding(exact: weld::ExactWeld, precision: weld::Precisio
     let (dropped, duplicates, cancelled, extra) = duplicate_faces(&all_topology);
     let mut copies = Polygons::new();
     // Room for every face: most are kept, and growing three lists face by face copied them.
-    let room = || {
-        let mut starts = Vec::with_capacity(exact.faces.starts.len());
-        starts.push(0);
-        Polygons {
-            indices: Vec::with_capacity(exact.faces.indices.len()),
-            starts,
-        }
-    };
+    let room = || Polygons::with_capacity(exact.faces.len(), exact.faces.indices.len());
     let (mut stored, mut kept, mut topology) = (room(), room(), room());
     let mut t = 0;
     for (i, face) in exact.faces.iter().enumerate() {

@@ -124,11 +124,7 @@ fn any_face(faces: &Polygons, hit: impl Fn(&[u32]) -> bool + Sync) -> bool {
 /// Faces through a vertex map: runs of a repeated vertex are folded, and faces left with fewer than
 /// three distinct vertices are dropped. Returns the faces kept and, per input face, whether it was kept.
 pub fn remap_faces(faces: &Polygons, remap: &[u32]) -> (Polygons, Vec<bool>) {
-    let mut out = Polygons {
-        indices: Vec::with_capacity(faces.indices.len()),
-        starts: Vec::with_capacity(faces.starts.len().max(1)),
-    };
-    out.starts.push(0);
+    let mut out = Polygons::with_capacity(faces.len(), faces.indices.len());
     let mut kept = Vec::with_capacity(faces.len());
     let mut f: Vec<u32> = Vec::new();
     let mut distinct: Vec<u32> = Vec::new();

@@ -795,8 +795,8 @@ fn closed_boxes_meeting(
 }
 
 /// Whether two boxes meet as closed boxes (touching counts).
-// `&`, not `&&`: six comparisons and no branch, as a grid query's boxes fail on any axis (cutting
-// shells 599.7 M -> 597.7 M instructions, the wheel 3,282.3 M -> 3,278.8 M).
+// `&`, not `&&`: six comparisons and no branch, as a grid query's boxes fail on any axis (figures:
+// docs/benchmarks.md, "Shells, round 31").
 #[allow(clippy::needless_bitwise_bool)]
 pub(super) fn overlap(a: &Aabb, b: &Aabb) -> bool {
     (a.lo[0] <= b.hi[0]) & (b.lo[0] <= a.hi[0]) & (a.lo[1] <= b.hi[1]) & (b.lo[1] <= a.hi[1]) & (a.lo[2] <= b.hi[2]) & (b.lo[2] <= a.hi[2])

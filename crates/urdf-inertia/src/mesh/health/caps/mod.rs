@@ -457,55 +457,57 @@ impl Caps {
     /// same numbers, without going over every member again, which was quadratic in the holes of
     /// one flat side). The area and box are the same running sum and extremes in member order.
     fn merged(&self, group: &CapShape, members: &[usize]) -> CapShape {
-        let normal = group.normal;
         let c = &self.loops[*members.last().expect("a group has members")];
         if members.len() > 2 {
             let mut g = group.clone();
-            g.area += c.area;
-            for k in 0..3 {
-                g.lo[k] = g.lo[k].min(c.lo[k]);
-                g.hi[k] = g.hi[k].max(c.hi[k]);
-            }
-            g.centre = [0, 1, 2].map(|k| 0.5 * (g.lo[k] + g.hi[k]));
+            grow_box(&mut g, c);
+            g.centre = box_centre(&g);
             if g.centre.map(f64::to_bits) == group.centre.map(f64::to_bits) {
-                for p in self.loop_vertices[c.loop_points.clone()].iter().chain([&c.centre]) {
-                    g.radius = g.radius.max(norm(sub(*p, g.centre)));
-                    g.deviation = g.deviation.max(dot(sub(*p, g.centre), normal).abs());
-                }
-                g.deviation = g.deviation.max(c.deviation);
+                self.grow_reach(&mut g, c);
                 return g;
             }
         }
-        self.merged_in_full(normal, members)
+        self.merged_in_full(group.normal, members)
     }
 
     /// [`Caps::merged`] computed over every member.
     fn merged_in_full(&self, normal: [f64; 3], members: &[usize]) -> CapShape {
         let mut g = self.loops[members[0]].clone();
         for &m in &members[1..] {
-            let c = &self.loops[m];
-            g.area += c.area;
-            for k in 0..3 {
-                g.lo[k] = g.lo[k].min(c.lo[k]);
-                g.hi[k] = g.hi[k].max(c.hi[k]);
-            }
+            grow_box(&mut g, &self.loops[m]);
         }
         g.normal = normal;
-        g.centre = [0, 1, 2].map(|k| 0.5 * (g.lo[k] + g.hi[k]));
-        let (mut radius, mut deviation) = (0.0f64, 0.0f64);
+        g.centre = box_centre(&g);
+        (g.radius, g.deviation) = (0.0, 0.0);
         for &m in members {
-            let c = &self.loops[m];
-            for p in self.loop_vertices[c.loop_points.clone()].iter().chain([&c.centre]) {
-                radius = radius.max(norm(sub(*p, g.centre)));
-                deviation = deviation.max(dot(sub(*p, g.centre), normal).abs());
-            }
-            // A member's own fan is within its deviation of its loop's plane.
-            deviation = deviation.max(c.deviation);
+            self.grow_reach(&mut g, &self.loops[m]);
         }
-        g.radius = radius;
-        g.deviation = deviation;
         g
     }
+
+    /// Widens `g`'s radius and deviation, about its centre and plane, by member `c`'s loop and fan
+    /// centre, and by `c`'s own deviation (its fan is within it of its loop's plane).
+    fn grow_reach(&self, g: &mut CapShape, c: &CapShape) {
+        for p in self.loop_vertices[c.loop_points.clone()].iter().chain([&c.centre]) {
+            g.radius = g.radius.max(norm(sub(*p, g.centre)));
+            g.deviation = g.deviation.max(dot(sub(*p, g.centre), g.normal).abs());
+        }
+        g.deviation = g.deviation.max(c.deviation);
+    }
+}
+
+/// Adds member `c`'s area and box to the group `g`'s.
+fn grow_box(g: &mut CapShape, c: &CapShape) {
+    g.area += c.area;
+    for k in 0..3 {
+        g.lo[k] = g.lo[k].min(c.lo[k]);
+        g.hi[k] = g.hi[k].max(c.hi[k]);
+    }
+}
+
+/// The centre of a group's box.
+fn box_centre(g: &CapShape) -> [f64; 3] {
+    [0, 1, 2].map(|k| 0.5 * (g.lo[k] + g.hi[k]))
 }
 
 /// Holes beyond which [`Caps::interaction`] (quadratic in them) is not computed but unbounded.
