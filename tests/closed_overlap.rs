@@ -177,7 +177,8 @@ fn a_box_stored_twice_triangulated_two_ways() {
         let s = solid(&(v.clone(), faces));
         let error = within_estimate(name, &s, &exact);
         assert!(error <= 1e-12, "{name}: {error:e} {:?}", s.warnings);
-        assert_estimate_at_most(&s, 1e-12);
+        // Decided, not bounded by boxes: what is left is the rounding of the cut points.
+        assert_estimate_at_most(&s, 1e-11);
     }
 }
 
@@ -222,6 +223,7 @@ fn boxes_covering_part_of_a_face() {
         ]));
         let error = within_estimate(name, &s, &exact);
         assert!(error <= 1e-12, "{name}: {error:e} {:?}", s.warnings);
-        assert_estimate_at_most(&s, 1e-12);
+        // Decided, not bounded by boxes: what is left is the rounding of the cut points.
+        assert_estimate_at_most(&s, 1e-11);
     }
 }

@@ -195,8 +195,15 @@ impl<'a> Ladder<'a> {
             model
                 .terms
                 .push((s.resolved_bound, Lever::Ball(s.ball.0, s.ball.1)));
+            let what = if s.cut_rounding == s.resolved_bound {
+                "the rounding of the cut points"
+            } else if s.cut_rounding > 0.0 {
+                "the pieces along the cuts left undecided and the rounding of the cut points"
+            } else {
+                "the pieces along the cuts left undecided"
+            };
             format!(
-                "; the pieces along the cuts left undecided may change at most {:.2e} m³, which is in the error estimate",
+                "; {what} may change at most {:.2e} m³, which is in the error estimate",
                 s.resolved_bound
             )
         } else {

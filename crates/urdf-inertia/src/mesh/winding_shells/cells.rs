@@ -53,9 +53,44 @@ pub(super) fn leaves_whole(d: &[f64], m: f64) -> bool {
 pub(super) struct Cut {
     pub(super) plane: CutPlane,
     pub(super) reach: Option<[[f64; 3]; 3]>,
+    /// How far the rounded normal may turn, in units of ε: the scale of its components' rounding
+    /// over its length (8 |ab| |ac| / |n| for a blocker's `ab × ac`).
+    pub(super) skew: f64,
+    /// How far the plane may lie from what it stands for, beyond rounding (a sliver's line: its
+    /// height), m.
+    pub(super) offset: f64,
 }
 
 impl Cut {
+    /// How far the line along which this cut crosses a piece of `piece`'s plane (normal `nt`) may
+    /// lie from the line it stands for, within that plane, where that matters, m (infinite when
+    /// the plane runs along the piece's plane); and the length along which it matters. The
+    /// winding number jumps across the line only along what the cut stands for (its reach: a
+    /// blocker's intersection with the piece's plane, a coplanar triangle's edge), so only there
+    /// does a line off its place move the solid; elsewhere the cells on both sides are decided
+    /// alike. `inherited` is how far the piece's corners may lie from their exact places.
+    ///
+    /// The line is where `d = n · (x − a)` is 0, `a` a stored corner: the rounded normal turns
+    /// the plane about `a` by `skew` ε, which moves it by `skew ε |x − a|` along the reach; the
+    /// difference and the dot product at the cells' corners (5 ε |n| |x − a|, |x − a| up to the
+    /// piece's reach from `a`) and the corners' own displacement move the crossings on the
+    /// cells' sides, and so the straight side between two of them; all of it over the sine of
+    /// the angle between the two planes, within the piece's plane. A corner made where the line
+    /// crosses a side (`p + s (q − p)`) adds 4 ε (|p|∞ + |q − p|). Twice the sum, for the
+    /// second-order terms left out.
+    pub(super) fn slack(&self, piece: &[[f64; 3]], nt: [f64; 3], inherited: f64) -> (f64, f64) {
+        let (a, n, _) = self.plane;
+        let reach = piece.iter().map(|x| norm(sub(*x, a))).fold(0.0, f64::max);
+        let big = piece.iter().chain([&a]).flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        let sin = norm(cross(n, nt)) / (norm(n) * norm(nt));
+        let local = self.reach.map_or(reach, |r| {
+            let d = |i: usize, j: usize| norm(sub(r[i], r[j]));
+            d(0, 1).max(d(1, 2)).max(d(0, 2)).max(r.iter().map(|x| norm(sub(*x, a))).fold(0.0, f64::max))
+        });
+        let moved = f64::EPSILON * (self.skew * local + 5.0 * reach) + self.offset + inherited;
+        (2.0 * (moved / sin + 4.0 * f64::EPSILON * (big + reach)), local)
+    }
+
     /// Whether the cut's reach lies [`beyond`] the polygon.
     pub(super) fn misses(&self, poly: &[[f64; 3]], nt: [f64; 3], margin: f64) -> bool {
         self.reach.as_ref().is_some_and(|r| beyond(poly, nt, r, margin))
@@ -181,6 +216,8 @@ mod tests {
         let line = |a, n| Cut {
             plane: (a, n, 1e-12),
             reach: None,
+            skew: 0.0,
+            offset: 0.0,
         };
         let planes = [
             line([0.5, 0.0, 0.0], [1.0, 0.0, 0.0]),

@@ -78,8 +78,11 @@ pub struct ShellOutcome {
     /// is Ω of the file's surface up to the bounds here, whatever the rung assumed about its
     /// closure and orientation.
     pub whole_as_stored: bool,
-    /// What the pieces left undecided can change: volume (m³), within a ball (centre, radius).
+    /// What the pieces left undecided and the rounding of the cut points can change: volume (m³),
+    /// within a ball (centre, radius).
     pub resolved_bound: f64,
+    /// The part of `resolved_bound` that the rounding of the cut points can change, m³.
+    pub cut_rounding: f64,
     pub ball: ([f64; 3], f64),
     /// The pieces' corners, numbered on from the surface's vertices.
     pub vertices: Vec<[f64; 3]>,
@@ -453,7 +456,8 @@ fn resolve_pairs(
         out.faces.push(face);
     }
     out.vertices = r.vertices;
-    out.resolved_bound = r.bound + swept;
+    out.resolved_bound = r.bound + swept + r.rounding;
+    out.cut_rounding = r.rounding;
     out.ball = (centre, bounds.diagonal() / 2.0);
     out.cut_faces = r.cut;
     out.changed |= r.changed;
