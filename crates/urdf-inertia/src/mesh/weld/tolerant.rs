@@ -595,6 +595,58 @@ mod tests {
     }
 
     #[test]
+    fn crowded_blocks_weld_as_the_27_cell_scan() {
+        let mut state = 0x5851_f42d_4c95_7f2du64;
+        let mut rand = move |m: u64| crate::xorshift(&mut state) % m;
+        // Binary STL triangles whose corners lie within 1e-7 of (0,0,0), (1,0,0) and (0,1,0), some
+        // corners repeated and some on a lattice (ties): cells of 2 f32 ulps of 1 m crowded by
+        // corners near the origin, whose tolerance is 1e-9 m.
+        let mut v: Vec<[f64; 3]> = Vec::new();
+        for _ in 0..2500 {
+            for corner in [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+                let p = match rand(4) {
+                    0 if !v.is_empty() => v[rand(v.len() as u64) as usize],
+                    1 => corner.map(|x| x + (rand(21) as f64 - 10.0) * 1e-9),
+                    _ => corner.map(|x| x + (rand(2001) as f64 - 1000.0) * 1e-10),
+                };
+                v.push(p.map(|x| f64::from(x as f32)));
+            }
+        }
+        assert_eq!(Precision::of(&v), Precision::F32);
+        let tol = tolerance(&v, Precision::F32);
+        let (t, crowding) = weld(&v, tol);
+        assert!(crowding.blocks > 0, "{crowding:?}");
+        assert_eq!(t.representative, tolerant_27(&v, tol), "{crowding:?}");
+        // Tolerances that vary steeply with the distance from the origin (a 5% ulp): many levels
+        // in a block, vertices whose reach spans more sub-cells than a level has members, lattices
+        // of several steps crossing zero, in shuffled order.
+        for (base, relative_ulp) in [(1e-6, 0.05), (1e-7, 0.01), (3e-5, 0.0)] {
+            let mut v: Vec<[f64; 3]> = (0..6000)
+                .map(|_| {
+                    let step = [1e-6, 1e-5, 1e-4, 1e-3][rand(4) as usize];
+                    [0, 1, 2].map(|_| (rand(41) as f64 - 20.0) * step)
+                })
+                .collect();
+            for i in (1..v.len()).rev() {
+                v.swap(i, rand(i as u64 + 1) as usize);
+            }
+            let mut tol = Tolerance {
+                base,
+                relative_ulp,
+                largest: 0.0,
+            };
+            tol.largest = v.iter().map(|p| tol.at(p)).fold(0.0, f64::max);
+            let (t, crowding) = weld(&v, tol);
+            // One tolerance everywhere (f64 data) leaves no block crowded.
+            assert_eq!(crowding.blocks > 0, relative_ulp > 0.0, "{base} {crowding:?}");
+            if relative_ulp > 0.01 {
+                assert!(crowding.whole_levels > 0, "{base} {crowding:?}");
+            }
+            assert_eq!(t.representative, tolerant_27(&v, tol), "{base} {crowding:?}");
+        }
+    }
+
+    #[test]
     fn tolerance_covers_parts_far_from_the_origin() {
         // A 1 mm part 1 km away: its round-off is 16 ulp of 1e3, above 1e-9 of 1e-3.
         let v = vec![[1e3, 0.0, 0.0], [1e3 + 1e-3, 1e-3, 1e-3]];
