@@ -352,6 +352,8 @@ struct Crowding {
 /// [fl(p − reach), fl(p + reach)]; its sub-cell, a monotone function of it (a product by a power of
 /// two, a floor, a saturating cast), is in the range searched. A vertex visited that is no
 /// candidate fails the same test as in the scan.
+// One loop over the vertices, searching and then inserting; its parts share most of its locals.
+#[allow(clippy::too_many_lines)]
 fn weld(vertices: &[[f64; 3]], tol: Tolerance) -> (TolerantWeld, Crowding) {
     let n = vertices.len();
     let mut representative: Vec<u32> = (0..n as u32).collect();
