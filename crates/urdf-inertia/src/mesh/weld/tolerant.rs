@@ -211,7 +211,7 @@ enum Block {
 }
 
 /// `reach` = max(tp, level's tolerance) × `REACH_SLACK` + `REACH_FLOOR` covers what rounding adds
-/// to a distance (see `tolerant`).
+/// to a distance (see `weld`).
 const REACH_SLACK: f64 = 1.0 + 1.0 / 1_048_576.0;
 const REACH_FLOOR: f64 = 1e-140;
 
