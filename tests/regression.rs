@@ -22,6 +22,7 @@
 //! | later | a book of triangles on one edge made capping quadratic in its pages (36 s for 200,000) | `a_book_of_many_pages_is_refused` |
 //! | later | many holes in one flat side made the caps' coplanar grouping quadratic in them (6 s for a plate with 10,000 holes through it) | `a_plate_of_many_holes_is_capped` (and the library's `merged_one_at_a_time_is_merged_in_full`) |
 //! | later | a vertex on many edges made the closed-surface proof quadratic in its degree (18 s for a 500k-face cone) | `a_vertex_on_many_edges_is_proven_closed` (and the library's `long_buckets_give_what_the_scan_gives`, `long_buckets_prove_what_the_full_analysis_finds`, `searched_buckets_answer_as_scanned_ones`) |
+//! | later | corners crowding a cell of the tolerant weld's grid made it quadratic in them (12 s for a cloud of 40,000 triangles) | `a_cloud_of_crowded_corners_is_welded` (and the library's `crowded_blocks_weld_as_the_27_cell_scan`) |
 //!
 //! Item 12's self-intersecting and nested outward shells are the winding-number work's (its tests are
 //! in `tests/winding_truth.rs`). docs/reliability.md has a row for each input above.
@@ -1405,6 +1406,12 @@ fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option
             perforated_plate(10_000),
             "a plate pierced by 10,000 holes (20,000 coplanar caps in two groups)",
             &["--open-mesh", "caps"][..],
+        ),
+        (
+            "cloud.stl",
+            weld_cloud(100_000),
+            "a cloud of 100,000 triangles within 1e-7 m of one (100,000 corners crowding a few cells of the weld's grid)",
+            &[][..],
         ),
     ];
     for (name, (v, f), what, extra) in shapes {
@@ -3604,4 +3611,74 @@ fn every_file_the_tool_opens_goes_through_the_input_guard() {
             stderr(&out)
         );
     }
+}
+
+/// `n` triangles whose corners lie within 1e-7 m of (0, 0, 0), (1, 0, 0) and (0, 1, 0), stored as
+/// f32. Near the origin the tolerant weld's tolerance is 1e-9 m, near 1 m two f32 ulps (2.4e-7 m),
+/// which is the size of its grid's cells: the corners near the origin stay apart and crowd a few
+/// cells.
+fn weld_cloud(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let mut rng = common::Rng(1);
+    let mut v = Vec::new();
+    for _ in 0..n {
+        for corner in [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+            v.push(corner.map(|x: f64| x + rng.range(-1e-7, 1e-7)));
+        }
+    }
+    (v, (0..n).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect())
+}
+
+/// A cloud of triangles on nearly one triangle once made the tolerant weld quadratic (12 s for
+/// 40,000 triangles, 0.5 s for 10,000): each corner near the origin scanned every one before it in
+/// the crowded cells. Crowded blocks of cells are now searched by each corner's own tolerance. The
+/// weld is the same: the cloud is open (the copies of the corners near the origin stay apart), so it
+/// is refused by default, and capped with caps.
+#[test]
+fn a_cloud_of_crowded_corners_is_welded() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (v, f) = weld_cloud(100_000);
+    let stl = stl_in(tmp.path(), "cloud.stl", &v, &f);
+    let out = bin().arg("mesh").arg(&stl).output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.contains("error[UI108]") && err.contains("cloud.stl"),
+        "{err}"
+    );
+    assert!(
+        err.contains(
+            "mesh is open (194793 boundary edges) and non-manifold (4 edges shared by 3+ faces)"
+        ),
+        "{err}"
+    );
+    let out = (bin().arg("mesh").arg(&stl))
+        .args([
+            "--open-mesh",
+            "caps",
+            "--format",
+            "json",
+            "--digits",
+            "full",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["provenance"], "capped", "{j}");
+    // The vertices and faces the weld and the caps leave, and the copies dropped: as before.
+    assert_eq!(
+        (j["vertices"].as_u64(), j["faces"].as_u64()),
+        (Some(300_775), Some(102_291))
+    );
+    let volume = j["volume"].as_f64().unwrap();
+    assert!(
+        (volume / 5.383255321406555e-4 - 1.0).abs() < 1e-9,
+        "{volume}"
+    );
+    let warnings = j["warnings"].to_string();
+    assert!(
+        warnings.contains("1301 faces stored more than once dropped")
+            && warnings.contains("closed its 775 hole(s) with flat caps"),
+        "{warnings}"
+    );
 }

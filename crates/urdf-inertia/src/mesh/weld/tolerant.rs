@@ -192,20 +192,181 @@ impl Candidate {
     }
 }
 
+/// The end of a list of representatives.
+const NONE: u32 = u32::MAX;
+
+/// A block whose list reaches this many representatives is searched by tolerance level from then
+/// on ([`Crowd`]). Real meshes rarely come near it: their representatives are further apart than
+/// their tolerances, and the cells are the largest tolerance wide (figures: docs/benchmarks.md,
+/// "Figures behind choices in the code").
+const CROWDED: u32 = 32;
+
+/// The representatives of a block of 2×2×2 cells.
+#[derive(Clone, Copy)]
+enum Block {
+    /// The latest one, the rest through `next`; `NONE` when empty.
+    List(u32),
+    /// Crowded: its representatives are in [`Crowd`], at the levels `Crowd::blocks[id]`.
+    Crowded(u32),
+}
+
+/// `reach` = max(tp, level's tolerance) × `REACH_SLACK` + `REACH_FLOOR` covers what rounding adds
+/// to a distance (see `weld`).
+const REACH_SLACK: f64 = 1.0 + 1.0 / 1_048_576.0;
+const REACH_FLOOR: f64 = 1e-140;
+
+/// The representatives of crowded blocks, sorted by their own tolerance t into levels, each level a
+/// hash grid of sub-cells 2^e wide, 2^e in (2t, 4t].
+///
+/// Representatives crowd a cell of the coarse grid when their tolerances are far below the largest
+/// one, which sets the cells' size: a binary STL's corners scattered within 1e-7 m of the origin,
+/// where the tolerance is 1e-9 m, in cells of 2.4e-7 m (2 f32 ulps of 1 m). Each vertex there
+/// scanned every one of them, quadratic work; in a level it looks only at the sub-cells within its
+/// reach, usually 8.
+#[derive(Default)]
+struct Crowd {
+    /// For each crowded block, the levels of its representatives (indices into `levels`).
+    blocks: Vec<Vec<u32>>,
+    levels: Vec<Level>,
+    /// The level of each sub-cell exponent e.
+    by_exponent: FxHashMap<i32, u32>,
+    /// The latest representative of each sub-cell (level, cell), the rest through `next`.
+    heads: FxHashMap<(u32, [i64; 3]), u32>,
+}
+
+/// The representatives of crowded blocks whose sub-cells are 2^e wide.
+struct Level {
+    /// 2^-e, exact: e is clamped to ±1000, which only makes sub-cells coarser or finer than ideal.
+    scale: f64,
+    /// The largest tolerance of a member.
+    tolerance: f64,
+    /// Every member, searched whole by a vertex whose reach spans more sub-cells than this.
+    members: Vec<u32>,
+}
+
+impl Crowd {
+    /// The level of a representative of tolerance `t`: e = ⌊log₂ t⌋ + 2 from its exponent bits.
+    fn level(&mut self, t: f64) -> u32 {
+        let e = (((t.to_bits() >> 52) & 0x7ff) as i32 - 1021).clamp(-1000, 1000);
+        let levels = &mut self.levels;
+        *self.by_exponent.entry(e).or_insert_with(|| {
+            levels.push(Level {
+                scale: f64::from_bits(((1023 - e) as u64) << 52),
+                tolerance: 0.0,
+                members: Vec::new(),
+            });
+            (levels.len() - 1) as u32
+        })
+    }
+
+    /// Adds the representative `at`, at `q` with tolerance `t`, to the crowded block `block`.
+    fn insert(&mut self, block: u32, at: u32, q: &[f64; 3], t: f64, next: &mut [u32]) {
+        let l = self.level(t);
+        let level = &mut self.levels[l as usize];
+        level.tolerance = level.tolerance.max(t);
+        level.members.push(at);
+        let key = (l, q.map(|x| (x * level.scale).floor() as i64));
+        let levels = &mut self.blocks[block as usize];
+        if !levels.contains(&l) {
+            levels.push(l);
+        }
+        let head = self.heads.entry(key).or_insert(NONE);
+        next[at as usize] = *head;
+        *head = at;
+    }
+
+    /// Visits every representative of the crowded blocks `blocks` that is a candidate for the
+    /// vertex `p` of tolerance `tp` (and others); how many levels were visited whole. `levels` is
+    /// room for the levels to search.
+    fn search(
+        &self,
+        blocks: &[u32],
+        levels: &mut Vec<u32>,
+        (p, tp): (&[f64; 3], f64),
+        next: &[u32],
+        mut visit: impl FnMut(usize),
+    ) -> usize {
+        levels.clear();
+        for &b in blocks {
+            levels.extend_from_slice(&self.blocks[b as usize]);
+        }
+        levels.sort_unstable();
+        levels.dedup();
+        let mut whole = 0;
+        for &l in levels.iter() {
+            let level = &self.levels[l as usize];
+            let reach = tp.max(level.tolerance) * REACH_SLACK + REACH_FLOOR;
+            let lo = p.map(|x| ((x - reach) * level.scale).floor() as i64);
+            let hi = p.map(|x| ((x + reach) * level.scale).floor() as i64);
+            let span = |k: usize| hi[k].abs_diff(lo[k]).saturating_add(1);
+            let cells = span(0).saturating_mul(span(1)).saturating_mul(span(2));
+            if cells > level.members.len() as u64 {
+                // A reach far wider than the level's tolerance (tolerances that vary steeply):
+                // the members are fewer than the sub-cells.
+                whole += 1;
+                level.members.iter().for_each(|&at| visit(at as usize));
+                continue;
+            }
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for z in lo[2]..=hi[2] {
+                        let mut r = self.heads.get(&(l, [x, y, z])).copied().unwrap_or(NONE);
+                        while r != NONE {
+                            visit(r as usize);
+                            r = next[r as usize];
+                        }
+                    }
+                }
+            }
+        }
+        whole
+    }
+}
+
 /// Merges each vertex into the nearest earlier representative within the larger of their two
 /// tolerances (Euclidean distance), greedily in index order, on a hash grid whose cells are the
 /// largest tolerance wide.
 pub fn tolerant(vertices: &[[f64; 3]], tol: Tolerance) -> TolerantWeld {
+    weld(vertices, tol).0
+}
+
+/// How a weld used [`Crowd`], for tests: crowded blocks, levels searched whole.
+#[derive(Debug, Default)]
+struct Crowding {
+    blocks: usize,
+    whole_levels: usize,
+}
+
+/// [`tolerant`], and how crowded it found the grid.
+///
+/// The result is the 27-cell scan's, crowded blocks or not. A vertex `p`'s candidates are the
+/// representatives `q` in the 27 cells around its own whose distance `d`, computed as below, is at
+/// most max(tp, tq). The one kept is the least by [`Candidate::before`], a strict total order on
+/// candidates (indices differ; a NaN distance is no candidate), so it is the same whatever order
+/// they are met in, and however often. Every candidate is in one of the 8 blocks: on a list, walked
+/// whole, or in a crowded block, whose levels are all searched. A candidate at a level has tq at
+/// most the level's tolerance T, so d ≤ R = max(tp, T); a computed distance d ≤ R bounds each
+/// coordinate's difference by R(1 + 2⁻⁵⁰) + 2⁻⁵³⁶ (each step rounds by a relative 2⁻⁵³ at most, or
+/// an absolute 2⁻¹⁰⁷⁵ below the normal range), which `reach` exceeds. So q's coordinate is in
+/// [p − reach, p + reach], and, rounding being monotone and the coordinate a float, in
+/// [fl(p − reach), fl(p + reach)]; its sub-cell, a monotone function of it (a product by a power of
+/// two, a floor, a saturating cast), is in the range searched. A vertex visited that is no
+/// candidate fails the same test as in the scan.
+// One loop over the vertices, searching and then inserting; its parts share most of its locals.
+#[allow(clippy::too_many_lines)]
+fn weld(vertices: &[[f64; 3]], tol: Tolerance) -> (TolerantWeld, Crowding) {
     let n = vertices.len();
     let mut representative: Vec<u32> = (0..n as u32).collect();
+    let mut crowding = Crowding::default();
     let cell_size = tol.largest;
     if !(cell_size > 0.0 && cell_size.is_finite()) || n == 0 {
-        return TolerantWeld {
+        let weld = TolerantWeld {
             representative,
             merged: 0,
             widest: 0.0,
             tolerance: tol,
         };
+        return (weld, crowding);
     }
     let origin = vertices[0];
     // Cell indices stay within ±1e9 for a mesh whose extent is at most 1e9 tolerances (the base
@@ -221,10 +382,12 @@ pub fn tolerant(vertices: &[[f64; 3]], tol: Tolerance) -> TolerantWeld {
     // in (dx, dy, dz) order, the latest representative of a cell first), so the result is that
     // scan's.
     let block = |c: [i64; 3]| c.map(|x| x.div_euclid(2));
-    let mut head: FxHashMap<[i64; 3], u32> =
+    let mut head: FxHashMap<[i64; 3], Block> =
         FxHashMap::with_capacity_and_hasher(n, FxBuildHasher);
-    let mut next: Vec<u32> = vec![u32::MAX; n];
+    let mut next: Vec<u32> = vec![NONE; n];
     let mut cells: Vec<[i64; 3]> = vec![[0; 3]; n];
+    let mut crowd = Crowd::default();
+    let (mut crowded, mut levels, mut moved) = (Vec::new(), Vec::new(), Vec::new());
     let mut merged = 0;
     let mut widest = 0.0f64;
     for i in 0..n {
@@ -232,51 +395,94 @@ pub fn tolerant(vertices: &[[f64; 3]], tol: Tolerance) -> TolerantWeld {
         let tp = tol.at(p);
         let c = cell(p);
         let first = block(c.map(|x| x - 1));
+        // The vertex's own block is the second of the two along an axis where its cell is even.
+        let own = (!c[0] & 1) << 2 | (!c[1] & 1) << 1 | (!c[2] & 1);
         let mut found: Option<Candidate> = None;
+        let mut consider = |at: usize| {
+            let off = [0, 1, 2].map(|k| cells[at][k] - c[k]);
+            if off.iter().any(|o| o.abs() > 1) {
+                return;
+            }
+            let q = &vertices[at];
+            let d = ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
+            let cand = Candidate {
+                d,
+                scan: (off[0] + 1) * 9 + (off[1] + 1) * 3 + off[2] + 1,
+                index: at as u32,
+            };
+            if d <= tp.max(tol.at(q)) && found.is_none_or(|f| cand.before(&f)) {
+                found = Some(cand);
+            }
+        };
+        let mut own_len = 0;
+        crowded.clear();
         for b in 0..8 {
             let key = [
                 first[0] + (b >> 2),
                 first[1] + ((b >> 1) & 1),
                 first[2] + (b & 1),
             ];
-            let mut r = head.get(&key).copied().unwrap_or(u32::MAX);
-            while r != u32::MAX {
-                let at = r as usize;
-                r = next[at];
-                let off = [0, 1, 2].map(|k| cells[at][k] - c[k]);
-                if off.iter().any(|o| o.abs() > 1) {
-                    continue;
-                }
-                let q = &vertices[at];
-                let d =
-                    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
-                let cand = Candidate {
-                    d,
-                    scan: (off[0] + 1) * 9 + (off[1] + 1) * 3 + off[2] + 1,
-                    index: at as u32,
-                };
-                if d <= tp.max(tol.at(q)) && found.is_none_or(|f| cand.before(&f)) {
-                    found = Some(cand);
+            match head.get(&key) {
+                None => {}
+                Some(&Block::Crowded(id)) => crowded.push(id),
+                Some(&Block::List(mut r)) => {
+                    let mut len = 0;
+                    while r != NONE {
+                        let at = r as usize;
+                        r = next[at];
+                        len += 1;
+                        consider(at);
+                    }
+                    if b == own {
+                        own_len = len;
+                    }
                 }
             }
+        }
+        if !crowded.is_empty() {
+            crowding.whole_levels +=
+                crowd.search(&crowded, &mut levels, (p, tp), &next, &mut consider);
         }
         if let Some(f) = found {
             representative[i] = f.index;
             merged += 1;
             widest = widest.max(f.d);
-        } else {
-            cells[i] = c;
-            let slot = head.entry(block(c)).or_insert(u32::MAX);
-            next[i] = *slot;
-            *slot = i as u32;
+            continue;
+        }
+        cells[i] = c;
+        let slot = head.entry(block(c)).or_insert(Block::List(NONE));
+        match *slot {
+            Block::List(r) if own_len < CROWDED => {
+                next[i] = r;
+                *slot = Block::List(i as u32);
+            }
+            Block::List(mut r) => {
+                // The list reaches `CROWDED`: its representatives move to the crowd, by level.
+                let id = crowd.blocks.len() as u32;
+                crowd.blocks.push(Vec::new());
+                crowding.blocks += 1;
+                *slot = Block::Crowded(id);
+                moved.clear();
+                while r != NONE {
+                    moved.push(r);
+                    r = next[r as usize];
+                }
+                for &at in &moved {
+                    let q = &vertices[at as usize];
+                    crowd.insert(id, at, q, tol.at(q), &mut next);
+                }
+                crowd.insert(id, i as u32, p, tp, &mut next);
+            }
+            Block::Crowded(id) => crowd.insert(id, i as u32, p, tp, &mut next),
         }
     }
-    TolerantWeld {
+    let weld = TolerantWeld {
         representative,
         merged,
         widest,
         tolerance: tol,
-    }
+    };
+    (weld, crowding)
 }
 
 #[cfg(test)]
@@ -387,6 +593,58 @@ mod tests {
                 .collect();
             let t = tolerant(&v, tol);
             assert_eq!(t.representative, tolerant_27(&v, tol), "step {step}");
+        }
+    }
+
+    #[test]
+    fn crowded_blocks_weld_as_the_27_cell_scan() {
+        let mut state = 0x5851_f42d_4c95_7f2du64;
+        let mut rand = move |m: u64| crate::xorshift(&mut state) % m;
+        // Binary STL triangles whose corners lie within 1e-7 of (0,0,0), (1,0,0) and (0,1,0), some
+        // corners repeated and some on a lattice (ties): cells of 2 f32 ulps of 1 m crowded by
+        // corners near the origin, whose tolerance is 1e-9 m.
+        let mut v: Vec<[f64; 3]> = Vec::new();
+        for _ in 0..2500 {
+            for corner in [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+                let p = match rand(4) {
+                    0 if !v.is_empty() => v[rand(v.len() as u64) as usize],
+                    1 => corner.map(|x| x + (rand(21) as f64 - 10.0) * 1e-9),
+                    _ => corner.map(|x| x + (rand(2001) as f64 - 1000.0) * 1e-10),
+                };
+                v.push(p.map(|x| f64::from(x as f32)));
+            }
+        }
+        assert_eq!(Precision::of(&v), Precision::F32);
+        let tol = tolerance(&v, Precision::F32);
+        let (t, crowding) = weld(&v, tol);
+        assert!(crowding.blocks > 0, "{crowding:?}");
+        assert_eq!(t.representative, tolerant_27(&v, tol), "{crowding:?}");
+        // Tolerances that vary steeply with the distance from the origin (ulps of 25% to 1%): many levels
+        // in a block, vertices whose reach spans more sub-cells than a level has members, lattices
+        // of several steps crossing zero, in shuffled order.
+        for (base, relative_ulp) in [(1e-6, 0.25), (1e-6, 0.05), (1e-7, 0.01), (3e-5, 0.0)] {
+            let mut v: Vec<[f64; 3]> = (0..6000)
+                .map(|_| {
+                    let step = [1e-6, 1e-5, 1e-4, 1e-3][rand(4) as usize];
+                    [0, 1, 2].map(|_| (rand(41) as f64 - 20.0) * step)
+                })
+                .collect();
+            for i in (1..v.len()).rev() {
+                v.swap(i, rand(i as u64 + 1) as usize);
+            }
+            let mut tol = Tolerance {
+                base,
+                relative_ulp,
+                largest: 0.0,
+            };
+            tol.largest = v.iter().map(|p| tol.at(p)).fold(0.0, f64::max);
+            let (t, crowding) = weld(&v, tol);
+            // One tolerance everywhere (f64 data) leaves no block crowded.
+            assert_eq!(crowding.blocks > 0, relative_ulp > 0.0, "{base} {crowding:?}");
+            if relative_ulp > 0.01 {
+                assert!(crowding.whole_levels > 0, "{base} {crowding:?}");
+            }
+            assert_eq!(t.representative, tolerant_27(&v, tol), "{base} {crowding:?}");
         }
     }
 
