@@ -725,6 +725,8 @@ pub(super) fn c3(p: [f64; 3]) -> Coord3D<f64> {
 /// Whether two triangles may touch: exact, and conservative for coplanar ones (any coplanar pair
 /// whose boxes meet counts as touching). Non-coplanar triangles meet only where an edge of one
 /// crosses the other.
+// The reference the forms with precomputed planes are tested against ([`corners_touch`]).
+#[cfg(test)]
 pub(super) fn triangles_touch(v: &[[f64; 3]], x: &[u32; 3], y: &[u32; 3]) -> bool {
     let p = |t: &[u32; 3]| t.map(|i| v[i as usize]);
     let (px, py) = (p(x), p(y));
