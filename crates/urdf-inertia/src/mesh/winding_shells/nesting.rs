@@ -9,10 +9,11 @@
 //! shells' common box), so a pair of shells with no such pair is known not to touch without
 //! work of its own. Of two sealed shells that do not touch, the winding number of one on the
 //! other is an integer, constant on the other; one exact ray (`orient3d` crossings, as
-//! [`super::grid`] counts them) from a corner of a shell counts the sum over all the sealed
-//! shells around it at once, in time of the triangles along the ray. Shells closed up to
-//! cracks, whose winding number is not an integer, keep the pair's solid angles and their
-//! [`NOT_INTEGER`](super::NOT_INTEGER) guard.
+//! [`super::grid`] counts them) from a corner of a shell counts the sum over all the shells
+//! around it at once, in time of the triangles along the ray. A neighbour closed only up to
+//! cracks could let a ray slip through one: its count is confirmed by a ray along another axis.
+//! Where no ray counts, the pairs' solid angles decide with their
+//! [`NOT_INTEGER`](super::NOT_INTEGER) guard, as pair by pair.
 
 use std::ops::ControlFlow;
 
@@ -133,9 +134,9 @@ impl Tree {
 }
 
 /// The pairs of closed shells with overlapping boxes that touch or cut each other (exact
-/// [`super::triangles_touch`], with the planes computed once, of each pair of their triangles
-/// whose boxes meet), their shells marked undecided. A pair of shells both undecided already is not asked. `None` past
-/// [`MAX_TRIANGLE_TESTS`].
+/// `triangles_touch`, as [`corners_touch`] with the planes computed once, of each pair of their
+/// triangles whose boxes meet), their shells marked undecided. A pair of shells both undecided
+/// already is not asked. `None` past [`MAX_TRIANGLE_TESTS`].
 fn touching(tree: &Tree, shells: &[Shell], decided: &mut [bool]) -> Option<FxHashSet<u64>> {
     let mut touching: FxHashSet<u64> = FxHashSet::default();
     let mut tests = 0usize;
