@@ -43,6 +43,17 @@ const MAX_PAIRS: usize = 20_000;
 /// that need no work of their own (closed shells nested in each other) cost a few words each.
 const MAX_BOX_PAIRS: usize = 4_000_000;
 
+/// Pairs of shells with overlapping boxes up to this many are decided pair by pair ([`nesting`]);
+/// more, all at once ([`nesting::nestings`]). Pair by pair costs pairs × their triangles, all at
+/// once a tree over every closed shell's triangles, which costs a real surface of a few shells
+/// 12–14% more instructions (G1 `torso_link_rev_1_0.STL`, cassie `hip-yaw.stl`) and wins only when
+/// the pairs are many (figures: docs/benchmarks.md, "Shells, round 32").
+const FEW_PAIRS: usize = 1_024;
+
+/// Segment–triangle tests per pair of shells, pair by pair, beyond which the pair is bounded, not
+/// decided.
+const MAX_TESTS: usize = 4_000_000;
+
 /// A shell with boundary edges (cracks left open) is classified like a closed one when its volume
 /// moves with the reference point by at most this share of itself; the move enters the bound.
 const NEARLY_CLOSED: f64 = 1e-3;
@@ -140,7 +151,12 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
     let tris: Vec<Vec<[u32; 3]>> = shells.iter().map(|s| fan(faces, &s.faces)).collect();
     // w_out per shell (the others' winding numbers on it), and whether every pair around it is
     // decided: for all pairs at once ([`nesting`]).
-    let Some((w_out, decided)) = nesting::nestings(vertices, &shells, &tris, &pairs) else {
+    let nestings = if pairs.len() <= FEW_PAIRS {
+        Some(pair_by_pair(vertices, &shells, &tris, &pairs))
+    } else {
+        nesting::nestings(vertices, &shells, &tris, &pairs)
+    };
+    let Some((w_out, decided)) = nestings else {
         return bounded(&pairs);
     };
     let mut out = ShellOutcome::default();
@@ -701,6 +717,121 @@ fn fan(faces: &Polygons, which: &[u32]) -> Vec<[u32; 3]> {
     out
 }
 
+/// Per shell: the others' winding numbers on it, and whether every pair around it is decided, pair
+/// by pair ([`nesting`]).
+fn pair_by_pair(
+    vertices: &[[f64; 3]],
+    shells: &[Shell],
+    tris: &[Vec<[u32; 3]>],
+    pairs: &[(usize, usize)],
+) -> (Vec<i64>, Vec<bool>) {
+    let mut w_out = vec![0i64; shells.len()];
+    let mut decided = vec![true; shells.len()];
+    for &(a, b) in pairs {
+        if let Some((wa, wb)) = nesting(vertices, shells, tris, a, b) {
+            w_out[a] += wa;
+            w_out[b] += wb;
+        } else {
+            decided[a] = false;
+            decided[b] = false;
+        }
+    }
+    (w_out, decided)
+}
+
+/// For two closed shells that do not touch: the winding number of `b` on `a` and of `a` on `b`.
+/// `None` when either is open, they touch or cut each other, or the test is too large.
+fn nesting(
+    vertices: &[[f64; 3]],
+    shells: &[Shell],
+    tris: &[Vec<[u32; 3]>],
+    a: usize,
+    b: usize,
+) -> Option<(i64, i64)> {
+    let (sa, sb) = (&shells[a], &shells[b]);
+    if !sa.closed || !sb.closed {
+        return None;
+    }
+    // The triangles whose boxes meet the two shells' common box, with their boxes.
+    let common = sa.bounds.intersection(sb.bounds);
+    let near = |ts: &[[u32; 3]]| -> (Vec<[u32; 3]>, Vec<Aabb>) {
+        ts.iter()
+            .map(|t| (*t, Aabb::of(t.map(|i| vertices[i as usize]))))
+            .filter(|(_, b)| overlap(b, &common))
+            .unzip()
+    };
+    let ((ta, boxes_a), (tb, boxes_b)) = (near(&tris[a]), near(&tris[b]));
+    if ta.len().saturating_mul(tb.len()) > MAX_TESTS {
+        return None;
+    }
+    let touch = |x: usize, y: usize| {
+        if triangles_touch(vertices, &ta[x], &tb[y]) {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    };
+    // A shell with no triangle in the other's box cannot touch it (nested shells, most often):
+    // the sweep then looks at nothing.
+    if closed_boxes_meeting(&boxes_a, &boxes_b, touch).is_break() {
+        return None;
+    }
+    let wa = integer(winding(
+        vertices,
+        &tris[b],
+        vertices[tris[a][0][0] as usize],
+    ))?;
+    let wb = integer(winding(
+        vertices,
+        &tris[a],
+        vertices[tris[b][0][0] as usize],
+    ))?;
+    Some((wa, wb))
+}
+
+/// Each pair of a box of `a` and a box of `b` that meet as closed boxes (touching counts), found
+/// by a sweep along x over the two lists, each sorted by where its boxes start: `visit(i, j)` with
+/// `i` in `a` and `j` in `b`, until it breaks. Every such pair is visited once (from the box that
+/// starts first, the one of `a` at a tie), so a test that holds for some pair finds one, as the loop
+/// over all pairs did, in time linear in the pairs whose x ranges meet rather than in all |a|·|b|;
+/// pairs within one list are never looked at (an empty list costs nothing).
+fn closed_boxes_meeting(
+    a: &[Aabb],
+    b: &[Aabb],
+    mut visit: impl FnMut(usize, usize) -> ControlFlow<()>,
+) -> ControlFlow<()> {
+    if a.is_empty() || b.is_empty() {
+        return ControlFlow::Continue(());
+    }
+    let sorted = |boxes: &[Aabb]| {
+        let mut order: Vec<usize> = (0..boxes.len()).collect();
+        order.sort_by(|&p, &q| boxes[p].lo[0].total_cmp(&boxes[q].lo[0]));
+        order
+    };
+    let (oa, ob) = (sorted(a), sorted(b));
+    let (mut i, mut j) = (0, 0);
+    while i < oa.len() && j < ob.len() {
+        let (x, y) = (&a[oa[i]], &b[ob[j]]);
+        if x.lo[0] <= y.lo[0] {
+            // x starts first: the boxes of b from y on that start within x's range along x.
+            for &q in ob[j..].iter().take_while(|&&q| b[q].lo[0] <= x.hi[0]) {
+                if overlap(x, &b[q]) {
+                    visit(oa[i], q)?;
+                }
+            }
+            i += 1;
+        } else {
+            for &p in oa[i..].iter().take_while(|&&p| a[p].lo[0] <= y.hi[0]) {
+                if overlap(&a[p], y) {
+                    visit(p, ob[j])?;
+                }
+            }
+            j += 1;
+        }
+    }
+    ControlFlow::Continue(())
+}
+
 /// Whether two boxes meet as closed boxes (touching counts).
 // `&`, not `&&`: six comparisons and no branch, as a grid query's boxes fail on any axis (figures:
 // docs/benchmarks.md, "Shells, round 31").
@@ -725,8 +856,6 @@ pub(super) fn c3(p: [f64; 3]) -> Coord3D<f64> {
 /// Whether two triangles may touch: exact, and conservative for coplanar ones (any coplanar pair
 /// whose boxes meet counts as touching). Non-coplanar triangles meet only where an edge of one
 /// crosses the other.
-// The reference the forms with precomputed planes are tested against ([`corners_touch`]).
-#[cfg(test)]
 pub(super) fn triangles_touch(v: &[[f64; 3]], x: &[u32; 3], y: &[u32; 3]) -> bool {
     let p = |t: &[u32; 3]| t.map(|i| v[i as usize]);
     let (px, py) = (p(x), p(y));
@@ -804,6 +933,57 @@ fn winding(vertices: &[[f64; 3]], tris: &[[u32; 3]], p: [f64; 3]) -> f64 {
 mod tests {
     use super::*;
 
+    /// The sweep visits exactly the pairs (one box of each list) that meet as closed boxes, each
+    /// once: boxes on a coarse lattice, so that many touch at a face, an edge or a corner only.
+    #[test]
+    fn the_sweep_visits_each_meeting_pair_once() {
+        let mut state = 0x2545_F491_4F6C_DD1D_u64;
+        let mut next = |n: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % n) as f64
+        };
+        let mut boxes = |count: usize| -> Vec<Aabb> {
+            (0..count)
+                .map(|_| {
+                    let lo = [next(6), next(6), next(6)];
+                    let size = [next(3), next(3), next(3)];
+                    Aabb::new(lo, [0, 1, 2].map(|k| lo[k] + size[k]))
+                })
+                .collect()
+        };
+        for (na, nb) in [(0, 5), (7, 0), (40, 30), (120, 90)] {
+            let (a, b) = (boxes(na), boxes(nb));
+            let mut want = Vec::new();
+            for (i, x) in a.iter().enumerate() {
+                for (j, y) in b.iter().enumerate() {
+                    if (0..3).all(|k| x.lo[k] <= y.hi[k] && y.lo[k] <= x.hi[k]) {
+                        want.push((i, j));
+                    }
+                }
+            }
+            let mut got = Vec::new();
+            let all = closed_boxes_meeting(&a, &b, |i, j| {
+                got.push((i, j));
+                ControlFlow::Continue(())
+            });
+            assert!(all.is_continue());
+            got.sort_unstable();
+            assert_eq!(got, want, "{na} × {nb}");
+            assert!(na * nb < 1000 || want.len() > 100, "{}", want.len());
+            // A visit that breaks stops the sweep.
+            if let Some(&first) = want.first() {
+                let mut seen = 0;
+                let stop = closed_boxes_meeting(&a, &b, |_, _| {
+                    seen += 1;
+                    ControlFlow::Break(())
+                });
+                assert!(stop.is_break() && seen == 1, "{first:?}");
+            }
+        }
+    }
+
     /// `count` boxes nested in each other (each 1 wider on every side, sides of different lengths,
     /// centres moving along x by ⅛), every other one inward from the outermost, which is outward,
     /// when `alternate`; as quads.
@@ -871,5 +1051,42 @@ mod tests {
         let out = classify(&vertices, &faces, &AsStored::default());
         assert_eq!(out.undecided_pairs, 0);
         assert!(out.resolved_pairs >= 2, "{}", out.resolved_pairs);
+    }
+
+    /// Pair by pair and all at once decide alike: nested boxes (all outward, or alternating), some
+    /// moved so that they cut their neighbours, one left open.
+    #[test]
+    fn pair_by_pair_and_all_at_once_agree() {
+        for (count, alternate, moved, open) in [
+            (12, false, None, false),
+            (12, true, None, false),
+            (40, true, Some(7), false),
+            (40, false, Some(20), true),
+        ] {
+            let (mut vertices, mut faces, _) = nested_boxes(count, alternate);
+            if let Some(k) = moved {
+                for v in &mut vertices[8 * k..8 * k + 8] {
+                    v[1] += 1.5;
+                }
+            }
+            if open {
+                let kept: Vec<Vec<u32>> = faces.iter().skip(1).map(<[u32]>::to_vec).collect();
+                faces = Polygons::new();
+                kept.iter().for_each(|f| faces.push(f));
+            }
+            let (shells, _) = shells(&vertices, &faces);
+            let pairs = overlapping_pairs(&shells);
+            assert!(pairs.len() >= count - 1, "{}", pairs.len());
+            let tris: Vec<Vec<[u32; 3]>> = shells.iter().map(|s| fan(&faces, &s.faces)).collect();
+            // `w_out` counts only where the shell is decided ([`orient`]).
+            let kept = |(w, d): (Vec<i64>, Vec<bool>)| -> Vec<Option<i64>> {
+                w.iter().zip(&d).map(|(&w, &d)| d.then_some(w)).collect()
+            };
+            let one = kept(pair_by_pair(&vertices, &shells, &tris, &pairs));
+            let all = kept(nesting::nestings(&vertices, &shells, &tris, &pairs).expect("within the caps"));
+            assert_eq!(one, all, "{count} {alternate} {moved:?} {open}");
+            // An open shell leaves every pair around it undecided: all of them, nested.
+            assert_eq!(one.iter().any(Option::is_some), !open);
+        }
     }
 }
