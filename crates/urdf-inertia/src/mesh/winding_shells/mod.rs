@@ -1072,7 +1072,9 @@ mod tests {
             if open {
                 let kept: Vec<Vec<u32>> = faces.iter().skip(1).map(<[u32]>::to_vec).collect();
                 faces = Polygons::new();
-                kept.iter().for_each(|f| faces.push(f));
+                for f in &kept {
+                    faces.push(f);
+                }
             }
             let (shells, _) = shells(&vertices, &faces);
             let pairs = overlapping_pairs(&shells);
