@@ -23,6 +23,7 @@
 //! | later | many holes in one flat side made the caps' coplanar grouping quadratic in them (6 s for a plate with 10,000 holes through it) | `a_plate_of_many_holes_is_capped` (and the library's `merged_one_at_a_time_is_merged_in_full`) |
 //! | later | a vertex on many edges made the closed-surface proof quadratic in its degree (18 s for a 500k-face cone) | `a_vertex_on_many_edges_is_proven_closed` (and the library's `long_buckets_give_what_the_scan_gives`, `long_buckets_prove_what_the_full_analysis_finds`, `searched_buckets_answer_as_scanned_ones`) |
 //! | later | corners crowding a cell of the tolerant weld's grid made it quadratic in them (12 s for a cloud of 40,000 triangles) | `a_cloud_of_crowded_corners_is_welded` (and the library's `crowded_blocks_weld_as_the_27_cell_scan`) |
+//! | later | shells nested in each other made the shells' classification quadratic in them, and past 20,000 pairs of overlapping boxes left unbounded (200 nested spheres 3.1 s) | `many_nested_shells_are_decided_exactly` (and the library's `many_nested_boxes_are_decided_exactly`, `the_tree_finds_what_all_pairs_find`) |
 //!
 //! Item 12's self-intersecting and nested outward shells are the winding-number work's (its tests are
 //! in `tests/winding_truth.rs`). docs/reliability.md has a row for each input above.
@@ -1411,6 +1412,12 @@ fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option
             "cloud.stl",
             weld_cloud(100_000),
             "a cloud of 100,000 triangles within 1e-7 m of one (100,000 corners crowding a few cells of the weld's grid)",
+            &[][..],
+        ),
+        (
+            "nested.stl",
+            nested_boxes(1_000),
+            "1,000 boxes nested in each other (499,500 pairs of shells whose boxes overlap)",
             &[][..],
         ),
     ];
@@ -3681,4 +3688,66 @@ fn a_cloud_of_crowded_corners_is_welded() {
             && warnings.contains("closed its 775 hole(s) with flat caps"),
         "{warnings}"
     );
+}
+
+/// `n` boxes nested in each other, all outward: box k has half-sides 1 + k/4, 1 + 3k/8, 1 + k/8
+/// about (k/16, 0, 0), exact in f32; the last is the outermost.
+fn nested_boxes(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let (mut v, mut f) = (Vec::new(), Vec::new());
+    for k in 0..n {
+        let k = f64::from(k);
+        let (c, h) = (
+            [k / 16.0, 0.0, 0.0],
+            [1.0 + k / 4.0, 1.0 + 3.0 * k / 8.0, 1.0 + k / 8.0],
+        );
+        let base = v.len() as u32;
+        for i in 0..8u32 {
+            let s = |b: u32| if (i >> b) & 1 == 1 { 1.0 } else { -1.0 };
+            v.push([c[0] + s(0) * h[0], c[1] + s(1) * h[1], c[2] + s(2) * h[2]]);
+        }
+        for q in [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ] {
+            f.push([base + q[0], base + q[1], base + q[2]]);
+            f.push([base + q[0], base + q[2], base + q[3]]);
+        }
+    }
+    (v, f)
+}
+
+/// Shells nested in each other were classified pair by pair (their boxes all overlap): 200 nested
+/// spheres took 3.1 s, and past 20,000 pairs every pair was bounded by its boxes' intersection (an
+/// unbounded estimate). 1,000 nested boxes (499,500 pairs) now give the outermost box alone, its
+/// volume exact, with no bound from the shells.
+#[test]
+fn many_nested_shells_are_decided_exactly() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (v, f) = nested_boxes(1_000);
+    let stl = stl_in(tmp.path(), "nested.stl", &v, &f);
+    let out = bin()
+        .args(["mesh", s(&stl), "--format", "json", "--digits", "full"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // The outermost box: half-sides 250.75, 375.625, 125.875.
+    let outer = 8.0 * 250.75 * 375.625 * 125.875;
+    assert_eq!(j["volume"].as_f64(), Some(outer), "{j}");
+    assert_eq!(j["center_of_mass"][0].as_f64(), Some(999.0 / 16.0), "{j}");
+    let estimate = j["error_estimate"].as_f64().unwrap();
+    assert!(estimate < 1e-12, "{j}");
+    assert!(j["notes"].to_string().contains("999 shell(s)"), "{j}");
+    // A box's moments about its centre: m (b² + c²) / 3 for half-sides b, c.
+    let h = [250.75, 375.625, 125.875];
+    for k in 0..3 {
+        let want =
+            outer * (h[(k + 1) % 3] * h[(k + 1) % 3] + h[(k + 2) % 3] * h[(k + 2) % 3]) / 3.0;
+        let got = j["inertia"][k][k].as_f64().unwrap();
+        assert!((got - want).abs() <= 1e-12 * want, "{k}: {got} {want}");
+    }
 }

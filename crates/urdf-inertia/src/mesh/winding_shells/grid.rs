@@ -62,7 +62,7 @@ impl Seen {
 }
 
 /// What an axis-parallel segment does at a triangle.
-enum Crossing {
+pub(super) enum Crossing {
     Miss,
     /// Crosses its interior: +1 leaving through its front (the side its normal points to), −1 entering.
     Through(i64),
@@ -428,7 +428,7 @@ impl Plane {
 /// most triangles (those coplanar with the face the ray starts from, whose sides of the start are
 /// zero, included) before the sides of their planes are asked. The answer is the one the two
 /// conditions give in either order.
-fn crossing(s: [f64; 3], e: [f64; 3], axis: usize, t: &Corners, plane: &Plane) -> Crossing {
+pub(super) fn crossing(s: [f64; 3], e: [f64; 3], axis: usize, t: &Corners, plane: &Plane) -> Crossing {
     let (j, l) = ((axis + 1) % 3, (axis + 2) % 3);
     let p2 = |x: [f64; 3]| Coord { x: x[j], y: x[l] };
     let (a, b, c, sp) = (p2(t[0]), p2(t[1]), p2(t[2]), p2(s));

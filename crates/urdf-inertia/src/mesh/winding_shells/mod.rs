@@ -19,11 +19,13 @@
 //! their bounding boxes (a closed shell's winding number is 0 outside its box), whose volume enters
 //! the error estimate.
 
+mod bvh;
 mod cells;
 mod correction;
 mod cracks;
 mod exact;
 mod grid;
+mod nesting;
 
 use crate::geometry::{cross, dot, norm, solid_angle, sub, x_sweep, Aabb};
 use crate::mass::Polygons;
@@ -33,10 +35,23 @@ use robust::Coord3D;
 use rustc_hash::FxHashMap;
 use std::ops::ControlFlow;
 
-/// Pairs of shells with overlapping boxes beyond this many are not decided one by one: all are bounded.
+/// Pairs of shells that need work of their own (they touch, or a shell is open or closed only up to
+/// cracks) beyond this many are not decided one by one: all pairs are bounded.
 const MAX_PAIRS: usize = 20_000;
 
-/// Segment–triangle tests per pair of shells beyond which the pair is bounded, not decided.
+/// Pairs of shells with overlapping boxes beyond this many are not decided: all are bounded. Those
+/// that need no work of their own (closed shells nested in each other) cost a few words each.
+const MAX_BOX_PAIRS: usize = 4_000_000;
+
+/// Pairs of shells with overlapping boxes up to this many are decided pair by pair ([`nesting`]);
+/// more, all at once ([`nesting::nestings`]). Pair by pair costs pairs × their triangles, all at
+/// once a tree over every closed shell's triangles, which costs a real surface of a few shells
+/// 12–14% more instructions (G1 `torso_link_rev_1_0.STL`, cassie `hip-yaw.stl`) and wins only when
+/// the pairs are many (figures: docs/benchmarks.md, "Shells, round 32").
+const FEW_PAIRS: usize = 1_024;
+
+/// Segment–triangle tests per pair of shells, pair by pair, beyond which the pair is bounded, not
+/// decided.
 const MAX_TESTS: usize = 4_000_000;
 
 /// A shell with boundary edges (cracks left open) is classified like a closed one when its volume
@@ -126,26 +141,27 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
         return unchanged(0, 0.0);
     }
     let pairs = overlapping_pairs(&shells);
-    if pairs.len() > MAX_PAIRS {
+    let bounded = |pairs: &[(usize, usize)]| {
         let bound = pairs
             .iter()
             .map(|&(a, b)| box_overlap(&shells[a], &shells[b]))
             .sum();
-        return unchanged(pairs.len(), bound);
+        unchanged(pairs.len(), bound)
+    };
+    if pairs.len() > MAX_BOX_PAIRS {
+        return bounded(&pairs);
     }
     let tris: Vec<Vec<[u32; 3]>> = shells.iter().map(|s| fan(faces, &s.faces)).collect();
-    // w_out per shell (the others' winding numbers on it), and whether every pair around it is decided.
-    let mut w_out = vec![0i64; shells.len()];
-    let mut decided = vec![true; shells.len()];
-    for &(a, b) in &pairs {
-        if let Some((wa, wb)) = nesting(vertices, &shells, &tris, a, b) {
-            w_out[a] += wa;
-            w_out[b] += wb;
-        } else {
-            decided[a] = false;
-            decided[b] = false;
-        }
-    }
+    // w_out per shell (the others' winding numbers on it), and whether every pair around it is
+    // decided: for all pairs at once ([`nesting`]).
+    let nestings = if pairs.len() <= FEW_PAIRS {
+        Some(pair_by_pair(vertices, &shells, &tris, &pairs))
+    } else {
+        nesting::nestings(vertices, &shells, &tris, &pairs)
+    };
+    let Some((w_out, decided)) = nestings else {
+        return bounded(&pairs);
+    };
     let mut out = ShellOutcome::default();
     // A pair with an undecided side is bounded whatever the other side's classification, unless
     // its cluster is a closed cycle, or both shells are: then it is decided face by face (the open
@@ -671,7 +687,7 @@ fn overlapping_pairs(shells: &[Shell]) -> Vec<(usize, usize)> {
         if box_overlap(&shells[a], &shells[b]) > 0.0 {
             pairs.push((a.min(b), a.max(b)));
         }
-        if pairs.len() > MAX_PAIRS {
+        if pairs.len() > MAX_BOX_PAIRS {
             ControlFlow::Break(())
         } else {
             ControlFlow::Continue(())
@@ -703,6 +719,28 @@ fn fan(faces: &Polygons, which: &[u32]) -> Vec<[u32; 3]> {
         }
     }
     out
+}
+
+/// Per shell: the others' winding numbers on it, and whether every pair around it is decided, pair
+/// by pair ([`nesting`]).
+fn pair_by_pair(
+    vertices: &[[f64; 3]],
+    shells: &[Shell],
+    tris: &[Vec<[u32; 3]>],
+    pairs: &[(usize, usize)],
+) -> (Vec<i64>, Vec<bool>) {
+    let mut w_out = vec![0i64; shells.len()];
+    let mut decided = vec![true; shells.len()];
+    for &(a, b) in pairs {
+        if let Some((wa, wb)) = nesting(vertices, shells, tris, a, b) {
+            w_out[a] += wa;
+            w_out[b] += wb;
+        } else {
+            decided[a] = false;
+            decided[b] = false;
+        }
+    }
+    (w_out, decided)
 }
 
 /// For two closed shells that do not touch: the winding number of `b` on `a` and of `a` on `b`.
@@ -947,6 +985,114 @@ mod tests {
                 });
                 assert!(stop.is_break() && seen == 1, "{first:?}");
             }
+        }
+    }
+
+    /// `count` boxes nested in each other (each 1 wider on every side, sides of different lengths,
+    /// centres moving along x by ⅛), every other one inward from the outermost, which is outward,
+    /// when `alternate`; as quads.
+    fn nested_boxes(count: usize, alternate: bool) -> (Vec<[f64; 3]>, Polygons, Vec<f64>) {
+        let (mut vertices, mut faces, mut volumes) = (Vec::new(), Polygons::new(), Vec::new());
+        for k in 0..count {
+            let kf = k as f64;
+            let (c, h) = ([0.125 * kf, 0.0, 0.0], [1.0 + kf, 1.0 + 1.25 * kf, 1.0 + 0.5 * kf]);
+            let base = vertices.len() as u32;
+            for i in 0..8 {
+                let s = |b: usize| if i >> b & 1 == 1 { 1.0 } else { -1.0 };
+                vertices.push([c[0] + s(0) * h[0], c[1] + s(1) * h[1], c[2] + s(2) * h[2]]);
+            }
+            // The outermost (last) box outward.
+            let inward = alternate && (count - 1 - k) % 2 == 1;
+            for q in [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]] {
+                let mut q = q.map(|i| base + i);
+                if inward {
+                    q.reverse();
+                }
+                faces.push(&q);
+            }
+            let v = 8.0 * h[0] * h[1] * h[2];
+            volumes.push(if inward { -v } else { v });
+        }
+        (vertices, faces, volumes)
+    }
+
+    /// Of 300 boxes nested in each other, all outward, only the outermost bounds Ω (every inner
+    /// one is enclosed twice or more and drops out); inward every other one, each bounds a
+    /// shell of Ω (w alternates 1, 0, 1, … inwards) and all stay as they are. Exact, with no
+    /// bound, where deciding pair by pair met the cap on pairs (44,850 of them).
+    #[test]
+    fn many_nested_boxes_are_decided_exactly() {
+        for alternate in [false, true] {
+            let (vertices, faces, volumes) = nested_boxes(300, alternate);
+            let out = classify(&vertices, &faces, &AsStored::default());
+            assert_eq!((out.undecided_pairs, out.overlap_bound, out.resolved_pairs), (0, 0.0, 0));
+            assert_eq!(out.turned_shells, 0);
+            let kept: Vec<Vec<u32>> = out.faces.iter().map(<[u32]>::to_vec).collect();
+            let want: Vec<Vec<u32>> = if alternate {
+                assert_eq!(out.dropped_shells, 0);
+                faces.iter().map(<[u32]>::to_vec).collect()
+            } else {
+                // The outermost box is the last.
+                assert_eq!((out.dropped_shells, out.dropped_faces), (299, 6 * 299));
+                faces.iter().skip(6 * 299).map(<[u32]>::to_vec).collect()
+            };
+            assert_eq!(kept, want, "alternate: {alternate}");
+            // Ω's volume from the boxes' sides: the kept shells' signed volumes.
+            let omega: f64 = if alternate { volumes.iter().sum() } else { volumes[299] };
+            assert!(omega > 0.0);
+        }
+    }
+
+    /// The same boxes with every other one moved so that it cuts its neighbours: those pairs
+    /// touch and go face by face, while the boxes that touch nothing stay decided whole.
+    #[test]
+    fn nested_boxes_that_cut_each_other_are_not_decided_whole() {
+        let (mut vertices, faces, _) = nested_boxes(6, false);
+        // Box 2 moved by 1.5 along y: it cuts boxes 1 and 3 (1 wider on each side), not 0, 4 or 5.
+        for v in &mut vertices[16..24] {
+            v[1] += 1.5;
+        }
+        let out = classify(&vertices, &faces, &AsStored::default());
+        assert_eq!(out.undecided_pairs, 0);
+        assert!(out.resolved_pairs >= 2, "{}", out.resolved_pairs);
+    }
+
+    /// Pair by pair and all at once decide alike: nested boxes (all outward, or alternating), some
+    /// moved so that they cut their neighbours, one left open.
+    #[test]
+    fn pair_by_pair_and_all_at_once_agree() {
+        for (count, alternate, moved, open) in [
+            (12, false, None, false),
+            (12, true, None, false),
+            (40, true, Some(7), false),
+            (40, false, Some(20), true),
+        ] {
+            let (mut vertices, mut faces, _) = nested_boxes(count, alternate);
+            if let Some(k) = moved {
+                for v in &mut vertices[8 * k..8 * k + 8] {
+                    v[1] += 1.5;
+                }
+            }
+            if open {
+                let kept: Vec<Vec<u32>> = faces.iter().skip(1).map(<[u32]>::to_vec).collect();
+                faces = Polygons::new();
+                for f in &kept {
+                    faces.push(f);
+                }
+            }
+            let (shells, _) = shells(&vertices, &faces);
+            let pairs = overlapping_pairs(&shells);
+            assert!(pairs.len() >= count - 1, "{}", pairs.len());
+            let tris: Vec<Vec<[u32; 3]>> = shells.iter().map(|s| fan(&faces, &s.faces)).collect();
+            // `w_out` counts only where the shell is decided ([`orient`]).
+            let kept = |(w, d): (Vec<i64>, Vec<bool>)| -> Vec<Option<i64>> {
+                w.iter().zip(&d).map(|(&w, &d)| d.then_some(w)).collect()
+            };
+            let one = kept(pair_by_pair(&vertices, &shells, &tris, &pairs));
+            let all = kept(nesting::nestings(&vertices, &shells, &tris, &pairs).expect("within the caps"));
+            assert_eq!(one, all, "{count} {alternate} {moved:?} {open}");
+            // An open shell leaves every pair around it undecided: all of them, nested.
+            assert_eq!(one.iter().any(Option::is_some), !open);
         }
     }
 }
