@@ -3693,31 +3693,21 @@ fn a_cloud_of_crowded_corners_is_welded() {
 /// `n` boxes nested in each other, all outward: box k has half-sides 1 + k/4, 1 + 3k/8, 1 + k/8
 /// about (k/16, 0, 0), exact in f32; the last is the outermost.
 fn nested_boxes(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let (mut v, mut f) = (Vec::new(), Vec::new());
-    for k in 0..n {
-        let k = f64::from(k);
-        let (c, h) = (
-            [k / 16.0, 0.0, 0.0],
-            [1.0 + k / 4.0, 1.0 + 3.0 * k / 8.0, 1.0 + k / 8.0],
-        );
-        let base = v.len() as u32;
-        for i in 0..8u32 {
-            let s = |b: u32| if (i >> b) & 1 == 1 { 1.0 } else { -1.0 };
-            v.push([c[0] + s(0) * h[0], c[1] + s(1) * h[1], c[2] + s(2) * h[2]]);
-        }
-        for q in [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ] {
-            f.push([base + q[0], base + q[1], base + q[2]]);
-            f.push([base + q[0], base + q[2], base + q[3]]);
-        }
-    }
-    (v, f)
+    let boxes: Vec<common::Mesh> = (0..n)
+        .map(|k| {
+            let k = f64::from(k);
+            let (c, h) = (
+                [k / 16.0, 0.0, 0.0],
+                [1.0 + k / 4.0, 1.0 + 3.0 * k / 8.0, 1.0 + k / 8.0],
+            );
+            common::box_at(
+                [0, 1, 2].map(|i| c[i] - h[i]),
+                [0, 1, 2].map(|i| c[i] + h[i]),
+            )
+        })
+        .collect();
+    let parts: Vec<(&common::Mesh, bool)> = boxes.iter().map(|b| (b, false)).collect();
+    common::shells::together(&parts)
 }
 
 /// Shells nested in each other were classified pair by pair (their boxes all overlap): 200 nested
