@@ -244,3 +244,34 @@ fn sweep() {
     }
     eprintln!("largest error / estimate {:e}: {}", worst.0, worst.1);
 }
+
+/// A tetrahedron whose face crosses the box's wall at a shallow angle (its corners `s` inside and
+/// outside the wall, the face about 0.4 across): the cut line within the wall is ill-conditioned
+/// by 1/s, and the bound grows with it; at s = 1e-8 the face is taken as in the wall's plane (its
+/// slab in the bound) and the volume moves by 1.6e-9, within it.
+#[test]
+fn shallow_cuts_are_within_the_estimate() {
+    for s in [1e-1, 1e-3, 1e-5, 1e-7, 1e-8] {
+        for (scale, offset) in [(1.0, 0.0), (1e-3, 0.7), (1.0, 100.0)] {
+            let at = |x: f64| x * scale + offset;
+            let b = common::box_at([at(0.0); 3], [at(1.0); 3]);
+            let t = tetrahedron([
+                [at(0.8), at(0.3), at(0.3)],
+                [at(1.0 - s), at(0.2), at(0.2)],
+                [at(1.0 + s), at(0.6), at(0.25)],
+                [at(1.0 + 0.3 * s), at(0.4), at(0.7)],
+            ]);
+            let mut both = halfspaces(&b);
+            both.extend(halfspaces(&t));
+            let exact = mesh_volume(&b) + mesh_volume(&t) - convex_volume(&both);
+            let m = together(&[(&open_top(&b), false), (&t, false)]);
+            let solid = solid_with(&m, HealthOptions::default(), "shallow.stl");
+            let error = common::rel_error(solid.unit.mass, &exact);
+            assert!(
+                error <= solid.error_estimate,
+                "s {s:e}, scale {scale}, offset {offset}: error {error:e}, estimate {:e}",
+                solid.error_estimate
+            );
+        }
+    }
+}
