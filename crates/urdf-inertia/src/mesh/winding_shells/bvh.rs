@@ -196,12 +196,7 @@ mod tests {
     #[test]
     fn the_tree_finds_what_all_pairs_find() {
         let mut state = 0x9E37_79B9_7F4A_7C15_u64;
-        let mut next = |n: u64| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state % n
-        };
+        let mut next = |n: u64| crate::xorshift(&mut state) % n;
         for count in [0, 1, 5, 37, 300] {
             let boxes: Vec<Aabb> = (0..count)
                 .map(|_| {

@@ -81,7 +81,7 @@ impl Cut {
     pub(super) fn slack(&self, piece: &[[f64; 3]], nt: [f64; 3], inherited: f64) -> (f64, f64) {
         let (a, n, _) = self.plane;
         let reach = piece.iter().map(|x| norm(sub(*x, a))).fold(0.0, f64::max);
-        let big = piece.iter().chain([&a]).flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        let big = largest_coordinate(piece).max(largest_coordinate(&[a]));
         let sin = norm(cross(n, nt)) / (norm(n) * norm(nt));
         let local = self.reach.map_or(reach, |r| {
             let d = |i: usize, j: usize| norm(sub(r[i], r[j]));
@@ -181,6 +181,11 @@ fn clip(poly: &[[f64; 3]], d: &[f64], side: f64, out: &mut Vec<[f64; 3]>) {
             out.push([0, 1, 2].map(|k| poly[i][k] + s * (poly[j][k] - poly[i][k])));
         }
     }
+}
+
+/// The largest magnitude of the points' coordinates (what their rounding scales with).
+pub(super) fn largest_coordinate(points: &[[f64; 3]]) -> f64 {
+    points.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
 pub(super) fn area(poly: &[[f64; 3]]) -> f64 {

@@ -10,7 +10,7 @@
 //! the cone it spans from the surface's box centre (the volume a wrong orientation can change) to
 //! the bound, twice when it may count twice.
 
-use super::cells::{area, cells, centroid, leaves_whole, split, CellWork, Cut, CutPlane};
+use super::cells::{area, cells, centroid, largest_coordinate, leaves_whole, split, CellWork, Cut, CutPlane};
 use super::grid::{Corners, Grid, Plane, Seen};
 use super::{corners_touch, edge_meets, overlap, EdgeUse};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
@@ -65,9 +65,9 @@ pub(super) struct Resolved {
     /// Pieces decided from a neighbouring triangle's rays across an edge ([`Faces::joined_across`]).
     pub(super) joined_across: usize,
     /// Per triangle: how far the corners of its emitted pieces may lie from the exact pieces'
-    /// (rounded cut points and midpoints), m, and the length of the cuts across it, m
+    /// (rounded cut points and midpoints), m, and the area of the bands about its cuts, m²
     /// ([`Faces::moved`]).
-    slack: Vec<(f64, f64)>,
+    moved: Vec<(f64, f64)>,
 }
 
 /// A piece of triangle `t` waiting to be decided: the volume it may change, its corners and the
@@ -223,7 +223,7 @@ fn resolve_with(
         cut: blockers.iter().filter(|b| !b.is_empty()).count(),
         changed: false,
         joined_across: 0,
-        slack: vec![(0.0, 0.0); tris.len()],
+        moved: vec![(0.0, 0.0); tris.len()],
     };
     let mut heap = BinaryHeap::new();
     f.patches((&blockers, &uses), &mut seen, &mut out, &mut heap);
@@ -246,7 +246,7 @@ fn resolve_with(
     }
     f.refine(heap, target, &mut seen, &mut out);
     out.joined_across = f.joins_across.get();
-    out.rounding = f.moved(&out.slack);
+    out.rounding = f.moved(&out.moved);
     out
 }
 
@@ -464,8 +464,7 @@ impl Faces<'_> {
             for child in split(p.corners) {
                 // Each midpoint is rounded once (a sum, then an exact halving): within 2 ε of its
                 // largest coordinate, twice that here.
-                let big = child.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-                let slack = p.slack + 4.0 * f64::EPSILON * big;
+                let slack = p.slack + 4.0 * f64::EPSILON * largest_coordinate(&child);
                 let b = inflated(Aabb::of(child), self.margin);
                 let mut blockers: Vec<Blocker> = p
                     .blockers
@@ -927,7 +926,7 @@ impl Faces<'_> {
     /// piece's (rounded cut points and midpoints), kept for [`Faces::moved`].
     fn emit_moved(&self, piece: &[[f64; 3]], kappa: i64, (t, slack): (u32, f64), out: &mut Resolved) {
         if kappa != 0 {
-            let s = &mut out.slack[t as usize].0;
+            let s = &mut out.moved[t as usize].0;
             *s = s.max(slack);
         }
         self.emit(piece, kappa, out);
@@ -944,15 +943,15 @@ impl Faces<'_> {
     /// area. (`tests/oblique_cuts.rs`: a millimetre part 0.7 m from the origin, cut by three
     /// tetrahedra, was 2.7e-15 off its exact volume with an estimate of 2.2e-15 before this
     /// term.)
-    fn moved(&self, slack: &[(f64, f64)]) -> f64 {
+    fn moved(&self, moved: &[(f64, f64)]) -> f64 {
         let mut bound = 0.0;
-        for (t, &(s, band)) in slack.iter().enumerate() {
+        for (t, &(s, band)) in moved.iter().enumerate() {
             if s > 0.0 || band > 0.0 {
                 let c = self.corners[t];
                 let perimeter: f64 = (0..3).map(|i| norm(sub(c[(i + 1) % 3], c[i]))).sum();
                 let reach = c.iter().map(|x| norm(sub(*x, self.centre))).fold(0.0, f64::max);
-                let band = band.min(area(&c));
-                bound += 2.0 / 3.0 * reach * (band + s * perimeter) + s * area(&c);
+                let a = area(&c);
+                bound += 2.0 / 3.0 * reach * (band.min(a) + s * perimeter) + s * a;
             }
         }
         bound
@@ -1063,7 +1062,7 @@ impl Faces<'_> {
             return false;
         };
         let (band, slack) = rounded(piece, nt, (planes, crossing), slack);
-        out.slack[t as usize].1 += band;
+        out.moved[t as usize].1 += band;
         for cell in cells.iter() {
             // The decision's point keeps off every plane whose reach is not beyond the cell: off
             // the blockers and the coplanar triangles' edges that come near, whose sides of the
@@ -1124,8 +1123,7 @@ fn rounded(piece: &Corners, nt: [f64; 3], (cuts, which): (&[Cut], &[usize]), sla
             2.0 * w * diameter.min(local)
         })
         .sum::<f64>();
-    let big = piece.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-    (band, slack + 8.0 * f64::EPSILON * (big + diameter))
+    (band, slack + 8.0 * f64::EPSILON * (largest_coordinate(piece) + diameter))
 }
 
 /// How a piece bounds Ω (1 outward, −1 inward, 0 not at all), and where its rays started when

@@ -942,12 +942,7 @@ mod tests {
     #[test]
     fn the_sweep_visits_each_meeting_pair_once() {
         let mut state = 0x2545_F491_4F6C_DD1D_u64;
-        let mut next = |n: u64| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state % n) as f64
-        };
+        let mut next = |n: u64| (crate::xorshift(&mut state) % n) as f64;
         let mut boxes = |count: usize| -> Vec<Aabb> {
             (0..count)
                 .map(|_| {
