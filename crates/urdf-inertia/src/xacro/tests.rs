@@ -288,6 +288,16 @@ fn errors_name_file_line_and_calls() {
         e.message
     );
     let e = error(&format!(
+        "{HEAD}\n<xacro:include filename=\"package://pkg/urdf/arm.xacro\"/>\n</robot>"
+    ));
+    assert!(
+        e.message.contains(
+            "not a URI, and fails here too: write filename=\"$(find pkg)/urdf/arm.xacro\""
+        ),
+        "{}",
+        e.message
+    );
+    let e = error(&format!(
         "{HEAD}\n<xacro:macro name=\"m\">\n<xacro:m/>\n</xacro:macro>\n<xacro:m/>\n</robot>"
     ));
     assert!(e.message.contains("recursion in macro m"), "{}", e.message);

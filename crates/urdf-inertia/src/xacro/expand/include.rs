@@ -9,6 +9,25 @@ use crate::xacro::FileKind;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
+/// What to write instead of a URI in an include's filename: xacro (2.1.1, `abs_filename_spec`)
+/// takes it as a path relative to the including file, so `package://` fails there too (seen in
+/// example-robot-data's hector `quadrotor_base.xacro`).
+fn uri_hint(name: &str) -> String {
+    if let Some(rest) = name.strip_prefix("package://") {
+        let (package, file) = rest.split_once('/').unwrap_or((rest, ""));
+        format!(
+            " (xacro reads an include's filename as a path, not a URI, and fails here too: \
+             write filename=\"$(find {package})/{file}\")"
+        )
+    } else if let Some(path) = name.strip_prefix("file://") {
+        format!(
+            " (xacro reads an include's filename as a path, not a URI: write filename=\"{path}\")"
+        )
+    } else {
+        String::new()
+    }
+}
+
 impl Expander<'_> {
     pub(super) fn include(
         &mut self,
@@ -62,7 +81,7 @@ impl Expander<'_> {
             }
             let k = self
                 .read(&path, FileKind::Xacro)
-                .map_err(|m| self.err(format!("cannot include {name}: {m}")))?;
+                .map_err(|m| self.err(format!("cannot include {name}: {m}{}", uri_hint(&name))))?;
             let root = self.parse_file(k)?;
             self.filestack.push(k);
             let r = self.expand_element(&root, &ns_macros, &ns_symbols);
