@@ -24,6 +24,7 @@
 //! | later | a vertex on many edges made the closed-surface proof quadratic in its degree (18 s for a 500k-face cone) | `a_vertex_on_many_edges_is_proven_closed` (and the library's `long_buckets_give_what_the_scan_gives`, `long_buckets_prove_what_the_full_analysis_finds`, `searched_buckets_answer_as_scanned_ones`) |
 //! | later | corners crowding a cell of the tolerant weld's grid made it quadratic in them (12 s for a cloud of 40,000 triangles) | `a_cloud_of_crowded_corners_is_welded` (and the library's `crowded_blocks_weld_as_the_27_cell_scan`) |
 //! | later | shells nested in each other made the shells' classification quadratic in them, and past 20,000 pairs of overlapping boxes left unbounded (200 nested spheres 3.1 s) | `many_nested_shells_are_decided_exactly` (and the library's `many_nested_boxes_are_decided_exactly`, `the_tree_finds_what_all_pairs_find`) |
+//! | later | shells whose boxes overlap along one or two axes but not in space (parts in rows) made the search for overlapping boxes quadratic in them (40,000 tetrahedra in a row 7.0 s); past 4,000,000 overlapping pairs, only those found were bounded | `parts_in_rows_are_paired_without_a_quadratic_search` (and the library's `box_pairs_are_the_x_sweeps`) |
 //!
 //! Item 12's self-intersecting and nested outward shells are the winding-number work's (its tests are
 //! in `tests/winding_truth.rs`). docs/reliability.md has a row for each input above.
@@ -1418,6 +1419,12 @@ fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option
             "nested.stl",
             nested_boxes(1_000),
             "1,000 boxes nested in each other (499,500 pairs of shells whose boxes overlap)",
+            &[][..],
+        ),
+        (
+            "rows.stl",
+            parts_in_rows(15_000, true),
+            "45,000 boxes in three rows (each row's boxes overlapping two by two along two axes, none in space)",
             &[][..],
         ),
     ];
@@ -3740,4 +3747,94 @@ fn many_nested_shells_are_decided_exactly() {
         let got = j["inertia"][k][k].as_f64().unwrap();
         assert!((got - want).abs() <= 1e-12 * want, "{k}: {got} {want}");
     }
+}
+
+/// Thin boxes in rows: `m` boxes 3m long along x, one after another along y; with `three`, as
+/// many along y in a row along z and along z in a row along x, each group apart from the others.
+/// Within a group all boxes overlap along two axes and none in space.
+fn parts_in_rows(m: u32, three: bool) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let l = 3.0 * f64::from(m);
+    let mut boxes = Vec::new();
+    for i in 0..m {
+        let r = 3.0 * f64::from(i);
+        boxes.push(common::box_at(
+            [10.0, r + 10.0, 10.0],
+            [l + 10.0, r + 11.0, 11.0],
+        ));
+        if three {
+            boxes.push(common::box_at(
+                [-5.0, -l - 5.0, r + 10.0],
+                [-4.0, -5.0, r + 11.0],
+            ));
+            boxes.push(common::box_at(
+                [r + 10.0, -5.0, -l - 5.0],
+                [r + 11.0, -4.0, -5.0],
+            ));
+        }
+    }
+    let parts: Vec<(&common::Mesh, bool)> = boxes.iter().map(|b| (b, false)).collect();
+    common::shells::together(&parts)
+}
+
+/// Shells whose boxes overlap along x but not in space (parts in a row along y) made the search
+/// for overlapping boxes quadratic (a sweep along x: 40,000 tetrahedra in a row 7.0 s); it now
+/// sweeps along the axis where the fewest overlap, or, when each axis has too many (three rows
+/// like these, 15,000 boxes each: 10 s), takes them from a tree of the boxes. Each box is
+/// its own closed shell and none meet, so the volume is the boxes' sum, exactly.
+#[test]
+fn parts_in_rows_are_paired_without_a_quadratic_search() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (m, three) in [(40_000u32, false), (15_000, true)] {
+        let (v, f) = parts_in_rows(m, three);
+        let stl = stl_in(tmp.path(), "rows.stl", &v, &f);
+        let out = bin()
+            .args(["mesh", s(&stl), "--format", "json", "--digits", "full"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let groups = if three { 3.0 } else { 1.0 };
+        let want = groups * f64::from(m) * 3.0 * f64::from(m);
+        assert_eq!(
+            j["volume"].as_f64(),
+            Some(want),
+            "{m} {three}: {}",
+            j["volume"]
+        );
+        let estimate = j["error_estimate"].as_f64().unwrap();
+        assert!(estimate < 1e-11, "{m} {three}: {estimate}");
+    }
+    // 3,000 tetrahedra piled on one another (4,498,500 pairs of overlapping boxes, past the
+    // 4,000,000 decided): not bounded, where the pairs found before the search stopped were
+    // summed as if they were all.
+    let (mut v, mut f) = (Vec::new(), Vec::new());
+    for i in 0..3_000u32 {
+        let x = f64::from(i) / 16_384.0;
+        v.extend([
+            [x, 0.0, 0.0],
+            [x + 1.0, 0.0, 0.0],
+            [x, 1.0, 0.0],
+            [x, 0.0, 1.0],
+        ]);
+        let b = 4 * i;
+        f.extend([
+            [b, b + 2, b + 1],
+            [b, b + 1, b + 3],
+            [b + 1, b + 2, b + 3],
+            [b, b + 3, b + 2],
+        ]);
+    }
+    let stl = stl_in(tmp.path(), "pile.stl", &v, &f);
+    let out = bin()
+        .args(["mesh", s(&stl), "--format", "json"])
+        .output()
+        .unwrap();
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(j["error_estimate"].is_null(), "{j}");
+    assert!(
+        j["warnings"]
+            .to_string()
+            .contains("more than 4000000 pairs of shells overlap in their boxes"),
+        "{j}"
+    );
 }

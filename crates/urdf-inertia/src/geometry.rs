@@ -124,23 +124,55 @@ impl Aabb {
 
 /// Each pair of `boxes` whose ranges along x overlap (the second starts before the first ends),
 /// found by a sweep along x: `visit(a, b)` with `a` the box that starts first, until it breaks.
-/// The pairs the overlap checks of components and of shells go through; each applies its own test
-/// and its own limit.
+/// The pairs the overlap checks of components go through; each applies its own test and its own
+/// limit.
 pub(crate) fn x_sweep(
     boxes: &[Aabb],
+    visit: impl FnMut(usize, usize) -> std::ops::ControlFlow<()>,
+) -> std::ops::ControlFlow<()> {
+    sweep(boxes, 0, visit)
+}
+
+/// [`x_sweep`] along `axis`.
+pub(crate) fn sweep(
+    boxes: &[Aabb],
+    axis: usize,
     mut visit: impl FnMut(usize, usize) -> std::ops::ControlFlow<()>,
 ) -> std::ops::ControlFlow<()> {
-    let mut order: Vec<usize> = (0..boxes.len()).collect();
-    order.sort_by(|&a, &b| boxes[a].lo[0].total_cmp(&boxes[b].lo[0]));
+    let order = starts(boxes, axis);
     for (i, &a) in order.iter().enumerate() {
         for &b in &order[i + 1..] {
-            if boxes[b].lo[0] >= boxes[a].hi[0] {
+            if boxes[b].lo[axis] >= boxes[a].hi[axis] {
                 break;
             }
             visit(a, b)?;
         }
     }
     std::ops::ControlFlow::Continue(())
+}
+
+/// The boxes' numbers in the order of their starts along `axis` (ties in number order).
+pub(crate) fn starts(boxes: &[Aabb], axis: usize) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..boxes.len()).collect();
+    order.sort_by(|&a, &b| boxes[a].lo[axis].total_cmp(&boxes[b].lo[axis]));
+    order
+}
+
+/// How many pairs [`sweep`] along `axis` visits, from the sorted starts alone: for the box at place
+/// `i` of the order, the boxes that start before it ends, less itself and those before it (all of
+/// which start before it ends, but for boxes of no width starting where it starts: a count to
+/// choose an axis by, not a bound).
+pub(crate) fn sweep_visits(boxes: &[Aabb], axis: usize) -> u64 {
+    let order = starts(boxes, axis);
+    let lo: Vec<f64> = order.iter().map(|&b| boxes[b].lo[axis]).collect();
+    order
+        .iter()
+        .enumerate()
+        .map(|(i, &b)| {
+            let before_end = lo.partition_point(|&x| x < boxes[b].hi[axis]);
+            before_end.saturating_sub(i + 1) as u64
+        })
+        .sum()
 }
 
 #[cfg(test)]

@@ -149,7 +149,10 @@ impl<'a> Ladder<'a> {
             model.terms.push((s.overlap_bound, Lever::Anywhere));
             // Shells closed up to cracks add the volume their cracks leave undefined; with no
             // undecided pair that is all the bound is.
-            let text = if s.undecided_pairs > 0 {
+            let text = if s.overlap_bound.is_infinite() {
+                format!("more than {} pairs of shells overlap in their boxes (or the search for them ran past its budget of box tests): they are not decided, and the volume they may count twice is not bounded",
+                    s.undecided_pairs - 1)
+            } else if s.undecided_pairs > 0 {
                 format!("{} pair(s) of shells touch or cut each other (or are open) where their boxes overlap: the volume they may count twice, at most {:.2e} m³ (their boxes' intersections), is in the error estimate",
                     s.undecided_pairs, s.overlap_bound)
             } else {
