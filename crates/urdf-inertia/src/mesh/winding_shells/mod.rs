@@ -1001,7 +1001,7 @@ fn winding(vertices: &[[f64; 3]], tris: &[[u32; 3]], p: [f64; 3]) -> f64 {
 mod tests {
     use super::*;
 
-    /// The pairs found along the cheapest axis are x_sweep's, in its order, on random boxes (some of
+    /// The pairs found along the cheapest axis are `x_sweep`'s, in its order, on random boxes (some of
     /// no width, many with equal starts) laid out so that each axis is the cheapest in turn, and from the tree.
     #[test]
     fn box_pairs_are_the_x_sweeps() {
