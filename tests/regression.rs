@@ -24,6 +24,7 @@
 //! | later | a vertex on many edges made the closed-surface proof quadratic in its degree (18 s for a 500k-face cone) | `a_vertex_on_many_edges_is_proven_closed` (and the library's `long_buckets_give_what_the_scan_gives`, `long_buckets_prove_what_the_full_analysis_finds`, `searched_buckets_answer_as_scanned_ones`) |
 //! | later | corners crowding a cell of the tolerant weld's grid made it quadratic in them (12 s for a cloud of 40,000 triangles) | `a_cloud_of_crowded_corners_is_welded` (and the library's `crowded_blocks_weld_as_the_27_cell_scan`) |
 //! | later | shells nested in each other made the shells' classification quadratic in them, and past 20,000 pairs of overlapping boxes left unbounded (200 nested spheres 3.1 s) | `many_nested_shells_are_decided_exactly` (and the library's `many_nested_boxes_are_decided_exactly`, `the_tree_finds_what_all_pairs_find`) |
+//! | later | shells that all cut one another made the face-by-face decision grind through every pair of meeting triangles and every split's blockers (3,000 piled tetrahedra 148 s, 1.2 GB) | `piled_shells_are_left_undecided_not_ground_through` (and the library's `blockers_from_the_tree_are_the_grids`) |
 //! | later | shells whose boxes overlap along one or two axes but not in space (parts in rows) made the search for overlapping boxes quadratic in them (40,000 tetrahedra in a row 7.0 s); past 4,000,000 overlapping pairs, only those found were bounded | `parts_in_rows_are_paired_without_a_quadratic_search` (and the library's `box_pairs_are_the_x_sweeps`) |
 //!
 //! Item 12's self-intersecting and nested outward shells are the winding-number work's (its tests are
@@ -1419,6 +1420,12 @@ fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option
             "nested.stl",
             nested_boxes(1_000),
             "1,000 boxes nested in each other (499,500 pairs of shells whose boxes overlap)",
+            &[][..],
+        ),
+        (
+            "pile.stl",
+            piled_tetrahedra(3_000),
+            "3,000 tetrahedra piled on one another (2,545,224 pairs of shells cutting each other, about 70 M pairs of triangles meeting)",
             &[][..],
         ),
         (
@@ -3837,4 +3844,55 @@ fn parts_in_rows_are_paired_without_a_quadratic_search() {
             .contains("more than 4000000 pairs of shells overlap in their boxes"),
         "{j}"
     );
+}
+
+/// `n` tetrahedra piled on one another, each `1/1024` along x from the last: they share two
+/// planes and cut each other's slanted faces.
+fn piled_tetrahedra(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let (mut v, mut f) = (Vec::new(), Vec::new());
+    for i in 0..n {
+        let x = f64::from(i) / 1024.0;
+        v.extend([
+            [x, 0.0, 0.0],
+            [x + 1.0, 0.0, 0.0],
+            [x, 1.0, 0.0],
+            [x, 0.0, 1.0],
+        ]);
+        let b = 4 * i;
+        f.extend([
+            [b, b + 2, b + 1],
+            [b, b + 1, b + 3],
+            [b + 1, b + 2, b + 3],
+            [b, b + 3, b + 2],
+        ]);
+    }
+    (v, f)
+}
+
+/// Closed shells that all cut one another were decided face by face with no limit on the pairs of
+/// triangles that meet, and each split of a piece asked all of its hundreds of blockers again
+/// (250 piled tetrahedra, 1,000 triangles: 7.6 s; 3,000 of them: 148 s and 1.2 GB). The
+/// splits now stop after 2,000,000 blockers asked, and past 20,000,000 pairs of meeting triangles
+/// none is cut: the faces are left as they are, each with what it can change in the bound (here
+/// unbounded, as it was).
+#[test]
+fn piled_shells_are_left_undecided_not_ground_through() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (n, crowded) in [(250, false), (3_000, true)] {
+        let (v, f) = piled_tetrahedra(n);
+        let stl = stl_in(tmp.path(), "pile.stl", &v, &f);
+        let out = bin()
+            .args(["mesh", s(&stl), "--format", "json"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert!(j["error_estimate"].is_null(), "{n}: {j}");
+        let warnings = j["warnings"].to_string();
+        assert_eq!(
+            warnings.contains("their faces are left as they are, undecided (more than 20,000,000 pairs of their triangles meet, too many to cut)"),
+            crowded,
+            "{n}: {warnings}"
+        );
+    }
 }

@@ -198,7 +198,9 @@ impl<'a> Ladder<'a> {
             model
                 .terms
                 .push((s.resolved_bound, Lever::Ball(s.ball.0, s.ball.1)));
-            let what = if s.cut_rounding == s.resolved_bound {
+            let what = if s.crowded {
+                "they"
+            } else if s.cut_rounding == s.resolved_bound {
                 "the rounding of the cut points"
             } else if s.cut_rounding > 0.0 {
                 "the pieces along the cuts left undecided and the rounding of the cut points"
@@ -239,9 +241,17 @@ impl<'a> Ladder<'a> {
         } else {
             format!(", on the surface as stored: {}", stored.join(", "))
         };
+        let how = if s.crowded {
+            "their faces are left as they are, undecided (more than 20,000,000 pairs of their triangles meet, too many to cut)".to_string()
+        } else {
+            format!(
+                "their faces are decided piece by piece by the winding number on each side ({} triangle(s) cut by others and split{stored})",
+                s.cut_faces
+            )
+        };
         self.warn(HealthKind::Repaired, format!(
-            "{} pair(s) of closed shells touch or cut each other: their faces are decided piece by piece by the winding number on each side ({} triangle(s) cut by others and split{stored}){bound}",
-            s.resolved_pairs, s.cut_faces
+            "{} pair(s) of closed shells touch or cut each other: {how}{bound}",
+            s.resolved_pairs
         ));
     }
 

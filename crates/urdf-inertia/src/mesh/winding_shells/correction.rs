@@ -11,6 +11,7 @@
 //! the bound, twice when it may count twice.
 
 use super::cells::{area, cells, centroid, largest_coordinate, leaves_whole, split, CellWork, Cut, CutPlane};
+use super::bvh::Bvh;
 use super::grid::{Corners, Grid, Plane, Seen};
 use super::{corners_touch, edge_meets, overlap, EdgeUse};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
@@ -23,9 +24,29 @@ use std::collections::BinaryHeap;
 /// Splits (one piece into four) beyond which the pieces still cut are bounded, not split.
 const MAX_SPLITS: usize = 20_000;
 
+/// The blockers of the pieces split (each split asks each of the four children which of its
+/// piece's blockers meet it, then cuts the child along them) beyond which the pieces still cut
+/// are bounded, not split: about 0.7–1 µs each. Tetrahedra piled on one another (250 of them, each
+/// face blocked by hundreds of others, coplanar along two planes) spent 8 M of them in 20,000
+/// splits, 6–8 s for 1,000 triangles (3,000 tetrahedra: 148 s); the most a mesh of the corpus
+/// needs is 1.2 M (fourier gr1t1 `head_pitch_link.STL`, at the split limit; the next, 54 k).
+const MAX_SPLIT_BLOCKERS: usize = 2_000_000;
+
 /// Pieces that more planes than this would cut (a triangle's, or a coplanar triangle's three edges)
 /// are split in four first.
 const MAX_CUTS: usize = 40;
+
+/// Pairs of triangles whose grown boxes meet ([`Faces::all_blockers`]) beyond which none is cut:
+/// each triangle is left as classified, what it can change in the bound. 3,000 tetrahedra piled on
+/// one another (12,000 triangles, about 70 M such pairs) took 17 s and 1.2 GB; the most a mesh
+/// of the corpus asks is far below.
+const MAX_MEETING: usize = 20_000_000;
+
+/// [`Grid::crowding`] beyond which [`Faces::all_blockers`] takes its pairs from a tree, not from the
+/// grid's queries: each triangle's query reads every entry of the cells its box covers, so their
+/// cost is about the sum of the cells' entries squared. Tetrahedra piled on one another (1,000 of
+/// them, 4,000 triangles over one region) spent 17 s in those queries.
+const CROWDED_GRID: u64 = 50_000_000;
 
 /// A triangle whose plane is within this share of the diagonal of a piece everywhere on it is taken
 /// as lying in the piece's plane.
@@ -60,6 +81,8 @@ pub(super) struct Resolved {
     pub(super) rounding: f64,
     /// Triangles that other triangles cut (split into pieces).
     pub(super) cut: usize,
+    /// Whether every triangle was left undecided, more than [`MAX_MEETING`] pairs of them meeting.
+    pub(super) crowded: bool,
     /// Whether some face's orientation differs from the classification's.
     pub(super) changed: bool,
     /// Pieces decided from a neighbouring triangle's rays across an edge ([`Faces::joined_across`]).
@@ -168,16 +191,17 @@ pub(super) fn resolve(
     centre: [f64; 3],
     target: f64,
 ) -> Resolved {
-    resolve_with(vertices, tris, sign, (centre, target), true)
+    resolve_with(vertices, tris, sign, (centre, target), (true, CROWDED_GRID))
 }
 
-/// [`resolve`], joining pieces across edges ([`Faces::joined_across`]) when `join_across`.
+/// [`resolve`], joining pieces across edges ([`Faces::joined_across`]) when `join_across`, and
+/// finding the pairs of triangles that meet from a tree past `crowded` ([`Faces::all_blockers`]).
 fn resolve_with(
     vertices: &[[f64; 3]],
     tris: &[[u32; 3]],
     sign: &[i64],
     (centre, target): ([f64; 3], f64),
-    join_across: bool,
+    (join_across, crowded): (bool, u64),
 ) -> Resolved {
     let corners: Vec<Corners> = tris
         .iter()
@@ -214,16 +238,26 @@ fn resolve_with(
         cut_work: RefCell::new(CutWork::default()),
     };
     let mut seen = Seen::new(tris.len());
-    let blockers = f.all_blockers(&boxes, &mut seen);
+    let blockers = f.all_blockers(&boxes, crowded, &mut seen);
     let mut out = Resolved {
         faces: Polygons::new(),
         vertices: Vec::new(),
         bound: 0.0,
         rounding: 0.0,
-        cut: blockers.iter().filter(|b| !b.is_empty()).count(),
+        cut: blockers.as_ref().map_or(0, |b| b.iter().filter(|b| !b.is_empty()).count()),
+        crowded: blockers.is_none(),
         changed: false,
         joined_across: 0,
         moved: vec![(0.0, 0.0); tris.len()],
+    };
+    let Some(blockers) = blockers else {
+        // Each triangle as classified, the most it can change in the bound (as the pieces left
+        // when the splits run out).
+        for t in 0..tris.len() {
+            out.bound += f.delta(&f.corners[t], t as u32);
+            f.emit_whole(t as u32, sign[t], &mut out);
+        }
+        return out;
     };
     let mut heap = BinaryHeap::new();
     f.patches((&blockers, &uses), &mut seen, &mut out, &mut heap);
@@ -257,27 +291,51 @@ impl Faces<'_> {
     /// one's query over a box grown enough to hold both conditions (the margin twice, and the
     /// rounding of the coordinates), and each condition is then checked as stated; the lists of
     /// two or more are put back in the order of the grid's query over `t`'s grown box (sorted by
-    /// [`Grid::first_shared_cell`], not asked again).
-    fn all_blockers(&self, boxes: &[Aabb], seen: &mut Seen) -> Vec<Vec<u32>> {
+    /// [`Grid::first_shared_cell`], not asked again). `None` past [`MAX_MEETING`] pairs.
+    fn all_blockers(&self, boxes: &[Aabb], crowded: u64, seen: &mut Seen) -> Option<Vec<Vec<u32>>> {
         let n = self.tris.len();
         let grown: Vec<Aabb> = boxes.iter().map(|b| inflated(*b, self.margin)).collect();
         let Aabb { lo, hi } = self.grid.bounds;
         let largest = (0..3).map(|k| lo[k].abs().max(hi[k].abs())).fold(0.0, f64::max);
         let pad = 2.0 * self.margin + 4.0 * f64::EPSILON * largest;
         let mut out = vec![Vec::new(); n];
-        let mut near = Vec::new();
-        for t in 0..n {
-            self.grid
-                .overlapping(&inflated(boxes[t], pad), Some(t as u32), seen, &mut near);
-            for &u in &near {
-                let u = u as usize;
-                let asked = (overlap(&grown[t], &boxes[u]), overlap(&grown[u], &boxes[t]));
-                let (tu, ut) = self.blocks_both(t, u, asked);
-                if tu {
-                    out[t].push(u as u32);
+        let mut meeting = 0;
+        let mut pair = |t: usize, u: usize| {
+            meeting += 1;
+            let asked = (overlap(&grown[t], &boxes[u]), overlap(&grown[u], &boxes[t]));
+            let (tu, ut) = self.blocks_both(t, u, asked);
+            if tu {
+                out[t].push(u as u32);
+            }
+            if ut {
+                out[u].push(t as u32);
+            }
+            meeting
+        };
+        if self.grid.crowding() > crowded {
+            // The same pairs from a tree of the grown boxes (a superset, each then asked as the
+            // grid asks it), in another order, which the sort below undoes.
+            let padded: Vec<Aabb> = boxes.iter().map(|b| inflated(*b, pad)).collect();
+            let own: Vec<u32> = (0..n as u32).collect();
+            let all = Bvh::new(padded, &own).pairs(|i, j| {
+                let (t, u) = (i.min(j) as usize, i.max(j) as usize);
+                if overlap(&inflated(boxes[t], pad), &boxes[u]) && pair(t, u) > MAX_MEETING {
+                    return std::ops::ControlFlow::Break(());
                 }
-                if ut {
-                    out[u].push(t as u32);
+                std::ops::ControlFlow::Continue(())
+            });
+            if all.is_break() {
+                return None;
+            }
+        } else {
+            let mut near = Vec::new();
+            for t in 0..n {
+                self.grid
+                    .overlapping(&inflated(boxes[t], pad), Some(t as u32), seen, &mut near);
+                for &u in &near {
+                    if pair(t, u as usize) > MAX_MEETING {
+                        return None;
+                    }
                 }
             }
         }
@@ -292,7 +350,7 @@ impl Faces<'_> {
                 list.extend(keyed.iter().map(|&(_, u)| u));
             }
         }
-        out
+        Some(out)
     }
 
     /// [`Faces::blocks`] of `t` by `u` and of `u` by `t`, each when `asked`, with what the two
@@ -456,11 +514,12 @@ impl Faces<'_> {
     /// Splits the pieces that may change the most until those left change at most `target`.
     fn refine(&self, mut heap: BinaryHeap<Piece>, target: f64, seen: &mut Seen, out: &mut Resolved) {
         let mut pending: f64 = heap.iter().map(|p| p.delta).sum();
-        let mut splits = 0;
-        while pending > target && splits < MAX_SPLITS {
+        let (mut splits, mut asked) = (0, 0);
+        while pending > target && splits < MAX_SPLITS && asked < MAX_SPLIT_BLOCKERS {
             let Some(p) = heap.pop() else { break };
             pending -= p.delta;
             splits += 1;
+            asked += p.blockers.len();
             for child in split(p.corners) {
                 // Each midpoint is rounded once (a sum, then an exact halving): within 2 ε of its
                 // largest coordinate, twice that here.
@@ -1783,14 +1842,43 @@ mod tests {
         push_sphere(&mut vertices, &mut tris, [0.0; 3], 1.0, 24);
         push_sphere(&mut vertices, &mut tris, [0.83, 0.21, 0.13], 0.7, 20);
         let signs = vec![1; tris.len()];
-        let joined = resolve_with(&vertices, &tris, &signs, ([0.4, 0.1, 0.1], 0.0), true);
-        let alone = resolve_with(&vertices, &tris, &signs, ([0.4, 0.1, 0.1], 0.0), false);
+        let joined = resolve_with(&vertices, &tris, &signs, ([0.4, 0.1, 0.1], 0.0), (true, CROWDED_GRID));
+        let alone = resolve_with(&vertices, &tris, &signs, ([0.4, 0.1, 0.1], 0.0), (false, CROWDED_GRID));
         assert_eq!(alone.joined_across, 0);
         assert!(joined.joined_across * 2 > joined.cut, "{} of {}", joined.joined_across, joined.cut);
         assert_eq!((joined.bound, alone.bound), (0.0, 0.0));
         let faces = |r: &Resolved| r.faces.iter().map(<[u32]>::to_vec).collect::<Vec<_>>();
         assert!(faces(&joined) == faces(&alone), "the faces emitted differ");
         assert!(joined.vertices == alone.vertices, "the pieces' corners differ");
+    }
+
+    /// The pairs of triangles that meet, from the tree and from the grid: the same blockers in the
+    /// same order, so the same faces, corners and bound (spheres cutting each other, and a pile of
+    /// coplanar, crossing tetrahedra).
+    #[test]
+    fn blockers_from_the_tree_are_the_grids() {
+        let (mut vertices, mut tris) = (Vec::new(), Vec::new());
+        push_sphere(&mut vertices, &mut tris, [0.0; 3], 1.0, 24);
+        push_sphere(&mut vertices, &mut tris, [0.83, 0.21, 0.13], 0.7, 20);
+        let spheres = (vertices, tris);
+        let (mut vertices, mut tris) = (Vec::new(), Vec::new());
+        for i in 0..40u32 {
+            let x = f64::from(i) / 64.0;
+            vertices.extend([[x, 0.0, 0.0], [x + 1.0, 0.0, 0.0], [x, 1.0, 0.0], [x, 0.0, 1.0]]);
+            let b = 4 * i;
+            tris.extend([[b, b + 2, b + 1], [b, b + 1, b + 3], [b + 1, b + 2, b + 3], [b, b + 3, b + 2]]);
+        }
+        for (vertices, tris) in [spheres, (vertices, tris)] {
+            let signs = vec![1; tris.len()];
+            let at = ([0.4, 0.1, 0.1], 0.0);
+            let grid = resolve_with(&vertices, &tris, &signs, at, (true, u64::MAX));
+            let tree = resolve_with(&vertices, &tris, &signs, at, (true, 0));
+            assert!(grid.cut > 0 && !grid.crowded && !tree.crowded);
+            assert_eq!((grid.cut, grid.bound, grid.rounding), (tree.cut, tree.bound, tree.rounding));
+            let faces = |r: &Resolved| r.faces.iter().map(<[u32]>::to_vec).collect::<Vec<_>>();
+            assert!(faces(&grid) == faces(&tree), "the faces emitted differ");
+            assert!(grid.vertices == tree.vertices, "the pieces' corners differ");
+        }
     }
 
     /// A triangle of area 8 with a smaller one turned the other way lying in its plane (area

@@ -177,6 +177,12 @@ impl Grid {
         });
     }
 
+    /// The sum over the cells of their entries squared: about what querying each entry's box costs
+    /// ([`Grid::overlapping`] reads every entry of each cell it visits).
+    pub(super) fn crowding(&self) -> u64 {
+        self.start.windows(2).map(|w| u64::from(w[1] - w[0]).pow(2)).sum()
+    }
+
     /// How many cells [`Grid::overlapping`] visits for a query box `b`.
     pub(super) fn cells_in(&self, b: &Aabb) -> usize {
         (0..3).map(|k| self.index(k, b.hi[k]) - self.index(k, b.lo[k]) + 1).product()
