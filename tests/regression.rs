@@ -3890,7 +3890,7 @@ fn piled_shells_are_left_undecided_not_ground_through() {
         assert!(j["error_estimate"].is_null(), "{n}: {j}");
         let warnings = j["warnings"].to_string();
         assert_eq!(
-            warnings.contains("their faces are left as they are, undecided (more than 20,000,000 pairs of their triangles meet, too many to cut)"),
+            warnings.contains("their 12000 triangle(s) are left as they are, undecided (more than 20,000,000 pairs of them meet, too many to cut)"),
             crowded,
             "{n}: {warnings}"
         );

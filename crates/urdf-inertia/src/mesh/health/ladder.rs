@@ -198,7 +198,7 @@ impl<'a> Ladder<'a> {
             model
                 .terms
                 .push((s.resolved_bound, Lever::Ball(s.ball.0, s.ball.1)));
-            let what = if s.crowded {
+            let what = if s.crowded > 0 {
                 "they"
             } else if s.cut_rounding == s.resolved_bound {
                 "the rounding of the cut points"
@@ -241,8 +241,11 @@ impl<'a> Ladder<'a> {
         } else {
             format!(", on the surface as stored: {}", stored.join(", "))
         };
-        let how = if s.crowded {
-            "their faces are left as they are, undecided (more than 20,000,000 pairs of their triangles meet, too many to cut)".to_string()
+        let how = if s.crowded > 0 {
+            format!(
+                "their {} triangle(s) are left as they are, undecided (more than 20,000,000 pairs of them meet, too many to cut)",
+                s.crowded
+            )
         } else {
             format!(
                 "their faces are decided piece by piece by the winding number on each side ({} triangle(s) cut by others and split{stored})",

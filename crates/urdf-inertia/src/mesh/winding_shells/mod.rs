@@ -103,8 +103,8 @@ pub struct ShellOutcome {
     pub resolved_bound: f64,
     /// The part of `resolved_bound` that the rounding of the cut points can change, m³.
     pub cut_rounding: f64,
-    /// Whether the triangles were left undecided whole, too many meeting to cut them.
-    pub crowded: bool,
+    /// Triangles left undecided whole, too many of them meeting to cut them (0 when they were cut).
+    pub crowded: usize,
     pub ball: ([f64; 3], f64),
     /// The pieces' corners, numbered on from the surface's vertices.
     pub vertices: Vec<[f64; 3]>,
@@ -480,7 +480,7 @@ fn resolve_pairs(
     out.vertices = r.vertices;
     out.resolved_bound = r.bound + swept + r.rounding;
     out.cut_rounding = r.rounding;
-    out.crowded = r.crowded;
+    out.crowded = if r.crowded { all.len() } else { 0 };
     out.ball = (centre, bounds.diagonal() / 2.0);
     out.cut_faces = r.cut;
     out.changed |= r.changed;
