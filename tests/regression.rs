@@ -1424,7 +1424,7 @@ fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option
         ),
         (
             "pile.stl",
-            piled_tetrahedra(3_000),
+            piled_tetrahedra(3_000, 1.0 / 1024.0),
             "3,000 tetrahedra piled on one another (2,545,224 pairs of shells cutting each other, about 70 M pairs of triangles meeting)",
             &[][..],
         ),
@@ -3814,23 +3814,7 @@ fn parts_in_rows_are_paired_without_a_quadratic_search() {
     // 3,000 tetrahedra piled on one another (4,498,500 pairs of overlapping boxes, past the
     // 4,000,000 decided): not bounded, where the pairs found before the search stopped were
     // summed as if they were all.
-    let (mut v, mut f) = (Vec::new(), Vec::new());
-    for i in 0..3_000u32 {
-        let x = f64::from(i) / 16_384.0;
-        v.extend([
-            [x, 0.0, 0.0],
-            [x + 1.0, 0.0, 0.0],
-            [x, 1.0, 0.0],
-            [x, 0.0, 1.0],
-        ]);
-        let b = 4 * i;
-        f.extend([
-            [b, b + 2, b + 1],
-            [b, b + 1, b + 3],
-            [b + 1, b + 2, b + 3],
-            [b, b + 3, b + 2],
-        ]);
-    }
+    let (v, f) = piled_tetrahedra(3_000, 1.0 / 16_384.0);
     let stl = stl_in(tmp.path(), "pile.stl", &v, &f);
     let out = bin()
         .args(["mesh", s(&stl), "--format", "json"])
@@ -3846,12 +3830,12 @@ fn parts_in_rows_are_paired_without_a_quadratic_search() {
     );
 }
 
-/// `n` tetrahedra piled on one another, each `1/1024` along x from the last: they share two
+/// `n` tetrahedra piled on one another, each `apart` along x from the last: they share two
 /// planes and cut each other's slanted faces.
-fn piled_tetrahedra(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+fn piled_tetrahedra(n: u32, apart: f64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
     let (mut v, mut f) = (Vec::new(), Vec::new());
     for i in 0..n {
-        let x = f64::from(i) / 1024.0;
+        let x = f64::from(i) * apart;
         v.extend([
             [x, 0.0, 0.0],
             [x + 1.0, 0.0, 0.0],
@@ -3879,7 +3863,7 @@ fn piled_tetrahedra(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
 fn piled_shells_are_left_undecided_not_ground_through() {
     let tmp = tempfile::tempdir().unwrap();
     for (n, crowded) in [(250, false), (3_000, true)] {
-        let (v, f) = piled_tetrahedra(n);
+        let (v, f) = piled_tetrahedra(n, 1.0 / 1024.0);
         let stl = stl_in(tmp.path(), "pile.stl", &v, &f);
         let out = bin()
             .args(["mesh", s(&stl), "--format", "json"])
