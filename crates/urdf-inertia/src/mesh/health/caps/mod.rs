@@ -6,7 +6,6 @@ use super::model::Lever;
 use crate::geometry::{cross, dot, norm, sub};
 use crate::mass::Polygons;
 use plane_boxes::PlaneBoxes;
-use rustc_hash::FxHashMap;
 
 mod cells;
 mod plane_boxes;
@@ -24,13 +23,9 @@ pub(super) struct Caps {
     pub(super) bound: f64,
     /// Total area of the caps, m².
     pub(super) area: f64,
-    /// Where the caps' uncertainty [`Caps::bound`] sits: the vertices of the loops closed and the
-    /// caps' centres, or the corners of the box of the cells [`cells::certify`] left uncertified.
-    pub(super) points: Vec<[f64; 3]>,
-    /// The vertices of the loops closed and the caps' centres.
+    /// The vertices of the loops closed and the caps' centres: where the flatness term
+    /// [`Caps::bound`] sits.
     loop_vertices: Vec<[f64; 3]>,
-    /// The caps' triangles as (centre, b, a), for [`cells::certify`].
-    triangles: Vec<[[f64; 3]; 3]>,
     /// Each cap's shape, for [`Caps::interaction`].
     loops: Vec<CapShape>,
     /// What the caps seeing each other can change ([`Caps::interaction`]), set once all are closed.
@@ -75,7 +70,53 @@ const CERTIFIED_ENOUGH: f64 = 1e-5;
 
 /// A boundary edge out of a vertex: the other end, the edge's number, and whether the mesh directs
 /// it that way.
-type Step = (u32, usize, bool);
+type Step = (u32, u32, bool);
+
+/// Each vertex's boundary edges, as [`cap_holes`] walks them: those the mesh directs out of it in
+/// the edges' order, then those into it. One flat array with each vertex's start (a counting
+/// sort), not a map of vectors: a hole of a million edges cost a million small vectors and a map
+/// of them (figures: docs/benchmarks.md, "Figures behind choices in the code").
+struct BoundarySteps {
+    /// Where each vertex's steps start, as offsets into `steps` (one more than the vertices).
+    start: Vec<u32>,
+    steps: Vec<Step>,
+}
+
+impl BoundarySteps {
+    fn new(half: &[(u32, u32)]) -> Self {
+        let n = half.iter().map(|&(u, v)| u.max(v) as usize + 1).max().unwrap_or(0);
+        let mut start = vec![0u32; n + 1];
+        for &(u, v) in half {
+            start[u as usize + 1] += 1;
+            start[v as usize + 1] += 1;
+        }
+        for k in 0..n {
+            start[k + 1] += start[k];
+        }
+        let mut fill = start.clone();
+        let mut steps = vec![(0, 0, false); 2 * half.len()];
+        let mut put = |at: u32, step: Step| {
+            steps[fill[at as usize] as usize] = step;
+            fill[at as usize] += 1;
+        };
+        for (i, &(u, v)) in (0u32..).zip(half) {
+            put(u, (v, i, true));
+        }
+        for (i, &(u, v)) in (0u32..).zip(half) {
+            put(v, (u, i, false));
+        }
+        BoundarySteps { start, steps }
+    }
+
+    /// The steps out of vertex `at` (none for a vertex on no boundary edge).
+    fn of(&self, at: u32) -> &[Step] {
+        let at = at as usize;
+        match (self.start.get(at), self.start.get(at + 1)) {
+            (Some(&a), Some(&b)) => &self.steps[a as usize..b as usize],
+            _ => &[],
+        }
+    }
+}
 
 /// Closes every boundary loop of `faces` with a fan from the loop's centroid, wound against the loop's
 /// edges so the result is consistently oriented. The volume uncertainty bound ([`Caps::certify`]):
@@ -91,16 +132,11 @@ pub(super) fn cap_holes(vertices: &[[f64; 3]], half: &[(u32, u32)]) -> Option<Ca
     }
     // Walk boundary edges as undirected (cracks and slivers often have both sides in one direction),
     // preferring the mesh's own direction; each cap triangle is wound against its own edge.
-    // Each vertex's boundary edges, and where in its list the unused ones start: edges are only
-    // ever marked used, so the walk's "first unused edge" is found from there, not from the list's
-    // start (which made a vertex on many boundary edges quadratic in their number).
-    let mut out_of: FxHashMap<u32, (usize, Vec<Step>)> = FxHashMap::default();
-    for (i, &(u, v)) in half.iter().enumerate() {
-        out_of.entry(u).or_default().1.push((v, i, true));
-    }
-    for (i, &(u, v)) in half.iter().enumerate() {
-        out_of.entry(v).or_default().1.push((u, i, false));
-    }
+    let out_of = BoundarySteps::new(half);
+    // Where in each vertex's steps the unused ones start: edges are only ever marked used, so the
+    // walk's "first unused edge" is found from there, not from the list's start (which made a
+    // vertex on many boundary edges quadratic in their number).
+    let mut from = vec![0u32; out_of.start.len()];
     let mut used = vec![false; half.len()];
     let base = vertices.len() as u32;
     let mut caps = Caps {
@@ -110,9 +146,7 @@ pub(super) fn cap_holes(vertices: &[[f64; 3]], half: &[(u32, u32)]) -> Option<Ca
         cracks: 0,
         bound: 0.0,
         area: 0.0,
-        points: Vec::new(),
         loop_vertices: Vec::new(),
-        triangles: Vec::new(),
         loops: Vec::new(),
         interaction: Interaction {
             volume: 0.0,
@@ -130,16 +164,16 @@ pub(super) fn cap_holes(vertices: &[[f64; 3]], half: &[(u32, u32)]) -> Option<Ca
         let mut at = half[start].1;
         let mut closed = true;
         while at != half[start].0 {
-            let Some((next, i, forward)) = out_of.get_mut(&at).and_then(|(from, o)| {
-                while o.get(*from).is_some_and(|e| used[e.1]) {
-                    *from += 1;
-                }
-                o.get(*from).copied()
-            }) else {
+            let o = out_of.of(at);
+            let first = &mut from[at as usize];
+            while o.get(*first as usize).is_some_and(|e| used[e.1 as usize]) {
+                *first += 1;
+            }
+            let Some(&(next, i, forward)) = o.get(*first as usize) else {
                 closed = false;
                 break;
             };
-            used[i] = true;
+            used[i as usize] = true;
             let (mu, mv) = if forward { (at, next) } else { (next, at) };
             steps.push((at, mu, mv));
             at = next;
@@ -153,14 +187,15 @@ pub(super) fn cap_holes(vertices: &[[f64; 3]], half: &[(u32, u32)]) -> Option<Ca
         caps.close(vertices, base, &steps);
     }
     // What cracks leave open is accounted for by the caller: the capped surface's vector area.
-    caps.points = caps.loop_vertices.clone();
     let b = crate::geometry::Aabb::of(vertices.iter().copied());
-    caps.certify(CERTIFIED_ENOUGH * (0..3).map(|k| b.hi[k] - b.lo[k]).product::<f64>());
+    let enough = CERTIFIED_ENOUGH * (0..3).map(|k| b.hi[k] - b.lo[k]).product::<f64>();
+    caps.certify(vertices, base, enough);
     Some(caps)
 }
 
 impl Caps {
-    /// Sets [`Caps::bound`], [`Caps::interaction`] and [`Caps::points`] once every hole is closed.
+    /// Sets [`Caps::interaction`] and, when they bound more, the certified cells once every hole is
+    /// closed.
     ///
     /// Flat caps (every loop in its plane, exactly): one hole is exact, several are bounded by
     /// [`Caps::interaction`]. (The cells bound them too, sometimes with less volume, but their
@@ -173,7 +208,7 @@ impl Caps {
     /// example-robot-data whose shells cut each other is off by more than the cells' bound and
     /// was covered only by the terms), so the terms are never undercut; the cells widen them
     /// where they are too small.
-    fn certify(&mut self, enough: f64) {
+    fn certify(&mut self, vertices: &[[f64; 3]], base: u32, enough: f64) {
         let flat = self.loops.iter().all(|c| c.deviation == 0.0);
         self.interaction = self.interaction();
         if flat {
@@ -184,7 +219,15 @@ impl Caps {
         // and which the ladder's overlapping shells may break: the larger stays honest where
         // today's terms were, and the certification stops once it is below them or `enough`.
         let terms = self.bound + self.interaction.volume;
-        let cert = cells::certify(&self.triangles, terms.max(enough));
+        // The caps' triangles as (centre, b, a), from their faces (kept only when needed: 72 MB
+        // for a hole of a million edges, flat and so never certified).
+        let triangles: Vec<[[f64; 3]; 3]> = (self.faces.iter())
+            .map(|f| {
+                let c = self.centroids[(f[0] - base) as usize];
+                [c, vertices[f[1] as usize], vertices[f[2] as usize]]
+            })
+            .collect();
+        let cert = cells::certify(&triangles, terms.max(enough));
         if cert.volume <= terms {
             return;
         }
@@ -207,7 +250,7 @@ impl Caps {
         let parts = if let Some(cells) = &self.cells {
             cells
         } else {
-            terms.push((self.bound, Lever::Near(self.points.clone())));
+            terms.push((self.bound, Lever::Near(self.loop_vertices.clone())));
             &self.interaction
         };
         if parts.volume.is_finite() {
@@ -237,8 +280,6 @@ impl Caps {
         for &(_, a, b) in steps {
             // The mesh has a → b on its boundary; the cap runs b → a.
             self.faces.push(&[ci, b, a]);
-            self.triangles
-                .push([c, vertices[b as usize], vertices[a as usize]]);
             let x = cross(sub(vertices[b as usize], c), sub(vertices[a as usize], c));
             for k in 0..3 {
                 area[k] += 0.5 * x[k];
@@ -660,9 +701,7 @@ mod tests {
             cracks: 0,
             bound: 0.0,
             area: 0.0,
-            points: Vec::new(),
             loop_vertices: Vec::new(),
-            triangles: Vec::new(),
             loops: Vec::new(),
             interaction: Interaction {
                 volume: 0.0,
