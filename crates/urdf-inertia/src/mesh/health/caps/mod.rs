@@ -516,14 +516,18 @@ impl Caps {
     /// deviation about it, exact when the centre stays put (bit for bit: the same maxima of the same
     /// numbers) and bounded when it moves.
     ///
-    /// Computed in f64, a point's distance from the centre and from the plane are within 5ε of
-    /// their exact values relative to its exact distance (one rounding per coordinate difference,
-    /// product and sum, and a square root), plus underflow's absolute 1e-161; where no difference
-    /// reaches 1e150 nothing overflows. A centre that moves by d (computed) moves each exact
-    /// distance by at most d (exact, within the same 5ε), so the computed radius about the new
-    /// centre is at most (hi + d)(1 + 1e-12) + 1e-150 ([`widened`]), hi the bound about the old
-    /// one; the deviation is likewise, its rounding relative to the radii before and after (the
-    /// 1e-12 × their sum), and both bounds become infinite past 1e150.
+    /// Why the bounds after a move hold (ε = 2⁻⁵³): a point p's computed distance from the
+    /// centre C is within 5ε of |p − C| relative to it (a rounding in each difference, square and
+    /// sum, and in the square root), and its computed distance from the plane within 5ε·|p − C|
+    /// of |(p − C)·n| (n the stored normal, |n| ≤ 1 + 2ε); underflow adds at most 1e-161 to
+    /// either, and nothing overflows while the bounds stay below 1e150. When the centre moves to
+    /// C′, every exact distance moves by at most |C′ − C|, itself within 5ε (and 1e-161) of the
+    /// computed d. So the computed radius about C′ is at most (1 + 5ε)((hi + 1e-161)/(1 − 5ε) +
+    /// (1 + 5ε)d + 1e-161) + 1e-161, hi the bound about C, which (hi + d)(1 + 1e-12) + 1e-150
+    /// exceeds even as rounded in f64 (three roundings of ε each: [`widened`]); the deviation
+    /// likewise, with 5ε of the radius about C and about C′ added before widening (1e-12 × the sum
+    /// of their bounds). Past 1e150 (or NaN) a bound is infinite: the tolerance is then decided
+    /// exactly.
     fn merge(&self, g: &mut Group, k: usize) {
         let c = &self.loops[k];
         g.members.push(k);
