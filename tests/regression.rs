@@ -20,12 +20,13 @@
 //! | 11 | temp files left by catchable signals and SIGXFSZ; 250-byte names; an edit lost during `fill -i`; `-i /dev/stdin` | `every_ending_signal_removes_the_temp_file`, `temp_file_has_the_targets_mode_and_is_removed_on_sigterm`, `file_size_limit_is_a_write_error`, `unchanged_output_is_not_written_and_long_names_fill_in_place`, `edit_during_fill_in_place_is_kept`, `fill_in_place_on_stdin_is_refused` |
 //! | 12 | two `<robot>` roots; CR-only line ends; UTF-32 and mark-less UTF-16; upper-case ASCII STL | `second_robot_root_is_left_alone`, `cr_only_urdf_keeps_its_line_ends_and_lines`, `utf16_without_a_mark_is_read_and_utf32_is_named`, `upper_case_ascii_stl_is_read_as_ascii` |
 //! | later | a book of triangles on one edge made capping quadratic in its pages (36 s for 200,000) | `a_book_of_many_pages_is_refused` |
-//! | later | many holes in one flat side made the caps' coplanar grouping quadratic in them (6 s for a plate with 10,000 holes through it) | `a_plate_of_many_holes_is_capped` (and the library's `merged_one_at_a_time_is_merged_in_full`) |
+//! | later | many holes in one flat side made the caps' coplanar grouping quadratic in them (6 s for a plate with 10,000 holes through it) | `a_plate_of_many_holes_is_capped` (and the library's `coplanar_groups_are_as_before`) |
 //! | later | a vertex on many edges made the closed-surface proof quadratic in its degree (18 s for a 500k-face cone) | `a_vertex_on_many_edges_is_proven_closed` (and the library's `long_buckets_give_what_the_scan_gives`, `long_buckets_prove_what_the_full_analysis_finds`, `searched_buckets_answer_as_scanned_ones`) |
 //! | later | corners crowding a cell of the tolerant weld's grid made it quadratic in them (12 s for a cloud of 40,000 triangles) | `a_cloud_of_crowded_corners_is_welded` (and the library's `crowded_blocks_weld_as_the_27_cell_scan`) |
 //! | later | shells nested in each other made the shells' classification quadratic in them, and past 20,000 pairs of overlapping boxes left unbounded (200 nested spheres 3.1 s) | `many_nested_shells_are_decided_exactly` (and the library's `many_nested_boxes_are_decided_exactly`, `the_tree_finds_what_all_pairs_find`) |
 //! | later | shells that all cut one another made the face-by-face decision grind through every pair of meeting triangles and every split's blockers (3,000 piled tetrahedra 148 s, 1.2 GB) | `piled_shells_are_left_undecided_not_ground_through` (and the library's `blockers_from_the_tree_are_the_grids`) |
 //! | later | shells whose boxes overlap along one or two axes but not in space (parts in rows) made the search for overlapping boxes quadratic in them (40,000 tetrahedra in a row 7.0 s); past 4,000,000 overlapping pairs, only those found were bounded | `parts_in_rows_are_paired_without_a_quadratic_search` (and the library's `box_pairs_are_the_x_sweeps`) |
+//! | later | holes in a row made the caps' coplanar grouping quadratic in them again (5.3 s for a strip of 20,000); one hole of a million edges cost 8 times the closed mesh's time and memory | `a_strip_of_many_holes_is_refused`, `a_hole_of_many_edges_is_capped` (and the library's `coplanar_groups_are_as_before`) |
 //!
 //! Item 12's self-intersecting and nested outward shells are the winding-number work's (its tests are
 //! in `tests/winding_truth.rs`). docs/reliability.md has a row for each input above.
@@ -1091,6 +1092,93 @@ fn a_book_of_many_pages_is_refused() {
     }
 }
 
+/// A flat sheet 3 × (2k + 1) unit squares, each split in two triangles, with `k` square holes
+/// (every other square of its middle row): the holes in a row, so the box of their caps grows
+/// with each one.
+fn strip_of_holes(k: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let n = 2 * k + 1;
+    let at = |i: u32, j: u32| i * 4 + j;
+    let mut v = Vec::new();
+    for i in 0..=n {
+        for j in 0..4 {
+            v.push([f64::from(i), f64::from(j), 0.0]);
+        }
+    }
+    let mut f = Vec::new();
+    for i in 0..n {
+        for j in 0..3 {
+            if j == 1 && i % 2 == 1 {
+                continue;
+            }
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            f.push([a, b, c]);
+            f.push([a, c, d]);
+        }
+    }
+    (v, f)
+}
+
+/// A strip of 20,000 holes in a row took 5.3 s: the caps of the flat sheet form one coplanar
+/// group, whose box grows (and its centre moves) with each hole, and each move went over every
+/// member again for the group's radius and deviation, and each hole's box was tested against
+/// every member's. The radius and deviation are now bounded after a move and computed once at the
+/// end, and the boxes are found from a grid. The sheet encloses nothing, so it is refused, by
+/// default and with caps.
+#[test]
+fn a_strip_of_many_holes_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (v, f) = strip_of_holes(50_000);
+    let stl = stl_in(tmp.path(), "strip.stl", &v, &f);
+    for extra in [&[][..], &["--open-mesh", "caps"][..]] {
+        let out = bin().arg("mesh").arg(&stl).args(extra).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        let err = stderr(&out);
+        assert!(
+            err.contains("strip.stl: the mesh encloses no volume (0 m³ against a bounding box of 0 m³): it is flat or degenerate"),
+            "{err}"
+        );
+    }
+}
+
+/// A cone of `n` triangles from the apex (1, 0, 0) to a ring of `n` points in the plane x = 0,
+/// without its base: one hole of `n` boundary edges.
+fn open_cone(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let (v, f) = cone(n);
+    (v, f.into_iter().filter(|t| t[0] == 0).collect())
+}
+
+/// A cone open at its base (one hole of a million edges) took 8 times the closed cone's time and
+/// memory: the boundary walk kept a map of a vector per boundary vertex, and the caps kept their
+/// triangles though flat caps are never certified. The walk now uses one flat adjacency in the same
+/// order. The base is capped flat, exactly: the capped solid is the closed cone whatever point in
+/// the base plane its fan starts from, so its volume is the exact rational integral of the stored
+/// (f32) closed cone.
+#[test]
+fn a_hole_of_many_edges_is_capped() {
+    let tmp = tempfile::tempdir().unwrap();
+    let n = 250_000;
+    let (v, f) = open_cone(n);
+    let stl = stl_in(tmp.path(), "open.stl", &v, &f);
+    let (v, closed) = cone(n);
+    let stored: Vec<[f64; 3]> = v.iter().map(|p| p.map(|x| f64::from(x as f32))).collect();
+    let exact = common::exact_mass(&common::exact_integrals(&stored, &closed));
+    let out = bin()
+        .args(["mesh", s(&stl), "--format", "json", "--digits", "full"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["provenance"], "capped", "{j}");
+    let volume = j["volume"].as_f64().unwrap();
+    assert!(common::rel_error(volume, &exact.volume) < 1e-12, "{volume}");
+    let x = j["center_of_mass"][0].as_f64().unwrap();
+    assert!(common::rel_error(x, &exact.com[0]) < 1e-12, "{x}");
+    assert!(
+        (j["notes"].to_string()).contains("open (250000 boundary edges): closed its 1 hole(s)"),
+        "{j}"
+    );
+}
+
 /// A slab `m` × `m` × 1 (`m` = 2⌈√k⌉ + 1 unit cells a side) pierced by `k` unit square holes that
 /// have no walls: `k` holes in its top face and `k` in its bottom one, each face one flat region.
 fn perforated_plate(k: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
@@ -1432,6 +1520,18 @@ fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option
             "rows.stl",
             parts_in_rows(15_000, true),
             "45,000 boxes in three rows (each row's boxes overlapping two by two along two axes, none in space)",
+            &[][..],
+        ),
+        (
+            "strip.stl",
+            strip_of_holes(100_000),
+            "a flat strip of 100,000 holes in a row (one coplanar group whose box grows with each cap)",
+            &["--open-mesh", "caps"][..],
+        ),
+        (
+            "opencone.stl",
+            open_cone(1_000_000),
+            "a cone of 1,000,000 faces open at its base (one hole of 1,000,000 edges)",
             &[][..],
         ),
     ];
