@@ -535,10 +535,10 @@ fn along_the_diagonal(delta: f64, turn: f64, (len, width): (f64, f64), theta: f6
 /// 0.3 long counted on the wrong side, while the face itself was cut along the wall exactly. The
 /// decided surface is open there, which the estimate's round-off term (the volume integrated about
 /// two points) would catch but for the mirrored tetrahedron, whose sliver on the opposite wall
-/// cancels it: 1e-7 off under an estimate of 2.6e-8. The tetrahedra alone (no mirror), a face of
-/// moderate angles, and a line turned off the diagonal or along the bottom edge are the same
-/// mechanism; the estimate now holds the band beside each plane that left a piece whole within
-/// the margin.
+/// cancels it: 7.0e-8 off under an estimate of 1.8e-8 (now 1.8e-5). The tetrahedra alone (no
+/// mirror), a face of moderate angles, and a line turned off the diagonal or along the bottom edge
+/// are the same mechanism; the estimate now holds the area of the sliver beyond each plane that
+/// left a piece or cell whole within the margin.
 #[test]
 fn slivers_left_whole_within_the_margin_are_within_the_estimate() {
     let diagonal = |delta, thin: (f64, f64), theta| along_the_diagonal(delta, 0.0, thin, theta);
@@ -630,9 +630,11 @@ fn touching_boxes(s: [f64; 5], (scale, offset): (f64, f64)) -> Option<(f64, f64)
 /// The decision margin's sweep: 2,000 random cases of tetrahedra through a box's wall whose faces
 /// cross its triangles within the margin (one, or two to four, each mirrored through the box's
 /// centre or not) and of two boxes side by side, each coinciding side off by less than the
-/// margin; parts of 1 mm to 30 m, 0 to 3e5 m from the origin. `SEED=n` runs case n alone.
+/// margin; parts of 1 mm to 30 m, 0 to 3e5 m from the origin. 1,549 cases made, 569 of them more
+/// than 1e-14 off, all within (the largest error 0.18 of its estimate; 5.6e-2 among errors above
+/// 1e-12). `SEED=n` runs case n alone.
 #[test]
-#[ignore = "about a minute: run by hand after changing the margin or the bound"]
+#[ignore = "five minutes: run by hand after changing the margin or the bound"]
 fn margin_sweep() {
     let only: Option<u64> = std::env::var("SEED").ok().map(|x| x.parse().unwrap());
     let (mut worst, mut ran, mut off, mut skipped) = (vec![(0.0, String::new()); 6], 0, 0, 0);
