@@ -46,6 +46,25 @@ pub(super) fn leaves_whole(d: &[f64], m: f64) -> bool {
     d.iter().all(|&x| x >= -m) || d.iter().all(|&x| x <= m)
 }
 
+/// The part of a convex polygon that a plane [`leaves_whole`] while crossing it (corners strictly
+/// on both sides, those on one side within the margin): the sliver on the side of the corners
+/// nearer the plane, which is decided with the rest of the polygon from a point on the other
+/// side, so perhaps wrongly. Its area, m² (0 when the plane does not cross); `d` are the corners'
+/// signed distances, `scratch` a list to clip into.
+pub(super) fn overhang(poly: &[[f64; 3]], d: &[f64], scratch: &mut Vec<[f64; 3]>) -> f64 {
+    let lo = d.iter().fold(0.0f64, |a, &x| a.min(x));
+    let hi = d.iter().fold(0.0f64, |a, &x| a.max(x));
+    if lo == 0.0 || hi == 0.0 {
+        return 0.0;
+    }
+    scratch.clear();
+    clip(poly, d, if -lo <= hi { -1.0 } else { 1.0 }, scratch);
+    if scratch.len() < 3 {
+        return 0.0;
+    }
+    area(scratch)
+}
+
 /// A cut: the plane, and the corners of what lies along it in the piece's plane (a blocker's
 /// three corners, or a coplanar triangle's edge with its end repeated), if any. A cell that these
 /// corners lie beyond is left whole by the cut, even where the plane crosses it: what the plane
@@ -120,6 +139,11 @@ pub(super) struct CellWork {
     cells: Cells,
     next: Cells,
     d: Vec<f64>,
+    /// Per cut (in the order of `which`), the area of the slivers ([`overhang`]) of the cells it
+    /// left whole while crossing them within the margin, its reach not beyond them, m².
+    slivers: Vec<f64>,
+    /// The list [`overhang`] clips into.
+    pub(super) sliver: Vec<[f64; 3]>,
 }
 
 /// `piece` (in the plane of normal `nt`) cut along the cuts `which` of `cuts` in turn into convex
@@ -131,20 +155,30 @@ pub(super) fn cells<'w>(
     nt: [f64; 3],
     margin: f64,
     work: &'w mut CellWork,
-) -> Option<&'w Cells> {
-    let CellWork { cells, next, d } = work;
+) -> Option<(&'w Cells, &'w [f64])> {
+    let CellWork { cells, next, d, slivers, sliver } = work;
     cells.clear();
     cells.corners.extend_from_slice(piece);
     cells.close();
+    slivers.clear();
     for cut in which.iter().map(|&i| &cuts[i]) {
         let (a, n, m) = cut.plane;
         next.clear();
+        let mut total = 0.0;
         for cell in cells.iter() {
             d.clear();
             d.extend(cell.iter().map(|x| dot(n, sub(*x, a))));
             // A plane along the cell's side (one cut already, or a shared edge), or one whose
-            // reach ends before the cell, leaves it whole.
-            if leaves_whole(d, m) || cut.misses(cell, nt, margin) {
+            // reach ends before the cell, leaves it whole; one that crosses it within the margin
+            // too, and the sliver it leaves ([`overhang`]) is in the bound.
+            let whole = leaves_whole(d, m);
+            if whole || cut.misses(cell, nt, margin) {
+                if whole {
+                    let o = overhang(cell, d, sliver);
+                    if o > 0.0 && !cut.misses(cell, nt, margin) {
+                        total += o;
+                    }
+                }
                 next.corners.extend_from_slice(cell);
                 next.close();
                 continue;
@@ -159,12 +193,13 @@ pub(super) fn cells<'w>(
                 }
             }
         }
+        slivers.push(total);
         std::mem::swap(cells, next);
         if cells.len() > MAX_CELLS {
             return None;
         }
     }
-    Some(cells)
+    Some((cells, slivers))
 }
 
 /// Appends to `out` the part of a convex polygon on one side (`side` = ±1) of a plane, given its
@@ -230,13 +265,33 @@ mod tests {
             line([0.0, 0.5, 0.0], [0.0, 1.0, 0.0]),
         ];
         let mut work = CellWork::default();
-        let c = cells(&t, (&planes, &[0, 1, 2]), [0.0, 0.0, 1.0], 1e-12, &mut work).expect("few cells");
+        let (c, _) = cells(&t, (&planes, &[0, 1, 2]), [0.0, 0.0, 1.0], 1e-12, &mut work).expect("few cells");
         assert_eq!(c.len(), 4);
         let areas: Vec<f64> = c.iter().map(area).collect();
         assert_eq!(areas, vec![0.5, 0.625, 0.625, 0.25]);
         assert_eq!(areas.iter().sum::<f64>(), 2.0);
         assert!(c.iter().flatten().all(|p| p[2] == 0.0));
         assert_eq!(centroid(&t), [2.0 / 3.0, 2.0 / 3.0, 0.0]);
+    }
+
+    /// A plane 1e-3 inside a unit square's side, parallel to it, leaves it whole within a margin
+    /// of 2e-3 and cuts off a sliver of 1e-3 × 1, on whichever side lies nearer; a plane along the
+    /// side or beyond the square cuts off nothing.
+    #[test]
+    fn the_sliver_a_plane_leaves_within_the_margin() {
+        let square = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+        let mut scratch = Vec::new();
+        let mut sliver = |offset: f64, sign: f64| {
+            let d: Vec<f64> = square.iter().map(|p| sign * (p[0] - offset)).collect();
+            assert!(leaves_whole(&d, 2e-3));
+            overhang(&square, &d, &mut scratch)
+        };
+        for sign in [1.0, -1.0] {
+            assert!((sliver(1e-3, sign) - 1e-3).abs() < 1e-15);
+            assert!((sliver(1.0 - 1e-3, sign) - 1e-3).abs() < 1e-15);
+            assert_eq!(sliver(0.0, sign), 0.0);
+            assert_eq!(sliver(-1e-3, sign), 0.0);
+        }
     }
 
     /// A cut's reach lies beyond a unit square (turning about +z) when one of its sides' lines

@@ -10,8 +10,8 @@
 //! the cone it spans from the surface's box centre (the volume a wrong orientation can change) to
 //! the bound, twice when it may count twice.
 
-use super::cells::{area, cells, centroid, largest_coordinate, leaves_whole, split, CellWork, Cut, CutPlane};
 use super::bvh::Bvh;
+use super::cells::{area, cells, centroid, largest_coordinate, leaves_whole, overhang, split, CellWork, Cut, CutPlane};
 use super::grid::{Corners, Grid, Plane, Seen};
 use super::{corners_touch, edge_meets, overlap, EdgeUse};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
@@ -1104,24 +1104,22 @@ impl Faces<'_> {
         // and again until the work ran out, and the pieces left entered the bound. The same holds
         // for a plane whose reach (the blocker, or the coplanar triangle's edge) ends before the
         // piece ([`Cut`]): a fan's long edges, extended, cross every piece of the face.
-        crossing.clear();
-        crossing.extend(planes.iter().enumerate().filter_map(|(i, cut)| {
-            let (a, n, m) = cut.plane;
-            let seam = i >= blocking && self.seam(t, (coplanar, sides, slot), ((i - blocking) / 3, (i - blocking) % 3));
-            (!seam && !leaves_whole(&piece.map(|x| dot(n, sub(x, a))), m) && !cut.misses(piece, nt, self.margin))
-                .then_some(i)
-        }));
+        // A plane that crosses the piece by less than the margin leaves it whole too, and the
+        // sliver beyond it is decided with the rest: its area is in the bound (`shallow`).
+        let seams = |i: usize| i >= blocking && self.seam(t, (coplanar, sides, slot), ((i - blocking) / 3, (i - blocking) % 3));
+        let shallow = self.crossing(piece, nt, (planes, seams), crossing, &mut cell_work.sliver);
         for cp in coplanar.iter() {
             slot[cp.u as usize] = 0;
         }
         if crossing.len() > MAX_CUTS {
             return false;
         }
-        let Some(cells) = cells(piece, (planes, crossing), nt, self.margin, cell_work) else {
+        let Some((cells, slivers)) = cells(piece, (planes, crossing), nt, self.margin, cell_work) else {
             return false;
         };
         let (band, slack) = rounded(piece, nt, (planes, crossing), slack);
-        out.moved[t as usize].1 += band;
+        // Twice the slivers' area, for the rounding of their corners and of the planes.
+        out.moved[t as usize].1 += band + 2.0 * (shallow + slivers.iter().sum::<f64>());
         for cell in cells.iter() {
             // The decision's point keeps off every plane whose reach is not beyond the cell: off
             // the blockers and the coplanar triangles' edges that come near, whose sides of the
@@ -1144,6 +1142,40 @@ impl Faces<'_> {
             }
         }
         true
+    }
+}
+
+impl Faces<'_> {
+    /// Fills `crossing` with the planes of `planes` that cross the piece (of normal `nt`) beyond
+    /// the margin, whose reach is not beyond it, and are not seams (`seam`); returns the area of
+    /// the slivers ([`overhang`]) that the others cut off within the margin where their reach is
+    /// not beyond the piece, m². `sliver` is a list to clip into.
+    fn crossing(
+        &self,
+        piece: &Corners,
+        nt: [f64; 3],
+        (planes, seam): (&[Cut], impl Fn(usize) -> bool),
+        crossing: &mut Vec<usize>,
+        sliver: &mut Vec<[f64; 3]>,
+    ) -> f64 {
+        crossing.clear();
+        let mut shallow = 0.0;
+        for (i, cut) in planes.iter().enumerate() {
+            if seam(i) {
+                continue;
+            }
+            let (a, n, m) = cut.plane;
+            let d = piece.map(|x| dot(n, sub(x, a)));
+            if leaves_whole(&d, m) {
+                let o = overhang(piece, &d, sliver);
+                if o > 0.0 && !cut.misses(piece, nt, self.margin) {
+                    shallow += o;
+                }
+            } else if !cut.misses(piece, nt, self.margin) {
+                crossing.push(i);
+            }
+        }
+        shallow
     }
 }
 
