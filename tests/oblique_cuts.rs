@@ -59,6 +59,11 @@ fn halfspaces(m: &Mesh) -> Vec<(V, Q)> {
 /// more is a facet, its corners ordered about their centre (counter-clockwise seen along n), and the
 /// volume is the divergence theorem's sum of the facets' fans.
 fn convex_volume(planes: &[(V, Q)]) -> Q {
+    volume_from(planes, &convex_corners(planes))
+}
+
+/// The points where three of the planes meet that satisfy all of them.
+fn convex_corners(planes: &[(V, Q)]) -> Vec<V> {
     let mut corners: Vec<V> = Vec::new();
     let n = planes.len();
     for i in 0..n {
@@ -78,6 +83,11 @@ fn convex_volume(planes: &[(V, Q)]) -> Q {
             }
         }
     }
+    corners
+}
+
+/// The volume of the convex polyhedron of `planes` with these `corners` ([`convex_volume`]).
+fn volume_from(planes: &[(V, Q)], corners: &[V]) -> Q {
     let mut facets: Vec<Vec<usize>> = Vec::new();
     let mut volume = Q::zero();
     for (pn, pd) in planes {
@@ -380,29 +390,11 @@ fn union_volume(parts: &[&Mesh]) -> Q {
 
 /// [`convex_volume`], 0 when the polyhedron is flat (two boxes touching along a face).
 fn convex_volume_or_flat(planes: &[(V, Q)]) -> Q {
-    let mut corners: Vec<V> = Vec::new();
-    let n = planes.len();
-    for i in 0..n {
-        for j in i + 1..n {
-            for k in j + 1..n {
-                let (a, b, c) = (&planes[i], &planes[j], &planes[k]);
-                let (bc, ca, ab) = (vcross(&b.0, &c.0), vcross(&c.0, &a.0), vcross(&a.0, &b.0));
-                let det = vdot(&a.0, &bc);
-                if det.is_zero() {
-                    continue;
-                }
-                let x: V =
-                    std::array::from_fn(|m| (&a.1 * &bc[m] + &b.1 * &ca[m] + &c.1 * &ab[m]) / &det);
-                if planes.iter().all(|(pn, pd)| vdot(pn, &x) <= *pd) && !corners.contains(&x) {
-                    corners.push(x);
-                }
-            }
-        }
-    }
+    let corners = convex_corners(planes);
     if flat(&corners) {
         return Q::zero();
     }
-    convex_volume(planes)
+    volume_from(planes, &corners)
 }
 
 /// The union of `parts` (the first opened at its top) healed: its relative error against the

@@ -139,21 +139,7 @@ pub(super) fn cap_holes(vertices: &[[f64; 3]], half: &[(u32, u32)]) -> Option<Ca
     let mut from = vec![0u32; out_of.start.len()];
     let mut used = vec![false; half.len()];
     let base = vertices.len() as u32;
-    let mut caps = Caps {
-        centroids: Vec::new(),
-        faces: Polygons::new(),
-        holes: 0,
-        cracks: 0,
-        bound: 0.0,
-        area: 0.0,
-        loop_vertices: Vec::new(),
-        loops: Vec::new(),
-        interaction: Interaction {
-            volume: 0.0,
-            parts: Vec::new(),
-        },
-        cells: None,
-    };
+    let mut caps = Caps::empty();
     for start in 0..half.len() {
         if used[start] {
             continue;
@@ -194,6 +180,25 @@ pub(super) fn cap_holes(vertices: &[[f64; 3]], half: &[(u32, u32)]) -> Option<Ca
 }
 
 impl Caps {
+    /// No caps yet.
+    fn empty() -> Caps {
+        Caps {
+            centroids: Vec::new(),
+            faces: Polygons::new(),
+            holes: 0,
+            cracks: 0,
+            bound: 0.0,
+            area: 0.0,
+            loop_vertices: Vec::new(),
+            loops: Vec::new(),
+            interaction: Interaction {
+                volume: 0.0,
+                parts: Vec::new(),
+            },
+            cells: None,
+        }
+    }
+
     /// Sets [`Caps::interaction`] and, when they bound more, the certified cells once every hole is
     /// closed.
     ///
@@ -769,21 +774,7 @@ mod tests {
     /// Caps closed over the given loops of `vertices` (no certification: the loops need not be
     /// flat).
     fn caps_over(vertices: &[[f64; 3]], loops: &[Vec<u32>]) -> Caps {
-        let mut caps = Caps {
-            centroids: Vec::new(),
-            faces: Polygons::new(),
-            holes: 0,
-            cracks: 0,
-            bound: 0.0,
-            area: 0.0,
-            loop_vertices: Vec::new(),
-            loops: Vec::new(),
-            interaction: Interaction {
-                volume: 0.0,
-                parts: Vec::new(),
-            },
-            cells: None,
-        };
+        let mut caps = Caps::empty();
         for l in loops {
             let steps: Vec<(u32, u32, u32)> =
                 (0..l.len()).map(|i| (l[i], l[i], l[(i + 1) % l.len()])).collect();
