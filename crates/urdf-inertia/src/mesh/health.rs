@@ -297,6 +297,40 @@ pub fn make_solid(mesh: &RawMesh, path: &Path, options: HealthOptions) -> Result
     heal(Cow::Borrowed(mesh), path, options, |_| weld::Precision::F64)
 }
 
+/// What welding dropped or collapsed, and what dropping cancelling pairs can change.
+fn welding_notes(ladder: &mut Ladder<'_>, w: &welding::Welding) {
+    if w.duplicates > 0 {
+        ladder.warn(
+            HealthKind::FacesDropped,
+            format!(
+            "{} faces stored more than once dropped (the copies would count their volume twice)",
+            w.duplicates
+        ),
+        );
+    }
+    if w.cancelled > 0 {
+        let apart = if w.cancelled_volume > 0.0 {
+            format!(
+                "; stored apart before welding, they may enclose at most {:.2e} m³, which is in the error estimate",
+                w.cancelled_volume
+            )
+        } else {
+            String::new()
+        };
+        ladder.note(HealthKind::FacesCancelled, format!(
+            "{} faces dropped in pairs, each a face and its reverse (a wall of no thickness; they cancel){apart}",
+            w.cancelled
+        ));
+        ladder.cancelled = w.cancelled_volume;
+    }
+    if w.collapsed > 0 {
+        ladder.note(HealthKind::Welded, format!(
+            "{} sliver faces collapse when corners within {:.1e} m are welded; left out of the topology",
+            w.collapsed, w.tolerant.tolerance.largest
+        ));
+    }
+}
+
 /// Turns a scaled mesh into a solid by the ladder in the module docs. `precision` tells how its file
 /// stored the coordinates, which sets the tolerance of the second welding pass: it gets the (scaled,
 /// welded) vertices and is asked only when that pass runs. A mesh its reader welded
@@ -355,27 +389,7 @@ pub fn heal(
     } else {
         edges(&w.topology)
     };
-    if w.duplicates > 0 {
-        ladder.warn(
-            HealthKind::FacesDropped,
-            format!(
-            "{} faces stored more than once dropped (the copies would count their volume twice)",
-            w.duplicates
-        ),
-        );
-    }
-    if w.cancelled > 0 {
-        ladder.note(HealthKind::FacesCancelled, format!(
-            "{} faces dropped in pairs, each a face and its reverse (a wall of no thickness; they cancel)",
-            w.cancelled
-        ));
-    }
-    if w.collapsed > 0 {
-        ladder.note(HealthKind::Welded, format!(
-            "{} sliver faces collapse when corners within {:.1e} m are welded; left out of the topology",
-            w.collapsed, w.tolerant.tolerance.largest
-        ));
-    }
+    welding_notes(&mut ladder, &w);
     if te.closed() && te.inconsistent == 0 {
         let rung = Rung::Welded {
             merged_vertices: w.tolerant.merged,

@@ -61,6 +61,8 @@ pub(super) struct Ladder<'a> {
     /// A closed surface of several components whose boxes overlap: its shells are classified like
     /// the repaired rungs' (a region two of them enclose counts once).
     pub(super) overlapping_components: bool,
+    /// What the faces dropped in cancelling pairs can change, m³ (`welding::cancelled_volume`).
+    pub(super) cancelled: f64,
 }
 
 impl<'a> Ladder<'a> {
@@ -82,6 +84,7 @@ impl<'a> Ladder<'a> {
             faces_read: mesh.faces.len(),
             known: None,
             as_stored: winding_shells::AsStored::default(),
+            cancelled: 0.0,
             overlapping_components: false,
         }
     }
@@ -272,6 +275,12 @@ impl<'a> Ladder<'a> {
         let mut model = model.into();
         let mut vertices = vertices;
         let faces = self.shells(&mut vertices, faces, &rung, &mut model);
+        if self.cancelled > 0.0 {
+            if self.cancelled > model.total() {
+                model.source = ModelError::Cracks;
+            }
+            model.terms.push((self.cancelled, Lever::Anywhere));
+        }
         let (unit, corner) = match self.known.take() {
             Some(k) => (MassProperties::from_integrals(&k.integrals, 1.0), k.corner),
             None => (unit_props(&vertices, &faces, None), None),
