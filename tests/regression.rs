@@ -3925,7 +3925,7 @@ fn parts_in_rows_are_paired_without_a_quadratic_search() {
     assert!(
         j["warnings"]
             .to_string()
-            .contains("more than 4000000 pairs of shells overlap in their boxes"),
+            .contains("more than 4,000,000 pairs of shells overlap in their boxes"),
         "{j}"
     );
 }

@@ -137,9 +137,17 @@ pub(crate) fn x_sweep(
 pub(crate) fn sweep(
     boxes: &[Aabb],
     axis: usize,
+    visit: impl FnMut(usize, usize) -> std::ops::ControlFlow<()>,
+) -> std::ops::ControlFlow<()> {
+    sweep_in(boxes, (axis, &starts(boxes, axis)), visit)
+}
+
+/// [`sweep`] along `axis`, given the boxes' [`starts`] along it (`order`).
+pub(crate) fn sweep_in(
+    boxes: &[Aabb],
+    (axis, order): (usize, &[usize]),
     mut visit: impl FnMut(usize, usize) -> std::ops::ControlFlow<()>,
 ) -> std::ops::ControlFlow<()> {
-    let order = starts(boxes, axis);
     for (i, &a) in order.iter().enumerate() {
         for &b in &order[i + 1..] {
             if boxes[b].lo[axis] >= boxes[a].hi[axis] {
@@ -162,8 +170,8 @@ pub(crate) fn starts(boxes: &[Aabb], axis: usize) -> Vec<usize> {
 /// `i` of the order, the boxes that start before it ends, less itself and those before it (all of
 /// which start before it ends, but for boxes of no width starting where it starts: a count to
 /// choose an axis by, not a bound).
-pub(crate) fn sweep_visits(boxes: &[Aabb], axis: usize) -> u64 {
-    let order = starts(boxes, axis);
+/// `order`: the boxes' [`starts`] along `axis`.
+pub(crate) fn sweep_visits(boxes: &[Aabb], (axis, order): (usize, &[usize])) -> u64 {
     let lo: Vec<f64> = order.iter().map(|&b| boxes[b].lo[axis]).collect();
     order
         .iter()

@@ -154,7 +154,7 @@ impl<'a> Ladder<'a> {
             // undecided pair that is all the bound is.
             let text = if s.overlap_bound.is_infinite() {
                 format!("more than {} pairs of shells overlap in their boxes (or the search for them ran past its budget of box tests): they are not decided, and the volume they may count twice is not bounded",
-                    s.undecided_pairs - 1)
+                    thousands(winding_shells::MAX_BOX_PAIRS))
             } else if s.undecided_pairs > 0 {
                 format!("{} pair(s) of shells touch or cut each other (or are open) where their boxes overlap: the volume they may count twice, at most {:.2e} m³ (their boxes' intersections), is in the error estimate",
                     s.undecided_pairs, s.overlap_bound)
@@ -246,8 +246,9 @@ impl<'a> Ladder<'a> {
         };
         let how = if s.crowded > 0 {
             format!(
-                "their {} triangle(s) are left as they are, undecided (more than 20,000,000 pairs of them meet, too many to cut)",
-                s.crowded
+                "their {} triangle(s) are left as they are, undecided (more than {} pairs of them meet, too many to cut)",
+                s.crowded,
+                thousands(winding_shells::MAX_MEETING)
             )
         } else {
             format!(
@@ -334,6 +335,19 @@ impl<'a> Ladder<'a> {
     }
 }
 
+/// `n` with its digits in groups of three, for the limits messages name: 20000000 → "20,000,000".
+fn thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -393,5 +407,11 @@ mod tests {
             assert_eq!(bits(&k.integrals), bits(&volume_integrals(&v, &f, &accurate)));
             assert_eq!(bits(&corner), bits(&volume_integrals(&v, &f, &about_lo)));
         }
+    }
+
+    #[test]
+    fn thousands_are_grouped() {
+        let got: Vec<String> = [0, 7, 999, 1_000, 4_000_000, 20_000_000, 123_456_789].map(super::thousands).into();
+        assert_eq!(got, ["0", "7", "999", "1,000", "4,000,000", "20,000,000", "123,456,789"]);
     }
 }

@@ -40,7 +40,7 @@ const MAX_CUTS: usize = 40;
 /// each triangle is left as classified, what it can change in the bound. 3,000 tetrahedra piled on
 /// one another (12,000 triangles, about 70 M such pairs) took 17 s and 1.2 GB; the most a mesh
 /// of the corpus asks is far below.
-const MAX_MEETING: usize = 20_000_000;
+pub(crate) const MAX_MEETING: usize = 20_000_000;
 
 /// [`Grid::crowding`] beyond which [`Faces::all_blockers`] takes its pairs from a tree, not from the
 /// grid's queries: each triangle's query reads every entry of the cells its box covers, so their

@@ -22,12 +22,13 @@
 mod bvh;
 mod cells;
 mod correction;
+pub(crate) use correction::MAX_MEETING;
 mod cracks;
 mod exact;
 mod grid;
 mod nesting;
 
-use crate::geometry::{cross, dot, norm, solid_angle, starts, sub, sweep, sweep_visits, Aabb};
+use crate::geometry::{cross, dot, norm, solid_angle, starts, sub, sweep_in, sweep_visits, Aabb};
 use crate::mass::Polygons;
 use crate::mesh::weld;
 use grid::orient3d;
@@ -42,7 +43,7 @@ const MAX_PAIRS: usize = 20_000;
 /// Pairs of shells with overlapping boxes beyond this many are not decided, and not bounded: those
 /// found are not all (the sum of their boxes' intersections bounded only them). Those that need no
 /// work of their own (closed shells nested in each other) cost a few words each.
-const MAX_BOX_PAIRS: usize = 4_000_000;
+pub(crate) const MAX_BOX_PAIRS: usize = 4_000_000;
 
 /// Box tests beyond which the search for overlapping boxes stops, on the cheapest axis
 /// ([`box_pairs`]; about 9 ns each, so about 2 s): the shells are then not decided, and not bounded.
@@ -710,14 +711,17 @@ fn box_pairs(
     (limit, budget): (usize, u64),
     keep: impl FnMut(usize, usize) -> bool,
 ) -> Option<Vec<(usize, usize)>> {
-    let visits = [0, 1, 2].map(|k| sweep_visits(boxes, k));
+    // Each axis's order sorted once: for the counts, the sweep and the x sweep's order.
+    let orders = [0, 1, 2].map(|k| starts(boxes, k));
+    let visits = [0, 1, 2].map(|k| sweep_visits(boxes, (k, &orders[k])));
     let axis = (0..3).min_by_key(|&k| visits[k]).unwrap_or(0);
-    box_pairs_along(boxes, (visits[axis] <= budget).then_some(axis), (limit, budget), keep)
+    box_pairs_along((boxes, &orders), (visits[axis] <= budget).then_some(axis), (limit, budget), keep)
 }
 
-/// [`box_pairs`] by a sweep along `axis`, or from the tree when `None`.
+/// [`box_pairs`] by a sweep along `axis`, or from the tree when `None`; `orders`: the boxes'
+/// [`starts`] along each axis.
 fn box_pairs_along(
-    boxes: &[Aabb],
+    (boxes, orders): (&[Aabb], &[Vec<usize>; 3]),
     axis: Option<usize>,
     (limit, budget): (usize, u64),
     mut keep: impl FnMut(usize, usize) -> bool,
@@ -733,7 +737,7 @@ fn box_pairs_along(
         ControlFlow::Continue(())
     };
     let full = if let Some(axis) = axis {
-        sweep(boxes, axis, &mut take)
+        sweep_in(boxes, (axis, &orders[axis]), &mut take)
     } else {
         let own: Vec<u32> = (0..boxes.len() as u32).collect();
         let mut met = 0u64;
@@ -750,7 +754,7 @@ fn box_pairs_along(
     }
     if axis != Some(0) {
         let mut place = vec![0; boxes.len()];
-        for (i, b) in starts(boxes, 0).into_iter().enumerate() {
+        for (i, &b) in orders[0].iter().enumerate() {
             place[b] = i;
         }
         for p in &mut pairs {
