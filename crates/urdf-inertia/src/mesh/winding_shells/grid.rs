@@ -13,6 +13,19 @@ pub(super) type Corners = [[f64; 3]; 3];
 const MAX_DIM: usize = 128;
 const _: () = assert!(MAX_DIM <= 256, "cell indices are stored as u8 in Grid::new");
 
+/// Grid entries (a triangle in each cell its box covers, 52 bytes each) per triangle beyond which
+/// the cells are made coarser ([`Grid::new`]), with [`MIN_ENTRIES`] more for any grid. The most a
+/// mesh of the corpus needs is 20.9 per triangle (877 meshes with overlapping shells; typically 8 to
+/// 12); two cutting star prisms of long triangles (each box spanning much of the grid) took
+/// 0.5 GB at 16,000 triangles and 2.0 GB at 32,000 before this limit, growing as n².
+const MAX_ENTRIES_PER_TRIANGLE: u64 = 32;
+
+/// Grid entries any grid may hold before [`MAX_ENTRIES_PER_TRIANGLE`] applies (3.4 MB).
+const MIN_ENTRIES: u64 = 1 << 16;
+
+/// The factor by which a cell's side grows each time the grid is made coarser (its volume doubles).
+const COARSER: f64 = 1.259_921_049_894_873_2;
+
 /// Triangles bucketed by the cells their boxes cover.
 pub(super) struct Grid {
     lo: [f64; 3],
@@ -76,19 +89,29 @@ impl Grid {
         let ext = bounds.extent();
         let largest = ext.iter().copied().fold(0.0, f64::max).max(f64::MIN_POSITIVE);
         let ext = ext.map(|e| e.max(largest * 1e-6));
-        let h = (ext.iter().product::<f64>() / boxes.len().max(1) as f64).cbrt();
-        let dims = ext.map(|e| ((e / h).ceil() as usize).clamp(1, MAX_DIM));
-        let cell = [0, 1, 2].map(|k| ext[k] / dims[k] as f64);
-        let mut grid = Grid {
-            lo: bounds.lo,
-            cell,
-            dims,
-            last: dims.map(|d| (d - 1) as f64),
-            start: Vec::new(),
-            items: Vec::new(),
-            item_boxes: Vec::new(),
-            bounds,
+        let mut h = (ext.iter().product::<f64>() / boxes.len().max(1) as f64).cbrt();
+        let sized = |h: f64| {
+            let dims = ext.map(|e| ((e / h).ceil() as usize).clamp(1, MAX_DIM));
+            Grid {
+                lo: bounds.lo,
+                cell: [0, 1, 2].map(|k| ext[k] / dims[k] as f64),
+                dims,
+                last: dims.map(|d| (d - 1) as f64),
+                start: Vec::new(),
+                items: Vec::new(),
+                item_boxes: Vec::new(),
+                bounds,
+            }
         };
+        let mut grid = sized(h);
+        // Coarser cells while the entries would pass the budget: triangles whose boxes span much
+        // of the grid (a star-shaped prism's sides) would otherwise fill about n² entries.
+        let budget = MAX_ENTRIES_PER_TRIANGLE * boxes.len() as u64 + MIN_ENTRIES;
+        while grid.dims != [1, 1, 1] && boxes.iter().map(|b| grid.cells_in(b) as u64).sum::<u64>() > budget {
+            h *= COARSER;
+            grid = sized(h);
+        }
+        let dims = grid.dims;
         let cells = dims.iter().product::<usize>();
         let mut count = vec![0u32; cells + 1];
         // Each box's range of cells, found once for both passes (an index is below `MAX_DIM`).
@@ -769,6 +792,48 @@ mod tests {
             several += usize::from(found.len() > 1);
         }
         assert!(several > 50, "{several}");
+    }
+
+    /// Boxes that each span much of the region (the long triangles of star prisms) would fill about
+    /// n² entries: the grid is made coarser until they fit the budget, and a query still finds
+    /// exactly the boxes that meet it, each once. Scattered small boxes keep the finer grid.
+    #[test]
+    fn a_grid_of_spanning_boxes_is_made_coarser() {
+        let mut next = uniform(0x5eed_0b0c_1234_9876);
+        let n = 6_000;
+        let boxes: Vec<Aabb> = (0..n)
+            .map(|_| {
+                let lo = [next() * 0.3, next() * 0.3, next() * 0.3];
+                Aabb::of([lo, [0.7 + next() * 0.3, 0.7 + next() * 0.3, 0.7 + next() * 0.3]])
+            })
+            .collect();
+        let budget = MAX_ENTRIES_PER_TRIANGLE * n as u64 + MIN_ENTRIES;
+        let fine: u64 = {
+            // The entries of the grid that the count alone would choose (about as many cells as boxes).
+            let h = (1.0f64 / n as f64).cbrt();
+            let d = (1.0 / h).ceil();
+            let cells = |lo: f64, hi: f64| ((hi * d).floor().min(d - 1.0) - (lo * d).floor().max(0.0) + 1.0) as u64;
+            boxes.iter().map(|b| (0..3).map(|k| cells(b.lo[k], b.hi[k])).product::<u64>()).sum()
+        };
+        assert!(fine > 50 * budget, "{fine} entries against {budget}");
+        let grid = Grid::new(&boxes);
+        assert!(grid.items.len() as u64 <= budget, "{} entries against {budget}", grid.items.len());
+        assert!(grid.dims.iter().all(|&d| d > 1), "{:?}", grid.dims);
+        let mut seen = Seen::new(n);
+        let mut found = Vec::new();
+        for q in 0..200 {
+            let lo = [next(), next(), next()];
+            let query = Aabb::of([lo, lo.map(|x| x + 0.1 * next())]);
+            grid.overlapping(&query, None, &mut seen, &mut found);
+            found.sort_unstable();
+            let want: Vec<u32> = (0..n as u32).filter(|&i| super::super::overlap(&boxes[i as usize], &query)).collect();
+            assert_eq!(found, want, "query {q}");
+        }
+        let small = scattered_boxes(&mut next, 6_000, 0.05);
+        let grid = Grid::new(&small);
+        let ext = grid.bounds.extent();
+        let h = (ext.iter().product::<f64>() / 6_000.0).cbrt();
+        assert_eq!(grid.dims, ext.map(|e| (e / h).ceil() as usize));
     }
 
     #[test]
