@@ -26,6 +26,7 @@
 //! | later | shells nested in each other made the shells' classification quadratic in them, and past 20,000 pairs of overlapping boxes left unbounded (200 nested spheres 3.1 s) | `many_nested_shells_are_decided_exactly` (and the library's `many_nested_boxes_are_decided_exactly`, `the_tree_finds_what_all_pairs_find`) |
 //! | later | shells that all cut one another made the face-by-face decision grind through every pair of meeting triangles and every split's blockers (3,000 piled tetrahedra 148 s, 1.2 GB) | `piled_shells_are_left_undecided_not_ground_through` (and the library's `blockers_from_the_tree_are_the_grids`) |
 //! | later | shells whose boxes overlap along one or two axes but not in space (parts in rows) made the search for overlapping boxes quadratic in them (40,000 tetrahedra in a row 7.0 s); past 4,000,000 overlapping pairs, only those found were bounded | `parts_in_rows_are_paired_without_a_quadratic_search` (and the library's `box_pairs_are_the_x_sweeps`) |
+//! | later | triangles whose boxes span much of the mesh's box (two cutting star prisms) filled the face-by-face decision's grid with about n² entries (32,000 triangles 2.0 GB) | `star_prisms_do_not_fill_the_grid_quadratically` (and the library's `a_grid_of_spanning_boxes_is_made_coarser`) |
 //! | later | holes in a row made the caps' coplanar grouping quadratic in them again (5.3 s for a strip of 20,000); one hole of a million edges cost 8 times the closed mesh's time and memory | `a_strip_of_many_holes_is_refused`, `a_hole_of_many_edges_is_capped` (and the library's `coplanar_groups_are_as_before`) |
 //!
 //! Item 12's self-intersecting and nested outward shells are the winding-number work's (its tests are
@@ -1514,6 +1515,12 @@ fn second_campaign_rows(d: &Path, add: &mut impl FnMut(&str, Vec<String>, Option
             "pile.stl",
             piled_tetrahedra(3_000, 1.0 / 1024.0),
             "3,000 tetrahedra piled on one another (2,545,224 pairs of shells cutting each other, about 70 M pairs of triangles meeting)",
+            &[][..],
+        ),
+        (
+            "stars.stl",
+            star_prisms(4_000),
+            "two star prisms of 4,000 spikes cutting each other (64,000 long triangles whose boxes span much of the mesh's box)",
             &[][..],
         ),
         (
@@ -3951,6 +3958,95 @@ fn piled_tetrahedra(n: u32, apart: f64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
         ]);
     }
     (v, f)
+}
+
+/// Two star prisms of `k` spikes each (radii 1 and 0.02, height 1), the second turned by half a
+/// spike (and a little more) and raised by half its height, so that they cut each other: `16 k`
+/// triangles, most of them long, whose boxes span much of the mesh's box.
+fn star_prisms(k: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let (mut v, mut f) = (Vec::new(), Vec::new());
+    for (turn, z0) in [
+        (0.0, 0.0),
+        (std::f64::consts::PI / f64::from(2 * k) + 0.001, 0.5),
+    ] {
+        let z1 = z0 + 1.0;
+        let ring: Vec<[f64; 2]> = (0..2 * k)
+            .map(|i| {
+                let r = if i % 2 == 0 { 1.0 } else { 0.02 };
+                let a = std::f64::consts::PI * f64::from(i) / f64::from(k) + turn;
+                [r * a.cos(), r * a.sin()]
+            })
+            .collect();
+        let base = v.len() as u32;
+        v.push([0.0, 0.0, z0]);
+        v.push([0.0, 0.0, z1]);
+        for p in &ring {
+            v.push([p[0], p[1], z0]);
+            v.push([p[0], p[1], z1]);
+        }
+        for i in 0..2 * k {
+            let (a0, a1, b0, b1) = (
+                base + 2 + 2 * i,
+                base + 3 + 2 * i,
+                base + 2 + 2 * ((i + 1) % (2 * k)),
+                base + 3 + 2 * ((i + 1) % (2 * k)),
+            );
+            f.extend([
+                [a0, b0, b1],
+                [a0, b1, a1],
+                [base + 1, a1, b1],
+                [base, b0, a0],
+            ]);
+        }
+    }
+    (v, f)
+}
+
+/// Triangles whose boxes span much of the mesh's box (the long sides and fan caps of star prisms)
+/// each sat in about half the cells of the grid that decides shells face by face, so the grid held
+/// about n² entries: two cutting star prisms took 0.5 GB at 16,000 triangles and 2.0 GB at 32,000.
+/// The grid is now made coarser to 32 entries a triangle (the library's
+/// `a_grid_of_spanning_boxes_is_made_coarser`); the prisms are decided as before where the pairs
+/// of meeting triangles are few enough, and left undecided past 20,000,000 of them.
+#[test]
+fn star_prisms_do_not_fill_the_grid_quadratically() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (k, crowded) in [(250, false), (4_000, true)] {
+        let (v, f) = star_prisms(k);
+        let stl = stl_in(tmp.path(), "stars.stl", &v, &f);
+        let out = bin()
+            .args(["mesh", s(&stl), "--format", "json", "--digits", "full"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let warnings = j["warnings"].to_string();
+        assert_eq!(
+            warnings.contains("left as they are, undecided"),
+            crowded,
+            "{k}: {warnings}"
+        );
+        // Each prism alone: its star's area (2k triangles of sides 1 and 0.02 at an angle π/k) times
+        // its height; the union lies between the larger and the sum. Left undecided, the faces
+        // count the overlap twice, and the estimate says it is not bounded.
+        let one = 2.0 * f64::from(k) * 0.5 * 0.02 * (std::f64::consts::PI / f64::from(k)).sin();
+        let volume = j["volume"].as_f64().unwrap();
+        if crowded {
+            assert!(j["error_estimate"].is_null(), "{k}: {j}");
+            assert!(
+                (volume / (2.0 * one) - 1.0).abs() < 1e-9,
+                "{k}: {volume} against {}",
+                2.0 * one
+            );
+        } else {
+            let estimate = j["error_estimate"].as_f64().unwrap();
+            assert!(estimate < 1e-3, "{k}: {estimate}");
+            assert!(
+                volume > one && volume < 2.0 * one,
+                "{k}: {volume} against {one}"
+            );
+        }
+    }
 }
 
 /// Closed shells that all cut one another were decided face by face with no limit on the pairs of
