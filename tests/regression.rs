@@ -1031,6 +1031,16 @@ fn stl_in(dir: &Path, name: &str, v: &[[f64; 3]], f: &[[u32; 3]]) -> PathBuf {
     path
 }
 
+/// `urdf-inertia mesh FILE --format json --digits full`, which must exit 0: its report.
+fn full_report(mesh: &Path) -> serde_json::Value {
+    let out = bin()
+        .args(["mesh", s(mesh), "--format", "json", "--digits", "full"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
 /// A vertex on many edges (a cone's apex and base centre, 250,000 edges each) once made the proof
 /// that a surface is closed quadratic in its degree (each twin found by scanning the vertex's
 /// half-edges: 18 s for this cone, 2.8 s at 100,000). Its long lists are now sorted and searched. The
@@ -1163,12 +1173,7 @@ fn a_hole_of_many_edges_is_capped() {
     let (v, closed) = cone(n);
     let stored: Vec<[f64; 3]> = v.iter().map(|p| p.map(|x| f64::from(x as f32))).collect();
     let exact = common::exact_mass(&common::exact_integrals(&stored, &closed));
-    let out = bin()
-        .args(["mesh", s(&stl), "--format", "json", "--digits", "full"])
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
-    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let j = full_report(&stl);
     assert_eq!(j["provenance"], "capped", "{j}");
     let volume = j["volume"].as_f64().unwrap();
     assert!(common::rel_error(volume, &exact.volume) < 1e-12, "{volume}");
@@ -3840,12 +3845,7 @@ fn many_nested_shells_are_decided_exactly() {
     let tmp = tempfile::tempdir().unwrap();
     let (v, f) = nested_boxes(1_000);
     let stl = stl_in(tmp.path(), "nested.stl", &v, &f);
-    let out = bin()
-        .args(["mesh", s(&stl), "--format", "json", "--digits", "full"])
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
-    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let j = full_report(&stl);
     // The outermost box: half-sides 250.75, 375.625, 125.875.
     let outer = 8.0 * 250.75 * 375.625 * 125.875;
     assert_eq!(j["volume"].as_f64(), Some(outer), "{j}");
@@ -3901,12 +3901,7 @@ fn parts_in_rows_are_paired_without_a_quadratic_search() {
     for (m, three) in [(40_000u32, false), (15_000, true)] {
         let (v, f) = parts_in_rows(m, three);
         let stl = stl_in(tmp.path(), "rows.stl", &v, &f);
-        let out = bin()
-            .args(["mesh", s(&stl), "--format", "json", "--digits", "full"])
-            .output()
-            .unwrap();
-        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
-        let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let j = full_report(&stl);
         let groups = if three { 3.0 } else { 1.0 };
         let want = groups * f64::from(m) * 3.0 * f64::from(m);
         assert_eq!(
@@ -4014,12 +4009,7 @@ fn star_prisms_do_not_fill_the_grid_quadratically() {
     for (k, crowded) in [(250, false), (4_000, true)] {
         let (v, f) = star_prisms(k);
         let stl = stl_in(tmp.path(), "stars.stl", &v, &f);
-        let out = bin()
-            .args(["mesh", s(&stl), "--format", "json", "--digits", "full"])
-            .output()
-            .unwrap();
-        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
-        let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let j = full_report(&stl);
         let warnings = j["warnings"].to_string();
         assert_eq!(
             warnings.contains("left as they are, undecided"),
