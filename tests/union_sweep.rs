@@ -10,7 +10,7 @@
 //!
 //! Truth, independent of the library: inside the parts in S and no other (a Venn atom), w is
 //! Σ_{i∈S} sᵢ (sᵢ = ±1 the winding), so Ω is the union of the atoms with |Σ sᵢ| ≥ 1, and its
-//! integrals are Σ_T c(T) I(T) over the intersections T of parts, c(T) = Σ_{S⊆T, S in Ω}
+//! integrals are `Σ_T c(T) I(T)` over the intersections T of parts, `c(T) = Σ_{S⊆T, S in Ω}`
 //! (−1)^{|T|−|S|} (inclusion–exclusion). Each intersection is convex: the first part's polyhedron
 //! clipped in rationals by every face plane of the others, its integrals those of the fans of its
 //! faces about the origin.
@@ -24,6 +24,7 @@ use num_bigint::BigInt;
 use num_rational::BigRational;
 use num_traits::{Signed, ToPrimitive, Zero};
 use std::cmp::Ordering;
+use std::fmt::Write;
 use urdf_inertia::mesh::health::HealthOptions;
 
 type Q = BigRational;
@@ -102,13 +103,13 @@ fn clip(p: &Poly, n: &V, d: &Q) -> Option<Poly> {
         }
     }
     if cap.len() >= 3 {
-        faces.push(ring(n, cap));
+        faces.push(ring(n, &cap));
     }
     Some(Poly { faces })
 }
 
 /// Points of one convex polygon in the plane of normal `n`, ordered counter-clockwise seen along n.
-fn ring(n: &V, points: Vec<V>) -> Vec<V> {
+fn ring(n: &V, points: &[V]) -> Vec<V> {
     let count = Q::from_integer(BigInt::from(points.len()));
     let g: V = std::array::from_fn(|m| points.iter().fold(Q::zero(), |s, p| s + &p[m]) / &count);
     let r = vsub(&points[0], &g);
@@ -204,7 +205,7 @@ impl Part {
     }
 }
 
-/// The exact integrals of Ω for the parts: Σ_T c(T) I(T) over the intersections T.
+/// The exact integrals of Ω for the parts: `Σ_T c(T) I(T)` over the intersections T.
 fn omega_integrals(parts: &[Part]) -> [Q; 10] {
     let n = parts.len();
     let planes: Vec<Vec<(V, Q)>> = parts.iter().map(Part::planes).collect();
@@ -545,6 +546,7 @@ fn extent(s: &Shape) -> f64 {
 }
 
 /// A part placed against `base` (an earlier part) in one of the ways of the sweep, or on its own.
+#[allow(clippy::too_many_lines)] // one arm per way of placing a part, each short
 fn related_shape(state: &mut u64, base: &Shape) -> (Shape, String) {
     let c = centre(base);
     let size = extent(base) / 2.0;
@@ -930,7 +932,7 @@ fn run(case: &Case) -> Outcome {
 fn describe(seed: u64, case: &Case) -> String {
     let mut out = format!("seed {seed}: {:?}", case.place);
     for (i, p) in case.parts.iter().enumerate() {
-        out += &format!("\n  {i}: {}", p.label);
+        let _ = write!(out, "\n  {i}: {}", p.label);
     }
     out
 }
@@ -992,7 +994,7 @@ impl Tally {
                     .max(inertia / estimate)
                     .max(com / com_estimate);
                 let tag = if turned { " (turned)" } else { "" };
-                if !(ratio <= 1.0) {
+                if ratio.is_nan() || ratio > 1.0 {
                     eprintln!("BREACH{tag} ratio {ratio:.2e} {line}");
                     if turned {
                         self.breaches_turned += 1;
