@@ -212,15 +212,18 @@ fn grown(v: &[[f64; 3]], face: &[u32], delta: f64) -> f64 {
 }
 
 /// A bound on what the faces that collapse under the tolerant weld (two corners or more on one
-/// representative) can change, m³. Moved corner by corner onto their representatives, such a face
-/// ends with no area, where it bounds nothing; on its way it passes only through its own corners'
-/// convex combinations, within its stored face grown by Δ, the largest distance of a corner from
-/// its representative ([`grown`]). So the solid of the surface with these faces and the one
-/// without them differ only there, whichever of the two the rung integrates: the whole parts
-/// smaller than the weld's tolerance that collapse so are left out of the topology that decides
-/// how shells overlap, and a region one encloses inside another part counts twice in the stored
-/// integral (`union_sweep` case 331: 4.1e-13 of the volume off under an estimate of 1.4e-15 before
-/// this was in the bound).
+/// representative) can change, m³. Moved linearly onto their representatives (each corner by at
+/// most Δ, its largest distance from its representative), such a face ends with no area, where it
+/// bounds nothing; on its way it passes only through its own corners' convex combinations, within
+/// its stored face grown by Δ ([`grown`]). So the winding number with the face and without it
+/// differ only there, by the number of times the moving face passes a point, whose integral is at
+/// most Δ times its mean area on the way, Δ (A + Δ P / 2 + 2 Δ² / 3) for a triangle of area A and
+/// perimeter P; where w without the face is 0 or 1, the solid with it and the integral with it
+/// differ by at most twice that, 2 Δ A + Δ² P + (4/3) Δ³, below the grown face's volume. That
+/// holds whether the rung integrates these faces or not: the whole parts smaller than the weld's
+/// tolerance that collapse so are left out of the topology that decides how shells overlap, and a
+/// region one encloses inside another part counted twice in the stored integral (`union_sweep`
+/// case 331: 4.1e-13 of the volume off under an estimate of 1.4e-15 before this was in the bound).
 fn collapsed_volume(exact: &weld::ExactWeld, tolerant: &weld::TolerantWeld, kept: &[bool]) -> f64 {
     let v = &exact.vertices;
     let rep = &tolerant.representative;
