@@ -1079,7 +1079,10 @@ fn the_exact_reference_agrees_with_the_meshes() {
     );
 }
 
-/// Cases 1 to 60 of the sweep: every error within the estimate.
+/// Cases 1 to 60 of the sweep: every error within the estimate, except in the cases where the
+/// ladder turned faces round (the known breach: `a_shell_turned_round_around_a_cavity_is_within_the_estimate`,
+/// `an_inward_shell_cutting_another_is_within_the_estimate`), which are counted, not asserted;
+/// once that is fixed, `Tally` should assert them too.
 #[test]
 fn unions_of_convex_parts_are_within_the_estimate() {
     let mut tally = Tally::default();
@@ -1391,6 +1394,26 @@ fn a_shell_turned_round_around_a_cavity_is_within_the_estimate() {
     let b = common::box_at([1.0, 0.5, 0.25], [1.25, 0.75, 0.5]);
     let result = check(vec![part(a, true), part(b, false), part(t, false)]);
     let Some((volume, estimate)) = result else {
+        panic!("no solid");
+    };
+    assert!(
+        volume <= estimate,
+        "error {volume:e}, estimate {estimate:e}"
+    );
+}
+
+/// The known breach's other path (not fixed): a closed, consistently wound mesh of a box and a box
+/// wound inward that cuts it. Ω is their symmetric difference (w = 0 in both): 1.0. The clean
+/// rung's `closed::misoriented` turns every component wound inward at an even nesting depth by
+/// boxes (here 0: the inward box is not inside the other's box) and charges nothing (the model is
+/// the cracks' alone), so w = 2 in the intersection and the shells, decided as classified, give
+/// the union: 1.125.
+#[test]
+#[ignore = "known breach: shells turned round by the ladder change Ω where they overlap others"]
+fn an_inward_shell_cutting_another_is_within_the_estimate() {
+    let a = common::box_at([0.0; 3], [1.0; 3]);
+    let b = common::box_at([0.5, 0.25, 0.25], [1.5, 0.75, 0.75]);
+    let Some((volume, estimate)) = check(vec![part(a, false), part(b, true)]) else {
         panic!("no solid");
     };
     assert!(
