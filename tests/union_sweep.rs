@@ -1422,3 +1422,25 @@ fn an_inward_shell_cutting_another_is_within_the_estimate() {
         "error {volume:e}, estimate {estimate:e}"
     );
 }
+
+/// A second known breach (not fixed; sweep case 3657 in its minimal form): a box stored twice (every
+/// face twice, the same way round) and a box wound inward inside it. w is 2 − 1 = 1 inside the inner
+/// box, so Ω is the outer box: 1. The weld drops the copies ("the copies would count their volume
+/// twice"), which lowers w by 1 everywhere inside the box, and the inner box, then a cavity, is
+/// decided by nesting alone, where the copies are not put back (only the shells decided face by
+/// face count them): 0.875, 0.125 off under an estimate of about 1e-15.
+#[test]
+#[ignore = "known breach: copies dropped around a shell nested inside change its side's w"]
+fn a_doubled_shell_around_a_cavity_is_within_the_estimate() {
+    let a = common::box_at([0.0; 3], [1.0; 3]);
+    let b = common::box_at([0.25; 3], [0.75; 3]);
+    let Some((volume, estimate)) =
+        check(vec![part(a.clone(), false), part(a, false), part(b, true)])
+    else {
+        panic!("no solid");
+    };
+    assert!(
+        volume <= estimate,
+        "error {volume:e}, estimate {estimate:e}"
+    );
+}
