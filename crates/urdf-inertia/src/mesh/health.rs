@@ -297,16 +297,26 @@ pub fn make_solid(mesh: &RawMesh, path: &Path, options: HealthOptions) -> Result
     heal(Cow::Borrowed(mesh), path, options, |_| weld::Precision::F64)
 }
 
-/// What welding dropped or collapsed, and what dropping cancelling pairs can change.
+/// What welding dropped or collapsed, and what dropping copies apart, cancelling pairs and collapsed
+/// faces can change.
 fn welding_notes(ladder: &mut Ladder<'_>, w: &welding::Welding) {
     if w.duplicates > 0 {
+        let apart = if w.copies_volume > 0.0 {
+            format!(
+                "; stored apart from the faces kept before welding, the copies may change at most {:.2e} m³, which is in the error estimate",
+                w.copies_volume
+            )
+        } else {
+            String::new()
+        };
         ladder.warn(
             HealthKind::FacesDropped,
             format!(
-            "{} faces stored more than once dropped (the copies would count their volume twice)",
+            "{} faces stored more than once dropped (the copies would count their volume twice){apart}",
             w.duplicates
         ),
         );
+        ladder.cancelled += w.copies_volume;
     }
     if w.cancelled > 0 {
         let apart = if w.cancelled_volume > 0.0 {
@@ -321,13 +331,22 @@ fn welding_notes(ladder: &mut Ladder<'_>, w: &welding::Welding) {
             "{} faces dropped in pairs, each a face and its reverse (a wall of no thickness; they cancel){apart}",
             w.cancelled
         ));
-        ladder.cancelled = w.cancelled_volume;
+        ladder.cancelled += w.cancelled_volume;
     }
     if w.collapsed > 0 {
+        let apart = if w.collapsed_volume > 0.0 {
+            format!(
+                "; they may change at most {:.2e} m³, which is in the error estimate",
+                w.collapsed_volume
+            )
+        } else {
+            String::new()
+        };
         ladder.note(HealthKind::Welded, format!(
-            "{} sliver faces collapse when corners within {:.1e} m are welded; left out of the topology",
+            "{} sliver faces collapse when corners within {:.1e} m are welded; left out of the topology{apart}",
             w.collapsed, w.tolerant.tolerance.largest
         ));
+        ladder.cancelled += w.collapsed_volume;
     }
 }
 

@@ -61,7 +61,9 @@ pub(super) struct Ladder<'a> {
     /// A closed surface of several components whose boxes overlap: its shells are classified like
     /// the repaired rungs' (a region two of them enclose counts once).
     pub(super) overlapping_components: bool,
-    /// What the faces dropped in cancelling pairs can change, m³ (`welding::cancelled_volume`).
+    /// What the faces dropped in cancelling pairs, the extra copies dropped and the faces collapsed
+    /// by the tolerant weld can change, m³ (`welding::cancelled_volume`, `copies_volume`,
+    /// `collapsed_volume`).
     pub(super) cancelled: f64,
 }
 
