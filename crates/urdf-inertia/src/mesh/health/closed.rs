@@ -330,16 +330,26 @@ pub(super) fn outward(
     // A component that ends mostly reversed was turned round as a whole (up to the faces
     // [`flip_change`] counts).
     let count = reversed_counts(o, reversed.as_slice());
+    // Turning every face keeps |w|, so Ω: the reference is the file's surface, or all of it turned
+    // when it is wound inward in all ([`turned_components`]).
+    let inward = vol.iter().sum::<f64>() < 0.0;
     let mut nested = 0.0;
     if let Some(boxes) = &boxes {
+        let overlap = |a: &Aabb, b: &Aabb| (0..3).all(|k| a.lo[k].max(b.lo[k]) < a.hi[k].min(b.hi[k]));
         for c in 0..o.ncomp {
-            // Only a component turned against the file can make the solid differ from Ω of the
-            // file's surface there: one kept as stored (a cavity left inward, a solid outward) is
-            // what the file's winding number says it is, and nesting is decided by it.
-            if count[c][1] <= count[c][0] {
+            // Only a component turned against the reference can make the solid differ from Ω of the
+            // file's surface: one kept so (a cavity left inward, a solid outward) is what the
+            // file's winding number says it is, and nesting is decided by it. Turned, it changes
+            // w by 2 inside it, and so Ω only inside it where another component's w is not 0:
+            // within its box where another's overlaps, inside another's box (a cavity turned
+            // outward), around another (a part enclosed by it) or cutting another. Only a box
+            // inside another's was charged: a box wound inward cutting an outward one, and a box
+            // turned round an outward part, were up to 0.125 of their volume off under 1e-12
+            // (`tests/union_sweep.rs`).
+            if (count[c][1] > count[c][0]) == inward {
                 continue;
             }
-            if (0..o.ncomp).any(|d| d != c && boxes[d].contains(&boxes[c])) {
+            if (0..o.ncomp).any(|d| d != c && (overlap(&boxes[c], &boxes[d]) || boxes[d].contains(&boxes[c]))) {
                 nested += 2.0 * vol[c].abs() / 6.0;
             }
         }
