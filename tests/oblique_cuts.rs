@@ -14,33 +14,11 @@ mod common;
 use common::shells::{open_top, solid_with, together};
 use common::Mesh;
 use num_bigint::BigInt;
-use num_rational::BigRational;
 use num_traits::{Signed, Zero};
 use std::cmp::Ordering;
 use urdf_inertia::mesh::health::HealthOptions;
 
-type Q = BigRational;
-type V = [Q; 3];
-
-fn q(x: f64) -> Q {
-    common::rat(x)
-}
-
-fn vsub(a: &V, b: &V) -> V {
-    std::array::from_fn(|k| &a[k] - &b[k])
-}
-
-fn vdot(a: &V, b: &V) -> Q {
-    &a[0] * &b[0] + &a[1] * &b[1] + &a[2] * &b[2]
-}
-
-fn vcross(a: &V, b: &V) -> V {
-    [
-        &a[1] * &b[2] - &a[2] * &b[1],
-        &a[2] * &b[0] - &a[0] * &b[2],
-        &a[0] * &b[1] - &a[1] * &b[0],
-    ]
-}
+use common::rational::{q, vcross, vdot, vsub, Q, V};
 
 /// The half-spaces n·x ≤ d of a convex closed mesh wound outward: one per triangle, exact.
 fn halfspaces(m: &Mesh) -> Vec<(V, Q)> {

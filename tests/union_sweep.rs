@@ -21,34 +21,12 @@ mod common;
 use common::shells::together;
 use common::Mesh;
 use num_bigint::BigInt;
-use num_rational::BigRational;
 use num_traits::{Signed, ToPrimitive, Zero};
 use std::cmp::Ordering;
 use std::fmt::Write;
 use urdf_inertia::mesh::health::HealthOptions;
 
-type Q = BigRational;
-type V = [Q; 3];
-
-fn q(x: f64) -> Q {
-    common::rat(x)
-}
-
-fn vsub(a: &V, b: &V) -> V {
-    std::array::from_fn(|k| &a[k] - &b[k])
-}
-
-fn vdot(a: &V, b: &V) -> Q {
-    &a[0] * &b[0] + &a[1] * &b[1] + &a[2] * &b[2]
-}
-
-fn vcross(a: &V, b: &V) -> V {
-    [
-        &a[1] * &b[2] - &a[2] * &b[1],
-        &a[2] * &b[0] - &a[0] * &b[2],
-        &a[0] * &b[1] - &a[1] * &b[0],
-    ]
-}
+use common::rational::{q, vcross, vdot, vsub, Q, V};
 
 /// A convex polyhedron: its faces, each a ring of corners counter-clockwise seen from outside.
 #[derive(Clone)]

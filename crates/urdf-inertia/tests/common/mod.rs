@@ -10,6 +10,7 @@ use num_rational::BigRational;
 use num_traits::{ToPrimitive, Zero};
 use std::collections::HashMap;
 
+pub mod rational;
 pub mod shells;
 pub mod wild;
 pub mod winding;
