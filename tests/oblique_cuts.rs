@@ -18,7 +18,7 @@ use num_traits::{Signed, Zero};
 use std::cmp::Ordering;
 use urdf_inertia::mesh::health::HealthOptions;
 
-use common::rational::{q, vcross, vdot, vsub, Q, V};
+use common::rational::{boxes_meet, q, vcross, vdot, vsub, Q, V};
 
 /// The half-spaces n·x ≤ d of a convex closed mesh wound outward: one per triangle, exact.
 fn halfspaces(m: &Mesh) -> Vec<(V, Q)> {
@@ -337,18 +337,7 @@ fn union_volume(parts: &[&Mesh]) -> Q {
     let mut total = Q::zero();
     for subset in 1u32..(1 << parts.len()) {
         let members: Vec<usize> = (0..parts.len()).filter(|i| subset >> i & 1 == 1).collect();
-        let meet = (0..3).all(|k| {
-            let lo = members
-                .iter()
-                .map(|&i| boxes[i].0[k])
-                .fold(f64::MIN, f64::max);
-            let hi = members
-                .iter()
-                .map(|&i| boxes[i].1[k])
-                .fold(f64::MAX, f64::min);
-            lo <= hi
-        });
-        if !meet {
+        if !boxes_meet(&members, &boxes) {
             continue;
         }
         let v = if members.len() == 1 {

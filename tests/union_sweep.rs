@@ -26,7 +26,7 @@ use std::cmp::Ordering;
 use std::fmt::Write;
 use urdf_inertia::mesh::health::HealthOptions;
 
-use common::rational::{q, vcross, vdot, vsub, Q, V};
+use common::rational::{boxes_meet, q, vcross, vdot, vsub, Q, V};
 
 /// A convex polyhedron: its faces, each a ring of corners counter-clockwise seen from outside.
 #[derive(Clone)]
@@ -200,17 +200,7 @@ fn omega_integrals(parts: &[Part]) -> [Q; 10] {
         let poly = if members.len() == 1 {
             Some(parts[last].poly())
         } else {
-            let meet = (0..3).all(|k| {
-                let lo = members
-                    .iter()
-                    .map(|&i| bounds[i].0[k])
-                    .fold(f64::MIN, f64::max);
-                let hi = members
-                    .iter()
-                    .map(|&i| bounds[i].1[k])
-                    .fold(f64::MAX, f64::min);
-                lo <= hi
-            });
+            let meet = boxes_meet(&members, &bounds);
             let rest = t & !(1 << last);
             match (&polys[rest], meet) {
                 (Some(p), true) => {

@@ -26,3 +26,18 @@ pub fn vcross(a: &V, b: &V) -> V {
         &a[0] * &b[1] - &a[1] * &b[0],
     ]
 }
+
+/// Whether the boxes (lowest and highest corners) of the `members` have a common point (closed).
+pub fn boxes_meet(members: &[usize], boxes: &[([f64; 3], [f64; 3])]) -> bool {
+    (0..3).all(|k| {
+        let lo = members
+            .iter()
+            .map(|&i| boxes[i].0[k])
+            .fold(f64::MIN, f64::max);
+        let hi = members
+            .iter()
+            .map(|&i| boxes[i].1[k])
+            .fold(f64::MAX, f64::min);
+        lo <= hi
+    })
+}
