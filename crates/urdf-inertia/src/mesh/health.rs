@@ -398,6 +398,7 @@ pub fn heal(
     ladder.as_stored = winding_shells::AsStored {
         faces: w.kept.clone(),
         copies: std::mem::take(&mut w.copies),
+        pairs: std::mem::take(&mut w.pairs),
         precision: Some(precision),
     };
     // Nothing merged or dropped: the topology is the exact weld's faces, which just failed the proof.

@@ -121,9 +121,13 @@ pub(super) fn consistent_closed(
         tolerance,
     } = rung
     {
-        ladder.note(HealthKind::Welded, format!(
-            "closed once {merged_vertices} corners stored up to {widest_crack:.1e} m apart are welded (tolerance {tolerance:.1e} m); integrated as stored"
-        ));
+        let text = if merged_vertices > 0 {
+            format!("closed once {merged_vertices} corners stored up to {widest_crack:.1e} m apart are welded (tolerance {tolerance:.1e} m); integrated as stored")
+        } else {
+            // No corner moved: the faces dropped (copies, cancelling pairs, collapsed) closed it.
+            "closed once the faces dropped above are left out; no corner welded".to_string()
+        };
+        ladder.note(HealthKind::Welded, text);
     }
     let model = if welded {
         open_volume(&vertices, &faces)

@@ -121,7 +121,10 @@ impl<'a> Ladder<'a> {
         rung: &Rung,
         model: &mut Model,
     ) -> Polygons {
+        // Cancelling pairs dropped: the walls they were may have joined bodies that overlap.
+        let walls = !self.as_stored.pairs.is_empty();
         if !self.overlapping_components
+            && !walls
             && !matches!(
                 rung,
                 Rung::Capped { .. } | Rung::NonManifold { .. } | Rung::Reoriented { .. }
@@ -143,7 +146,7 @@ impl<'a> Ladder<'a> {
             // surface integrated now (what else the rung assumed stays).
             model.as_stored_orientation(open_volume(vertices, &s.faces));
         }
-        if s.resolved_pairs > 0 {
+        if s.resolved_pairs > 0 || s.copies_restored > 0 {
             self.resolved(&s, model);
         }
         if s.overlap_bound > 0.0 {
@@ -235,6 +238,12 @@ impl<'a> Ladder<'a> {
                 w.text += &put_back;
             }
         }
+        if s.walls_restored > 0 {
+            stored.push(format!(
+                "{} faces of cancelling pairs put back (walls between bodies, which may overlap)",
+                s.walls_restored
+            ));
+        }
         if s.turned_back > 0 {
             stored.push(format!("{} re-oriented faces as stored", s.turned_back));
         }
@@ -258,10 +267,13 @@ impl<'a> Ladder<'a> {
                 s.cut_faces
             )
         };
-        self.warn(HealthKind::Repaired, format!(
-            "{} pair(s) of closed shells touch or cut each other: {how}{bound}",
-            s.resolved_pairs
-        ));
+        let which = if s.resolved_pairs > 0 {
+            format!("{} pair(s) of closed shells touch or cut each other", s.resolved_pairs)
+        } else {
+            // Shells that neither touch nor cut: decided face by face for the copies alone.
+            "closed shells stored with copies of their faces overlap other shells (the copies add to the winding number inside them)".to_string()
+        };
+        self.warn(HealthKind::Repaired, format!("{which}: {how}{bound}"));
     }
 
     /// Integrates, checks the volume and estimates the error: the last step of every rung. `model`

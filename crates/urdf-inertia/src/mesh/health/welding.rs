@@ -39,17 +39,22 @@ pub(super) struct Welding {
     /// The extra copies dropped, as stored (a face kept once stands for them): the winding number of
     /// the surface as stored counts them, so deciding overlapping shells face by face puts them back.
     pub(super) copies: Polygons,
+    /// The faces dropped in cancelling pairs, as stored: a pair adds nothing to the winding number,
+    /// but the wall it leaves out may have joined two bodies into one shell that cuts itself where
+    /// they overlap, which the shells' classification finds only with the wall put back.
+    pub(super) pairs: Polygons,
 }
 
 pub(super) fn tolerant_welding(exact: weld::ExactWeld, precision: weld::Precision) -> Welding {
     let tol = weld::tolerance(&exact.vertices, precision);
     let tolerant = weld::tolerant(&exact.vertices, tol);
     let (all_topology, kept_mask) = weld::remap_faces(&exact.faces, &tolerant.representative);
-    let (dropped, duplicates, cancelled, extra, facing) = duplicate_faces(&all_topology);
+    let (dropped, duplicates, cancelled, extra, facing, paired) = duplicate_faces(&all_topology);
     let cancelled_volume = cancelled_volume(&exact, &tolerant, &kept_mask, (&dropped, &facing));
     let copies_volume = copies_volume(&exact, &tolerant, &all_topology, &kept_mask, (&dropped, &facing));
     let collapsed_volume = collapsed_volume(&exact, &tolerant, &kept_mask);
     let mut copies = Polygons::new();
+    let mut pairs = Polygons::new();
     // Room for every face: most are kept, and growing three lists face by face copied them.
     let room = || Polygons::with_capacity(exact.faces.len(), exact.faces.indices.len());
     let (mut stored, mut kept, mut topology) = (room(), room(), room());
@@ -60,6 +65,9 @@ pub(super) fn tolerant_welding(exact: weld::ExactWeld, precision: weld::Precisio
             continue;
         }
         (0..extra[t]).for_each(|_| copies.push(face));
+        if paired[t] {
+            pairs.push(face);
+        }
         if !dropped[t] {
             stored.push(face);
             kept.push(face);
@@ -80,6 +88,7 @@ pub(super) fn tolerant_welding(exact: weld::ExactWeld, precision: weld::Precisio
         topology,
         tolerant,
         copies,
+        pairs,
     }
 }
 
@@ -246,9 +255,12 @@ fn collapsed_volume(exact: &weld::ExactWeld, tolerant: &weld::TolerantWeld, kept
 /// Faces that repeat another one's vertices in the same cyclic order (a duplicate: kept once) or in
 /// the reverse order (a zero-thickness wall: the pair cancels, both dropped). Returns per face whether
 /// it is dropped, how many extra copies were dropped, how many faces in cancelling pairs, and per
-/// face kept how many extra copies it stands for, and per face whether its group has both
-/// directions (its drop is a cancelling pair's, or a copy's beside one).
-pub(super) fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize, usize, Vec<u32>, Vec<bool>) {
+/// face kept how many extra copies it stands for, per face whether its group has both
+/// directions (its drop is a cancelling pair's, or a copy's beside one), and per face whether it
+/// was dropped as one of a cancelling pair (not as a copy).
+pub(super) type Duplicates = (Vec<bool>, usize, usize, Vec<u32>, Vec<bool>, Vec<bool>);
+
+pub(super) fn duplicate_faces(faces: &Polygons) -> Duplicates {
     // Each face's vertices rotated to start at the smallest index, in whichever direction reads
     // smaller, and whether that was backwards. Sorting the keys groups the copies.
     let canonical = |f: &[u32]| -> (Vec<u32>, bool) {
@@ -291,6 +303,7 @@ pub(super) fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize, usize, Vec
     let mut dropped = vec![false; faces.len()];
     let mut extra = vec![0u32; faces.len()];
     let mut facing = vec![false; faces.len()];
+    let mut paired = vec![false; faces.len()];
     let (mut repeated, mut cancelled) = (0, 0);
     let mut drop_group = |members: &[(bool, u32)]| {
         let ahead = members.iter().filter(|m| !m.0).count();
@@ -306,12 +319,20 @@ pub(super) fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize, usize, Vec
         // Keep one face of the majority direction (none when the directions balance).
         let keep_dir = back > ahead;
         let mut keep = usize::from(ahead != back);
+        // Of the majority's faces dropped, the first `copies` are the copies; the rest, and every
+        // face of the minority, are pairs.
+        let mut as_copies = copies;
         for &(reversed, i) in members {
             if reversed == keep_dir && keep > 0 {
                 keep -= 1;
                 extra[i as usize] = copies as u32;
             } else {
                 dropped[i as usize] = true;
+                if reversed == keep_dir && as_copies > 0 {
+                    as_copies -= 1;
+                } else {
+                    paired[i as usize] = true;
+                }
             }
         }
     };
@@ -323,7 +344,7 @@ pub(super) fn duplicate_faces(faces: &Polygons) -> (Vec<bool>, usize, usize, Vec
         let members: Vec<(bool, u32)> = group.iter().map(|m| (m.1, m.2)).collect();
         drop_group(&members);
     }
-    (dropped, repeated, cancelled, extra, facing)
+    (dropped, repeated, cancelled, extra, facing, paired)
 }
 
 /// Sorts triangle keys as `sort_unstable` would (they are all distinct, so the order is the same):

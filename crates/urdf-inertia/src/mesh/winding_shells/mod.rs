@@ -90,6 +90,8 @@ pub struct ShellOutcome {
     /// turned back; whether cracks were welded (see [`classify`]).
     pub copies_restored: usize,
     pub turned_back: usize,
+    /// Faces of cancelling pairs (walls of no thickness) put back to decide the shells.
+    pub walls_restored: usize,
     pub cracks_welded: bool,
     /// Faces the ladder turned round, in all (where shells were decided face by face): when
     /// `turned_back` is all of them, the ladder's orientation enters the solid nowhere.
@@ -138,6 +140,29 @@ struct Shell {
 /// back (`stored.copies`: the winding number of the file's surface counts them), and where their
 /// edges balance only so, with the faces the ladder turned round turned back (`stored.faces`).
 pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> ShellOutcome {
+    if stored.pairs.is_empty() || faces.len() != stored.faces.len() {
+        return classify_faces(vertices, faces, stored);
+    }
+    // The walls put back, at the end of both lists (so that the faces stay aligned with their
+    // stored orientation): the bodies they separate become shells of their own, open along the
+    // walls' rims, whose clusters balance and are decided face by face. Where nothing is decided
+    // or changed, the faces come back as they were, without the pairs (which cancel).
+    let mut with = faces.clone();
+    let mut stored_with = stored.clone();
+    for face in stored.pairs.iter() {
+        with.push(face);
+        stored_with.faces.push(face);
+    }
+    stored_with.pairs = Polygons::new();
+    let mut out = classify_faces(vertices, &with, &stored_with);
+    if out.changed || out.resolved_pairs > 0 || out.copies_restored > 0 || out.undecided_pairs > 0 {
+        out.walls_restored = stored.pairs.len();
+        return out;
+    }
+    classify_faces(vertices, faces, &AsStored { pairs: Polygons::new(), ..stored.clone() })
+}
+
+fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> ShellOutcome {
     let (shells, uses) = shells(vertices, faces);
     let unchanged = |undecided_pairs, overlap_bound| ShellOutcome {
         faces: faces.clone(),
@@ -192,7 +217,8 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
     let mut turn = vec![false; faces.len()];
     let sign = orient(&shells, &decided, &w_out, &mut keep, &mut turn, &mut out);
     out.changed = out.dropped_shells > 0 || out.turned_shells > 0;
-    if out.resolved_pairs > 0 {
+    let resolving = relevant.iter().any(|&r| r);
+    if resolving {
         for (i, s) in shells.iter().enumerate() {
             if relevant[i] {
                 s.faces.iter().for_each(|&f| keep[f as usize] = false);
@@ -200,9 +226,9 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
         }
     }
     out.faces = rebuilt(faces, &keep, &turn);
-    if out.resolved_pairs > 0 {
+    if resolving {
         let welded = welded.as_deref();
-        let copied = copied(&stored.copies, &clusters.copy_shell, &relevant);
+        let copied = copied(&stored.copies, &clusters, &relevant);
         out.copies_restored = copied.len();
         out.cracks_welded = welded.is_some();
         let (tris, turned) = as_stored(faces, &shells, &tris, &clusters.unflip, &flip);
@@ -232,6 +258,10 @@ pub struct AsStored {
     pub faces: Polygons,
     /// Extra copies of faces, in their stored orientation, that welding dropped as duplicates.
     pub copies: Polygons,
+    /// Faces that welding dropped in cancelling pairs (a face and its reverse: a wall of no
+    /// thickness), as stored. Where they are, the faces are classified with them put back: a wall
+    /// between two bodies joins them into one shell, which cuts itself where the bodies overlap.
+    pub pairs: Polygons,
     /// The precision of the file's own numbers, which set the ladder's tolerant weld; cracks are
     /// welded with the same tolerance. Taken from the vertices when not given: of scaled
     /// coordinates (f32 times 0.001) that says f64, a tolerance far below the file's cracks.
@@ -251,7 +281,7 @@ fn clusters(
     uses: &[EdgeUse],
 ) -> (Clusters, Vec<bool>, Option<Vec<u32>>) {
     let flip = turned_round(faces, &stored.faces);
-    let copies = (&stored.copies, &flip[..]);
+    let copies = (&stored.copies, &stored.faces, &flip[..]);
     let mut clusters = resolvable(faces, copies, shells, pairs, (uses, None));
     let welded = clusters
         .unbalanced
@@ -276,6 +306,9 @@ struct Clusters {
     unbalanced: bool,
     /// Per extra copy of a face: the shell of the face it copies, when it has one.
     copy_shell: Vec<Option<usize>>,
+    /// Per extra copy: whether the face it copies was turned round by the ladder (the copy is then
+    /// turned with it on the surface as classified).
+    copy_turned: Vec<bool>,
 }
 
 /// The shells to decide face by face: clusters of shells (joined by overlapping boxes, and by edges
@@ -288,7 +321,7 @@ struct Clusters {
 /// cycle of the file is undone).
 fn resolvable(
     faces: &Polygons,
-    (copies, flip): (&Polygons, &[bool]),
+    (copies, stored, flip): (&Polygons, &Polygons, &[bool]),
     shells: &[Shell],
     (pairs, decided): (&[(usize, usize)], &[bool]),
     (uses, rep): (&[EdgeUse], Option<&[u32]>),
@@ -319,7 +352,8 @@ fn resolvable(
         }
         edges.push((group[0].key, (first, net, as_stored)));
     }
-    let (copy_shell, extra) = copied_edges(copies, rep, &mut edges, &mut parent);
+    let copy_turned = copies_turned(copies, stored, flip, (uses, rep));
+    let (copy_shell, extra) = copied_edges((copies, &copy_turned), rep, &mut edges, &mut parent);
     // Per cluster: open as classified, open as stored.
     let mut open = vec![(false, false); shells.len()];
     for &(s, net, as_stored) in edges.iter().map(|e| &e.1).chain(extra.values()) {
@@ -327,9 +361,16 @@ fn resolvable(
         open[r].0 |= net != 0;
         open[r].1 |= as_stored != 0;
     }
+    // A shell some of whose faces welding dropped as copies: the file's surface winds around it
+    // once more per copy, which the nesting of shells (one winding number per shell) does not count,
+    // so a cluster where it overlaps another shell is decided face by face, the copies put back (a
+    // box stored twice around a box wound inward: w = 2 − 1 inside the inner one, which is in Ω,
+    // not a cavity).
+    let mut copied = vec![false; shells.len()];
+    copy_shell.iter().flatten().for_each(|&s| copied[s] = true);
     let mut wanted = vec![false; shells.len()];
     for &(a, b) in pairs {
-        if !decided[a] || !decided[b] {
+        if !decided[a] || !decided[b] || copied[a] || copied[b] {
             wanted[root(&mut parent, a as u32) as usize] = true;
         }
     }
@@ -341,14 +382,43 @@ fn resolvable(
         unflip: roots.iter().map(|&r| wanted[r] && open[r].0 && !open[r].1).collect(),
         unbalanced: (0..shells.len()).any(|r| wanted[r] && open[r].0 && open[r].1),
         copy_shell,
+        copy_turned,
     }
+}
+
+/// Per extra copy of a face: whether the face it copies (the stored face it repeats, found among the
+/// uses of its first edge) was turned round by the ladder. A copy is the same face stored again: the
+/// surface as classified turns it with its face, or else the two would cancel where the file's
+/// surface counts the face twice (two coincident shells wound inward, one turned outward by the
+/// ladder, cancelled each other: the sweep's case 1002).
+fn copies_turned(
+    copies: &Polygons,
+    stored: &Polygons,
+    flip: &[bool],
+    (uses, rep): (&[EdgeUse], Option<&[u32]>),
+) -> Vec<bool> {
+    let at = |v: u32| rep.map_or(v, |r| r[v as usize]);
+    copies
+        .iter()
+        .map(|face| {
+            let key = edge_key(at(face[0]), at(face[1]));
+            let from = uses.partition_point(|e| e.key < key);
+            uses[from..]
+                .iter()
+                .take_while(|e| e.key == key)
+                .map(|e| e.face as usize)
+                .find(|&f| f < stored.len() && stored.face(f) == face)
+                .is_some_and(|f| flip[f])
+        })
+        .collect()
 }
 
 /// The extra copies of faces counted in the faces' `edges` (sorted by edge), in order: each joins
 /// the shell of the first use of its first edge (by a face, or by an earlier copy), when there is
-/// one. Per copy, that shell; and the edges only copies use.
+/// one. Per copy, that shell; and the edges only copies use. A copy counts as stored, and as
+/// classified turned with its face when the ladder turned that (`turned`).
 fn copied_edges(
-    copies: &Polygons,
+    (copies, turned): (&Polygons, &[bool]),
     rep: Option<&[u32]>,
     edges: &mut [(u64, EdgeSums)],
     parent: &mut [u32],
@@ -356,7 +426,7 @@ fn copied_edges(
     let at = |v: u32| rep.map_or(v, |r| r[v as usize]);
     let mut extra: FxHashMap<u64, EdgeSums> = FxHashMap::default();
     let mut copy_shell = Vec::with_capacity(copies.len());
-    for face in copies.iter() {
+    for (c, face) in copies.iter().enumerate() {
         let key = edge_key(at(face[0]), at(face[1]));
         let shell = match edges.binary_search_by_key(&key, |e| e.0) {
             Ok(i) => Some(edges[i].1 .0),
@@ -375,7 +445,7 @@ fn copied_edges(
                 Err(_) => extra.entry(key).or_insert((shell, 0, 0)),
             };
             let d = if u < v { 1 } else { -1 };
-            e.1 += d;
+            e.1 += if turned[c] { -d } else { d };
             e.2 += d;
             join(parent, e.0, shell);
         }
@@ -487,12 +557,20 @@ fn resolve_pairs(
     out.changed |= r.changed;
 }
 
-/// The triangles of the copies whose shells are decided face by face, with their shells.
-fn copied(copies: &Polygons, shell: &[Option<usize>], relevant: &[bool]) -> Vec<(usize, Vec<[u32; 3]>)> {
+/// The triangles of the copies whose shells are decided face by face, with their shells: as
+/// stored where the shell is decided so, else turned with the face they copy.
+fn copied(copies: &Polygons, clusters: &Clusters, relevant: &[bool]) -> Vec<(usize, Vec<[u32; 3]>)> {
     let all: Vec<u32> = (0..copies.len() as u32).collect();
-    let tris = |f: u32| fan(copies, &all[f as usize..=f as usize]);
+    let tris = |c: usize, s: usize| {
+        let t = fan(copies, &all[c..=c]);
+        if clusters.copy_turned[c] && !clusters.unflip[s] {
+            t.into_iter().map(|t| [t[2], t[1], t[0]]).collect()
+        } else {
+            t
+        }
+    };
     (0..copies.len())
-        .filter_map(|c| shell[c].filter(|&s| relevant[s]).map(|s| (s, tris(c as u32))))
+        .filter_map(|c| (clusters.copy_shell[c].filter(|&s| relevant[s])).map(|s| (s, tris(c, s))))
         .collect()
 }
 
