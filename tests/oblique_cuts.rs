@@ -15,10 +15,9 @@ use common::shells::{open_top, solid_with, together};
 use common::Mesh;
 use num_bigint::BigInt;
 use num_traits::{Signed, Zero};
-use std::cmp::Ordering;
 use urdf_inertia::mesh::health::HealthOptions;
 
-use common::rational::{boxes_meet, q, vcross, vdot, vsub, Q, V};
+use common::rational::{boxes_meet, q, ring, vcross, vdot, vsub, Q, V};
 
 /// The half-spaces n·x ≤ d of a convex closed mesh wound outward: one per triangle, exact.
 fn halfspaces(m: &Mesh) -> Vec<(V, Q)> {
@@ -76,31 +75,8 @@ fn volume_from(planes: &[(V, Q)], corners: &[V]) -> Q {
             continue;
         }
         facets.push(on.clone());
-        let count = Q::from_integer(BigInt::from(on.len()));
-        let g: V =
-            std::array::from_fn(|m| on.iter().fold(Q::zero(), |s, &i| s + &corners[i][m]) / &count);
-        let r = vsub(&corners[on[0]], &g);
-        let half = |v: &V| {
-            let s = vdot(pn, &vcross(&r, v));
-            !(s.is_positive() || (s.is_zero() && vdot(&r, v).is_positive()))
-        };
-        let mut ring: Vec<V> = on.iter().map(|&i| vsub(&corners[i], &g)).collect();
-        ring.sort_by(|u, v| {
-            half(u).cmp(&half(v)).then_with(|| {
-                let s = vdot(pn, &vcross(u, v));
-                if s.is_positive() {
-                    Ordering::Less
-                } else if s.is_negative() {
-                    Ordering::Greater
-                } else {
-                    Ordering::Equal
-                }
-            })
-        });
-        let p: Vec<V> = ring
-            .iter()
-            .map(|u| std::array::from_fn(|m| &u[m] + &g[m]))
-            .collect();
+        let points: Vec<V> = on.iter().map(|&i| corners[i].clone()).collect();
+        let p = ring(pn, &points);
         for w in 1..p.len() - 1 {
             volume += vdot(&p[0], &vcross(&p[w], &p[w + 1]));
         }

@@ -22,11 +22,10 @@ use common::shells::together;
 use common::Mesh;
 use num_bigint::BigInt;
 use num_traits::{Signed, ToPrimitive, Zero};
-use std::cmp::Ordering;
 use std::fmt::Write;
 use urdf_inertia::mesh::health::HealthOptions;
 
-use common::rational::{boxes_meet, q, vcross, vdot, vsub, Q, V};
+use common::rational::{boxes_meet, q, ring, vcross, vdot, vsub, Q, V};
 
 /// A convex polyhedron: its faces, each a ring of corners counter-clockwise seen from outside.
 #[derive(Clone)]
@@ -84,33 +83,6 @@ fn clip(p: &Poly, n: &V, d: &Q) -> Option<Poly> {
         faces.push(ring(n, &cap));
     }
     Some(Poly { faces })
-}
-
-/// Points of one convex polygon in the plane of normal `n`, ordered counter-clockwise seen along n.
-fn ring(n: &V, points: &[V]) -> Vec<V> {
-    let count = Q::from_integer(BigInt::from(points.len()));
-    let g: V = std::array::from_fn(|m| points.iter().fold(Q::zero(), |s, p| s + &p[m]) / &count);
-    let r = vsub(&points[0], &g);
-    let half = |v: &V| {
-        let s = vdot(n, &vcross(&r, v));
-        !(s.is_positive() || (s.is_zero() && vdot(&r, v).is_positive()))
-    };
-    let mut rel: Vec<V> = points.iter().map(|p| vsub(p, &g)).collect();
-    rel.sort_by(|u, v| {
-        half(u).cmp(&half(v)).then_with(|| {
-            let s = vdot(n, &vcross(u, v));
-            if s.is_positive() {
-                Ordering::Less
-            } else if s.is_negative() {
-                Ordering::Greater
-            } else {
-                Ordering::Equal
-            }
-        })
-    });
-    rel.iter()
-        .map(|u| std::array::from_fn(|m| &u[m] + &g[m]))
-        .collect()
 }
 
 /// `[T1, Tx, Ty, Tz, Tx², Ty², Tz², Txy, Tyz, Tzx]` of the polyhedron: the sums of
