@@ -401,17 +401,23 @@ fn prism_shape(
             });
         }
     }
+    Shape {
+        points,
+        faces: prism_faces(n),
+        family: "prism",
+        aabb: None,
+    }
+}
+
+/// The faces of a prism whose two rings of `n` corners are numbered 0..n and n..2n: the two ends,
+/// then a quad per side.
+fn prism_faces(n: usize) -> Vec<Vec<usize>> {
     let mut faces = vec![(0..n).collect::<Vec<_>>(), (n..2 * n).collect()];
     for i in 0..n {
         let j = (i + 1) % n;
         faces.push(vec![i, j, n + j, n + i]);
     }
-    Shape {
-        points,
-        faces,
-        family: "prism",
-        aabb: None,
-    }
+    faces
 }
 
 fn centre(s: &Shape) -> [f64; 3] {
@@ -541,15 +547,10 @@ fn related_shape(state: &mut u64, base: &Shape) -> (Shape, String) {
                         std::array::from_fn(|k| base.points[i][k] + out[k] * h + shear[k])
                     }),
                 );
-                let mut faces = vec![(0..m).collect::<Vec<_>>(), (m..2 * m).collect()];
-                for i in 0..m {
-                    let j = (i + 1) % m;
-                    faces.push(vec![i, j, m + j, m + i]);
-                }
                 (
                     Shape {
                         points,
-                        faces,
+                        faces: prism_faces(m),
                         family: "prism on a face",
                         aabb: None,
                     },
