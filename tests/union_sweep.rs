@@ -1424,3 +1424,27 @@ fn a_wall_between_bodies_that_overlap_is_put_back() {
         "error {volume:e} (inertia {inertia:e}), estimate {estimate:e}"
     );
 }
+
+/// A known breach (not fixed; sweep case 3187 less its last two parts): three tetrahedra ~3 cm across,
+/// 9,000 m from the origin, stored within about an ulp of each other (1e-11 of their size apart,
+/// where an ulp of the coordinates is 6e-11 of it), wound outward, inward and outward. Ω is where
+/// w = 1 − 1 + 1 = 1, about the tetrahedron: 2.707e-6 m³. The face-by-face decision cuts them at
+/// points rounded to f64, which moves them by as much as they are apart: 6.418e-6 m³, 1.37 of the
+/// volume off under an estimate of 0.58 (the round-off term, the faces' dependence on the reference
+/// point, which says the pieces no longer close but not by how much). The same on 6b56a09.
+#[test]
+#[ignore = "known breach: shells within an ulp of each other, cut at rounded points"]
+fn three_tetrahedra_within_an_ulp_are_within_the_estimate() {
+    let mut case = random_case(3187).expect("made");
+    case.parts.truncate(3);
+    let Outcome::Checked {
+        volume, estimate, ..
+    } = run(&case)
+    else {
+        panic!("no solid");
+    };
+    assert!(
+        volume <= estimate,
+        "error {volume:e}, estimate {estimate:e}"
+    );
+}
