@@ -1323,16 +1323,19 @@ fn copies_welded_from_apart_are_within_the_estimate() {
 /// small rotated box at a corner and a tetrahedron on an edge. The non-manifold rung turned the
 /// kept box outward while its dropped copies were put back as stored, inward: the two cancelled and
 /// Ω lost the box, 0.17 m³ against 20,933 under an estimate of 7.1e-3. A copy is now turned with
-/// the face it copies. And case 2616 whole (see `a_wall_between_bodies_that_overlap_is_put_back`).
+/// the face it copies. And case 2616 whole (see `a_wall_between_bodies_that_overlap_is_put_back`),
+/// and case 4137, which putting walls back first broke: pieces of a wall made shells closed up to
+/// cracks that nesting turned on their own (1.9e-8 off under 1.3e-8); the walls' answer is now
+/// taken only where it turns and drops the same shells as the one without them.
 #[test]
 fn sweep_cases_once_off_are_within_the_estimate() {
     let mut tally = Tally::default();
-    for seed in [13, 331, 1002, 2616] {
+    for seed in [13, 331, 1002, 2616, 4137] {
         tally.case(seed, false);
     }
     assert!(tally.breaches.is_empty(), "{}", tally.breaches.join("\n"));
     assert_eq!(tally.breaches_turned, 0);
-    assert_eq!(tally.checked, 4);
+    assert_eq!(tally.checked, 5);
 }
 
 /// A breach found by the sweep, now within the estimate: a box wound inward, a tetrahedron wound outward inside it with an
