@@ -99,6 +99,11 @@ impl Aabb {
         }
     }
 
+    /// Whether the two boxes share a positive volume (touching faces, edges or corners do not).
+    pub fn overlaps(&self, other: &Aabb) -> bool {
+        (0..3).all(|k| self.lo[k].max(other.lo[k]) < self.hi[k].min(other.hi[k]))
+    }
+
     /// Whether `inner` lies within the box (faces included).
     pub fn contains(&self, inner: &Aabb) -> bool {
         (0..3).all(|k| self.lo[k] <= inner.lo[k] && inner.hi[k] <= self.hi[k])

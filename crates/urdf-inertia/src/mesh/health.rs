@@ -300,33 +300,30 @@ pub fn make_solid(mesh: &RawMesh, path: &Path, options: HealthOptions) -> Result
 /// What welding dropped or collapsed, and what dropping copies apart, cancelling pairs and collapsed
 /// faces can change.
 fn welding_notes(ladder: &mut Ladder<'_>, w: &welding::Welding) {
-    if w.duplicates > 0 {
-        let apart = if w.copies_volume > 0.0 {
-            format!(
-                "; stored apart from the faces kept before welding, the copies may change at most {:.2e} m³, which is in the error estimate",
-                w.copies_volume
-            )
+    // "; {what} {volume} m³, which is in the error estimate", or nothing where the bound is 0.
+    let bound = |what: &str, volume: f64| {
+        if volume > 0.0 {
+            format!("; {what} {volume:.2e} m³, which is in the error estimate")
         } else {
             String::new()
-        };
+        }
+    };
+    if w.duplicates > 0 {
+        let apart = bound(
+            "stored apart from the faces kept before welding, the copies may change at most",
+            w.copies_volume,
+        );
         ladder.warn(
             HealthKind::FacesDropped,
             format!(
-            "{} faces stored more than once dropped (the copies would count their volume twice){apart}",
-            w.duplicates
-        ),
+                "{} faces stored more than once dropped (the copies would count their volume twice){apart}",
+                w.duplicates
+            ),
         );
         ladder.cancelled += w.copies_volume;
     }
     if w.cancelled > 0 {
-        let apart = if w.cancelled_volume > 0.0 {
-            format!(
-                "; stored apart before welding, they may enclose at most {:.2e} m³, which is in the error estimate",
-                w.cancelled_volume
-            )
-        } else {
-            String::new()
-        };
+        let apart = bound("stored apart before welding, they may enclose at most", w.cancelled_volume);
         ladder.note(HealthKind::FacesCancelled, format!(
             "{} faces dropped in pairs, each a face and its reverse (a wall of no thickness; they cancel){apart}",
             w.cancelled
@@ -334,14 +331,7 @@ fn welding_notes(ladder: &mut Ladder<'_>, w: &welding::Welding) {
         ladder.cancelled += w.cancelled_volume;
     }
     if w.collapsed > 0 {
-        let apart = if w.collapsed_volume > 0.0 {
-            format!(
-                "; they may change at most {:.2e} m³, which is in the error estimate",
-                w.collapsed_volume
-            )
-        } else {
-            String::new()
-        };
+        let apart = bound("they may change at most", w.collapsed_volume);
         ladder.note(HealthKind::Welded, format!(
             "{} sliver faces collapse when corners within {:.1e} m are welded; left out of the topology{apart}",
             w.collapsed, w.tolerant.tolerance.largest

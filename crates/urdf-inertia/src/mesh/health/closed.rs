@@ -191,9 +191,8 @@ pub(super) fn misoriented(vertices: &[[f64; 3]], faces: &Polygons, comp: &[u32],
         return vec![false; ncomp];
     }
     let boxes = component_boxes(vertices, faces, comp, ncomp);
-    let overlap = |a: &Aabb, b: &Aabb| (0..3).all(|k| a.lo[k].max(b.lo[k]) < a.hi[k].min(b.hi[k]));
     (0..ncomp)
-        .map(|c| vol[c] < 0.0 && !(0..ncomp).any(|d| d != c && overlap(&boxes[c], &boxes[d])))
+        .map(|c| vol[c] < 0.0 && !(0..ncomp).any(|d| d != c && boxes[c].overlaps(&boxes[d])))
         .collect()
 }
 
@@ -339,7 +338,6 @@ pub(super) fn outward(
     let inward = vol.iter().sum::<f64>() < 0.0;
     let mut nested = 0.0;
     if let Some(boxes) = &boxes {
-        let overlap = |a: &Aabb, b: &Aabb| (0..3).all(|k| a.lo[k].max(b.lo[k]) < a.hi[k].min(b.hi[k]));
         for c in 0..o.ncomp {
             // Only a component turned against the reference can make the solid differ from Ω of the
             // file's surface: one kept so (a cavity left inward, a solid outward) is what the
@@ -353,7 +351,7 @@ pub(super) fn outward(
             if (count[c][1] > count[c][0]) == inward {
                 continue;
             }
-            if (0..o.ncomp).any(|d| d != c && (overlap(&boxes[c], &boxes[d]) || boxes[d].contains(&boxes[c]))) {
+            if (0..o.ncomp).any(|d| d != c && (boxes[c].overlaps(&boxes[d]) || boxes[d].contains(&boxes[c]))) {
                 nested += 2.0 * vol[c].abs() / 6.0;
             }
         }
