@@ -1,4 +1,4 @@
-//! One `make_solid` of a `shells_` row of `benches/open_mesh.rs` (`crossing` or `cutting`), for
+//! One `make_solid` of a `shells_` row of `benches/open_mesh.rs` (`nested`, `crossing`, `cutting` or `coincident`), for
 //! instruction counts under callgrind (docs/benchmarks.md, the shells rows):
 //! `RAYON_NUM_THREADS=1 valgrind --tool=callgrind target/release/examples/shells_once cutting`.
 
@@ -17,8 +17,20 @@ fn main() {
         "nested" => common::shells::spheres(&[(0.0, 0.5)]),
         "crossing" => common::shells::spheres(&[(0.5, 0.5)]),
         "cutting" => common::shells::spheres(&[(-0.7, 0.6), (0.7, 0.6)]),
+        "coincident" => {
+            let (lo, hi) = ([0.0; 3], [1.0; 3]);
+            let (v, f) = common::shells::together(&[
+                (&common::grid_box(lo, hi, 36), false),
+                (&common::grid_box(lo, hi, 55), false),
+            ]);
+            urdf_inertia::mesh::RawMesh {
+                vertices: v,
+                faces: urdf_inertia::mass::Polygons::from_triangles(&f),
+                ..urdf_inertia::mesh::RawMesh::default()
+            }
+        }
         _ => {
-            eprintln!("usage: shells_once (nested | crossing | cutting)");
+            eprintln!("usage: shells_once (nested | crossing | cutting | coincident)");
             std::process::exit(2);
         }
     };

@@ -3,11 +3,15 @@
 
 use super::closed::open_volume;
 use super::geometry::{bbox, unit_props};
-use super::model::{check_volume, reach, round_off, round_off_against, Lever, Model};
+use super::model::{
+    check_volume, reach, round_off, round_off_against, round_off_bound, Lever, Model,
+};
 use super::{ErrorEstimate, HealthKind, HealthMessage, HealthOptions, ModelError, Rung, Solid};
 use crate::geometry::dot;
 use crate::geometry::Aabb;
-use crate::mass::integrals::{box_centre, volume_integrals_about_two, VolumeIntegrals};
+use crate::mass::integrals::{
+    bounding_box_centre, box_centre, volume_integrals_about_two, VolumeIntegrals,
+};
 use crate::mass::{IntegrationOptions, MassProperties, Polygons};
 use crate::mesh::{winding_shells, MeshError, MeshErrorKind, RawMesh};
 use std::path::Path;
@@ -114,6 +118,18 @@ impl<'a> Ladder<'a> {
     /// On the repaired rungs, the faces that bound the solid when shells overlap (see
     /// [`super::winding_shells`]): doubly enclosed shells dropped, inside-out ones turned, and what is
     /// left undecided bounded in `model`. The surfaces integrated as stored pay nothing.
+    /// Whether [`Ladder::shells`] classifies the shells of `rung`'s surface by the winding number.
+    fn classifies(&self, rung: &Rung) -> bool {
+        // Cancelling pairs dropped: the walls they were may have joined bodies that overlap.
+        let walls = !self.as_stored.pairs.is_empty();
+        self.overlapping_components
+            || walls
+            || matches!(
+                rung,
+                Rung::Capped { .. } | Rung::NonManifold { .. } | Rung::Reoriented { .. }
+            )
+    }
+
     pub(super) fn shells(
         &mut self,
         vertices: &mut Vec<[f64; 3]>,
@@ -121,15 +137,7 @@ impl<'a> Ladder<'a> {
         rung: &Rung,
         model: &mut Model,
     ) -> Polygons {
-        // Cancelling pairs dropped: the walls they were may have joined bodies that overlap.
-        let walls = !self.as_stored.pairs.is_empty();
-        if !self.overlapping_components
-            && !walls
-            && !matches!(
-                rung,
-                Rung::Capped { .. } | Rung::NonManifold { .. } | Rung::Reoriented { .. }
-            )
-        {
+        if !self.classifies(rung) {
             return faces;
         }
         let mut s = winding_shells::classify(vertices, &faces, &self.as_stored);
@@ -289,6 +297,7 @@ impl<'a> Ladder<'a> {
     ) -> Result<Solid, MeshError> {
         let mut model = model.into();
         let mut vertices = vertices;
+        let classified = self.classifies(&rung);
         let faces = self.shells(&mut vertices, faces, &rung, &mut model);
         if self.cancelled > 0.0 {
             if self.cancelled > model.total() {
@@ -296,9 +305,17 @@ impl<'a> Ladder<'a> {
             }
             model.terms.push((self.cancelled, Lever::Anywhere));
         }
-        let (unit, corner) = match self.known.take() {
-            Some(k) => (MassProperties::from_integrals(&k.integrals, 1.0), k.corner),
-            None => (unit_props(&vertices, &faces, None), None),
+        let (unit, corner, reference) = match self.known.take() {
+            Some(k) => (
+                MassProperties::from_integrals(&k.integrals, 1.0),
+                k.corner,
+                k.integrals.reference,
+            ),
+            None => (
+                unit_props(&vertices, &faces, None),
+                None,
+                bounding_box_centre(&vertices),
+            ),
         };
         // One pass for the box both checks use, unless the integrals came with it.
         let bounds = corner.as_ref().map_or_else(|| bbox(&vertices), |c| c.0);
@@ -306,6 +323,14 @@ impl<'a> Ladder<'a> {
         let round_off = match corner {
             Some((_, t)) => round_off_against(&MassProperties::from_integrals(&t, 1.0), &unit),
             None => round_off(&vertices, &faces, bounds.lo, &unit),
+        };
+        // Where the winding number decided the faces, the solid can be a thin slab of large faces
+        // whose contributions cancel: the estimate above is then a sample of the round-off, and
+        // the bound is taken as well.
+        let round_off = if classified {
+            round_off.max(round_off_bound(&vertices, &faces, reference, &unit))
+        } else {
+            round_off
         };
         let source = model.source;
         let bound = model.bound(&unit, &vertices);
