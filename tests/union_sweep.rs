@@ -1480,26 +1480,31 @@ fn a_wall_between_bodies_that_overlap_is_put_back() {
     );
 }
 
-/// A known breach (not fixed; sweep case 3187 less its last two parts): three tetrahedra ~3 cm across,
-/// 9,000 m from the origin, stored within about an ulp of each other (1e-11 of their size apart,
-/// where an ulp of the coordinates is 6e-11 of it), wound outward, inward and outward. Ω is where
-/// w = 1 − 1 + 1 = 1, about the tetrahedron: 2.707e-6 m³. The face-by-face decision cuts them at
-/// points rounded to f64, which moves them by as much as they are apart: 6.418e-6 m³, 1.37 of the
-/// volume off under an estimate of 0.58 (the round-off term, the faces' dependence on the reference
-/// point, which says the pieces no longer close but not by how much). The same on 6b56a09.
+/// A breach until session 36 (sweep case 3187, whole and less its last two parts): three
+/// tetrahedra ~3 cm across, 9,000 m from the origin, stored within about an ulp of each other
+/// (1e-11 of their size apart, where an ulp of the coordinates is 6e-11 of it), wound outward,
+/// inward and outward. Ω is where w = 1 − 1 + 1 = 1, about the tetrahedron: 2.707e-6 m³. The
+/// face-by-face decision cuts them at points rounded to f64, which moves them by as much as they
+/// are apart: 6.418e-6 m³, 1.37 of the volume off under an estimate of 0.58 (the round-off term,
+/// the faces' dependence on the reference point, which says the pieces no longer close but not by
+/// how much); the whole case 2.6 of its volume off under 0.61. Now the pieces' gap is seen to be
+/// beyond what their rounding and the estimate's terms allow: the value is not bounded, and a
+/// warning says why.
 #[test]
-#[ignore = "known breach: shells within an ulp of each other, cut at rounded points"]
 fn three_tetrahedra_within_an_ulp_are_within_the_estimate() {
-    let mut case = random_case(3187).expect("made");
-    case.parts.truncate(3);
-    let Outcome::Checked {
-        volume, estimate, ..
-    } = run(&case)
-    else {
-        panic!("no solid");
-    };
-    assert!(
-        volume <= estimate,
-        "error {volume:e}, estimate {estimate:e}"
-    );
+    for keep in [3, 5] {
+        let mut case = random_case(3187).expect("made");
+        case.parts.truncate(keep);
+        let s = solid(&case).expect("a solid");
+        assert!(
+            s.error_estimate.is_infinite(),
+            "{keep}: {:e}",
+            s.error_estimate
+        );
+        assert!(
+            s.warnings.iter().any(|w| w.text.contains("do not close")),
+            "{keep}: {:?}",
+            s.warnings
+        );
+    }
 }

@@ -1,7 +1,7 @@
 //! The error model: volumes by which a solid can differ from the stored surface, turned into relative
 //! bounds on volume, inertia and centre of mass; the round-off estimate and the empty-solid check.
 
-use super::geometry::{dist, polygon_area, unit_props};
+use super::geometry::{dist, polygon_area};
 use super::{ModelError, ROUND_OFF_FLOOR, ZERO_VOLUME_ROUNDOFFS};
 use crate::geometry::Aabb;
 use crate::mass::integrals::two_sum;
@@ -147,12 +147,8 @@ pub(super) fn reach(unit: &MassProperties, vertices: &[[f64; 3]]) -> f64 {
 }
 
 /// The round-off estimate: the relative disagreement of volume and central inertia integrated about
-/// two reference points (bounding-box centre and corner), never below [`ROUND_OFF_FLOOR`].
-pub(super) fn round_off(vertices: &[[f64; 3]], faces: &Polygons, lo: [f64; 3], base: &MassProperties) -> f64 {
-    round_off_against(&unit_props(vertices, faces, Some(lo)), base)
-}
-
-/// [`round_off`] from the properties integrated about the second reference point, `other`.
+/// two reference points (`base` about the bounding-box centre, `other` about its corner), never
+/// below [`ROUND_OFF_FLOOR`].
 pub(super) fn round_off_against(other: &MassProperties, base: &MassProperties) -> f64 {
     let mut d = [[0.0; 3]; 3];
     for i in 0..3 {
@@ -266,7 +262,7 @@ fn chunked_area(vertices: &[[f64; 3]], faces: &Polygons) -> Option<f64> {
 /// `reference` (the point it integrated about), can make on `faces`, first order in ε with
 /// generous constants, never below [`ROUND_OFF_FLOOR`].
 ///
-/// [`round_off`] compares two evaluations; it sees how much the faces' contributions cancel, but
+/// [`round_off_against`] compares two evaluations; it sees how much the faces' contributions cancel, but
 /// only as one sample of the error. Where the winding number leaves a thin solid of large faces
 /// (two shells an ulp apart, one wound outward and one inward, leave a slab between them), the
 /// contributions about the reference cancel by a factor of a thousand and the sample fell 1.2 to
