@@ -293,18 +293,21 @@ pub(super) fn round_off_bound(
     // by 6, 24 and 120, and the sums of their terms' absolute values.
     let mut out = ([0.0f64; 10], [0.0f64; 10]);
     let mut triangles = 0usize;
-    // A corner shifted as the kernel shifts it, and how far the rounding moved it (exactly: the
-    // error of a two-sum).
-    let shifted = |i: u32| {
-        let v = vertices[i as usize];
-        let mut moved = 0.0f64;
-        let p: [f64; 3] = std::array::from_fn(|k| {
-            let (s, e) = two_sum(v[k], -reference[k]);
-            moved = moved.max(e.abs());
-            s
-        });
-        (p, moved)
-    };
+    // Each vertex shifted as the kernel shifts it, and how far the rounding moved it (exactly: the
+    // error of a two-sum), once for the faces that share it.
+    let shifted: Vec<([f64; 3], f64)> = vertices
+        .iter()
+        .map(|v| {
+            let mut moved = 0.0f64;
+            let p: [f64; 3] = std::array::from_fn(|k| {
+                let (s, e) = two_sum(v[k], -reference[k]);
+                moved = moved.max(e.abs());
+                s
+            });
+            (p, moved)
+        })
+        .collect();
+    let shifted = |i: u32| shifted[i as usize];
     for face in faces.iter() {
         let Some((&first, rest)) = face.split_first() else {
             continue;
