@@ -3,7 +3,7 @@
 
 use super::geometry::{dist, polygon_area};
 use super::{ModelError, ROUND_OFF_FLOOR, ZERO_VOLUME_ROUNDOFFS};
-use crate::geometry::Aabb;
+use crate::geometry::{cross, dot, sub, Aabb};
 use crate::mass::integrals::two_sum;
 use crate::mass::{frobenius, MassProperties, Polygons};
 use crate::mesh::{MeshError, MeshErrorKind};
@@ -333,14 +333,9 @@ const EPS: f64 = f64::EPSILON / 2.0;
 /// and moved by at most `moved` in each coordinate by that shift: adds to `out.0` what the kernel
 /// can round in each of its ten raw integrals, to `out.1` their terms' absolute values.
 fn triangle_rounding([a, b, c]: [[f64; 3]; 3], moved: f64, out: &mut ([f64; 10], [f64; 10])) {
-    let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    let n = [
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
-    ];
-    let d = a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
+    // As the kernel evaluates them (the same operations in the same order).
+    let (e1, e2) = (sub(b, a), sub(c, a));
+    let d = dot(a, cross(e1, e2));
     // The cross product's products, absolute.
     let cross = [
         (e1[1] * e2[2]).abs() + (e1[2] * e2[1]).abs(),
@@ -353,9 +348,7 @@ fn triangle_rounding([a, b, c]: [[f64; 3]; 3], moved: f64, out: &mut ([f64; 10],
         .flat_map(|p| p.iter())
         .fold(0.0f64, |m, x| m.max(x.abs()));
     // The kernel's test for re-evaluating d with error-free products.
-    let aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-    let ee = (e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2])
-        * (e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
+    let (aa, ee) = (dot(a, a), dot(e1, e1) * dot(e2, e2));
     let slow = d * d * 16_777_216.0 < aa * ee;
     let evaluated = if slow {
         4.0 * EPS * d.abs() + 64.0 * EPS * EPS * largest.powi(3)
