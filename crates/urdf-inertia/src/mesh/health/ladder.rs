@@ -119,9 +119,6 @@ impl<'a> Ladder<'a> {
         }
     }
 
-    /// On the repaired rungs, the faces that bound the solid when shells overlap (see
-    /// [`super::winding_shells`]): doubly enclosed shells dropped, inside-out ones turned, and what is
-    /// left undecided bounded in `model`. The surfaces integrated as stored pay nothing.
     /// For a solid whose faces the winding number decided, the round-off `round_off` at least
     /// the kernel's rounding bounded face by face ([`round_off_bound`]): such a solid can be a
     /// thin slab of large faces whose contributions cancel, of which the two points'
@@ -168,6 +165,9 @@ impl<'a> Ladder<'a> {
             )
     }
 
+    /// On the repaired rungs, the faces that bound the solid when shells overlap (see
+    /// [`super::winding_shells`]): doubly enclosed shells dropped, inside-out ones turned, and what is
+    /// left undecided bounded in `model`. The surfaces integrated as stored pay nothing.
     pub(super) fn shells(
         &mut self,
         vertices: &mut Vec<[f64; 3]>,
@@ -347,13 +347,9 @@ impl<'a> Ladder<'a> {
             Some(k) => (
                 MassProperties::from_integrals(&k.integrals, 1.0),
                 k.corner,
-                k.integrals.reference,
+                Some(k.integrals.reference),
             ),
-            None => (
-                unit_props(&vertices, &faces, None),
-                None,
-                bounding_box_centre(&vertices),
-            ),
+            None => (unit_props(&vertices, &faces, None), None, None),
         };
         // One pass for the box both checks use, unless the integrals came with it.
         let bounds = corner.as_ref().map_or_else(|| bbox(&vertices), |c| c.0);
@@ -365,6 +361,8 @@ impl<'a> Ladder<'a> {
         };
         let mut round_off = round_off_against(&other, &unit);
         if classified {
+            // The point the kernel integrated about: the vertices' box centre unless given.
+            let reference = reference.unwrap_or_else(|| bounding_box_centre(&vertices));
             self.closure(&other, &unit, (&vertices, &faces, reference), &mut model, &mut round_off);
         }
         let source = model.source;

@@ -269,9 +269,9 @@ fn chunked_area(vertices: &[[f64; 3]], faces: &Polygons) -> Option<f64> {
 /// 2.75 times below the error (sweep cases 587, 1654, 1725 and 4371 of `tests/union_sweep.rs`).
 /// This bound adds up, face by face, what each step of the kernel can round
 /// (`mass::integrals::triangles`):
-/// - the shift of each corner by `-reference`, rounded (up to ε of the corner's largest
-///   coordinate): on a closed surface the corners move together, so the integrals change by at
-///   most each face's area times that move times the integrand's largest value on it;
+/// - the shift of each corner by `-reference`, rounded (by the exact error of a two-sum): on a
+///   closed surface the corners move together, so the integrals change by at most each face's
+///   area times that move times the integrand's largest value on it;
 /// - `d`, six times the signed tetrahedron with the reference: 8ε times the sum of the absolute
 ///   values of its products where the kernel takes it plainly, 4ε|d| (and ε² of its products)
 ///   where it re-evaluates it with error-free products (the same test as the kernel);
