@@ -1495,6 +1495,12 @@ fn three_tetrahedra_within_an_ulp_are_within_the_estimate() {
     for keep in [3, 5] {
         let mut case = random_case(3187).expect("made");
         case.parts.truncate(keep);
+        // Against Ω in exact rationals, more than the whole volume off: no finite sample of the
+        // pieces' gap (0.58 and 0.61 of it) bounds that.
+        let Outcome::Checked { volume, .. } = run(&case) else {
+            panic!("no solid");
+        };
+        assert!(volume > 1.0, "{keep}: error {volume:e}");
         let s = solid(&case).expect("a solid");
         assert!(
             s.error_estimate.is_infinite(),

@@ -9,9 +9,7 @@ use super::model::{
 use super::{ErrorEstimate, HealthKind, HealthMessage, HealthOptions, ModelError, Rung, Solid};
 use crate::geometry::dot;
 use crate::geometry::Aabb;
-use crate::mass::integrals::{
-    bounding_box_centre, box_centre, volume_integrals_about_two, VolumeIntegrals,
-};
+use crate::mass::integrals::{box_centre, volume_integrals_about_two, VolumeIntegrals};
 use crate::mass::{IntegrationOptions, MassProperties, Polygons};
 use crate::mesh::{winding_shells, MeshError, MeshErrorKind, RawMesh};
 use std::path::Path;
@@ -361,8 +359,10 @@ impl<'a> Ladder<'a> {
         };
         let mut round_off = round_off_against(&other, &unit);
         if classified {
-            // The point the kernel integrated about: the vertices' box centre unless given.
-            let reference = reference.unwrap_or_else(|| bounding_box_centre(&vertices));
+            // The point the kernel integrated about: unless given, the centre of the box found
+            // above (the kernel's `bounding_box_centre` but for the sign of a zero, which moves no
+            // bound).
+            let reference = reference.unwrap_or_else(|| box_centre(bounds.lo, bounds.hi));
             self.closure(&other, &unit, (&vertices, &faces, reference), &mut model, &mut round_off);
         }
         let source = model.source;

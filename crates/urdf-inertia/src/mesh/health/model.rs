@@ -361,11 +361,7 @@ fn triangle_rounding([a, b, c]: [[f64; 3]; 3], moved: f64, out: &mut ([f64; 10],
     // integrand's largest value on the face (1, below s_k, below p_k): in units of d,
     // 6 × (√3/2)·moved, then 24 × and 120 × the same.
     let moved = moved * (cross[0] + cross[1] + cross[2]);
-    let s = [
-        a[0].abs() + b[0].abs() + c[0].abs(),
-        a[1].abs() + b[1].abs() + c[1].abs(),
-        a[2].abs() + b[2].abs() + c[2].abs(),
-    ];
+    let s: [f64; 3] = std::array::from_fn(|k| a[k].abs() + b[k].abs() + c[k].abs());
     let q = |i: usize, j: usize| {
         (a[i] * a[j]).abs() + (b[i] * b[j]).abs() + (c[i] * c[j]).abs() + s[i] * s[j]
     };
@@ -398,9 +394,10 @@ fn central_rounding(t: &[f64; 10], reference: [f64; 3], unit: &MassProperties) -
     let diag = |k: usize| {
         t[4 + k] + 2.0 * r[k] * t[1 + k] + r[k] * r[k] * t[0] + 4.0 * EPS * (c_diag[k] + m * r[k] * r[k])
     };
-    // Products: (x, y), (y, z), (z, x) with their entries of the tensor.
-    let pair = |k: usize, x: usize, y: usize| {
-        t[7 + k]
+    // The product of axes x and x + 1 (xy, yz, zx: the integrals' order) with its entry.
+    let pair = |x: usize| {
+        let y = (x + 1) % 3;
+        t[7 + x]
             + r[x] * t[1 + y]
             + r[y] * t[1 + x]
             + r[x] * r[y] * t[0]
@@ -408,9 +405,9 @@ fn central_rounding(t: &[f64; 10], reference: [f64; 3], unit: &MassProperties) -
     };
     let dc = [diag(0), diag(1), diag(2)];
     let di = [
-        [dc[1] + dc[2], pair(0, 0, 1), pair(2, 2, 0)],
-        [pair(0, 0, 1), dc[2] + dc[0], pair(1, 1, 2)],
-        [pair(2, 2, 0), pair(1, 1, 2), dc[0] + dc[1]],
+        [dc[1] + dc[2], pair(0), pair(2)],
+        [pair(0), dc[2] + dc[0], pair(1)],
+        [pair(2), pair(1), dc[0] + dc[1]],
     ];
     let n = frobenius(&unit.inertia);
     let inertia = if n > 0.0 {
