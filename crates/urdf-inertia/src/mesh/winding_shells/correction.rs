@@ -13,7 +13,7 @@
 use super::bvh::Bvh;
 use super::cells::{area, cells, centroid, largest_coordinate, leaves_whole, overhang, split, CellWork, Cut, CutPlane};
 use super::grid::{Corners, Grid, Plane, Seen};
-use super::{corners_touch, edge_meets, overlap, EdgeUse};
+use super::{corners_touch, edge_meets, in_order, overlap, EdgeUse};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
 use crate::mass::Polygons;
 use robust::{orient2d, Coord};
@@ -178,6 +178,9 @@ struct CutWork {
     sides: Vec<bool>,
     /// Per triangle, its place in `coplanar` plus one, 0 when it is not there (set during a cut).
     slot: Vec<u32>,
+    /// The coplanar triangles' edges that are not seams ([`Faces::seam`]): their place in
+    /// `coplanar` and the edge. Those that cross the piece join `planes` as cuts.
+    edges: Vec<(u32, u8)>,
     crossing: Vec<usize>,
     cells: CellWork,
 }
@@ -294,7 +297,9 @@ impl Faces<'_> {
     /// [`Grid::first_shared_cell`], not asked again). `None` past [`MAX_MEETING`] pairs.
     fn all_blockers(&self, boxes: &[Aabb], crowded: u64, seen: &mut Seen) -> Option<Vec<Vec<u32>>> {
         let n = self.tris.len();
-        let grown: Vec<Aabb> = boxes.iter().map(|b| inflated(*b, self.margin)).collect();
+        // Each box grown by the margin where it is asked (a list of them was 48 bytes a triangle
+        // of fresh memory).
+        let grown = |t: usize| inflated(boxes[t], self.margin);
         let Aabb { lo, hi } = self.grid.bounds;
         let largest = (0..3).map(|k| lo[k].abs().max(hi[k].abs())).fold(0.0, f64::max);
         let pad = 2.0 * self.margin + 4.0 * f64::EPSILON * largest;
@@ -302,7 +307,7 @@ impl Faces<'_> {
         let mut meeting = 0;
         let mut pair = |t: usize, u: usize| {
             meeting += 1;
-            let asked = (overlap(&grown[t], &boxes[u]), overlap(&grown[u], &boxes[t]));
+            let asked = (overlap(&grown(t), &boxes[u]), overlap(&grown(u), &boxes[t]));
             let (tu, ut) = self.blocks_both(t, u, asked);
             if tu {
                 out[t].push(u as u32);
@@ -342,7 +347,7 @@ impl Faces<'_> {
         let mut keyed = Vec::new();
         for (t, list) in out.iter_mut().enumerate() {
             if list.len() > 1 {
-                let corner = self.grid.cell_of(grown[t].lo);
+                let corner = self.grid.cell_of(grown(t).lo);
                 keyed.clear();
                 keyed.extend(list.iter().map(|&u| (self.grid.first_shared_cell(corner, &boxes[u as usize]), u)));
                 keyed.sort_unstable();
@@ -366,7 +371,7 @@ impl Faces<'_> {
             // The corners shared may then differ seen from each.
             return (asked.0 && self.blocks(t, u), asked.1 && self.blocks(u, t));
         }
-        let in_u = tt.map(|v| tu.contains(&v));
+        let in_u = in_order(|k| tu.contains(&tt[k]));
         match in_u.iter().filter(|&&x| x).count() {
             // Symmetric: whether an edge of either crosses the other.
             0 => {
@@ -403,7 +408,7 @@ impl Faces<'_> {
     /// one side of `t`'s plane; an edge shared, the planes apart) end before any copy.
     fn blocks(&self, t: usize, u: usize) -> bool {
         let (tt, tu) = (self.tris[t], self.tris[u]);
-        let in_u = tt.map(|v| tu.contains(&v));
+        let in_u = in_order(|k| tu.contains(&tt[k]));
         match in_u.iter().filter(|&&x| x).count() {
             0 => self.touch(t, u),
             1 => {
@@ -424,7 +429,7 @@ impl Faces<'_> {
     /// [`super::triangles_touch`] of `t` and `u`, with their planes' sides precomputed.
     fn touch(&self, t: usize, u: usize) -> bool {
         let (pt, pu) = (&self.planes[t], &self.planes[u]);
-        corners_touch(self.corners[t], self.corners[u], (|q| pt.side(q), |q| pu.side(q)))
+        corners_touch(&self.corners[t], &self.corners[u], (|q| pt.side(q), |q| pu.side(q)))
     }
 
     /// [`Faces::blocks`] for triangles sharing an edge, in one plane: a blocker unless the two lie
@@ -793,7 +798,7 @@ impl Faces<'_> {
         for &u in passed {
             let pu = &self.planes[u as usize];
             let cu = self.corners[u as usize];
-            if !edge_meets(lo, hi, pu.side(lo), pu.side(hi), cu) {
+            if !edge_meets(lo, hi, pu.side(lo), pu.side(hi), &cu) {
                 continue;
             }
             clear = false;
@@ -840,7 +845,7 @@ impl Faces<'_> {
         near.iter().all(|&u| {
             let plane = &self.planes[u as usize];
             let corners = self.corners[u as usize];
-            let meets = |(s, e): ([f64; 3], [f64; 3])| edge_meets(s, e, plane.side(s), plane.side(e), corners);
+            let meets = |(s, e): ([f64; 3], [f64; 3])| edge_meets(s, e, plane.side(s), plane.side(e), &corners);
             (but.contains(&u) || !meets((p, q))) && (u == but[0] || starts.clone().all(|&s| !meets(s)))
         })
     }
@@ -1053,14 +1058,20 @@ impl Faces<'_> {
             coplanar,
             sides,
             slot,
+            edges,
             crossing,
             cells: cell_work,
         } = &mut *work;
         planes.clear();
         coplanar.clear();
+        edges.clear();
+        let tc = &self.corners[t as usize];
         for blocker in blockers.iter_mut() {
             let u = blocker.u;
-            let [a, b, c] = self.corners[u as usize];
+            // Read through the reference: an array of the corners made here and read back at
+            // once stalled its loads (see [`in_order`]).
+            let cu = &self.corners[u as usize];
+            let [a, b, c] = *cu;
             let (ab, ac) = (sub(b, a), sub(c, a));
             let n = cross(ab, ac);
             // The pair's gap, the same seen from either (each triangle's corners against the
@@ -1068,34 +1079,42 @@ impl Faces<'_> {
             // where the neighbour's larger pieces did not take it so, and one of two faces 1e-9
             // apart was dropped where the other was kept (g1's `left_hip_pitch_link.STL`: its
             // decided surface open, 1.1e-3 off).
-            let tc = self.corners[t as usize];
             let gap_of = |n: [f64; 3], a: [f64; 3], xs: &Corners| {
                 xs.iter().map(|x| dot(n, sub(*x, a)).abs() / norm(n)).fold(0.0, f64::max)
             };
-            let gap = gap_of(n, a, &tc).max(gap_of(nt, tc[0], &[a, b, c]));
             // In t's plane exactly: a corner of t is, without a predicate; the others by orient3d.
             let exact = *blocker.in_plane.get_or_insert_with(|| {
                 let plane = &self.planes[t as usize];
-                [a, b, c].iter().all(|&x| tc.contains(&x) || plane.side(x) == 0.0)
+                cu.iter().all(|&x| tc.contains(&x) || plane.side(x) == 0.0)
             });
+            // The gap is asked only of a blocker not exactly in the plane (the one it is used for).
+            let gap = if exact { 0.0 } else { gap_of(n, a, tc).max(gap_of(nt, tc[0], cu)) };
             if exact || gap <= NEAR * self.grid.bounds.diagonal() {
                 // Nearly in t's plane: taken as in it, which moves the solid by at most the slab
                 // between the two over the piece (on both sides).
                 if !exact {
                     out.bound += 2.0 * area(piece) * gap;
                 }
-                coplanar.push(Coplanar::new(u, [a, b, c], nt, self.margin, exact));
+                coplanar.push(Coplanar::new(u, *cu, nt, self.margin, exact));
             } else {
-                planes.push(blocker_cut([a, b, c], n, nt, (self.margin, skew)));
+                planes.push(blocker_cut(*cu, n, nt, (self.margin, skew)));
             }
         }
-        // Every plane cuts but the seams between coplanar triangles (their edges' planes follow
-        // the blockers', three each).
-        let blocking = planes.len();
-        for cp in coplanar.iter() {
-            planes.extend(cp.cuts(skew));
-        }
+        // Every plane cuts but the seams between coplanar triangles: the other edges' planes
+        // follow the blockers', as cuts once they cross the piece. (Every edge was a cut, seams
+        // skipped by each test: building and copying cuts most of which cut nothing was about
+        // a tenth of the time of coincident shells.)
         self.seam_sides(t, coplanar, sides, slot);
+        for i in 0..coplanar.len() {
+            for e in 0..3 {
+                if !self.seam(t, (coplanar, sides, slot), (i, e)) {
+                    edges.push((i as u32, e as u8));
+                }
+            }
+        }
+        for cp in coplanar.iter() {
+            slot[cp.u as usize] = 0;
+        }
         // Only planes that cross the piece can cut it (its cells lie inside it, so a plane that
         // leaves the piece whole leaves each of its cells whole in `cells`): those along its
         // sides or beyond it leave every cell whole, so they neither count against the limit nor
@@ -1106,11 +1125,8 @@ impl Faces<'_> {
         // piece ([`Cut`]): a fan's long edges, extended, cross every piece of the face.
         // A plane that crosses the piece by less than the margin leaves it whole too, and the
         // sliver beyond it is decided with the rest: its area is in the bound (`shallow`).
-        let seams = |i: usize| i >= blocking && self.seam(t, (coplanar, sides, slot), ((i - blocking) / 3, (i - blocking) % 3));
-        let shallow = self.crossing(piece, nt, (planes, seams), crossing, &mut cell_work.sliver);
-        for cp in coplanar.iter() {
-            slot[cp.u as usize] = 0;
-        }
+        let blocking = planes.len();
+        let shallow = self.crossing(piece, (nt, skew), (planes, coplanar, edges), crossing, &mut cell_work.sliver);
         if crossing.len() > MAX_CUTS {
             return false;
         }
@@ -1128,11 +1144,14 @@ impl Faces<'_> {
             // undecided, an estimate of 3.5e-2, against 1.4e-13 m³.) The reach is asked only of
             // a plane the point is near: most points are far from most planes, and the reach
             // costs a pass over the cell's sides.
+            // The blockers' cuts, then every coplanar edge, seam or not (those that cross the
+            // piece are also in `planes`, after the blockers).
+            let far = |x: [f64; 3], (a, n, m): CutPlane| dot(n, sub(x, a)).abs() > m;
             let apart = |x: [f64; 3]| {
-                planes.iter().all(|cut| {
-                    let (a, n, m) = cut.plane;
-                    dot(n, sub(x, a)).abs() > m || cut.misses(cell, nt, self.margin)
-                })
+                planes[..blocking].iter().all(|cut| far(x, cut.plane) || cut.misses(cell, nt, self.margin))
+                    && coplanar.iter().all(|cp| {
+                        (0..3).all(|e| far(x, cp.edges[e]) || cp.cut(e, skew).misses(cell, nt, self.margin))
+                    })
             };
             if let Some(k) = self.decide_linked(cell, t, seen, apart, coplanar) {
                 self.emit_moved(cell, k, (t, slack), out);
@@ -1146,33 +1165,47 @@ impl Faces<'_> {
 }
 
 impl Faces<'_> {
-    /// Fills `crossing` with the planes of `planes` that cross the piece (of normal `nt`) beyond
-    /// the margin, whose reach is not beyond it, and are not seams (`seam`); returns the area of
-    /// the slivers ([`overhang`]) that the others cut off within the margin where their reach is
-    /// not beyond the piece, m². `sliver` is a list to clip into.
+    /// Fills `crossing` with the cuts that cross the piece (of normal `nt`) beyond the margin and
+    /// whose reach is not beyond it: of `planes` (the blockers'), then of the coplanar triangles'
+    /// `edges` (place in `coplanar`, edge), which join `planes` when they do (`skew`: the piece's
+    /// normal's, [`Cut::skew`]). Returns the area of the slivers ([`overhang`]) that the others cut
+    /// off within the margin where their reach is not beyond the piece, m². `sliver` is a list to
+    /// clip into.
     fn crossing(
         &self,
         piece: &Corners,
-        nt: [f64; 3],
-        (planes, seam): (&[Cut], impl Fn(usize) -> bool),
+        (nt, skew): ([f64; 3], f64),
+        (planes, coplanar, edges): (&mut Vec<Cut>, &[Coplanar], &[(u32, u8)]),
         crossing: &mut Vec<usize>,
         sliver: &mut Vec<[f64; 3]>,
     ) -> f64 {
         crossing.clear();
         let mut shallow = 0.0;
-        for (i, cut) in planes.iter().enumerate() {
-            if seam(i) {
-                continue;
-            }
-            let (a, n, m) = cut.plane;
-            let d = piece.map(|x| dot(n, sub(x, a)));
+        // Whether the plane crosses, the sliver's area when it leaves the piece whole, each asked
+        // of the cut only when the plane alone does not settle it.
+        let mut test = |(a, n, m): CutPlane, misses: &dyn Fn() -> bool| {
+            let d = in_order(|k| dot(n, sub(piece[k], a)));
             if leaves_whole(&d, m) {
                 let o = overhang(piece, &d, sliver);
-                if o > 0.0 && !cut.misses(piece, nt, self.margin) {
+                if o > 0.0 && !misses() {
                     shallow += o;
                 }
-            } else if !cut.misses(piece, nt, self.margin) {
+                false
+            } else {
+                !misses()
+            }
+        };
+        for i in 0..planes.len() {
+            let cut = &planes[i];
+            if test(cut.plane, &|| cut.misses(piece, nt, self.margin)) {
                 crossing.push(i);
+            }
+        }
+        for &(i, e) in edges {
+            let (cp, e) = (&coplanar[i as usize], e as usize);
+            if test(cp.edges[e], &|| cp.cut(e, skew).misses(piece, nt, self.margin)) {
+                crossing.push(planes.len());
+                planes.push(cp.cut(e, skew));
             }
         }
         shallow
@@ -1305,14 +1338,16 @@ struct Coplanar {
 impl Coplanar {
     fn new(u: u32, c: Corners, nt: [f64; 3], margin: f64, exact: bool) -> Coplanar {
         let nu = cross(sub(c[1], c[0]), sub(c[2], c[0]));
-        let edges = [0, 1, 2].map(|k| {
-            let (a, b, o) = (c[k], c[(k + 1) % 3], c[(k + 2) % 3]);
+        // Three calls, not `[0, 1, 2].map`: the array's map ran out of line, and its results,
+        // stored piece by piece and read back whole, stalled (see [`in_order`]).
+        let edge = |(a, b, o): ([f64; 3], [f64; 3], [f64; 3])| {
             let mut n = cross(nt, sub(b, a));
             if dot(n, sub(o, a)) < 0.0 {
-                n = n.map(|x| -x);
+                n = [-n[0], -n[1], -n[2]];
             }
             (a, n, margin * norm(nt) * norm(sub(b, a)))
-        });
+        };
+        let edges = [edge((c[0], c[1], c[2])), edge((c[1], c[2], c[0])), edge((c[2], c[0], c[1]))];
         Coplanar {
             u,
             corners: c,
@@ -1323,18 +1358,16 @@ impl Coplanar {
         }
     }
 
-    /// Its edges as cuts, each reaching along the edge only; `skew` is the piece's normal's (the
+    /// Its edge `k` as a cut, reaching along the edge only; `skew` is the piece's normal's (the
     /// edges' planes are `nt × (b − a)`).
-    fn cuts(&self, skew: f64) -> impl Iterator<Item = Cut> + '_ {
-        (0..3).map(move |k| {
-            let end = self.corners[(k + 1) % 3];
-            Cut {
-                plane: self.edges[k],
-                reach: Some([self.corners[k], end, end]),
-                skew,
-                offset: 0.0,
-            }
-        })
+    fn cut(&self, k: usize, skew: f64) -> Cut {
+        let end = self.corners[(k + 1) % 3];
+        Cut {
+            plane: self.edges[k],
+            reach: Some([self.corners[k], end, end]),
+            skew,
+            offset: 0.0,
+        }
     }
 
     /// Whether `p` lies strictly inside, seen along axis `k` (exact `orient2d`). The point keeps
@@ -1352,7 +1385,7 @@ impl Coplanar {
 
 /// Whether `x` lies strictly inside triangle `c` seen along axis `k` (exact `orient2d`).
 fn strictly_inside(c: Corners, x: [f64; 3], k: usize) -> bool {
-    strict_sign([0, 1, 2].map(|i| orient2d(c2(c[i], k), c2(c[(i + 1) % 3], k), c2(x, k)))).is_some()
+    strict_sign(in_order(|i| orient2d(c2(c[i], k), c2(c[NEXT[i]], k), c2(x, k)))).is_some()
 }
 
 /// 1 when all three are positive, −1 when all are negative, else `None` (a zero among them, or
@@ -1372,9 +1405,10 @@ fn strict_sign(s: [f64; 3]) -> Option<f64> {
 /// meeting `t`, so that `t` is not joined across that edge: [`Faces::patches`]), given the sides
 /// of `u`'s other corners of `t`'s plane (not both strictly on one side) and `u`'s plane (a turn
 /// of the corners leaves a plane's sides as they are).
+#[inline(always)]
 fn shares_corner(t: Corners, u: Corners, (ub, uc): (f64, f64), plane_u: &Plane) -> bool {
     if ub == 0.0 && uc == 0.0 {
-        return !coplanar_apart(t, u);
+        return !coplanar_apart((&t, 0), (&u, 0));
     }
     // One other corner of `u` in `t`'s plane and the third off it: `u` meets that plane along
     // the segment from `v` to that corner, which meets `t` beyond `v` when it points into `t`'s
@@ -1396,7 +1430,7 @@ fn shares_corner(t: Corners, u: Corners, (ub, uc): (f64, f64), plane_u: &Plane) 
     if tc == 0.0 {
         return within_angle(u, t[2]);
     }
-    edge_meets(u[1], u[2], ub, uc, t) || edge_meets(t[1], t[2], tb, tc, u)
+    edge_meets(u[1], u[2], ub, uc, &t) || edge_meets(t[1], t[2], tb, tc, &u)
 }
 
 /// Whether the segment from `t`'s first corner to `x` (in `t`'s plane, exactly) meets `t` beyond
@@ -1423,6 +1457,11 @@ fn blocks_at_corner((p, i): (&Corners, usize), (q, j): (&Corners, usize), (plane
     if (sides.0 > 0.0 && sides.1 > 0.0) || (sides.0 < 0.0 && sides.1 < 0.0) {
         return false;
     }
+    // Coplanar (most such pairs under coincident shells): read from the corners as stored, not
+    // from turned copies, whose loads stalled (see [`in_order`]).
+    if sides.0 == 0.0 && sides.1 == 0.0 {
+        return !coplanar_apart((p, i), (q, j));
+    }
     shares_corner(rotated(p, i), rotated(q, j), sides, plane_q)
 }
 
@@ -1438,20 +1477,26 @@ fn rotated(p: &Corners, i: usize) -> Corners {
     }
 }
 
-/// Two coplanar triangles sharing their first corner: whether a line through it along one of their
-/// edges separates them.
-fn coplanar_apart(t: Corners, u: Corners) -> bool {
-    let k = normal_axis(t);
-    let p = |x: [f64; 3]| c2(x, k);
-    let apart = |x: Corners, y: Corners| {
-        [(1, 2), (2, 1)].iter().any(|&(e, o)| {
-            let s = orient2d(p(x[0]), p(x[e]), p(x[o]));
-            s != 0.0
-                && orient2d(p(x[0]), p(x[e]), p(y[1])) * s <= 0.0
-                && orient2d(p(x[0]), p(x[e]), p(y[2])) * s <= 0.0
-        })
-    };
-    apart(t, u) || apart(u, t)
+/// [`coplanar_apart`]'s test: the line from the shared corner `v` along edge `e`, with the other
+/// corner `o` of the same triangle strictly on one side and the other triangle's two corners `y1`,
+/// `y2` not on that side. A function inlined, not a closure: the closure ran out of line, its
+/// points read from memory just written (see [`in_order`]).
+#[inline(always)]
+fn apart(v: Coord<f64>, e: Coord<f64>, o: Coord<f64>, y1: Coord<f64>, y2: Coord<f64>) -> bool {
+    let s = orient2d(v, e, o);
+    s != 0.0 && orient2d(v, e, y1) * s <= 0.0 && orient2d(v, e, y2) * s <= 0.0
+}
+
+/// Two coplanar triangles sharing corner `t[i]` = `u[j]`: whether a line through it along one of
+/// their edges separates them.
+#[inline(always)]
+fn coplanar_apart((t, i): (&Corners, usize), (u, j): (&Corners, usize)) -> bool {
+    let (t0, t1, t2) = (t[i], t[NEXT[i]], t[NEXT[NEXT[i]]]);
+    let k = normal_axis_of(t0, t1, t2);
+    // Each corner seen along `k` once (the shared one is the same point in both).
+    let (v, t1, t2) = (c2(t0, k), c2(t1, k), c2(t2, k));
+    let (u1, u2) = (c2(u[NEXT[j]], k), c2(u[NEXT[NEXT[j]]], k));
+    apart(v, t1, t2, u1, u2) || apart(v, t2, t1, u1, u2) || apart(v, u1, u2, t1, t2) || apart(v, u2, u1, t1, t2)
 }
 
 /// The plane along which a blocker `c` (normal `n`, not in the plane of normal `nt` of the piece it
@@ -1499,18 +1544,27 @@ fn collinear(c: Corners) -> bool {
 
 /// The axis along which a triangle's normal is largest (dropping it projects the triangle without
 /// folding it).
+#[inline(always)]
 fn normal_axis(t: Corners) -> usize {
-    let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+    normal_axis_of(t[0], t[1], t[2])
+}
+
+/// [`normal_axis`] of the triangle `a b c`.
+#[inline(always)]
+fn normal_axis_of(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> usize {
+    let n = cross(sub(b, a), sub(c, a));
     (0..3)
         .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
         .unwrap_or(2)
 }
 
+/// `p` seen along axis `drop`: its next two coordinates, in turn. The axes come from a table:
+/// the two remainders by 3 of a run-time axis were about 2% of the instructions of coincident
+/// shells (`benches/open_mesh.rs`, callgrind), where every coplanar test projects its corners.
 fn c2(p: [f64; 3], drop: usize) -> Coord<f64> {
-    Coord {
-        x: p[(drop + 1) % 3],
-        y: p[(drop + 2) % 3],
-    }
+    const NEXT_TWO: [[usize; 2]; 3] = [[1, 2], [2, 0], [0, 1]];
+    let [i, j] = NEXT_TWO[drop];
+    Coord { x: p[i], y: p[j] }
 }
 
 fn inflated(b: Aabb, m: f64) -> Aabb {
@@ -1709,7 +1763,7 @@ mod tests {
             let (x, y) = ([0, 1, 2], [3, 4, 5]);
             let (px, py) = (x.map(|i| vertices[i as usize]), y.map(|i| vertices[i as usize]));
             let (plane_x, plane_y) = (Plane::new(&px), Plane::new(&py));
-            let got = corners_touch(px, py, (|q| plane_x.side(q), |q| plane_y.side(q)));
+            let got = corners_touch(&px, &py, (|q| plane_x.side(q), |q| plane_y.side(q)));
             assert_eq!(got, super::super::triangles_touch(&vertices, &x, &y), "{vertices:?}");
             if got {
                 touching += 1;

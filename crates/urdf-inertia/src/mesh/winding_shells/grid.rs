@@ -213,7 +213,7 @@ impl Grid {
 
     /// The cell of a point, per axis (clamped to the grid).
     pub(super) fn cell_of(&self, p: [f64; 3]) -> [usize; 3] {
-        [0, 1, 2].map(|k| self.index(k, p[k]))
+        super::in_order(|k| self.index(k, p[k]))
     }
 
     /// Where [`Grid::overlapping`] of a query box whose lowest corner is in cell `query`
@@ -222,7 +222,7 @@ impl Grid {
     /// every axis (the cells are visited in order of their number, and a cell's entries in order
     /// of theirs). Sorting by (this, number) puts triangles in its order without a second query.
     pub(super) fn first_shared_cell(&self, query: [usize; 3], b: &Aabb) -> usize {
-        let idx = [0, 1, 2].map(|k| query[k].max(self.index(k, b.lo[k])));
+        let idx = super::in_order(|k| query[k].max(self.index(k, b.lo[k])));
         (idx[0] * self.dims[1] + idx[1]) * self.dims[2] + idx[2]
     }
 
@@ -245,7 +245,7 @@ impl Grid {
     /// The cells a ray from `p` along `sign`·e_`axis` passes, from `p`'s to the grid's end: cell
     /// `first + i · stride` for each `i` of the range.
     fn row(&self, p: [f64; 3], axis: usize, sign: f64) -> (usize, usize, std::ops::Range<usize>) {
-        let idx = [0, 1, 2].map(|k| self.index(k, p[k]));
+        let idx = super::in_order(|k| self.index(k, p[k]));
         let stride = match axis {
             0 => self.dims[1] * self.dims[2],
             1 => self.dims[2],

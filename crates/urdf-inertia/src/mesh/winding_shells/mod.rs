@@ -1019,14 +1019,24 @@ pub(super) fn triangles_touch(v: &[[f64; 3]], x: &[u32; 3], y: &[u32; 3]) -> boo
     let p = |t: &[u32; 3]| t.map(|i| v[i as usize]);
     let (px, py) = (p(x), p(y));
     let side = |t: [[f64; 3]; 3]| move |q: [f64; 3]| orient3d(c3(t[0]), c3(t[1]), c3(t[2]), c3(q));
-    corners_touch(px, py, (side(px), side(py)))
+    corners_touch(&px, &py, (side(px), side(py)))
+}
+
+/// `[f(0), f(1), f(2)]`, the calls inlined. `[T; 3]::map` and `[0, 1, 2].map` ran the closure out
+/// of line in the shells' hot loops, and their results, stored one by one on the stack and read
+/// back as one, stalled the loads (`perf annotate`: about a third of `Faces::cut`'s samples
+/// under coincident shells were on the loads after such maps). Arrays of corners are passed by
+/// reference for the same reason: a copy made for a call and read by it at once stalled too.
+#[inline(always)]
+pub(super) fn in_order<T>(mut f: impl FnMut(usize) -> T) -> [T; 3] {
+    [f(0), f(1), f(2)]
 }
 
 /// [`triangles_touch`] of the triangles of corners `px` and `py`, given for each a function with
 /// the sign of `orient3d` of its corners and a point (a precomputed plane's side).
 pub(super) fn corners_touch(
-    px: [[f64; 3]; 3],
-    py: [[f64; 3]; 3],
+    px: &[[f64; 3]; 3],
+    py: &[[f64; 3]; 3],
     (side_x, side_y): (impl Fn([f64; 3]) -> f64, impl Fn([f64; 3]) -> f64),
 ) -> bool {
     let boxes_meet = (0..3).all(|k| {
@@ -1046,25 +1056,25 @@ pub(super) fn corners_touch(
         return false;
     }
     // Each corner's side of the other's plane once (both edges at a corner use it).
-    let edges_meet = |p: [[f64; 3]; 3], o: [f64; 3], t| {
+    let edges_meet = |p: &[[f64; 3]; 3], o: [f64; 3], t| {
         (0..3).any(|i| {
             let j = (i + 1) % 3;
             edge_meets(p[i], p[j], o[i], o[j], t)
         })
     };
-    edges_meet(px, px.map(&side_y), py) || edges_meet(py, py.map(&side_x), px)
+    edges_meet(px, in_order(|i| side_y(px[i])), py) || edges_meet(py, in_order(|i| side_x(py[i])), px)
 }
 
 /// Whether the closed segment `s e` meets the closed triangle `t` (coplanar: yes, conservatively),
 /// given `s`'s and `e`'s sides of `t`'s plane (`orient3d` of `t`'s corners and each).
-pub(super) fn edge_meets(s: [f64; 3], e: [f64; 3], o1: f64, o2: f64, t: [[f64; 3]; 3]) -> bool {
-    let (a, b, c) = (c3(t[0]), c3(t[1]), c3(t[2]));
+pub(super) fn edge_meets(s: [f64; 3], e: [f64; 3], o1: f64, o2: f64, t: &[[f64; 3]; 3]) -> bool {
     if (o1 > 0.0 && o2 > 0.0) || (o1 < 0.0 && o2 < 0.0) {
         return false;
     }
     if o1 == 0.0 && o2 == 0.0 {
         return true;
     }
+    let (a, b, c) = (c3(t[0]), c3(t[1]), c3(t[2]));
     let (cs, ce) = (c3(s), c3(e));
     // The line passes beside the triangle when two of its edges see it on opposite sides: the
     // first two often do, and the third is then not asked.

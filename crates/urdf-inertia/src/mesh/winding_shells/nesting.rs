@@ -160,7 +160,7 @@ fn touching(tree: &Tree, shells: &[Shell], decided: &mut [bool]) -> Option<FxHas
         }
         let (i, j) = (i as usize, j as usize);
         let sides = (|q| tree.planes[i].side(q), |q| tree.planes[j].side(q));
-        if corners_touch(tree.corners[i], tree.corners[j], sides) {
+        if corners_touch(&tree.corners[i], &tree.corners[j], sides) {
             touching.insert(key);
             decided[a as usize] = false;
             decided[b as usize] = false;
