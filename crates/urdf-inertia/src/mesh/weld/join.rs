@@ -1,6 +1,6 @@
 //! Welding vertices that repeat across chunks welded on their own, every pass in parallel.
 
-use super::table::hash;
+use super::table::{hash, same_point};
 use rayon::prelude::*;
 
 /// Welds vertices that repeat across independently welded chunks: `vertices` are the chunks'
@@ -234,7 +234,7 @@ fn first_copies(r: usize, parts: &[Part], blocks: &[&[[f64; 3]]], bases: &[usize
     let vertex = |p: usize| {
         // The last block starting at or before `p` (empty blocks start where the next does).
         let c = bases.partition_point(|&b| b <= p) - 1;
-        blocks[c][p - bases[c]].map(f64::to_bits)
+        &blocks[c][p - bases[c]]
     };
     let mut out = Vec::with_capacity(len);
     for (part, (block, &base)) in parts.iter().zip(blocks.iter().zip(bases)) {
@@ -242,7 +242,7 @@ fn first_copies(r: usize, parts: &[Part], blocks: &[&[[f64; 3]]], bases: &[usize
             let p = e as u32 as usize;
             // Read only when a tag matches (a copy, nearly always): a vertex read for every entry
             // is a cache miss for every entry once the vertices outgrow the cache.
-            let bits = || block[p - base].map(f64::to_bits);
+            let point = || &block[p - base];
             // The hash's low half picks the slot (its top bits picked the run).
             let mut s = (e >> 32) as usize & mask;
             loop {
@@ -252,7 +252,7 @@ fn first_copies(r: usize, parts: &[Part], blocks: &[&[[f64; 3]]], bases: &[usize
                         out.push(p as u32);
                         break;
                     }
-                    f if f >> 32 == e >> 32 && vertex(f as u32 as usize) == bits() => {
+                    f if f >> 32 == e >> 32 && same_point(vertex(f as u32 as usize), point()) => {
                         out.push(f as u32);
                         break;
                     }
