@@ -43,7 +43,7 @@ impl VertexTable {
     }
 
     /// The index of the vertex with exactly the bits of `p`, added if new.
-    #[inline]
+    #[inline(always)]
     pub fn insert(&mut self, p: [f64; 3]) -> u32 {
         let bits = p.map(f64::to_bits);
         let h = hash(&bits);
