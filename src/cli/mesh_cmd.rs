@@ -87,7 +87,7 @@ pub fn run(args: &MeshArgs) -> ExitStatus {
 /// and `--warn-as-error`.
 fn diagnostics(solid: &Solid, scale: [f64; 3], policy: &Policy) -> Vec<Diagnostic> {
     let mut ds = urdf_inertia::diagnostic::mesh_health(solid);
-    if let Some(m) = urdf_inertia::millimetre_slip(&solid.vertices, scale) {
+    if let Some(m) = solid.millimetre_slip(scale) {
         ds.push(Diagnostic::new(Code::MeshTooLarge, m));
     }
     if solid.error_estimate < policy.note_below {

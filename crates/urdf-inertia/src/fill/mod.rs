@@ -27,6 +27,7 @@ mod select;
 
 use densities::{body, densities, scale_to_total_mass};
 pub use parts::millimetre_slip;
+pub(crate) use parts::slip_message;
 use parts::{geometry_part, part_location, Part};
 use select::is_target;
 pub use select::{existing_props, selected, unresolved_meshes, unused_selection};

@@ -124,7 +124,11 @@ fn primitive_part(c: &Collision, what: String, unit: MassProperties, shape: Part
 /// already scaled by `scale`), if it is: a link's error by default, a warning with
 /// `--allow-large-parts`, and `mesh`'s warning.
 pub fn millimetre_slip(vertices: &[[f64; 3]], scale: [f64; 3]) -> Option<String> {
-    let extent = crate::mesh::bounds(vertices).diagonal();
+    slip_message(crate::mesh::bounds(vertices).diagonal(), scale)
+}
+
+/// [`millimetre_slip`] of vertices whose box has the diagonal `extent`, m.
+pub(crate) fn slip_message(extent: f64, scale: [f64; 3]) -> Option<String> {
     if extent <= MILLIMETRE_SLIP {
         return None;
     }
@@ -198,7 +202,7 @@ fn mesh_part(
         .get(&path, scale)
         .map_err(|e| link_error(link, c, LinkErrorKind::Mesh(e)))?;
     let mut diagnostics = diagnostic::mesh_health(&solid);
-    if let Some(m) = millimetre_slip(&solid.vertices, scale) {
+    if let Some(m) = solid.millimetre_slip(scale) {
         if !ctx.opts.allow_large_parts {
             // 10⁹ times the mass, written without a word but a warning, is worse than no value.
             return Err(link_error(link, c, LinkErrorKind::PartTooLarge(m)));

@@ -267,6 +267,10 @@ pub struct Solid {
     pub error: ErrorEstimate,
     /// Faces in the file (before welding and dropping degenerate ones).
     pub faces_read: usize,
+    /// The box of `vertices`: its lowest and its highest corner, found with the integrals (one
+    /// pass over the vertices fewer for each of [`Solid::largest_coordinate`] and
+    /// [`Solid::millimetre_slip`]: at 1.3 M faces each pass is a few milliseconds of reading).
+    pub bounds: [[f64; 3]; 2],
 }
 
 /// Options of the ladder.

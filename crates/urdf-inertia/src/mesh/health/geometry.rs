@@ -106,13 +106,19 @@ pub(super) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 impl super::Solid {
+    /// [`crate::millimetre_slip`] of the solid's vertices, from the box found with the integrals
+    /// instead of a pass over them.
+    pub fn millimetre_slip(&self, scale: [f64; 3]) -> Option<String> {
+        crate::fill::slip_message(Aabb::new(self.bounds[0], self.bounds[1]).diagonal(), scale)
+    }
+
     /// The largest magnitude of a vertex coordinate (0 without vertices): the scale of the centre
-    /// of mass, which `mesh` rounds against. One pass over the vertices, a large mesh's on the pool.
+    /// of mass, which `mesh` rounds against. Read from the box found with the integrals.
     pub fn largest_coordinate(&self) -> f64 {
         if self.vertices.is_empty() {
             return 0.0;
         }
-        let b = bbox(&self.vertices);
+        let b = Aabb::new(self.bounds[0], self.bounds[1]);
         // On each axis the coordinate of largest magnitude is the box's lowest or highest.
         b.lo.iter().chain(&b.hi).fold(0.0, |m, x| m.max(x.abs()))
     }

@@ -351,6 +351,14 @@ impl<'a> Ladder<'a> {
         };
         // One pass for the box both checks use, unless the integrals came with it.
         let bounds = corner.as_ref().map_or_else(|| bbox(&vertices), |c| c.0);
+        // The box of the vertices as they are now, for the solid: that box, but where the shells
+        // were classified (their cuts may have added vertices since).
+        let own = if classified { bbox(&vertices) } else { bounds };
+        debug_assert!({
+            let b = bbox(&vertices);
+            let bits = |x: [f64; 3]| x.map(f64::to_bits);
+            (bits(b.lo), bits(b.hi)) == (bits(own.lo), bits(own.hi))
+        });
         check_volume(&vertices, &faces, bounds, unit.mass, self.path)?;
         // The integrals about a second reference point: the round-off estimate compares the two.
         let other = match corner {
@@ -403,6 +411,7 @@ impl<'a> Ladder<'a> {
             error_estimate: error.total(),
             error,
             faces_read: self.faces_read,
+            bounds: [own.lo, own.hi],
         })
     }
 }
