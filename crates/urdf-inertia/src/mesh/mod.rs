@@ -79,13 +79,24 @@ impl MeshFormat {
 }
 
 /// Why a mesh file could not become a solid.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct MeshError {
     pub path: PathBuf,
     /// 1-based line, where the format has lines.
     pub line: Option<usize>,
     pub kind: MeshErrorKind,
+    /// For [`MeshErrorKind::ZeroVolume`] from the healing: the mesh's largest extent along an axis,
+    /// from the box the healing found, for [`out_of_range`] (the mesh itself has moved into the
+    /// healing by then, and finding the extent before it was a pass over every vertex that only a
+    /// mesh of no volume needs). Not part of the error's identity.
+    extent: Option<f64>,
+}
+
+impl PartialEq for MeshError {
+    fn eq(&self, other: &Self) -> bool {
+        (&self.path, self.line, &self.kind) == (&other.path, other.line, &other.kind)
+    }
 }
 
 /// What went wrong with a mesh.
@@ -175,6 +186,24 @@ impl MeshError {
             path: path.to_path_buf(),
             line,
             kind,
+            extent: None,
+        }
+    }
+
+    /// A [`MeshErrorKind::ZeroVolume`] of signed volume `volume` for a mesh whose vertices' box is
+    /// `bounds`.
+    pub(crate) fn zero_volume(path: &Path, volume: f64, bounds: crate::geometry::Aabb) -> Self {
+        let e = bounds.extent();
+        MeshError {
+            extent: Some(e.iter().fold(0.0, |m, &x| f64::max(m, x))),
+            ..MeshError::new(
+                path,
+                None,
+                MeshErrorKind::ZeroVolume {
+                    volume,
+                    bbox_volume: e.iter().product(),
+                },
+            )
         }
     }
 }
@@ -427,11 +456,17 @@ fn solid_from(
 ) -> Result<health::Solid, MeshError> {
     catching_panics(path, || {
         if scale == [1.0; 3] {
-            // A unit scale (the common case) uses the mesh as read.
-            // The extent is taken before healing takes the mesh: one pass over the vertices.
-            let size = flat_or_out_of_range(&raw, scale)();
-            return health::heal(raw, path, options, weld::Precision::of)
-                .map_err(|e| out_of_range(e, || size, scale));
+            // A unit scale (the common case) uses the mesh as read. The healing takes the mesh;
+            // a mesh of no volume comes back with its extent from the healing's box.
+            let borrowed = match &raw {
+                Cow::Borrowed(r) => Some(*r),
+                Cow::Owned(_) => None,
+            };
+            return health::heal(raw, path, options, weld::Precision::of).map_err(|e| {
+                let found = e.extent;
+                let size = move || found.or_else(|| borrowed.map(|r| flat_or_out_of_range(r, scale)())).unwrap_or(0.0);
+                out_of_range(e, size, scale)
+            });
         }
         let scaled = apply_scale(&raw, scale, path)?;
         // The precision of the file's own numbers, before the scale multiplies them; the largest

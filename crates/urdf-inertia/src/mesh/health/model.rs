@@ -6,7 +6,7 @@ use super::{ModelError, ROUND_OFF_FLOOR, ZERO_VOLUME_ROUNDOFFS};
 use crate::geometry::{cross, dot, sub, Aabb};
 use crate::mass::integrals::two_sum;
 use crate::mass::{frobenius, MassProperties, Polygons};
-use crate::mesh::{MeshError, MeshErrorKind};
+use crate::mesh::MeshError;
 use std::path::Path;
 
 /// Where the volume of a model error may sit: anywhere in the solid, near given points (the loops a
@@ -177,14 +177,7 @@ pub(super) fn check_volume(
     path: &Path,
 ) -> Result<(), MeshError> {
     if empty(vertices, faces, bounds.diagonal(), volume) {
-        return Err(MeshError::new(
-            path,
-            None,
-            MeshErrorKind::ZeroVolume {
-                volume,
-                bbox_volume: bounds.extent().iter().product(),
-            },
-        ));
+        return Err(MeshError::zero_volume(path, volume, bounds));
     }
     Ok(())
 }

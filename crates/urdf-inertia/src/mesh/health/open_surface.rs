@@ -148,13 +148,10 @@ pub(super) fn open_or_nonmanifold(ladder: Ladder<'_>, w: Welding, te: &Edges) ->
         // No closing encloses a volume: a flat plate or a two-sided sheet has none to speak of (the
         // part contributes nothing); anything else defines no solid.
         (_, None) if crate::mesh::open::encloses_nothing(&w.vertices, &w.stored) => {
-            Err(MeshError::new(
+            Err(MeshError::zero_volume(
                 ladder.path,
-                None,
-                MeshErrorKind::ZeroVolume {
-                    volume: signed_volume(&w.vertices, &w.stored),
-                    bbox_volume: bbox(&w.vertices).extent().iter().product(),
-                },
+                signed_volume(&w.vertices, &w.stored),
+                bbox(&w.vertices),
             ))
         }
         (_, None) => Err(no_solid(None, false)),
@@ -302,14 +299,7 @@ pub(super) fn convex_hull(
     let moves = vector_area(&w.vertices, &w.stored) * diag / 6.0;
     // The hull of the vertices the faces use: unused stored positions are not the surface's.
     let (hv, ht) = hull::convex_hull_of_used(&w.vertices, &w.stored).map_err(|err| match err {
-        hull::HullError::Degenerate => MeshError::new(
-            ladder.path,
-            None,
-            MeshErrorKind::ZeroVolume {
-                volume: own,
-                bbox_volume: bounds.extent().iter().product(),
-            },
-        ),
+        hull::HullError::Degenerate => MeshError::zero_volume(ladder.path, own, bounds),
     })?;
     let hull_faces = Polygons::from_triangles(&ht);
     let hull_volume = signed_volume(&hv, &hull_faces);
