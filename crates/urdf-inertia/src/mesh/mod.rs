@@ -457,15 +457,11 @@ fn solid_from(
     catching_panics(path, || {
         if scale == [1.0; 3] {
             // A unit scale (the common case) uses the mesh as read. The healing takes the mesh;
-            // a mesh of no volume comes back with its extent from the healing's box.
-            let borrowed = match &raw {
-                Cow::Borrowed(r) => Some(*r),
-                Cow::Owned(_) => None,
-            };
+            // a mesh of no volume comes back with its extent from the healing's box (every
+            // no-volume error of the healing carries it: [`MeshError::zero_volume`]).
             return health::heal(raw, path, options, weld::Precision::of).map_err(|e| {
-                let found = e.extent;
-                let size = move || found.or_else(|| borrowed.map(|r| flat_or_out_of_range(r, scale)())).unwrap_or(0.0);
-                out_of_range(e, size, scale)
+                let size = e.extent.unwrap_or(0.0);
+                out_of_range(e, || size, scale)
             });
         }
         let scaled = apply_scale(&raw, scale, path)?;

@@ -109,7 +109,12 @@ impl super::Solid {
     /// [`crate::millimetre_slip`] of the solid's vertices, from the box found with the integrals
     /// instead of a pass over them.
     pub fn millimetre_slip(&self, scale: [f64; 3]) -> Option<String> {
-        crate::fill::slip_message(Aabb::new(self.bounds[0], self.bounds[1]).diagonal(), scale)
+        crate::fill::slip_message(self.bbox().diagonal(), scale)
+    }
+
+    /// [`super::Solid::bounds`] as a box.
+    fn bbox(&self) -> Aabb {
+        Aabb::new(self.bounds[0], self.bounds[1])
     }
 
     /// The largest magnitude of a vertex coordinate (0 without vertices): the scale of the centre
@@ -118,7 +123,7 @@ impl super::Solid {
         if self.vertices.is_empty() {
             return 0.0;
         }
-        let b = Aabb::new(self.bounds[0], self.bounds[1]);
+        let b = self.bbox();
         // On each axis the coordinate of largest magnitude is the box's lowest or highest.
         b.lo.iter().chain(&b.hi).fold(0.0, |m, x| m.max(x.abs()))
     }

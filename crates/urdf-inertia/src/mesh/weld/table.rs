@@ -57,7 +57,7 @@ impl VertexTable {
             }
             if slot & 0xffff_ffff_0000_0000 == tag {
                 let i = (slot as u32 - 1) as usize;
-                if same_bits(&self.vertices[i], &bits) {
+                if same_point(&self.vertices[i], &p) {
                     return i as u32;
                 }
             }
@@ -118,16 +118,10 @@ pub(super) fn hash(b: &[u64; 3]) -> u64 {
     h ^ (h >> 32)
 }
 
-/// Whether `v` has exactly the bits `bits`, compared coordinate by coordinate. As two arrays
+/// Whether two points have exactly the same bits, compared coordinate by coordinate. As arrays
 /// (`v.map(f64::to_bits) == bits`) the compare read `bits` back from the stack as one 16-byte and
 /// one 8-byte load just after three 8-byte stores, which stalled: `VertexTable::insert` spent
 /// about two thirds of its samples there (`perf annotate`, a 1.3 M-face binary STL, one thread).
-#[inline(always)]
-pub(super) fn same_bits(v: &[f64; 3], bits: &[u64; 3]) -> bool {
-    v[0].to_bits() == bits[0] && v[1].to_bits() == bits[1] && v[2].to_bits() == bits[2]
-}
-
-/// Whether two points have exactly the same bits ([`same_bits`], neither copied).
 #[inline(always)]
 pub(super) fn same_point(a: &[f64; 3], b: &[f64; 3]) -> bool {
     a[0].to_bits() == b[0].to_bits() && a[1].to_bits() == b[1].to_bits() && a[2].to_bits() == b[2].to_bits()
