@@ -12,7 +12,7 @@
 
 use super::bvh::Bvh;
 use super::cells::{area, cells, centroid, largest_coordinate, leaves_whole, overhang, split, CellWork, Cut, CutPlane};
-use super::grid::{Corners, Grid, Plane, Seen};
+use super::grid::{crossing, Corners, Crossing, Grid, Plane, Seen};
 use super::{corners_touch, edge_meets, in_order, overlap, EdgeUse};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
 use crate::mass::Polygons;
@@ -20,6 +20,7 @@ use robust::{orient2d, Coord};
 use std::cell::RefCell;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
+use std::ops::Range;
 
 /// Splits (one piece into four) beyond which the pieces still cut are bounded, not split.
 const MAX_SPLITS: usize = 20_000;
@@ -187,14 +188,92 @@ struct CutWork {
 
 /// Decides the triangles `tris` (closed shells whose pairs the classification left open; `sign` per
 /// triangle) until the pieces left undecided change at most `target` m³, or the work is spent.
+/// The triangles of each range of `sealed` are a shell of their own whose every edge two of its
+/// triangles share with opposite directions: a shell that [`embedded`] certifies is not searched
+/// for pairs of its own triangles that meet, as none do.
 pub(super) fn resolve(
     vertices: &[[f64; 3]],
     tris: &[[u32; 3]],
     sign: &[i64],
+    sealed: &[Range<usize>],
     centre: [f64; 3],
     target: f64,
 ) -> Resolved {
-    resolve_with(vertices, tris, sign, (centre, target), (true, CROWDED_GRID))
+    resolve_with(vertices, tris, sign, (centre, target), (true, CROWDED_GRID), sealed)
+}
+
+/// Whether the triangles of a shell (every edge shared by two of them with opposite directions)
+/// meet one another only where they share a corner or an edge, certified exactly: some point `c`
+/// (the mean of the corners, or one of two points near it) lies strictly on one side of every
+/// triangle's plane, the same side for all (`orient3d`), and one axis-parallel ray from `c`
+/// crosses exactly one triangle, through its interior ([`crossing`], exact).
+/// Then the shell seen from `c` covers the sphere of directions once (the degree of the radial
+/// projection is the one crossing, and no triangle is seen edge-on or from behind), so two of its
+/// triangles that met elsewhere than at what they share would cover an open set of directions
+/// twice: a point of one triangle inside another, or on an edge other than a shared one, puts the
+/// other in front of the triangles around that point, whose directions surround it. Convex shells
+/// and shells star-shaped about their mean corner pass; others (and rays through an edge on all
+/// three axes) are not certified, and keep the search.
+fn embedded(corners: &[Corners], planes: &[Plane]) -> bool {
+    if corners.len() < 4 {
+        return false;
+    }
+    let mut sum = [0.0; 3];
+    let mut b = Aabb::EMPTY;
+    for p in corners.iter().flatten() {
+        sum = in_order(|k| sum[k] + p[k]);
+        b = b.union(Aabb { lo: *p, hi: *p });
+    }
+    let mean = sum.map(|x| x / (3 * corners.len()) as f64);
+    let extent = b.extent();
+    // The mean, then two points a little off it in no special direction: a box's mean sees the
+    // middle of each side, on the diagonal its two triangles share, along all three axes.
+    for shift in [[0.0; 3], [0.0137, 0.0291, 0.0071], [-0.0219, 0.0113, 0.0257]] {
+        let c = in_order(|k| mean[k] + shift[k] * extent[k]);
+        if !c.iter().all(|x| x.is_finite()) {
+            return false;
+        }
+        let first = planes[0].side(c);
+        if first == 0.0 || !planes.iter().all(|p| p.side(c) * first.signum() > 0.0) {
+            continue;
+        }
+        for axis in 0..3 {
+            let mut e = c;
+            e[axis] = b.hi[axis] + b.hi[axis].abs() + 1.0;
+            if !e[axis].is_finite() {
+                return false;
+            }
+            if let Some(hits) = hits(c, e, axis, corners, planes) {
+                return hits == 1;
+            }
+        }
+    }
+    false
+}
+
+/// The triangles that the segment `s e` along `axis` crosses through their interiors, or `None`
+/// when it touches one's edge, corner or plane.
+fn hits(s: [f64; 3], e: [f64; 3], axis: usize, corners: &[Corners], planes: &[Plane]) -> Option<usize> {
+    let mut hits = 0;
+    for (t, plane) in corners.iter().zip(planes) {
+        match crossing(s, e, axis, t, plane) {
+            Crossing::Miss => {}
+            Crossing::Through(_) => hits += 1,
+            Crossing::Degenerate => return None,
+        }
+    }
+    Some(hits)
+}
+
+/// Per triangle: the end of its range of `sealed` when [`embedded`] certifies it, else 0.
+fn certified_ends(corners: &[Corners], planes: &[Plane], sealed: &[Range<usize>]) -> Vec<u32> {
+    let mut end = vec![0u32; corners.len()];
+    for r in sealed {
+        if embedded(&corners[r.clone()], &planes[r.clone()]) {
+            end[r.clone()].fill(r.end as u32);
+        }
+    }
+    end
 }
 
 /// [`resolve`], joining pieces across edges ([`Faces::joined_across`]) when `join_across`, and
@@ -205,6 +284,7 @@ fn resolve_with(
     sign: &[i64],
     (centre, target): ([f64; 3], f64),
     (join_across, crowded): (bool, u64),
+    sealed: &[Range<usize>],
 ) -> Resolved {
     let corners: Vec<Corners> = tris
         .iter()
@@ -213,7 +293,8 @@ fn resolve_with(
     let boxes: Vec<Aabb> = corners.iter().map(|c| Aabb::of(*c)).collect();
     let grid = Grid::new(&boxes);
     let margin = 1e-12 * grid.bounds.diagonal();
-    let planes = corners.iter().map(Plane::new).collect();
+    let planes: Vec<Plane> = corners.iter().map(Plane::new).collect();
+    let free = certified_ends(&corners, &planes, sealed);
     let numbered = (0..tris.len()).map(|i| (i as u32, &tris[i][..]));
     let uses = super::edge_uses(vertices.len(), &numbered, None);
     let closed = balanced(&uses);
@@ -241,7 +322,7 @@ fn resolve_with(
         cut_work: RefCell::new(CutWork::default()),
     };
     let mut seen = Seen::new(tris.len());
-    let blockers = f.all_blockers(&boxes, crowded, &mut seen);
+    let blockers = f.all_blockers((&boxes, &free), crowded, &mut seen);
     let mut out = Resolved {
         faces: Polygons::new(),
         vertices: Vec::new(),
@@ -295,7 +376,7 @@ impl Faces<'_> {
     /// rounding of the coordinates), and each condition is then checked as stated; the lists of
     /// two or more are put back in the order of the grid's query over `t`'s grown box (sorted by
     /// [`Grid::first_shared_cell`], not asked again). `None` past [`MAX_MEETING`] pairs.
-    fn all_blockers(&self, boxes: &[Aabb], crowded: u64, seen: &mut Seen) -> Option<Vec<Vec<u32>>> {
+    fn all_blockers(&self, (boxes, free): (&[Aabb], &[u32]), crowded: u64, seen: &mut Seen) -> Option<Vec<Vec<u32>>> {
         let n = self.tris.len();
         // Each box grown by the margin where it is asked (a list of them was 48 bytes a triangle
         // of fresh memory).
@@ -324,6 +405,9 @@ impl Faces<'_> {
             let own: Vec<u32> = (0..n as u32).collect();
             let all = Bvh::new(padded, &own).pairs(|i, j| {
                 let (t, u) = (i.min(j) as usize, i.max(j) as usize);
+                if (u as u32) < free[t] {
+                    return std::ops::ControlFlow::Continue(());
+                }
                 if overlap(&inflated(boxes[t], pad), &boxes[u]) && pair(t, u) > MAX_MEETING {
                     return std::ops::ControlFlow::Break(());
                 }
@@ -335,8 +419,9 @@ impl Faces<'_> {
         } else {
             let mut near = Vec::new();
             for t in 0..n {
-                self.grid
-                    .overlapping(&inflated(boxes[t], pad), Some(t as u32), seen, &mut near);
+                // A certified shell's own triangles are passed (see [`embedded`]).
+                let after = (t as u32).max(free[t].saturating_sub(1));
+                self.grid.overlapping(&inflated(boxes[t], pad), Some(after), seen, &mut near);
                 for &u in &near {
                     if pair(t, u as usize) > MAX_MEETING {
                         return None;
@@ -1657,7 +1742,7 @@ mod tests {
         let c = at(30.0).map(|x| x / 3.0);
         push_box(&mut vertices, &mut tris, [c[0] - 0.01, c[1] - 0.01, 0.49], [c[0] + 0.01, c[1] + 0.01, 0.51]);
         let signs = vec![1; tris.len()];
-        let r = resolve(&vertices, &tris, &signs, [0.3, 0.3, 0.5], 0.0);
+        let r = resolve(&vertices, &tris, &signs, &[], [0.3, 0.3, 0.5], 0.0);
         let want = 1.0 / 6.0 + 0.02 * 0.04 * 0.04;
         assert_eq!(r.bound, 0.0);
         let got = enclosed(&vertices, &r);
@@ -1684,7 +1769,7 @@ mod tests {
         vertices.extend(triangle);
         tris.push([base, base + 1, base + 2]);
         let signs = vec![1; tris.len()];
-        let r = resolve(&vertices, &tris, &signs, [0.5; 3], 0.0);
+        let r = resolve(&vertices, &tris, &signs, &[], [0.5; 3], 0.0);
         let got = enclosed(&vertices, &r);
         (r, got)
     }
@@ -1738,7 +1823,7 @@ mod tests {
             [p1, f11, a],
         ]);
         let signs = vec![1; tris.len()];
-        let r = resolve(&vertices, &tris, &signs, [1.0, 0.5, 0.5], 0.0);
+        let r = resolve(&vertices, &tris, &signs, &[], [1.0, 0.5, 0.5], 0.0);
         let open = norm(area_vector(&vertices, &r));
         assert!(open < 4.0 * e, "decided surface open: vector area {open:e}");
         let got = enclosed(&vertices, &r);
@@ -1919,6 +2004,132 @@ mod tests {
         }
     }
 
+    /// A torus about the z axis (radii `big` and `small`, `n` × `m` quads as two triangles each),
+    /// facing out.
+    fn push_torus(vertices: &mut Vec<[f64; 3]>, tris: &mut Vec<[u32; 3]>, (big, small): (f64, f64), (n, m): (u32, u32)) {
+        let base = vertices.len() as u32;
+        for i in 0..n {
+            let u = 2.0 * std::f64::consts::PI * f64::from(i) / f64::from(n);
+            for j in 0..m {
+                let v = 2.0 * std::f64::consts::PI * f64::from(j) / f64::from(m);
+                let r = big + small * v.cos();
+                vertices.push([r * u.cos(), r * u.sin(), small * v.sin()]);
+            }
+        }
+        let at = |i: u32, j: u32| base + (i % n) * m + j % m;
+        for i in 0..n {
+            for j in 0..m {
+                tris.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                tris.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+    }
+
+    /// A bipyramid over a pentagram: five corners 144° apart around the axis (the equator winds
+    /// twice), an apex above and one below, a little off the axis. Every edge is shared by two of
+    /// its ten triangles with opposite directions, and each triangle is seen from the front from
+    /// the mean of its corners, but the triangles cross one another: the surface covers the
+    /// directions around that point twice.
+    fn pentagram_bipyramid() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let mut vertices = vec![[0.1, 0.05, 1.0], [-0.07, 0.03, -1.0]];
+        for k in 0..5 {
+            let a = 0.3 + 4.0 * std::f64::consts::PI * f64::from(k) / 5.0;
+            vertices.push([a.cos(), a.sin(), 0.2]);
+        }
+        let ring = |k: u32| 2 + k % 5;
+        let mut tris = Vec::new();
+        for k in 0..5 {
+            tris.push([0, ring(k), ring(k + 1)]);
+            tris.push([1, ring(k + 1), ring(k)]);
+        }
+        (vertices, tris)
+    }
+
+    fn corners_and_planes(vertices: &[[f64; 3]], tris: &[[u32; 3]]) -> (Vec<Corners>, Vec<Plane>) {
+        let corners: Vec<Corners> = tris.iter().map(|t| t.map(|i| vertices[i as usize])).collect();
+        let planes = corners.iter().map(Plane::new).collect();
+        (corners, planes)
+    }
+
+    /// The certificate that a sealed shell's triangles meet only where they share corners or
+    /// edges: a box (also turned inside out), a sphere and a box with a dent it can see past are
+    /// certified; a torus (seen from its hole, its inner side faces away) is not; nor is the
+    /// pentagram bipyramid, whose every triangle faces the mean corner as a convex shell's would
+    /// but whose triangles cross one another: one ray from that point crosses two of them.
+    #[test]
+    fn embedded_certifies_shells_seen_once_from_a_point() {
+        let certified = |vertices: &[[f64; 3]], tris: &[[u32; 3]]| {
+            let (corners, planes) = corners_and_planes(vertices, tris);
+            embedded(&corners, &planes)
+        };
+        let (mut vertices, mut tris) = (Vec::new(), Vec::new());
+        push_box(&mut vertices, &mut tris, [0.0; 3], [1.0, 2.0, 3.0]);
+        assert!(certified(&vertices, &tris));
+        let inward: Vec<[u32; 3]> = tris.iter().map(|t| [t[0], t[2], t[1]]).collect();
+        assert!(certified(&vertices, &inward));
+        // The top's centre pushed down a little: a fan of four triangles in place of the top's two.
+        let mut dented = tris[..2].to_vec();
+        dented.extend_from_slice(&tris[4..]);
+        let centre = vertices.len() as u32;
+        vertices.push([0.5, 1.0, 2.5]);
+        let top = [4, 5, 7, 6];
+        for k in 0..4 {
+            dented.push([top[k], top[(k + 1) % 4], centre]);
+        }
+        assert_eq!(dented.len(), 14);
+        assert!(certified(&vertices, &dented));
+        let (mut vertices, mut tris) = (Vec::new(), Vec::new());
+        push_sphere(&mut vertices, &mut tris, [0.3, -0.2, 0.1], 0.8, 12);
+        assert!(certified(&vertices, &tris));
+        let (mut vertices, mut tris) = (Vec::new(), Vec::new());
+        push_torus(&mut vertices, &mut tris, (1.0, 0.3), (24, 12));
+        assert!(!certified(&vertices, &tris));
+        let (vertices, tris) = pentagram_bipyramid();
+        let (corners, planes) = corners_and_planes(&vertices, &tris);
+        let c = corners.iter().flatten().fold([0.0; 3], |s, p| in_order(|k| s[k] + p[k])).map(|x| x / 30.0);
+        let first = planes[0].side(c);
+        assert!(planes.iter().all(|p| p.side(c) * first > 0.0), "every triangle faces the same way");
+        assert_eq!(hits(c, [10.0, c[1], c[2]], 0, &corners, &planes), Some(2));
+        assert!(!embedded(&corners, &planes));
+    }
+
+    /// Certified shells are not searched for their own pairs, and decide as the search decides:
+    /// two spheres cutting each other enclose the same volume, with nothing undecided, and no
+    /// more triangles cut. The pentagram bipyramid with a box through it is not certified, and
+    /// comes out the same bit for bit with its range given or not.
+    #[test]
+    fn certified_shells_decide_as_the_search_does() {
+        let (mut vertices, mut tris) = (Vec::new(), Vec::new());
+        push_sphere(&mut vertices, &mut tris, [0.0; 3], 1.0, 24);
+        let first = tris.len();
+        push_sphere(&mut vertices, &mut tris, [0.83, 0.21, 0.13], 0.7, 20);
+        let signs = vec![1; tris.len()];
+        let at = ([0.4, 0.1, 0.1], 0.0);
+        let sealed = [0..first, first..tris.len()];
+        let (corners, planes) = corners_and_planes(&vertices, &tris);
+        let ends = certified_ends(&corners, &planes, &sealed);
+        assert!(ends[..first].iter().all(|&e| e as usize == first));
+        assert!(ends[first..].iter().all(|&e| e as usize == tris.len()));
+        let searched = resolve_with(&vertices, &tris, &signs, at, (true, CROWDED_GRID), &[]);
+        let passed = resolve_with(&vertices, &tris, &signs, at, (true, CROWDED_GRID), &sealed);
+        let tree = resolve_with(&vertices, &tris, &signs, at, (true, 0), &sealed);
+        assert_eq!((searched.bound, passed.bound, tree.bound), (0.0, 0.0, 0.0));
+        assert!(passed.cut <= searched.cut && passed.cut > 0, "{} against {}", passed.cut, searched.cut);
+        let (want, got) = (enclosed(&vertices, &searched), enclosed(&vertices, &passed));
+        assert!((got - want).abs() < 1e-14 * want, "{got} against {want}");
+        assert_eq!(enclosed(&vertices, &tree).to_bits(), got.to_bits());
+
+        let (mut vertices, mut tris) = pentagram_bipyramid();
+        let star = tris.len();
+        push_box(&mut vertices, &mut tris, [-0.2, -0.15, -0.3], [0.25, 0.2, 0.45]);
+        let signs = vec![1; tris.len()];
+        let plain = resolve_with(&vertices, &tris, &signs, at, (true, CROWDED_GRID), &[]);
+        let given = resolve_with(&vertices, &tris, &signs, at, (true, CROWDED_GRID), &[0..star, star..tris.len()]);
+        let faces = |r: &Resolved| r.faces.iter().map(<[u32]>::to_vec).collect::<Vec<_>>();
+        assert!(plain.cut > 0 && faces(&plain) == faces(&given) && plain.vertices == given.vertices);
+        assert_eq!((plain.bound, plain.cut), (given.bound, given.cut));
+    }
+
     /// Two spheres that cut each other: the pieces decided from a neighbouring triangle's rays
     /// across a shared edge are decided as their own rays decide them (the same faces, in the same
     /// order, with nothing left undecided), and they are most first pieces of the cut triangles.
@@ -1928,8 +2139,8 @@ mod tests {
         push_sphere(&mut vertices, &mut tris, [0.0; 3], 1.0, 24);
         push_sphere(&mut vertices, &mut tris, [0.83, 0.21, 0.13], 0.7, 20);
         let signs = vec![1; tris.len()];
-        let joined = resolve_with(&vertices, &tris, &signs, ([0.4, 0.1, 0.1], 0.0), (true, CROWDED_GRID));
-        let alone = resolve_with(&vertices, &tris, &signs, ([0.4, 0.1, 0.1], 0.0), (false, CROWDED_GRID));
+        let joined = resolve_with(&vertices, &tris, &signs, ([0.4, 0.1, 0.1], 0.0), (true, CROWDED_GRID), &[]);
+        let alone = resolve_with(&vertices, &tris, &signs, ([0.4, 0.1, 0.1], 0.0), (false, CROWDED_GRID), &[]);
         assert_eq!(alone.joined_across, 0);
         assert!(joined.joined_across * 2 > joined.cut, "{} of {}", joined.joined_across, joined.cut);
         assert_eq!((joined.bound, alone.bound), (0.0, 0.0));
@@ -1957,8 +2168,8 @@ mod tests {
         for (vertices, tris) in [spheres, (vertices, tris)] {
             let signs = vec![1; tris.len()];
             let at = ([0.4, 0.1, 0.1], 0.0);
-            let grid = resolve_with(&vertices, &tris, &signs, at, (true, u64::MAX));
-            let tree = resolve_with(&vertices, &tris, &signs, at, (true, 0));
+            let grid = resolve_with(&vertices, &tris, &signs, at, (true, u64::MAX), &[]);
+            let tree = resolve_with(&vertices, &tris, &signs, at, (true, 0), &[]);
             assert!(grid.cut > 0 && !grid.crowded && !tree.crowded);
             assert_eq!((grid.cut, grid.bound, grid.rounding), (tree.cut, tree.bound, tree.rounding));
             let faces = |r: &Resolved| r.faces.iter().map(<[u32]>::to_vec).collect::<Vec<_>>();
@@ -1989,7 +2200,7 @@ mod tests {
             };
             assert!(small_area > 0.0);
             let tris = [[0, 1, 2], [3, 4, 5]];
-            let r = resolve(&vertices, &tris, &[1, 1], [1.0, 1.0, 1.0], 0.0);
+            let r = resolve(&vertices, &tris, &[1, 1], &[], [1.0, 1.0, 1.0], 0.0);
             let got = area_vector(&vertices, &r);
             assert_eq!(r.bound, 0.0, "shift {shift:?}");
             assert!((got[2] - (8.0 - small_area)).abs() < 1e-12, "shift {shift:?}: {got:?}");
@@ -2064,7 +2275,7 @@ mod tests {
             push_block(&mut vertices, &mut tris, square, 0.5, |x, y| up(plane(x, y)));
         }
         let signs = vec![1; tris.len()];
-        let r = resolve(&vertices, &tris, &signs, [1024.5, 1024.5, 0.5], 0.0);
+        let r = resolve(&vertices, &tris, &signs, &[], [1024.5, 1024.5, 0.5], 0.0);
         assert_eq!(r.bound, 0.0);
         // The volume about (1024, 1024, 0), whose coordinates are exact differences.
         let moved: Vec<[f64; 3]> = vertices.iter().map(|v| [v[0] - 1024.0, v[1] - 1024.0, v[2]]).collect();

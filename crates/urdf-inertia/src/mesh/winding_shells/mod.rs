@@ -521,7 +521,7 @@ fn resolve_pairs(
     welded: Option<&[u32]>,
     out: &mut ShellOutcome,
 ) {
-    let (mut all, mut signs) = (Vec::new(), Vec::new());
+    let (mut all, mut signs, mut sealed) = (Vec::new(), Vec::new(), Vec::new());
     let mut swept = 0.0;
     let ShellSet {
         shells,
@@ -529,13 +529,13 @@ fn resolve_pairs(
         relevant,
         sign,
     } = *set;
-    let own = (0..shells.len()).filter(|&i| relevant[i]).map(|i| (i, &tris[i]));
-    let all_shells = own.chain(copied.iter().map(|(i, t)| (*i, t)));
+    let own = (0..shells.len()).filter(|&i| relevant[i]).map(|i| (i, &tris[i], true));
+    let all_shells = own.chain(copied.iter().map(|(i, t)| (*i, t, false)));
     // Room for every triangle (a weld may drop some), each shell's appended without a copy.
-    let room = all_shells.clone().map(|(_, t)| t.len()).sum();
+    let room = all_shells.clone().map(|(_, t, _)| t.len()).sum();
     all.reserve(room);
     signs.reserve(room);
-    for (i, tris) in all_shells {
+    for (i, tris, whole) in all_shells {
         let before = all.len();
         match welded {
             Some(rep) => {
@@ -546,11 +546,16 @@ fn resolve_pairs(
             None => all.extend_from_slice(tris),
         }
         signs.extend(std::iter::repeat_n(sign[i], all.len() - before));
+        // A sealed shell's triangles as they are (not welded again), which `resolve` may certify
+        // to meet one another only where they share corners or edges (a copy's come after them).
+        if whole && welded.is_none() && shells[i].sealed {
+            sealed.push(before..all.len());
+        }
     }
     let volume: f64 = shells.iter().map(|s| s.volume6.abs() / 6.0).sum();
     let bounds = Aabb::of(vertices.iter().copied());
     let centre = crate::mass::integrals::bounding_box_centre(vertices);
-    let r = correction::resolve(vertices, &all, &signs, centre, RESOLVED_TARGET * volume);
+    let r = correction::resolve(vertices, &all, &signs, &sealed, centre, RESOLVED_TARGET * volume);
     for face in r.faces.iter() {
         out.faces.push(face);
     }
