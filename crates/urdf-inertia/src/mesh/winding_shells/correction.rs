@@ -345,6 +345,7 @@ fn resolve_with(
     };
     let mut heap = BinaryHeap::new();
     f.patches((&blockers, &uses), &mut seen, &mut out, &mut heap);
+    let mut flat: Option<Vec<bool>> = None;
     for (t, b) in blockers.into_iter().enumerate() {
         if b.is_empty() {
             continue;
@@ -353,11 +354,12 @@ fn resolve_with(
         // jump across it, so it cuts nothing. Kept, its plane (undefined: every point lies in it)
         // left every cell near it undecided (robosuite b1's `calf.obj`: a zero-area sliver across
         // eleven faces, an estimate of 1.3e-1 against 8.4e-6 without it).
-        let mut b: Vec<Blocker> = b
-            .into_iter()
-            .filter(|&u| !collinear(f.corners[u as usize]))
-            .map(|u| Blocker { u, in_plane: None })
-            .collect();
+        // (Asked once per triangle, not once per pair: under coincident shells each triangle
+        // blocks a dozen others.)
+        let flat = flat.get_or_insert_with(|| f.corners.iter().map(|&c| collinear(c)).collect());
+        let mut list = Vec::with_capacity(b.len());
+        list.extend(b.into_iter().filter(|&u| !flat[u as usize]).map(|u| Blocker { u, in_plane: None }));
+        let mut b = list;
         if !f.cut(&f.corners[t], (t as u32, 0.0), &mut b, &mut seen, &mut out) {
             heap.push(f.piece(f.corners[t], t as u32, b, 0.0));
         }
@@ -390,11 +392,19 @@ impl Faces<'_> {
             meeting += 1;
             let asked = (overlap(&grown(t), &boxes[u]), overlap(&grown(u), &boxes[t]));
             let (tu, ut) = self.blocks_both(t, u, asked);
+            // Room for a dozen at the first (coincident shells: each triangle under a dozen of
+            // the other's), not grown from four.
+            let push = |list: &mut Vec<u32>, x: usize| {
+                if list.capacity() == 0 {
+                    list.reserve(12);
+                }
+                list.push(x as u32);
+            };
             if tu {
-                out[t].push(u as u32);
+                push(&mut out[t], u);
             }
             if ut {
-                out[u].push(t as u32);
+                push(&mut out[u], t);
             }
             meeting
         };
