@@ -222,7 +222,7 @@ fn embedded(corners: &[Corners], planes: &[Plane]) -> bool {
     let mut b = Aabb::EMPTY;
     for p in corners.iter().flatten() {
         sum = in_order(|k| sum[k] + p[k]);
-        b = b.union(Aabb { lo: *p, hi: *p });
+        b.add(*p);
     }
     let mean = sum.map(|x| x / (3 * corners.len()) as f64);
     let extent = b.extent();
