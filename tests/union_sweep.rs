@@ -1512,6 +1512,44 @@ fn faces_that_do_not_close_in_their_inertia_are_not_bounded() {
     }
 }
 
+/// Breaches until session 39 (sweep cases 13113 and 14946, found by cases 12501–15000), in their
+/// least forms. 14946 (parts 0, 1, 3): an outward box, a tetrahedron on one of its edges, and an
+/// inward box 8.9e-12 of their size from the first, 3,231 m from the origin; Ω is about the
+/// tetrahedron, 9.0e-6 m³. 13113 (parts 0–3): an inward box and an outward box 5.3e-8 of their
+/// size apart and a cancelling pair of tetrahedra on a corner; Ω is the slivers between the boxes,
+/// 4.4e-18 m³. The boxes' corners weld in the topology, so every side of a box is a component of
+/// its own, and the ladder turned the inward box's sides outward (a side is open: nothing charged
+/// it). Their cluster balances both as turned and as stored, and was decided as turned: the union,
+/// one box (3.76e-3 m³ under an estimate of 1.5e-8; 2.77e-11 under 5.2e-4). Now a cluster that
+/// balances as stored is decided as stored, whose winding number defines Ω, and the values are
+/// within their estimates (exact rationals): 14946 2.9e-9 off under 4.3e-4; 13113 not bounded.
+#[test]
+fn boxes_the_ladder_turned_side_by_side_are_decided_as_stored() {
+    for (seed, keep) in [(14946, &[0, 1, 3][..]), (13113, &[0, 1, 2, 3][..])] {
+        let mut case = random_case(seed).expect("made");
+        let parts = std::mem::take(&mut case.parts);
+        case.parts = (parts.into_iter().enumerate())
+            .filter(|(i, _)| keep.contains(i))
+            .map(|(_, p)| p)
+            .collect();
+        let Outcome::Checked {
+            volume,
+            inertia,
+            estimate,
+            turned,
+            ..
+        } = run(&case)
+        else {
+            panic!("{seed}: no solid");
+        };
+        assert!(turned, "{seed}: the ladder turned no face");
+        assert!(
+            volume <= estimate && inertia <= estimate,
+            "{seed}: errors {volume:e} {inertia:e} under {estimate:e}"
+        );
+    }
+}
+
 /// A breach until session 36 (sweep case 3187, whole and less its last two parts): three
 /// tetrahedra ~3 cm across, 9,000 m from the origin, stored within about an ulp of each other
 /// (1e-11 of their size apart, where an ulp of the coordinates is 6e-11 of it), wound outward,

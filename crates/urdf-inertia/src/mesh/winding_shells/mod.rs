@@ -14,8 +14,9 @@
 //! ([`correction`]): a piece of face that no other triangle meets has one winding number in front of
 //! it, which an exact ray counts; the pieces along the cuts that stay undecided bound the error. A
 //! cluster is decided so when its edges balance (a closed cycle), if need be on the surface as the
-//! file stores it: cracks welded ([`cracks`]), copies of faces that welding dropped put back, faces
-//! the ladder turned round turned back. Pairs with an open shell even so are not decided: the region they can count twice lies in the intersection of
+//! file stores it: cracks welded ([`cracks`]), copies of faces that welding dropped put back; and
+//! wherever it balances with them so, the faces the ladder turned round are turned back (the file's
+//! winding number defines Ω). Pairs with an open shell even so are not decided: the region they can count twice lies in the intersection of
 //! their bounding boxes (a closed shell's winding number is 0 outside its box), whose volume enters
 //! the error estimate.
 
@@ -322,9 +323,12 @@ struct Clusters {
 /// balance (as many uses each way: a closed cycle, whose winding number is an integer everywhere and
 /// is counted exactly by a ray's crossings), counting the extra `copies` of faces and taking
 /// vertices as their representatives `rep` when given (`uses`: the edge uses on them). A cluster
-/// balances with its faces as classified (the ladder's repairs kept), or else in their stored
-/// orientation (the faces marked in `flip` turned back: a re-orientation that broke a closed
-/// cycle of the file is undone).
+/// that balances in its stored orientation is decided so (the faces marked in `flip` turned back),
+/// since the file's winding number defines Ω: a re-orientation that broke a closed cycle of the
+/// file is undone, and one that kept it (whole sides of a box turned, each side a component of its
+/// own where two boxes' corners weld: sweep case 14946, the union of an outward and an inward box
+/// one box off under 1.5e-8) changes nothing. Otherwise it is decided with its faces as classified
+/// (the ladder's repairs kept), where they balance so.
 fn resolvable(
     faces: &Polygons,
     (copies, stored, flip): (&Polygons, &Polygons, &[bool]),
@@ -385,7 +389,7 @@ fn resolvable(
         .collect();
     Clusters {
         relevant: roots.iter().map(|&r| wanted[r] && !(open[r].0 && open[r].1)).collect(),
-        unflip: roots.iter().map(|&r| wanted[r] && open[r].0 && !open[r].1).collect(),
+        unflip: roots.iter().map(|&r| wanted[r] && !open[r].1).collect(),
         unbalanced: (0..shells.len()).any(|r| wanted[r] && open[r].0 && open[r].1),
         copy_shell,
         copy_turned,
