@@ -1146,23 +1146,27 @@ fn sampled() {
     );
 }
 
+/// Case `seed` with only the parts that `keep` keeps (by their place in the case).
+fn case_with(seed: u64, keep: impl Fn(usize) -> bool) -> Case {
+    let mut case = random_case(seed).expect("made");
+    let parts = std::mem::take(&mut case.parts);
+    case.parts = (parts.into_iter().enumerate())
+        .filter(|(i, _)| keep(*i))
+        .map(|(_, p)| p)
+        .collect();
+    case
+}
+
 /// `SEED=n KEEP=0,2` runs case n with only those parts (to minimise a breach); `OFFSET=0` moves it
 /// back to the origin (as it was made, then shifted in f64).
 #[test]
 #[ignore = "by hand"]
 fn subset() {
     let seed: u64 = std::env::var("SEED").unwrap().parse().unwrap();
-    let mut case = random_case(seed).expect("made");
-    if let Ok(keep) = std::env::var("KEEP") {
-        let keep: Vec<usize> = keep.split(',').map(|x| x.parse().unwrap()).collect();
-        let parts = std::mem::take(&mut case.parts);
-        case.parts = parts
-            .into_iter()
-            .enumerate()
-            .filter(|(i, _)| keep.contains(i))
-            .map(|(_, p)| p)
-            .collect();
-    }
+    let keep: Option<Vec<usize>> = std::env::var("KEEP")
+        .ok()
+        .map(|keep| keep.split(',').map(|x| x.parse().unwrap()).collect());
+    let mut case = case_with(seed, |i| keep.as_ref().is_none_or(|k| k.contains(&i)));
     if std::env::var("FLIP").is_ok() {
         for p in &mut case.parts {
             p.inward = !p.inward;
@@ -1454,14 +1458,7 @@ fn a_doubled_shell_around_a_cavity_is_within_the_estimate() {
 /// decided face by face.
 #[test]
 fn a_wall_between_bodies_that_overlap_is_put_back() {
-    let mut case = random_case(2616).expect("made");
-    let parts = std::mem::take(&mut case.parts);
-    case.parts = parts
-        .into_iter()
-        .enumerate()
-        .filter(|(i, _)| *i != 2)
-        .map(|(_, p)| p)
-        .collect();
+    let case = case_with(2616, |i| i != 2);
     assert!(case.parts.iter().all(|p| !p.inward));
     let Outcome::Checked {
         volume,
@@ -1526,12 +1523,7 @@ fn faces_that_do_not_close_in_their_inertia_are_not_bounded() {
 #[test]
 fn boxes_the_ladder_turned_side_by_side_are_decided_as_stored() {
     for (seed, keep) in [(14946, &[0, 1, 3][..]), (13113, &[0, 1, 2, 3][..])] {
-        let mut case = random_case(seed).expect("made");
-        let parts = std::mem::take(&mut case.parts);
-        case.parts = (parts.into_iter().enumerate())
-            .filter(|(i, _)| keep.contains(i))
-            .map(|(_, p)| p)
-            .collect();
+        let case = case_with(seed, |i| keep.contains(&i));
         let Outcome::Checked {
             volume,
             inertia,
