@@ -16,9 +16,9 @@
 //! cluster is decided so when its edges balance (a closed cycle), if need be on the surface as the
 //! file stores it: cracks welded ([`cracks`]), copies of faces that welding dropped put back; and
 //! wherever it balances with them so, the faces the ladder turned round are turned back (the file's
-//! winding number defines Ω). Pairs with an open shell even so are not decided: the region they can count twice lies in the intersection of
-//! their bounding boxes (a closed shell's winding number is 0 outside its box), whose volume enters
-//! the error estimate.
+//! winding number defines Ω). Pairs with an open shell even so are not decided: the region they can
+//! count twice lies in the intersection of their bounding boxes (a closed shell's winding number is
+//! 0 outside its box), whose volume enters the error estimate.
 
 mod bvh;
 mod cells;
@@ -325,10 +325,11 @@ struct Clusters {
 /// vertices as their representatives `rep` when given (`uses`: the edge uses on them). A cluster
 /// that balances in its stored orientation is decided so (the faces marked in `flip` turned back),
 /// since the file's winding number defines Ω: a re-orientation that broke a closed cycle of the
-/// file is undone, and one that kept it (whole sides of a box turned, each side a component of its
-/// own where two boxes' corners weld: sweep case 14946, the union of an outward and an inward box
-/// one box off under 1.5e-8) changes nothing. Otherwise it is decided with its faces as classified
-/// (the ladder's repairs kept), where they balance so.
+/// file is undone, and so is one that kept the cycle closed, which still changes Ω (an inward box
+/// whose sides the ladder turned one by one, each a component of its own where its corners weld
+/// to an outward box's, made the two boxes' union, which the file's surface does not enclose:
+/// sweep case 14946, one box off under an estimate of 1.5e-8). Otherwise it is decided with its
+/// faces as classified (the ladder's repairs kept), where they balance so.
 fn resolvable(
     faces: &Polygons,
     (copies, stored, flip): (&Polygons, &Polygons, &[bool]),
