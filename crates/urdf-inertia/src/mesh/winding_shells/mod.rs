@@ -252,6 +252,12 @@ fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) ->
             sign: &sign,
         };
         resolve_pairs(vertices, &set, &copied, welded, &mut out);
+        // The decided faces differ from those given wherever faces were turned back or copies put
+        // back, even where every face is kept as it came to `resolve` (which compares with those):
+        // otherwise the faces given, turned, were integrated (sweep case 29472: an inward box
+        // inside an outward one, turned by the ladder and decided as stored, counted outward,
+        // 5.7% off under an estimate of 3e-14).
+        out.changed |= out.turned_back > 0 || out.copies_restored > 0;
     }
     out
 }
