@@ -1489,24 +1489,28 @@ fn a_wall_between_bodies_that_overlap_is_put_back() {
 fn faces_that_do_not_close_in_their_inertia_are_not_bounded() {
     for (seed, off) in [(11638, 0.5), (11883, 0.03)] {
         let case = random_case(seed).expect("made");
-        let Outcome::Checked { volume, .. } = run(&case) else {
-            panic!("{seed}: no solid");
-        };
-        assert!(volume > off, "{seed}: error {volume:e}");
-        let s = solid(&case).expect("a solid");
-        assert!(
-            s.error_estimate.is_infinite(),
-            "{seed}: {:e}",
-            s.error_estimate
-        );
-        assert!(
-            s.warnings
-                .iter()
-                .any(|w| w.text.contains("volume or inertia differs")),
-            "{seed}: {:?}",
-            s.warnings
-        );
+        off_and_unbounded(&case, off, "volume or inertia differs", seed);
     }
+}
+
+/// That `case` is more than `off` of its volume off Ω (exact rationals), and that its value is
+/// left unbounded with a warning that says `says`; `what` names the case in the messages.
+fn off_and_unbounded(case: &Case, off: f64, says: &str, what: impl std::fmt::Display) {
+    let Outcome::Checked { volume, .. } = run(case) else {
+        panic!("{what}: no solid");
+    };
+    assert!(volume > off, "{what}: error {volume:e}");
+    let s = solid(case).expect("a solid");
+    assert!(
+        s.error_estimate.is_infinite(),
+        "{what}: {:e}",
+        s.error_estimate
+    );
+    assert!(
+        s.warnings.iter().any(|w| w.text.contains(says)),
+        "{what}: {:?}",
+        s.warnings
+    );
 }
 
 /// Breaches until session 39 (sweep cases 13113 and 14946, found by cases 12501–15000), in their
@@ -1568,20 +1572,6 @@ fn three_tetrahedra_within_an_ulp_are_within_the_estimate() {
         case.parts.truncate(keep);
         // Against Ω in exact rationals, more than the whole volume off: no finite sample of the
         // pieces' gap (0.58 and 0.61 of it) bounds that.
-        let Outcome::Checked { volume, .. } = run(&case) else {
-            panic!("no solid");
-        };
-        assert!(volume > 1.0, "{keep}: error {volume:e}");
-        let s = solid(&case).expect("a solid");
-        assert!(
-            s.error_estimate.is_infinite(),
-            "{keep}: {:e}",
-            s.error_estimate
-        );
-        assert!(
-            s.warnings.iter().any(|w| w.text.contains("do not close")),
-            "{keep}: {:?}",
-            s.warnings
-        );
+        off_and_unbounded(&case, 1.0, "do not close", keep);
     }
 }
