@@ -1,7 +1,7 @@
 //! A uniform grid of triangles: which triangles may meet a box, and the winding number in front of a
 //! point on a face, counted by exact crossings (`orient3d`) of an axis-parallel ray.
 
-use crate::geometry::Aabb;
+use crate::geometry::{cross, dot, sub, Aabb};
 use robust::{orient2d, Coord, Coord3D};
 
 use super::c3;
@@ -23,10 +23,21 @@ const MAX_ENTRIES_PER_TRIANGLE: u64 = 32;
 /// Grid entries any grid may hold before [`MAX_ENTRIES_PER_TRIANGLE`] applies (3.4 MB).
 const MIN_ENTRIES: u64 = 1 << 16;
 
+/// Cells of a triangle's box from which [`Grid::of_triangles`] keeps only those the triangle may
+/// meet: below, the test costs more than the entries it saves (instructions, `examples/shells_once`
+/// and UR5 `visual/upperarm.dae`: docs/benchmarks.md, "Long triangles in the cells they meet").
+const SLANTED: usize = 16;
+
+/// Whether a range of cells holds [`SLANTED`] cells or more.
+fn slanted(r: &[(usize, usize); 3]) -> bool {
+    r.iter().map(|&(a, z)| z - a + 1).product::<usize>() >= SLANTED
+}
+
 /// The factor by which a cell's side grows each time the grid is made coarser (its volume doubles).
 const COARSER: f64 = 1.259_921_049_894_873_2;
 
-/// Triangles bucketed by the cells their boxes cover.
+/// Triangles bucketed by the cells their boxes cover ([`Grid::of_triangles`]: by those of the cells
+/// each may meet).
 pub(super) struct Grid {
     lo: [f64; 3],
     cell: [f64; 3],
@@ -43,7 +54,7 @@ pub(super) struct Grid {
     pub(super) bounds: Aabb,
 }
 
-/// Which triangles a query has seen already (a triangle sits in every cell its box covers).
+/// Which triangles a query has seen already (a triangle sits in several cells).
 pub(super) struct Seen {
     mark: Vec<u32>,
     round: u32,
@@ -84,7 +95,21 @@ pub(super) enum Crossing {
 }
 
 impl Grid {
+    /// The grid of boxes `boxes`, each in every cell it covers.
+    #[cfg(test)]
     pub(super) fn new(boxes: &[Aabb]) -> Grid {
+        Grid::build(boxes, None)
+    }
+
+    /// The grid of triangles `corners` (`boxes` their boxes), each in the cells its box covers that
+    /// it may meet ([`CellBoxes::may_meet`]): a long triangle slanting across its box, as CAD fans
+    /// have them, sits in a band of the cells its box covers, not in all of them. A query of a box
+    /// or a ray then finds every triangle that meets it, as before, and fewer that do not.
+    pub(super) fn of_triangles(boxes: &[Aabb], corners: &[Corners]) -> Grid {
+        Grid::build(boxes, Some(corners))
+    }
+
+    fn build(boxes: &[Aabb], corners: Option<&[Corners]>) -> Grid {
         let bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
         let ext = bounds.extent();
         let largest = ext.iter().copied().fold(0.0, f64::max).max(f64::MIN_POSITIVE);
@@ -120,22 +145,43 @@ impl Grid {
             .map(|b| grid.cell_range(b).map(|(a, z)| [a as u8, z as u8]))
             .collect();
         let range = |r: &[[u8; 2]; 3]| r.map(|[a, z]| (usize::from(a), usize::from(z)));
-        for r in &ranges {
-            grid.each_cell_in(range(r), |c| count[c + 1] += 1);
-        }
+        // With corners, the cells of each triangle's box that it may meet, for the triangles
+        // whose boxes cover [`SLANTED`] cells or more, found once for both passes: their runs
+        // one after the other in `kept`.
+        let kept: Vec<u32> = corners.map_or_else(Vec::new, |corners| {
+            let cell_boxes = CellBoxes::new(&grid);
+            let mut kept = Vec::new();
+            for (t, r) in corners.iter().zip(&ranges) {
+                let r = range(r);
+                if slanted(&r) {
+                    let t = cell_boxes.triangle(t);
+                    for x in r[0].0..=r[0].1 {
+                        for y in r[1].0..=r[1].1 {
+                            for z in r[2].0..=r[2].1 {
+                                if t.may_meet([x, y, z]) {
+                                    kept.push(grid.cell_number([x, y, z]) as u32);
+                                }
+                            }
+                        }
+                    }
+                    kept.push(u32::MAX);
+                }
+            }
+            kept
+        });
+        let slanted = |r: &[(usize, usize); 3]| corners.is_some() && slanted(r);
+        grid.entries(&ranges, &kept, slanted, |_, c| count[c + 1] += 1);
         for c in 0..cells {
             count[c + 1] += count[c];
         }
         let mut fill = count.clone();
         let mut items = vec![0u32; count[cells] as usize];
         let mut item_boxes = vec![Aabb::EMPTY; count[cells] as usize];
-        for (i, (b, r)) in boxes.iter().zip(&ranges).enumerate() {
-            grid.each_cell_in(range(r), |c| {
-                items[fill[c] as usize] = i as u32;
-                item_boxes[fill[c] as usize] = *b;
-                fill[c] += 1;
-            });
-        }
+        grid.entries(&ranges, &kept, slanted, |i, c| {
+            items[fill[c] as usize] = i as u32;
+            item_boxes[fill[c] as usize] = boxes[i];
+            fill[c] += 1;
+        });
         grid.start = count;
         grid.items = items;
         grid.item_boxes = item_boxes;
@@ -169,8 +215,30 @@ impl Grid {
         for x in r[0].0..=r[0].1 {
             for y in r[1].0..=r[1].1 {
                 for z in r[2].0..=r[2].1 {
-                    f((x * self.dims[1] + y) * self.dims[2] + z);
+                    f(self.cell_number([x, y, z]));
                 }
+            }
+        }
+    }
+
+    /// The number of the cell of indices `[x, y, z]`.
+    fn cell_number(&self, [x, y, z]: [usize; 3]) -> usize {
+        (x * self.dims[1] + y) * self.dims[2] + z
+    }
+
+    /// Calls `f(i, c)` for each cell `c` of triangle `i`, triangle by triangle, each one's cells in
+    /// the order of their numbers: all those of its range of cells (`ranges`), or where `slanted`
+    /// holds of the range, those of its run in `kept` (the runs one after the other, each ended by
+    /// `u32::MAX`).
+    #[inline(always)]
+    fn entries(&self, ranges: &[[[u8; 2]; 3]], kept: &[u32], slanted: impl Fn(&[(usize, usize); 3]) -> bool, mut f: impl FnMut(usize, usize)) {
+        let mut run = kept.iter();
+        for (i, r) in ranges.iter().enumerate() {
+            let r = r.map(|[a, z]| (usize::from(a), usize::from(z)));
+            if slanted(&r) {
+                run.by_ref().take_while(|&&c| c != u32::MAX).for_each(|&c| f(i, c as usize));
+            } else {
+                self.each_cell_in(r, |c| f(i, c));
             }
         }
     }
@@ -182,7 +250,9 @@ impl Grid {
     }
 
     /// The triangles numbered above `after` (all when `None`) whose boxes meet `b` (closed
-    /// boxes), each once, in the order of the cells `b` covers.
+    /// boxes) and that are listed in a cell `b` covers, each once, in the order of those cells:
+    /// in a grid of boxes every one whose box meets `b`; in one of triangles every triangle that
+    /// meets `b`, and fewer that do not.
     pub(super) fn overlapping(&self, b: &Aabb, after: Option<u32>, seen: &mut Seen, out: &mut Vec<u32>) {
         out.clear();
         seen.next();
@@ -217,10 +287,12 @@ impl Grid {
     }
 
     /// Where [`Grid::overlapping`] of a query box whose lowest corner is in cell `query`
-    /// ([`Grid::cell_of`]) finds a triangle whose box `b` meets it (closed boxes): the first cell
-    /// it visits that holds the triangle, the corner of the two boxes' ranges of cells lowest on
-    /// every axis (the cells are visited in order of their number, and a cell's entries in order
-    /// of theirs). Sorting by (this, number) puts triangles in its order without a second query.
+    /// ([`Grid::cell_of`]) finds a triangle whose box `b` meets it (closed boxes) in a grid of
+    /// boxes: the first cell it visits that holds the triangle, the corner of the two boxes'
+    /// ranges of cells lowest on every axis (the cells are visited in order of their number, and a
+    /// cell's entries in order of theirs). Sorting by (this, number) puts triangles in that order
+    /// without a second query; in a grid of triangles, which lists a triangle in fewer cells, the
+    /// order is the same, a function of the boxes alone.
     pub(super) fn first_shared_cell(&self, query: [usize; 3], b: &Aabb) -> usize {
         let idx = super::in_order(|k| query[k].max(self.index(k, b.lo[k])));
         (idx[0] * self.dims[1] + idx[1]) * self.dims[2] + idx[2]
@@ -321,6 +393,87 @@ impl Grid {
             }
         }
         Some(w)
+    }
+}
+
+/// The cells of a [`Grid`] as closed boxes that hold every point [`Grid::index`] puts in them,
+/// for [`Grid::of_triangles`]: cell `i` along axis k is `lo + (i + ½)·cell ± (½·cell + δ)`, δ a
+/// millionth of a cell, far above what rounding can move a point across a cell's side (the
+/// index's subtraction and division err by at most 2ε of the grid's extent, which is at most 128
+/// cells). Positions are taken from `lo`, so a mesh far from the origin loses nothing.
+struct CellBoxes {
+    lo: [f64; 3],
+    cell: [f64; 3],
+    half: [f64; 3],
+    /// The grid's largest extent.
+    ext: f64,
+}
+
+/// A triangle as [`CellBoxes::may_meet`] tests it: per candidate separating axis (its normal, and
+/// each edge crossed with each axis), the axis `a`, what its corners project to (least and most,
+/// from the grid's `lo`), what a cell's box reaches from its centre with the slack for rounding,
+/// and `a`'s components times a cell's sides.
+struct Slanted {
+    axes: [Axis; 10],
+}
+
+#[derive(Clone, Copy, Default)]
+struct Axis {
+    least: f64,
+    most: f64,
+    reach: f64,
+    step: [f64; 3],
+}
+
+impl CellBoxes {
+    fn new(grid: &Grid) -> CellBoxes {
+        let ext = (0..3).map(|k| grid.cell[k] * grid.dims[k] as f64).fold(0.0, f64::max);
+        CellBoxes {
+            lo: grid.lo,
+            cell: grid.cell,
+            half: grid.cell.map(|c| 0.5 * c + 1e-6 * c + 4.0 * f64::EPSILON * ext),
+            ext,
+        }
+    }
+
+    fn triangle(&self, t: &Corners) -> Slanted {
+        let v = t.map(|v| sub(v, self.lo));
+        let edges = [0, 1, 2].map(|i| sub(v[(i + 1) % 3], v[i]));
+        let mut axes = [Axis::default(); 10];
+        let mut put = |i: usize, a: [f64; 3]| {
+            let p = v.map(|x| dot(a, x));
+            let r: f64 = (0..3).map(|k| self.half[k] * a[k].abs()).sum();
+            let size: f64 = a.iter().map(|x| x.abs()).sum::<f64>() * self.ext;
+            axes[i] = Axis {
+                least: p[0].min(p[1]).min(p[2]),
+                most: p[0].max(p[1]).max(p[2]),
+                // Rounding errs by a few ε of `size` in the projections and the centres'.
+                reach: r + 1e-9 * size,
+                step: std::array::from_fn(|k| a[k] * self.cell[k]),
+            };
+        };
+        put(0, cross(edges[0], edges[1]));
+        for (i, e) in edges.iter().enumerate() {
+            // e × x, e × y, e × z: the edge's other two components, turned (no rounding).
+            put(1 + 3 * i, [0.0, e[2], -e[1]]);
+            put(2 + 3 * i, [-e[2], 0.0, e[0]]);
+            put(3 + 3 * i, [e[1], -e[0], 0.0]);
+        }
+        Slanted { axes }
+    }
+}
+
+impl Slanted {
+    /// Whether the triangle may meet the cell of indices `idx`: false only where one of its axes
+    /// parts the cell's box from the corners by more than rounding could (any axis that parts the
+    /// projections of two convex sets parts the sets, so the axes' own rounding does not matter);
+    /// a NaN parts nothing.
+    fn may_meet(&self, idx: [usize; 3]) -> bool {
+        let mid = idx.map(|i| i as f64 + 0.5);
+        !self.axes.iter().any(|a| {
+            let centre = a.step[0] * mid[0] + a.step[1] * mid[1] + a.step[2] * mid[2];
+            a.least - centre > a.reach || a.most - centre < -a.reach
+        })
     }
 }
 
@@ -863,5 +1016,136 @@ mod tests {
             }
         }
     }
-}
 
+    /// A dyadic number near `x`: a multiple of 2⁻¹², so that the points of [`on_triangle`] are
+    /// exact also 68,000 m from the origin.
+    fn dyadic(x: f64) -> f64 {
+        (x * 4096.0).round() / 4096.0
+    }
+
+    /// Points of triangle `t` exactly (dyadic corners, weights in 64ths): its corners, points
+    /// along its edges and inside it.
+    fn on_triangle(t: &Corners) -> Vec<[f64; 3]> {
+        let mut out = Vec::new();
+        for i in (0..=64).step_by(4) {
+            for j in (0..=64 - i).step_by(4) {
+                let w = [f64::from(i) / 64.0, f64::from(j) / 64.0, f64::from(64 - i - j) / 64.0];
+                out.push(std::array::from_fn(|k| w[0] * t[0][k] + w[1] * t[1][k] + w[2] * t[2][k]));
+            }
+        }
+        out
+    }
+
+    /// Triangles as CAD fans have them, `offset` from the origin, corners dyadic: long slivers
+    /// slanting across the region, fans in planes along the axes (a cap), small triangles, and
+    /// triangles with collinear corners.
+    fn slanted_triangles(next: &mut impl FnMut() -> f64, offset: f64) -> Vec<Corners> {
+        let mut point = |scale: f64, at: [f64; 3]| -> [f64; 3] { std::array::from_fn(|k| dyadic(offset + at[k] + scale * next())) };
+        let mut out = Vec::new();
+        for _ in 0..300 {
+            let (a, b) = (point(4.0, [0.0; 3]), point(4.0, [0.0; 3]));
+            let c: [f64; 3] = std::array::from_fn(|k| dyadic(b[k] + 0.01 * (k as f64 - 1.0)));
+            out.push([a, b, c]);
+        }
+        for axis in 0..3 {
+            let n = 96;
+            let centre = point(2.0, [0.0; 3]);
+            let rim = |i: usize| -> [f64; 3] {
+                let angle = std::f64::consts::TAU * i as f64 / n as f64;
+                let (j, l) = ((axis + 1) % 3, (axis + 2) % 3);
+                let mut p = centre;
+                p[j] = dyadic(centre[j] + 1.5 * angle.cos());
+                p[l] = dyadic(centre[l] + 1.5 * angle.sin());
+                p
+            };
+            out.extend((0..n).map(|i| [centre, rim(i), rim(i + 1)]));
+        }
+        for _ in 0..600 {
+            let a = point(4.0, [0.0; 3]);
+            let near = a.map(|x| x - offset);
+            out.push([a, point(0.05, near), point(0.05, near)]);
+        }
+        for _ in 0..100 {
+            let (a, b) = (point(4.0, [0.0; 3]), point(4.0, [0.0; 3]));
+            out.push([a, b, std::array::from_fn(|k| 0.5 * (a[k] + b[k]))]);
+        }
+        out
+    }
+
+    /// Every point of a triangle is in a cell that lists it, as [`Grid::index`] finds the cell
+    /// (that is how rays and box queries look cells up), for slanted triangles at the origin and
+    /// far from it; the entries are some of those of the grid of their boxes, and far fewer.
+    #[test]
+    fn triangles_sit_in_the_cell_of_each_of_their_points() {
+        let mut next = uniform(0x0dd5_1a7e_5eed_2026);
+        for offset in [0.0, 68_000.0, -4096.5] {
+            let tris = slanted_triangles(&mut next, offset);
+            let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::of(*t)).collect();
+            let grid = Grid::of_triangles(&boxes, &tris);
+            let full = Grid::new(&boxes);
+            assert_eq!(grid.dims, full.dims);
+            for (i, t) in tris.iter().enumerate() {
+                for p in on_triangle(t) {
+                    let c = grid.cell_number(grid.cell_of(p));
+                    let listed = grid.cell_items(c).0.contains(&(i as u32));
+                    assert!(listed, "offset {offset}: triangle {i} {t:?} not in the cell of {p:?}");
+                }
+            }
+            for c in 0..grid.start.len() - 1 {
+                let (ours, all) = (grid.cell_items(c).0, full.cell_items(c).0);
+                assert!(ours.iter().all(|i| all.contains(i)), "cell {c}");
+            }
+            let (ours, all) = (grid.items.len(), full.items.len());
+            assert!(3 * ours < 2 * all, "offset {offset}: {ours} entries against {all}");
+        }
+    }
+
+    /// A closed cylinder of long triangles (its side two long slivers a segment, its caps fans):
+    /// rays through the grid of the triangles count the winding number the grid of their boxes
+    /// counts, and what the cylinder is, 1 inside and 0 outside, at the origin and far from it.
+    #[test]
+    fn rays_count_in_the_grid_of_triangles_what_they_count_in_the_grid_of_boxes() {
+        let mut next = uniform(0xc711_4de2_0bad_cafe);
+        for offset in [0.0, 68_000.0] {
+            let n = 128;
+            let (r, h) = (1.0, 6.0);
+            let rim = |i: usize, z: f64| {
+                let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
+                [offset + r * a.cos(), offset + r * a.sin(), offset + z]
+            };
+            let (bottom, top) = ([offset, offset, offset], [offset, offset, offset + h]);
+            let mut tris = Vec::new();
+            for i in 0..n {
+                tris.push([rim(i, 0.0), rim(i + 1, 0.0), rim(i + 1, h)]);
+                tris.push([rim(i, 0.0), rim(i + 1, h), rim(i, h)]);
+                tris.push([bottom, rim(i + 1, 0.0), rim(i, 0.0)]);
+                tris.push([top, rim(i, h), rim(i + 1, h)]);
+            }
+            let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::of(*t)).collect();
+            let planes: Vec<Plane> = tris.iter().map(Plane::new).collect();
+            let (grid, full) = (Grid::of_triangles(&boxes, &tris), Grid::new(&boxes));
+            let (ours, all) = (grid.items.len(), full.items.len());
+            assert!(ours < all, "{ours} entries against {all}");
+            let mut seen = Seen::new(tris.len());
+            let mut counted = 0;
+            for _ in 0..4000 {
+                let p = [offset + 2.4 * next(), offset + 2.4 * next(), offset + h / 2.0 + 7.0 * next()];
+                let (x, y, z) = (p[0] - offset, p[1] - offset, p[2] - offset);
+                let inside = x * x + y * y < 0.98 * r * r && z > 0.01 && z < h - 0.01;
+                let outside = x * x + y * y > r * r * 1.001 || !(-0.01..=h + 0.01).contains(&z);
+                let axis = (next() * 6.0 + 3.0) as usize % 3;
+                let sign = if next() < 0.0 { -1.0 } else { 1.0 };
+                let ours = grid.winding((&tris, &planes), p, axis, sign, &[], &mut seen, None);
+                let theirs = full.winding((&tris, &planes), p, axis, sign, &[], &mut seen, None);
+                assert_eq!(ours, theirs, "{p:?} along {axis} ({sign})");
+                if let Some(w) = ours {
+                    if inside || outside {
+                        assert_eq!(w, i64::from(inside), "{p:?} along {axis} ({sign})");
+                        counted += 1;
+                    }
+                }
+            }
+            assert!(counted > 3000, "{counted}");
+        }
+    }
+}
