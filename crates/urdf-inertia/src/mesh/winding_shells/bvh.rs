@@ -1,9 +1,10 @@
 //! A hierarchy of boxes over the triangles of many shells: the pairs of triangles of different
 //! shells whose boxes meet, and the triangles whose boxes an axis-parallel ray meets.
 //!
-//! A uniform grid ([`super::grid`]) puts a triangle in every cell its box covers; shells nested
-//! in each other (concentric spheres of growing radius) have triangles of every size, and the
-//! large ones cover thousands of cells each. A tree of boxes holds each triangle once.
+//! A uniform grid ([`super::grid`]) puts a triangle in every cell its box covers (or, a large one,
+//! in those of them it may meet); shells nested in each other (concentric spheres of growing
+//! radius) have triangles of every size, and the large ones cover thousands of cells each. A tree
+//! of boxes holds each triangle once.
 
 use crate::geometry::Aabb;
 use std::ops::ControlFlow;
