@@ -1555,6 +1555,35 @@ fn boxes_the_ladder_turned_side_by_side_are_decided_as_stored() {
     }
 }
 
+/// A breach until session 40 (sweep case 37374, found by cases 32501–37500): five parts with f32
+/// corners, 34.7 m across. After the rounding the first two boxes are one box with other
+/// diagonals, whose faces (each side a shell of its own in a non-manifold cluster) lie flat; the
+/// last box's bottom face is one f32 unit below their top faces over its whole 29.6 m² footprint.
+/// Shell pairs were only those whose boxes meet in a volume, which a flat face's box never does:
+/// the last box was decided whole, the top faces were decided without it, and the slab between,
+/// inside both, was counted twice (1.5e-8 off, 5.65e-5 m³, under an estimate of 3.6e-11). A flat
+/// open shell across another's box now makes a pair, and the value is exact.
+#[test]
+fn a_face_one_f32_unit_inside_a_box_is_decided_with_it() {
+    let case = random_case(37374).expect("made");
+    let Outcome::Checked {
+        volume,
+        inertia,
+        estimate,
+        turned,
+        ..
+    } = run(&case)
+    else {
+        panic!("no solid");
+    };
+    assert!(turned, "the ladder turned no face");
+    assert!(estimate < 1e-9, "estimate {estimate:e}");
+    assert!(
+        volume <= estimate && inertia <= estimate,
+        "errors {volume:e} {inertia:e} under {estimate:e}"
+    );
+}
+
 /// A breach until session 36 (sweep case 3187, whole and less its last two parts): three
 /// tetrahedra ~3 cm across, 9,000 m from the origin, stored within about an ulp of each other
 /// (1e-11 of their size apart, where an ulp of the coordinates is 6e-11 of it), wound outward,
