@@ -1536,23 +1536,29 @@ fn boxes_the_ladder_turned_side_by_side_are_decided_as_stored() {
         (13113, &[0, 1, 2, 3][..]),
         (29472, &[0, 1, 2][..]),
     ] {
-        let case = case_with(seed, |i| keep.contains(&i));
-        let Outcome::Checked {
-            volume,
-            inertia,
-            estimate,
-            turned,
-            ..
-        } = run(&case)
-        else {
-            panic!("{seed}: no solid");
-        };
-        assert!(turned, "{seed}: the ladder turned no face");
-        assert!(
-            volume <= estimate && inertia <= estimate,
-            "{seed}: errors {volume:e} {inertia:e} under {estimate:e}"
-        );
+        turned_and_within(&case_with(seed, |i| keep.contains(&i)), &seed.to_string());
     }
+}
+
+/// Asserts that the ladder turned faces of `case` and that its value is within its estimate
+/// (volume and inertia, against exact rationals); the estimate.
+fn turned_and_within(case: &Case, what: &str) -> f64 {
+    let Outcome::Checked {
+        volume,
+        inertia,
+        estimate,
+        turned,
+        ..
+    } = run(case)
+    else {
+        panic!("{what}: no solid");
+    };
+    assert!(turned, "{what}: the ladder turned no face");
+    assert!(
+        volume <= estimate && inertia <= estimate,
+        "{what}: errors {volume:e} {inertia:e} under {estimate:e}"
+    );
+    estimate
 }
 
 /// A breach until session 40 (sweep case 37374, found by cases 32501–37500): five parts with f32
@@ -1565,23 +1571,8 @@ fn boxes_the_ladder_turned_side_by_side_are_decided_as_stored() {
 /// open shell across another's box now makes a pair, and the value is exact.
 #[test]
 fn a_face_one_f32_unit_inside_a_box_is_decided_with_it() {
-    let case = random_case(37374).expect("made");
-    let Outcome::Checked {
-        volume,
-        inertia,
-        estimate,
-        turned,
-        ..
-    } = run(&case)
-    else {
-        panic!("no solid");
-    };
-    assert!(turned, "the ladder turned no face");
+    let estimate = turned_and_within(&random_case(37374).expect("made"), "37374");
     assert!(estimate < 1e-9, "estimate {estimate:e}");
-    assert!(
-        volume <= estimate && inertia <= estimate,
-        "errors {volume:e} {inertia:e} under {estimate:e}"
-    );
 }
 
 /// A breach until session 36 (sweep case 3187, whole and less its last two parts): three
