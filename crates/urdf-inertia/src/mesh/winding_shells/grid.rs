@@ -25,7 +25,8 @@ const MIN_ENTRIES: u64 = 1 << 16;
 
 /// Cells of a triangle's box from which [`Grid::of_triangles`] keeps only those the triangle may
 /// meet: below, the test costs more than the entries it saves (instructions, `examples/shells_once`
-/// and UR5 `visual/upperarm.dae`: docs/benchmarks.md, "Long triangles in the cells they meet").
+/// and UR5 `visual/upperarm.dae`: docs/benchmarks.md, "Session 40: long triangles in the cells
+/// they meet").
 const SLANTED: usize = 16;
 
 /// Whether a range of cells holds [`SLANTED`] cells or more.
@@ -102,7 +103,7 @@ impl Grid {
     }
 
     /// The grid of triangles `corners` (`boxes` their boxes), each in the cells its box covers that
-    /// it may meet ([`CellBoxes::may_meet`]): a long triangle slanting across its box, as CAD fans
+    /// it may meet ([`Slanted::may_meet`]): a long triangle slanting across its box, as CAD fans
     /// have them, sits in a band of the cells its box covers, not in all of them. A query of a box
     /// or a ray then finds every triangle that meets it, as before, and fewer that do not.
     pub(super) fn of_triangles(boxes: &[Aabb], corners: &[Corners]) -> Grid {
@@ -409,10 +410,10 @@ struct CellBoxes {
     ext: f64,
 }
 
-/// A triangle as [`CellBoxes::may_meet`] tests it: per candidate separating axis (its normal, and
-/// each edge crossed with each axis), the axis `a`, what its corners project to (least and most,
-/// from the grid's `lo`), what a cell's box reaches from its centre with the slack for rounding,
-/// and `a`'s components times a cell's sides.
+/// A triangle as [`Slanted::may_meet`] tests it: per candidate separating axis `a` (its normal,
+/// and each edge crossed with each axis), what its corners project to (least and most, from the
+/// grid's `lo`), what a cell's box reaches from its centre with the slack for rounding, and `a`'s
+/// components times a cell's sides.
 struct Slanted {
     axes: [Axis; 10],
 }
