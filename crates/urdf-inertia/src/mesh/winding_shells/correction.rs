@@ -105,15 +105,17 @@ struct Piece {
     slack: f64,
 }
 
-/// A triangle that may meet a piece of triangle `t`, and whether it lies exactly in `t`'s plane:
-/// found by the first cut that asks (an exact zero is orient3d's most expensive answer) and carried
-/// by the pieces split from that piece, which ask again for each blocker (14 times per pair on a
-/// real gripper with coincident shells). A table of the pairs, asked once per pair, cost the cut a
-/// cache miss per blocker (docs/benchmarks.md, "Fewer cache misses and fewer tests").
+/// A triangle that may meet a piece of triangle `t`: whether it lies exactly in `t`'s plane (an
+/// exact zero is orient3d's most expensive answer), and whether it is taken as in it though not
+/// exactly ([`Faces::blocker`], [`Faces::near_groups`]). Both are asked once per pair, before the
+/// first cut, and carried by the pieces split from that piece, which would ask again for each
+/// blocker (14 times per pair on a real gripper with coincident shells). A table of the pairs cost
+/// the cut a cache miss per blocker (docs/benchmarks.md, "Fewer cache misses and fewer tests").
 #[derive(Clone, Copy)]
 struct Blocker {
     u: u32,
-    in_plane: Option<bool>,
+    in_plane: bool,
+    near: bool,
 }
 
 impl PartialEq for Piece {
@@ -347,21 +349,8 @@ fn resolve_with(
     };
     let mut heap = BinaryHeap::new();
     f.patches((&blockers, &uses), &mut seen, &mut out, &mut heap);
-    let mut flat: Option<Vec<bool>> = None;
-    for (t, b) in blockers.into_iter().enumerate() {
-        if b.is_empty() {
-            continue;
-        }
-        // A triangle with collinear corners (exactly) bounds no area: the winding number does not
-        // jump across it, so it cuts nothing. Kept, its plane (undefined: every point lies in it)
-        // left every cell near it undecided (robosuite b1's `calf.obj`: a zero-area sliver across
-        // eleven faces, an estimate of 1.3e-1 against 8.4e-6 without it).
-        // (Asked once per triangle, not once per pair: under coincident shells each triangle
-        // blocks a dozen others.)
-        let flat = flat.get_or_insert_with(|| f.corners.iter().map(|&c| collinear(c)).collect());
-        let mut list = Vec::with_capacity(b.len());
-        list.extend(b.into_iter().filter(|&u| !flat[u as usize]).map(|u| Blocker { u, in_plane: None }));
-        let mut b = list;
+    for (t, b) in f.blocker_lists(blockers, &boxes).into_iter().enumerate() {
+        let Some(mut b) = b else { continue };
         if !f.cut(&f.corners[t], (t as u32, 0.0), &mut b, &mut seen, &mut out) {
             heap.push(f.piece(f.corners[t], t as u32, b, 0.0));
         }
@@ -373,6 +362,116 @@ fn resolve_with(
 }
 
 impl Faces<'_> {
+    /// Each triangle's blockers as the cut takes them ([`Faces::blocker`], [`Faces::near_groups`]),
+    /// `None` for a triangle no other may meet.
+    fn blocker_lists(&self, blockers: Vec<Vec<u32>>, boxes: &[Aabb]) -> Vec<Option<Vec<Blocker>>> {
+        // The triangles others may meet: cut, even where every blocker is flat.
+        let blocked: Vec<bool> = blockers.iter().map(|b| !b.is_empty()).collect();
+        let mut flat: Option<Vec<bool>> = None;
+        let mut lists: Vec<Vec<Blocker>> = Vec::with_capacity(blockers.len());
+        for (t, b) in blockers.into_iter().enumerate() {
+            if b.is_empty() {
+                lists.push(Vec::new());
+                continue;
+            }
+            // A triangle with collinear corners (exactly) bounds no area: the winding number does
+            // not jump across it, so it cuts nothing. Kept, its plane (undefined: every point lies
+            // in it) left every cell near it undecided (robosuite b1's `calf.obj`: a zero-area
+            // sliver across eleven faces, an estimate of 1.3e-1 against 8.4e-6 without it).
+            // (Asked once per triangle, not once per pair: under coincident shells each triangle
+            // blocks a dozen others.)
+            let flat = flat.get_or_insert_with(|| self.corners.iter().map(|&c| collinear(c)).collect());
+            let mut list = Vec::with_capacity(b.len());
+            list.extend(b.into_iter().filter(|&u| !flat[u as usize]).map(|u| self.blocker(t as u32, u)));
+            lists.push(list);
+        }
+        self.near_groups(&mut lists, boxes);
+        lists.into_iter().zip(blocked).map(|(list, b)| b.then_some(list)).collect()
+    }
+
+    /// Triangle `u` as a blocker of `t`: whether it lies in `t`'s plane exactly (a corner of `t`
+    /// is, without a predicate; the others by orient3d), or within [`NEAR`] of the surface's
+    /// diagonal of it ([`gap`]), where a cut is taken as in it.
+    fn blocker(&self, t: u32, u: u32) -> Blocker {
+        let (tc, cu) = (&self.corners[t as usize], &self.corners[u as usize]);
+        let plane = &self.planes[t as usize];
+        let exact = cu.iter().all(|&x| tc.contains(&x) || plane.side(x) == 0.0);
+        Blocker {
+            u,
+            in_plane: exact,
+            near: !exact && gap(tc, cu) <= NEAR * self.grid.bounds.diagonal(),
+        }
+    }
+
+    /// Makes the triangles taken as in one plane a relation that is closed: where a triangle is
+    /// in a plane with two others ([`Faces::blocker`]) and one of those pairs is only near it,
+    /// the two others are a pair too, blockers of each other taken as in one plane, and so on
+    /// through each group so joined, among those of its triangles whose boxes come near.
+    ///
+    /// A cell's decision counts the jumps of the triangles in its plane that cover its point, and
+    /// the lowest-numbered of them carries the sum, the others nothing ([`Faces::decide_where`]).
+    /// That needs each of them to list the same triangles as in its plane: two in one plane
+    /// exactly that cover a point meet there, so each lists the other. Two faces 7e-16 apart and
+    /// parallel do not meet, and a third cutting both at a slant of 1e-12 is near the plane of
+    /// each: that third triangle's jump was carried by both, each of the two believing itself the
+    /// lowest, while the third carried nothing (sweep case 33740: three tetrahedra stacked on one
+    /// another, two faces of the one they bound dropped on all three, 0.48% off under an
+    /// estimate of 0.42%). Within a group every pair is now taken as in one plane, which moves
+    /// the solid by at most the slab between the two ([`gap`]), charged as for any near pair.
+    fn near_groups(&self, lists: &mut [Vec<Blocker>], boxes: &[Aabb]) {
+        let n = lists.len();
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        // Per group (at its root, once joined): whether it has a near pair, and the sum of their
+        // gaps, which bounds how far apart along the normal two of its triangles can be.
+        let mut near = vec![false; n];
+        let mut reach = vec![0.0f64; n];
+        for (t, list) in lists.iter().enumerate() {
+            for b in list.iter().filter(|b| b.near || b.in_plane) {
+                let (x, y) = (super::root(&mut parent, t as u32), super::root(&mut parent, b.u));
+                let g = if b.near { gap(&self.corners[t], &self.corners[b.u as usize]) } else { 0.0 };
+                let (lo, hi) = (x.min(y) as usize, x.max(y) as usize);
+                parent[hi] = lo as u32;
+                let joined = if lo == hi { 0.0 } else { reach[hi] };
+                reach[lo] += joined + g;
+                near[lo] = near[lo] || near[hi] || b.near;
+            }
+        }
+        // The members of the groups with a near pair, by root, each group along x.
+        let mut members: Vec<(u32, f64, u32)> = Vec::new();
+        for t in 0..n as u32 {
+            let r = super::root(&mut parent, t);
+            if near[r as usize] {
+                members.push((r, boxes[t as usize].lo[0], t));
+            }
+        }
+        members.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        for group in members.chunk_by(|a, b| a.0 == b.0) {
+            // Two members that cover one point seen along an axis lie within the gaps of the
+            // chain that joins them of each other, along the normal: their boxes, grown by twice
+            // that, overlap.
+            let pad = 2.0 * reach[group[0].0 as usize] + self.margin;
+            for (i, &(_, _, t)) in group.iter().enumerate() {
+                let grown = inflated(boxes[t as usize], pad);
+                for &(_, lo, u) in &group[i + 1..] {
+                    if lo > grown.hi[0] {
+                        break;
+                    }
+                    if !overlap(&grown, &boxes[u as usize]) || lists[t as usize].iter().any(|b| b.u == u) {
+                        continue;
+                    }
+                    // Two exactly in one plane that cover one point meet there: already a pair.
+                    let mut b = self.blocker(t, u);
+                    if b.in_plane {
+                        continue;
+                    }
+                    b.near = true;
+                    lists[t as usize].push(b);
+                    lists[u as usize].push(Blocker { u: t, ..b });
+                }
+            }
+        }
+    }
+
     /// For each triangle, the others that may meet it other than along a shared edge or at a
     /// shared corner: those whose boxes meet its box grown by the margin, in the order of the
     /// grid's cells over that box. Each pair of triangles is found once, from the lower-numbered
@@ -631,12 +730,19 @@ impl Faces<'_> {
                 // largest coordinate, twice that here.
                 let slack = p.slack + 4.0 * f64::EPSILON * largest_coordinate(&child);
                 let b = inflated(Aabb::of(child), self.margin);
-                let mut blockers: Vec<Blocker> = p
-                    .blockers
-                    .iter()
-                    .copied()
-                    .filter(|x| overlap(&b, &Aabb::of(self.corners[x.u as usize])) && self.may_meet(&child, x.u))
-                    .collect();
+                // A blocker taken as in the plane stays while it may cover a point of the child
+                // seen along an axis, whether or not it meets the child: the triangles in a plane
+                // must list each other where they cover one point ([`Faces::near_groups`]).
+                let keeps = |x: &Blocker| {
+                    let cu = &self.corners[x.u as usize];
+                    if x.near {
+                        let g = gap(&self.corners[p.t as usize], cu);
+                        overlap(&inflated(b, 2.0 * g), &Aabb::of(*cu))
+                    } else {
+                        overlap(&b, &Aabb::of(*cu)) && self.may_meet(&child, x.u)
+                    }
+                };
+                let mut blockers: Vec<Blocker> = p.blockers.iter().copied().filter(keeps).collect();
                 if blockers.is_empty() {
                     if let Some(k) = self.decide_linked(&child, p.t, seen, |_| true, &[]) {
                         self.emit_moved(&child, k, (p.t, slack), out);
@@ -1172,32 +1278,18 @@ impl Faces<'_> {
             // Read through the reference: an array of the corners made here and read back at
             // once stalled its loads (see [`in_order`]).
             let cu = &self.corners[u as usize];
-            let [a, b, c] = *cu;
-            let (ab, ac) = (sub(b, a), sub(c, a));
-            let n = cross(ab, ac);
-            // The pair's gap, the same seen from either (each triangle's corners against the
-            // other's plane): decided per piece, a small piece took its neighbour as in its plane
-            // where the neighbour's larger pieces did not take it so, and one of two faces 1e-9
-            // apart was dropped where the other was kept (g1's `left_hip_pitch_link.STL`: its
-            // decided surface open, 1.1e-3 off).
-            let gap_of = |n: [f64; 3], a: [f64; 3], xs: &Corners| {
-                xs.iter().map(|x| dot(n, sub(*x, a)).abs() / norm(n)).fold(0.0, f64::max)
-            };
-            // In t's plane exactly: a corner of t is, without a predicate; the others by orient3d.
-            let exact = *blocker.in_plane.get_or_insert_with(|| {
-                let plane = &self.planes[t as usize];
-                cu.iter().all(|&x| tc.contains(&x) || plane.side(x) == 0.0)
-            });
-            // The gap is asked only of a blocker not exactly in the plane (the one it is used for).
-            let gap = if exact { 0.0 } else { gap_of(n, a, tc).max(gap_of(nt, tc[0], cu)) };
-            if exact || gap <= NEAR * self.grid.bounds.diagonal() {
+            // How the pair lies was asked once for the pair ([`Faces::blocker`]), not per piece.
+            let exact = blocker.in_plane;
+            if exact || blocker.near {
                 // Nearly in t's plane: taken as in it, which moves the solid by at most the slab
                 // between the two over the piece (on both sides).
                 if !exact {
-                    out.bound += 2.0 * area(piece) * gap;
+                    out.bound += 2.0 * area(piece) * gap(tc, cu);
                 }
                 coplanar.push(Coplanar::new(u, *cu, nt, self.margin, exact));
             } else {
+                let [a, b, c] = *cu;
+                let n = cross(sub(b, a), sub(c, a));
                 planes.push(blocker_cut(*cu, n, nt, (self.margin, skew)));
             }
         }
@@ -1666,6 +1758,19 @@ fn c2(p: [f64; 3], drop: usize) -> Coord<f64> {
     const NEXT_TWO: [[usize; 2]; 3] = [[1, 2], [2, 0], [0, 1]];
     let [i, j] = NEXT_TWO[drop];
     Coord { x: p[i], y: p[j] }
+}
+
+/// The gap between two triangles, the same seen from either: the farthest of each one's corners
+/// from the other's plane, m. Asked per piece, a small piece took its neighbour as in its plane
+/// where the neighbour's larger pieces did not take it so, and one of two faces 1e-9 apart was
+/// dropped where the other was kept (g1's `left_hip_pitch_link.STL`: its decided surface open,
+/// 1.1e-3 off).
+fn gap(t: &Corners, u: &Corners) -> f64 {
+    let from = |p: &Corners, xs: &Corners| {
+        let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+        xs.iter().map(|x| dot(n, sub(*x, p[0])).abs() / norm(n)).fold(0.0, f64::max)
+    };
+    from(u, t).max(from(t, u))
 }
 
 fn inflated(b: Aabb, m: f64) -> Aabb {
@@ -2333,5 +2438,57 @@ mod tests {
             assert!(sides.0 * sides.1 < 0.0);
             assert!(shares_corner(pt, pu, sides, &Plane::new(&pu)));
         }
+    }
+
+    /// Sweep case 33740's three tetrahedra (a box on a corner of the first changes nothing here):
+    /// the first wound inward, the second the first moved 7.2e-16 along y (parallel faces that do
+    /// not meet), the third the first with its corners moved by up to 1.6e-13, whose faces cut
+    /// the other two's at slants near 1e-12. Ω is about the third (w = −1 + 1 + 1). The third's
+    /// faces are near the planes of both others' and taken as in them, but the first two's do not
+    /// meet: each of those two carried the third's jump as the lowest-numbered triangle of its
+    /// plane, and the third carried nothing, so on two of the four sides all three were dropped
+    /// and the surface was left open (its area vector 8.7e-8 m², a face's 5.9e-8). Taken as in
+    /// one plane all three, each side is decided once.
+    #[test]
+    fn faces_near_one_plane_through_a_third_are_decided_as_one_plane() {
+        let first = [
+            [-94.38519640341579, 0.0037677824734437836, 0.0030094996909610927],
+            [-94.3857382149314, 0.0034564920956139836, 0.002992742825881578],
+            [-94.38580073521106, 0.0035166878615596787, 0.0027537564892554656],
+            [-94.38541544227293, 0.0037932171617656787, 0.003040723444428295],
+        ];
+        let second = [
+            [-94.38519640341579, 0.0037677824734445044, 0.0030094996909610927],
+            [-94.3857382149314, 0.0034564920956147043, 0.002992742825881578],
+            [-94.38580073521106, 0.0035166878615603995, 0.0027537564892554656],
+            [-94.38541544227293, 0.0037932171617664, 0.003040723444428295],
+        ];
+        let third = [
+            [-94.38519640341595, 0.003767782473380246, 0.0030094996909610927],
+            [-94.38573821493131, 0.0034564920956977867, 0.002992742825881578],
+            [-94.38580073521095, 0.0035166878616149895, 0.0027537564892554656],
+            [-94.38541544227299, 0.003793217161690102, 0.003040723444428295],
+        ];
+        let (mut vertices, mut tris) = (Vec::new(), Vec::new());
+        for (corners, inward) in [(first, true), (second, false), (third, false)] {
+            let base = vertices.len() as u32;
+            vertices.extend_from_slice(&corners);
+            for t in [[0, 1, 2], [3, 1, 0], [0, 2, 3], [3, 2, 1]] {
+                let t = if inward { [t[2], t[1], t[0]] } else { t };
+                tris.push(t.map(|i| base + i));
+            }
+        }
+        let signs = vec![1; tris.len()];
+        let centre = [-94.3855, 0.0036, 0.0029];
+        let r = resolve(&vertices, &tris, &signs, &[], centre, 0.0);
+        let open = norm(area_vector(&vertices, &r));
+        assert!(open < 1e-15, "the decided faces leave {open:e} m² open");
+        // The third tetrahedron's volume; the slivers between the three are below 1e-20 m³.
+        let c = third.map(|x| sub(x, third[0]));
+        let want = dot(c[1], cross(c[2], c[3])).abs() / 6.0;
+        let about: Vec<[f64; 3]> = vertices.iter().map(|v| sub(*v, third[0])).collect();
+        let pieces: Vec<[f64; 3]> = r.vertices.iter().map(|v| sub(*v, third[0])).collect();
+        let got = enclosed(&about, &Resolved { vertices: pieces, ..r });
+        assert!((got - want).abs() < 1e-19, "{got:e} against {want:e}");
     }
 }
