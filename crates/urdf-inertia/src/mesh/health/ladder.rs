@@ -49,8 +49,8 @@ impl Known {
 /// The share of the volume or inertia by which the faces the winding number decided may fail to
 /// close before the value is left unbounded ([`Ladder::closure`]). Below it the disagreement is
 /// carried as round-off: it held against libigl on the corpus meshes where it was 0.01% to 0.5%
-/// (0.037% at most since session 41: docs/accuracy.md); above it, sweep cases 11638 and 11883 of `tests/union_sweep.rs` (5.5% and
-/// 2.4%) were 56% and 3.7% off.
+/// (since session 41 seven meshes carry one, at most 0.037%: docs/accuracy.md); above it, sweep
+/// cases 11638 and 11883 of `tests/union_sweep.rs` (5.5% and 2.4%) were 56% and 3.7% off.
 const UNCLOSED: f64 = 0.01;
 
 /// Shared by the rungs: where the mesh came from and what has been said about it.
@@ -128,8 +128,8 @@ impl<'a> Ladder<'a> {
     /// by at most its cracks' term of `model`. A difference beyond twice all that (`round_off`
     /// as it comes, the two points' disagreement, relative) is a part the decided pieces leave
     /// undefined; the round-off term carries it, and against libigl's winding number that held
-    /// on the nine corpus meshes where it was 0.01% to 0.5%, and seven are left since session 41,
-    /// the largest 0.037% (docs/accuracy.md). Past [`UNCLOSED`] it did not: two boxes rounded onto
+    /// on the nine corpus meshes where it was 0.01% to 0.5% (since session 41 seven meshes carry
+    /// one, at most 0.037%: docs/accuracy.md). Past [`UNCLOSED`] it did not: two boxes rounded onto
     /// each other with different diagonals and a prism on a face (sweep case 11638 of
     /// `tests/union_sweep.rs`) differ by 5.5% of their inertia (their volume by 1e-16) and were
     /// 56% off. There the value is left unbounded, with a warning.

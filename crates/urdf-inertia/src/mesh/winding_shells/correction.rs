@@ -374,13 +374,12 @@ impl Faces<'_> {
     /// `None` for a triangle no other may meet; `None` in all when the groups would add more than
     /// `budget` pairs.
     fn blocker_lists(&self, blockers: Vec<Vec<u32>>, boxes: &[Aabb], budget: usize) -> Option<Vec<Option<Vec<Blocker>>>> {
-        // The triangles others may meet: cut, even where every blocker is flat.
-        let blocked: Vec<bool> = blockers.iter().map(|b| !b.is_empty()).collect();
         let mut flat: Option<Vec<bool>> = None;
-        let mut lists: Vec<Vec<Blocker>> = Vec::with_capacity(blockers.len());
+        let mut lists: Vec<Option<Vec<Blocker>>> = Vec::with_capacity(blockers.len());
         for (t, b) in blockers.into_iter().enumerate() {
+            // The triangles others may meet are cut, even where every blocker is flat.
             if b.is_empty() {
-                lists.push(Vec::new());
+                lists.push(None);
                 continue;
             }
             // A triangle with collinear corners (exactly) bounds no area: the winding number does
@@ -392,10 +391,10 @@ impl Faces<'_> {
             let flat = flat.get_or_insert_with(|| self.corners.iter().map(|&c| collinear(c)).collect());
             let mut list = Vec::with_capacity(b.len());
             list.extend(b.into_iter().filter(|&u| !flat[u as usize]).map(|u| self.blocker(t as u32, u)));
-            lists.push(list);
+            lists.push(Some(list));
         }
         self.near_groups(&mut lists, boxes, budget)?;
-        Some(lists.into_iter().zip(blocked).map(|(list, b)| b.then_some(list)).collect())
+        Some(lists)
     }
 
     /// Triangle `u` as a blocker of `t`: whether it lies in `t`'s plane exactly (a corner of `t`
@@ -428,7 +427,7 @@ impl Faces<'_> {
     /// another, two faces of the one they bound dropped on all three, 0.48% off under an
     /// estimate of 0.42%). Within a group every pair is now taken as in one plane, which moves
     /// the solid by at most the slab between the two ([`gap`]), charged as for any near pair.
-    fn near_groups(&self, lists: &mut [Vec<Blocker>], boxes: &[Aabb], budget: usize) -> Option<()> {
+    fn near_groups(&self, lists: &mut [Option<Vec<Blocker>>], boxes: &[Aabb], budget: usize) -> Option<()> {
         let n = lists.len();
         let mut parent: Vec<u32> = (0..n as u32).collect();
         // Per group (at its root, once joined): whether it has a near pair, and the sum of their
@@ -436,7 +435,7 @@ impl Faces<'_> {
         let mut near = vec![false; n];
         let mut reach = vec![0.0f64; n];
         for (t, list) in lists.iter().enumerate() {
-            for b in list.iter().filter(|b| b.near || b.in_plane) {
+            for b in list.iter().flatten().filter(|b| b.near || b.in_plane) {
                 let (x, y) = (super::root(&mut parent, t as u32), super::root(&mut parent, b.u));
                 let g = if b.near { gap(&self.corners[t], &self.corners[b.u as usize]) } else { 0.0 };
                 let (lo, hi) = (x.min(y) as usize, x.max(y) as usize);
@@ -469,7 +468,7 @@ impl Faces<'_> {
                     }
                     if !overlap(&grown, &boxes[u as usize])
                         || apart_seen_along_normal(&self.corners[t as usize], &self.corners[u as usize], pad)
-                        || lists[t as usize].iter().any(|b| b.u == u)
+                        || lists[t as usize].iter().flatten().any(|b| b.u == u)
                     {
                         continue;
                     }
@@ -479,8 +478,9 @@ impl Faces<'_> {
                         continue;
                     }
                     b.near = true;
-                    lists[t as usize].push(b);
-                    lists[u as usize].push(Blocker { u: t, ..b });
+                    // Members of a group have lists (their pairs in one plane are blockers).
+                    lists[t as usize].get_or_insert_with(Vec::new).push(b);
+                    lists[u as usize].get_or_insert_with(Vec::new).push(Blocker { u: t, ..b });
                     added += 1;
                     if added > budget {
                         return None;
