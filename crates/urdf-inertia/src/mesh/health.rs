@@ -155,8 +155,10 @@ impl ModelError {
 /// A bound on the relative error of a solid's volume and central inertia (Frobenius norm).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ErrorEstimate {
-    /// Round-off of the integration: the disagreement of two integrations about different reference
-    /// points, and never less than 4ε.
+    /// Round-off of the integration: the kernel's rounding bounded face by face in the pass that
+    /// integrated (`mass::integrals::Rounding`), never less than 4ε; where the winding number
+    /// decided the faces, at least the disagreement of two integrations about different reference
+    /// points.
     pub round_off: f64,
     /// How far the solid can be from the stored surface (0 for exact and clean welded meshes).
     pub model: f64,

@@ -22,14 +22,16 @@ mod exact;
 // the tool itself.
 #[cfg(any(test, feature = "internals"))]
 mod polygons;
+mod rounding;
 mod triangles;
 
 use exact::Accumulator;
+pub use rounding::Rounding;
 pub(crate) use exact::{two_prod, two_sum};
 #[cfg(any(test, feature = "internals"))]
 pub use polygons::mirtich_polygons;
 pub use triangles::triangle_integrals;
-use triangles::{run_kernel, Batch, KernelLoop, RawSums};
+use triangles::{run_kernel, Batch, KernelLoop, RawSums, LANES};
 
 /// The ten integrals `T1, Tx, Ty, Tz, Tx², Ty², Tz², Txy, Tyz, Tzx` of a polyhedron about a reference point.
 ///
@@ -295,42 +297,35 @@ fn combine<'a>(chunks: impl Iterator<Item = &'a RawSums>) -> RawSums {
     (hi, lo)
 }
 
-/// [`volume_integrals`] about the options' reference point and about `second`, in one pass over
-/// the faces: each triangle's corners are gathered once and fed to two kernels, each summing what
-/// it would sum alone, in the same order and the same chunks, so each result is, bit for bit, that
-/// of [`volume_integrals`] with its reference point. The gather (a random access per corner) is
-/// what a second pass would repeat: the health ladder's round-off estimate integrates about the
-/// box's corner as well as its centre (docs/benchmarks.md, "Round seven").
-pub fn volume_integrals_about_two(
+/// [`volume_integrals`] with a bound on its round-off ([`Rounding`]), in one pass over the faces:
+/// the integrals are, bit for bit, those of [`volume_integrals`] (the same kernel, sums and chunks),
+/// and the bound is added up from the corners the kernel holds.
+pub fn volume_integrals_and_rounding(
     vertices: &[[f64; 3]],
     faces: &Polygons,
     options: &IntegrationOptions,
-    second: [f64; 3],
-) -> (VolumeIntegrals, VolumeIntegrals) {
+) -> (VolumeIntegrals, Rounding) {
     let reference = options.reference_for(vertices);
-    let other = IntegrationOptions {
-        reference: Some(second),
-        ..*options
-    };
-    let (references, both) = ([reference, second], [options, &other]);
     let n = faces.len();
-    let (a, b) = if options.summation == Summation::Compensated && n > CHUNK {
+    let (raw, rounding) = if options.summation == Summation::Compensated && n > CHUNK {
         use rayon::prelude::*;
-        let chunks: Vec<(RawSums, RawSums)> = crate::threads::install(|| {
+        let chunks: Vec<(RawSums, Rounding)> = crate::threads::install(|| {
             (0..n.div_ceil(CHUNK))
                 .into_par_iter()
                 .map(|c| {
                     let range = c * CHUNK..((c + 1) * CHUNK).min(n);
-                    fan_sums_two(vertices, range.map(|i| faces.face(i)), references, both)
+                    fan_sums_rounding(vertices, range.map(|i| faces.face(i)), reference, options)
                 })
                 .collect()
         });
-        (combine(chunks.iter().map(|c| &c.0)), combine(chunks.iter().map(|c| &c.1)))
+        let rounding = chunks
+            .iter()
+            .fold(Rounding::default(), |sum, c| sum.plus(&c.1));
+        (combine(chunks.iter().map(|c| &c.0)), rounding)
     } else {
-        fan_sums_two(vertices, faces.iter(), references, both)
+        fan_sums_rounding(vertices, faces.iter(), reference, options)
     };
-    let divisors = [6.0, 24.0, 120.0, 120.0];
-    (finish(a, reference, divisors), finish(b, second, divisors))
+    (finish(raw, reference, [6.0, 24.0, 120.0, 120.0]), rounding)
 }
 
 /// Faces per chunk of a parallel integration (meshes up to this size are summed in one sequence).
@@ -351,19 +346,19 @@ fn fan_sums<'a>(
     })
 }
 
-/// [`fan_sums`] about two reference points at once, each with its options.
-fn fan_sums_two<'a>(
+/// [`fan_sums`] with the bound on their round-off.
+fn fan_sums_rounding<'a>(
     vertices: &[[f64; 3]],
     faces: impl Iterator<Item = &'a [u32]>,
-    references: [[f64; 3]; 2],
-    options: [&IntegrationOptions; 2],
-) -> (RawSums, RawSums) {
-    run_kernel(FanLoopTwo {
+    reference: [f64; 3],
+    options: &IntegrationOptions,
+) -> (RawSums, Rounding) {
+    run_kernel(FanLoopRounding(FanLoop {
         vertices,
         faces,
-        references,
+        reference,
         options,
-    })
+    }))
 }
 
 /// [`fan_sums`]'s loop: polygons fanned into triangles, vertices shifted on the fly.
@@ -398,41 +393,62 @@ impl<'f, I: Iterator<Item = &'f [u32]>> KernelLoop for FanLoop<'_, I> {
     }
 }
 
-/// [`volume_integrals_about_two`]'s loop: [`FanLoop`] feeding two batches, each with its own
-/// reference point, from one gather of the corners.
-struct FanLoopTwo<'a, I> {
-    vertices: &'a [[f64; 3]],
-    faces: I,
-    references: [[f64; 3]; 2],
-    options: [&'a IntegrationOptions; 2],
-}
+/// [`volume_integrals_and_rounding`]'s loop: [`FanLoop`], each full batch also added to the bound.
+struct FanLoopRounding<'a, I>(FanLoop<'a, I>);
 
-impl<'f, I: Iterator<Item = &'f [u32]>> KernelLoop for FanLoopTwo<'_, I> {
-    type Output = (RawSums, RawSums);
+impl<'f, I: Iterator<Item = &'f [u32]>> KernelLoop for FanLoopRounding<'_, I> {
+    type Output = (RawSums, Rounding);
 
     #[inline(always)]
-    fn sums<const FMA: bool>(self) -> (RawSums, RawSums) {
-        let (vertices, [r0, r1]) = (self.vertices, self.references);
-        let accurate = self.options.map(|o| o.accurate_faces);
-        let mut acc = self.options.map(|o| Accumulator::new(o.summation));
-        let mut batch = [Batch::new(), Batch::new()];
-        for face in self.faces {
+    fn sums<const FMA: bool>(self) -> (RawSums, Rounding) {
+        let FanLoop {
+            vertices,
+            faces,
+            reference,
+            options,
+        } = self.0;
+        let accurate = options.accurate_faces;
+        let mut acc = Accumulator::new(options.summation);
+        let mut bound = rounding::Lanes::new();
+        let mut batch = Batch::new();
+        // How far each lane's corners moved when shifted, exactly ([`rounding::shift`]).
+        let mut moved = [0.0; LANES];
+        for face in faces {
             if face.len() < 3 {
                 continue;
             }
-            let a = vertices[face[0] as usize];
-            let (a0, a1) = (sub(a, r0), sub(a, r1));
+            let (a, moved_a) = rounding::shift(vertices[face[0] as usize], reference);
             for k in 1..face.len() - 1 {
-                let b = vertices[face[k] as usize];
-                let c = vertices[face[k + 1] as usize];
-                batch[0].add::<FMA>(a0, sub(b, r0), sub(c, r0), &mut acc[0], accurate[0]);
-                batch[1].add::<FMA>(a1, sub(b, r1), sub(c, r1), &mut acc[1], accurate[1]);
+                let (b, moved_b) = rounding::shift(vertices[face[k] as usize], reference);
+                let (c, moved_c) = rounding::shift(vertices[face[k + 1] as usize], reference);
+                moved[batch.len] = moved_a.max(moved_b).max(moved_c);
+                batch.push(a, b, c);
+                if batch.len == LANES {
+                    flush::<FMA>(&batch, &moved, (&mut acc, &mut bound), accurate, LANES);
+                    batch.len = 0;
+                }
             }
         }
-        let [a0, a1] = acc;
-        let [b0, b1] = batch;
-        (b0.finish::<FMA>(a0, accurate[0]), b1.finish::<FMA>(a1, accurate[1]))
+        if batch.len > 0 {
+            flush::<FMA>(&batch, &moved, (&mut acc, &mut bound), accurate, batch.len);
+        }
+        (acc.total(), bound.total())
     }
+}
+
+/// [`FanLoopRounding`]'s batch of `len` triangles into the sums and the bound (a function, not a
+/// closure, so that it is inlined into the loop compiled for the CPU's instruction set).
+#[inline(always)]
+fn flush<const FMA: bool>(
+    batch: &Batch,
+    moved: &[f64; LANES],
+    (acc, bound): (&mut Accumulator, &mut rounding::Lanes),
+    accurate: bool,
+    len: usize,
+) {
+    let (d, slow) = batch.volumes::<FMA>(accurate);
+    acc.add_batch(&batch.terms_of(&d), len);
+    bound.add(batch, &d, slow, moved, len);
 }
 
 impl VolumeIntegrals {
@@ -542,7 +558,7 @@ mod tests {
     /// reference point: on polygons (fans) and on a mesh of more than two chunks (the chunked sums),
     /// with plain and compensated sums, on one thread and on three.
     #[test]
-    fn two_references_in_one_pass_are_two_passes() {
+    fn the_pass_with_its_rounding_bound_is_the_plain_pass() {
         let (v, f) = cube_quads(0.37);
         let mut rng = 0x2545_f491_4f6c_dd1du64;
         let mut next = || (crate::xorshift(&mut rng) >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
@@ -551,27 +567,29 @@ mod tests {
         let tris: Vec<[u32; 3]> = (0..n as u32).map(|i| [i, i + 1, i + 2]).collect();
         let big_f = Polygons::from_triangles(&tris);
         let bits = |t: &VolumeIntegrals| (t.to_array().map(f64::to_bits), t.low.map(f64::to_bits), t.reference.map(f64::to_bits));
+        let mut bounds = Vec::new();
         for threads in [1, 3] {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
             pool.install(|| {
                 for (v, f) in [(&v, &f), (&big_v, &big_f)] {
                     for summation in [Summation::Compensated, Summation::Plain] {
-                        let opts = IntegrationOptions {
-                            summation,
-                            ..IntegrationOptions::accurate()
-                        };
-                        let second = [-0.4, 3.0e-3, 9.5];
-                        let (a, b) = volume_integrals_about_two(v, f, &opts, second);
-                        let other = IntegrationOptions {
-                            reference: Some(second),
-                            ..opts
-                        };
-                        assert_eq!(bits(&a), bits(&volume_integrals(v, f, &opts)));
-                        assert_eq!(bits(&b), bits(&volume_integrals(v, f, &other)));
+                        for accurate_faces in [true, false] {
+                            let opts = IntegrationOptions {
+                                summation,
+                                accurate_faces,
+                                reference: Some([-0.4, 3.0e-3, 9.5]),
+                            };
+                            let (t, rounding) = volume_integrals_and_rounding(v, f, &opts);
+                            assert_eq!(bits(&t), bits(&volume_integrals(v, f, &opts)));
+                            assert_eq!(rounding.triangles, f.triangles().len() as u64);
+                            bounds.push(rounding);
+                        }
                     }
                 }
             });
         }
+        // The same bound on any number of threads.
+        assert_eq!(bounds[..8], bounds[8..]);
     }
 
     #[test]

@@ -100,7 +100,7 @@ impl KernelLoop for TriangleLoop<'_> {
 pub(super) struct Batch {
     /// Corner coordinates relative to the reference point: `p[corner][axis][lane]`.
     pub(super) p: [[[f64; LANES]; 3]; 3],
-    len: usize,
+    pub(super) len: usize,
 }
 
 /// Triangles per batch: the compensated block.
@@ -115,7 +115,7 @@ impl Batch {
     }
 
     #[inline(always)]
-    fn push(&mut self, a: [f64; 3], b: [f64; 3], c: [f64; 3]) {
+    pub(super) fn push(&mut self, a: [f64; 3], b: [f64; 3], c: [f64; 3]) {
         let l = self.len;
         for k in 0..3 {
             self.p[0][k][l] = a[k];
@@ -190,6 +190,17 @@ impl Batch {
     /// zero triangles and contribute 0).
     #[inline(always)]
     fn terms<const FMA: bool>(&self, accurate: bool) -> [[f64; LANES]; 10] {
+        let (d, _) = self.volumes::<FMA>(accurate);
+        self.terms_of(&d)
+    }
+
+    /// Six times each lane's signed tetrahedron with the reference point, `d`, and whether the lane
+    /// took the slow path (re-evaluated with error-free products; only where `accurate`).
+    #[inline(always)]
+    pub(super) fn volumes<const FMA: bool>(
+        &self,
+        accurate: bool,
+    ) -> ([f64; LANES], [bool; LANES]) {
         let [a, b, c] = &self.p;
         let mut d = [0.0; LANES];
         let mut slow = [false; LANES];
@@ -220,7 +231,16 @@ impl Batch {
                     d[l] = exact[l];
                 }
             }
+        } else {
+            slow = [false; LANES];
         }
+        (d, slow)
+    }
+
+    /// The raw contributions of the batch's triangles from their `d` ([`Batch::volumes`]).
+    #[inline(always)]
+    pub(super) fn terms_of(&self, d: &[f64; LANES]) -> [[f64; LANES]; 10] {
+        let [a, b, c] = &self.p;
         let mut out = [[0.0; LANES]; 10];
         for l in 0..LANES {
             let s = [

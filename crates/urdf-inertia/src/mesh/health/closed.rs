@@ -39,7 +39,7 @@ pub(super) fn prove(
         }
         let (proof, t) = rayon::join(
             || closed_consistent_split(faces, vertices.len()),
-            || Known::both(vertices, faces),
+            || Known::of(vertices, faces),
         );
         (proof, Some(t))
     })
@@ -60,7 +60,8 @@ pub(super) fn consistent_closed(
 ) -> Result<Solid, MeshError> {
     // Closed only once welded within tolerance: the stored surface's vector area is not exactly 0.
     let welded = kept.is_some();
-    let Known { integrals: t, corner } = known.unwrap_or_else(|| Known::both(&vertices, &stored));
+    let known = known.unwrap_or_else(|| Known::of(&vertices, &stored));
+    let t = known.integrals;
     let inverted = t.t1 < 0.0;
     let mut faces = stored;
     let mut kept = kept;
@@ -134,12 +135,11 @@ pub(super) fn consistent_closed(
     } else {
         0.0
     };
-    // The faces are the stored ones, or all of them reversed: their integrals are known (about the
-    // corner, reversed faces are integrated again: fanned from another corner, their round-off
-    // differs from the negated sums').
+    // The faces are the stored ones, or all of them reversed: their integrals are known, negated
+    // for reversed faces, whose rounding is then the stored faces' (negation is exact).
     ladder.known = Some(Known {
         integrals: if inverted { t.negated() } else { t },
-        corner: corner.filter(|_| !inverted),
+        ..known
     });
     ladder.finish(
         vertices,
@@ -159,14 +159,11 @@ pub(super) fn welded_closed(
     rung: Rung,
     known: Option<Known>,
 ) -> Result<Solid, MeshError> {
-    // The integrals about the centre stand for the welded faces; the round-off estimate integrates
-    // the welded vertices about their own box's corner.
+    // The integrals about the centre, and the bound on their rounding, stand for the welded faces;
+    // the welded vertices have a box of their own.
     let known = known
         .filter(|_| w.duplicates == 0 && w.cancelled == 0)
-        .map(|k| Known {
-            corner: None,
-            ..k
-        });
+        .map(|k| Known { bounds: None, ..k });
     consistent_closed(ladder, w.vertices, (w.stored, known), Some(w.kept), components, rung)
 }
 

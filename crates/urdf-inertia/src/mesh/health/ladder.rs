@@ -9,28 +9,31 @@ use super::model::{
 use super::{ErrorEstimate, HealthKind, HealthMessage, HealthOptions, ModelError, Rung, Solid};
 use crate::geometry::dot;
 use crate::geometry::Aabb;
-use crate::mass::integrals::{box_centre, volume_integrals_about_two, VolumeIntegrals};
+use crate::mass::integrals::{
+    box_centre, volume_integrals_and_rounding, Rounding, VolumeIntegrals,
+};
 use crate::mass::{IntegrationOptions, MassProperties, Polygons};
 use crate::mesh::{winding_shells, MeshError, MeshErrorKind, RawMesh};
 use std::path::Path;
 
-/// Integrals of the faces and vertices [`Ladder::finish`] gets, computed before it: about the box's
-/// centre, and, when they came from the same pass ([`volume_integrals_about_two`]), the vertices'
-/// box with the integrals about its lowest corner, which the round-off estimate compares them with.
+/// Integrals of the faces and vertices [`Ladder::finish`] gets, computed before it, about the box's
+/// centre, with the bound on their round-off from the same pass ([`volume_integrals_and_rounding`])
+/// and, when the vertices are still the ones integrated, their box.
 #[derive(Clone)]
 pub(super) struct Known {
     pub(super) integrals: VolumeIntegrals,
-    pub(super) corner: Option<(Aabb, VolumeIntegrals)>,
+    pub(super) rounding: Rounding,
+    pub(super) bounds: Option<Aabb>,
 }
 
 impl Known {
-    /// The integrals about the box's centre and lowest corner, in one pass over the faces. The box
-    /// is found once, on the pool: its centre is
+    /// The integrals about the box's centre and the bound on their round-off, in one pass over the
+    /// faces. The box is found once, on the pool: its centre is
     /// [`crate::mass::integrals::bounding_box_centre`]'s (a serial pass of its own
     /// otherwise) whenever no side of it is at a zero coordinate; minimum and maximum are then the
     /// same bits whatever the order of the vertices, while a box with a side at 0.0 or −0.0 may
     /// differ from it in the sign of that zero, and keeps the serial pass.
-    pub(super) fn both(vertices: &[[f64; 3]], faces: &Polygons) -> Known {
+    pub(super) fn of(vertices: &[[f64; 3]], faces: &Polygons) -> Known {
         let bounds = bbox(vertices);
         let (lo, hi) = (bounds.lo, bounds.hi);
         let plain = lo.iter().chain(&hi).all(|x| x.is_finite() && *x != 0.0);
@@ -38,10 +41,11 @@ impl Known {
             reference: plain.then(|| box_centre(lo, hi)),
             ..IntegrationOptions::accurate()
         };
-        let (integrals, corner) = volume_integrals_about_two(vertices, faces, &options, lo);
+        let (integrals, rounding) = volume_integrals_and_rounding(vertices, faces, &options);
         Known {
             integrals,
-            corner: Some((bounds, corner)),
+            rounding,
+            bounds: Some(bounds),
         }
     }
 }
@@ -120,33 +124,20 @@ impl<'a> Ladder<'a> {
         }
     }
 
-    /// For a solid whose faces the winding number decided, the round-off `round_off` at least
-    /// the kernel's rounding bounded face by face ([`round_off_bound`]): such a solid can be a
-    /// thin slab of large faces whose contributions cancel, of which the two points'
-    /// disagreement is only a sample. And a check that the faces close: about two points a
-    /// closed surface's volume and inertia differ by its rounding, a surface closed up to cracks
-    /// by at most its cracks' term of `model`. A difference beyond twice all that (`round_off`
-    /// as it comes, the two points' disagreement, relative) is a part the decided pieces leave
-    /// undefined; the round-off term carries it, and against libigl's winding number that held
-    /// on the nine corpus meshes where it was 0.01% to 0.5% (since session 41 seven meshes carry
-    /// one, at most 0.037%: docs/accuracy.md). Past [`UNCLOSED`] it did not: two boxes rounded onto
-    /// each other with different diagonals and a prism on a face (sweep case 11638 of
-    /// `tests/union_sweep.rs`) differ by 5.5% of their inertia (their volume by 1e-16) and were
-    /// 56% off. There the value is left unbounded, with a warning.
-    fn closure(
-        &mut self,
-        unit: &MassProperties,
-        (vertices, faces, reference): (&[[f64; 3]], &Polygons, [f64; 3]),
-        model: &mut Model,
-        round_off: &mut f64,
-    ) {
-        // The two points' disagreement of volume and central inertia, relative (the round-off
-        // figure as compared): the inertia too, as faces doubled on one side and on the opposite
-        // side cancel in the volume's dependence on the point but not in the inertia's.
-        let disagree = *round_off;
-        let bound = round_off_bound(vertices, faces, reference, unit);
-        *round_off = round_off.max(bound);
-        let allowed = bound + model.total() / unit.mass.abs();
+    /// For a solid whose faces the winding number decided, a check that the faces close: about two
+    /// points a closed surface's volume and inertia differ by its rounding (`round_off`, the
+    /// kernel's rounding bounded face by face: [`round_off_bound`]), a surface closed up to cracks
+    /// by at most its cracks' term of `model`. A difference `disagree` (the two points'
+    /// disagreement of volume and central inertia, relative) beyond twice all that is a part the
+    /// decided pieces leave undefined; the round-off term carries it, and against libigl's winding
+    /// number that held on the nine corpus meshes where it was 0.01% to 0.5% (since session 41
+    /// seven meshes carry one, at most 0.037%: docs/accuracy.md). Past [`UNCLOSED`] it did not: two
+    /// boxes rounded onto each other with different diagonals and a prism on a face (sweep case
+    /// 11638 of `tests/union_sweep.rs`) differ by 5.5% of their inertia (their volume by 1e-16) and
+    /// were 56% off. There the value is left unbounded, with a warning.
+    fn closure(&mut self, unit: &MassProperties, disagree: f64, model: &mut Model, round_off: &mut f64) {
+        let allowed = *round_off + model.total() / unit.mass.abs();
+        *round_off = round_off.max(disagree);
         if disagree > 2.0 * allowed && disagree > UNCLOSED {
             model.source = ModelError::Overlap;
             model.terms.push((f64::INFINITY, Lever::Anywhere));
@@ -347,16 +338,16 @@ impl<'a> Ladder<'a> {
             }
             model.terms.push((self.cancelled, Lever::Anywhere));
         }
-        let (unit, corner, reference) = match self.known.take() {
-            Some(k) => (
-                MassProperties::from_integrals(&k.integrals, 1.0),
-                k.corner,
-                Some(k.integrals.reference),
-            ),
-            None => (unit_props(&vertices, &faces, None), None, None),
+        let (integrals, rounding, known_box) = if let Some(k) = self.known.take() {
+            (k.integrals, k.rounding, k.bounds)
+        } else {
+            let accurate = IntegrationOptions::accurate();
+            let (t, r) = volume_integrals_and_rounding(&vertices, &faces, &accurate);
+            (t, r, None)
         };
+        let unit = MassProperties::from_integrals(&integrals, 1.0);
         // One pass for the box both checks use, unless the integrals came with it.
-        let bounds = corner.as_ref().map_or_else(|| bbox(&vertices), |c| c.0);
+        let bounds = known_box.unwrap_or_else(|| bbox(&vertices));
         // The box of the vertices as they are now, for the solid: that box, but where the shells
         // were classified (their cuts may have added vertices since).
         let own = if classified { bbox(&vertices) } else { bounds };
@@ -366,18 +357,14 @@ impl<'a> Ladder<'a> {
             (bits(b.lo), bits(b.hi)) == (bits(own.lo), bits(own.hi))
         });
         check_volume(&vertices, &faces, bounds, unit.mass, self.path)?;
-        // The integrals about a second reference point: the round-off estimate compares the two.
-        let other = match corner {
-            Some((_, t)) => MassProperties::from_integrals(&t, 1.0),
-            None => unit_props(&vertices, &faces, Some(bounds.lo)),
-        };
-        let mut round_off = round_off_against(&other, &unit);
+        // The kernel's rounding, bounded face by face in the pass that integrated.
+        let mut round_off = round_off_bound(&rounding, integrals.reference, &unit);
         if classified {
-            // The point the kernel integrated about: unless given, the centre of the box found
-            // above (the kernel's `bounding_box_centre` but for the sign of a zero, which moves no
-            // bound).
-            let reference = reference.unwrap_or_else(|| box_centre(bounds.lo, bounds.hi));
-            self.closure(&unit, (&vertices, &faces, reference), &mut model, &mut round_off);
+            // The integrals about a second reference point: decided faces that do not close
+            // depend on it.
+            let other = unit_props(&vertices, &faces, Some(bounds.lo));
+            let disagree = round_off_against(&other, &unit);
+            self.closure(&unit, disagree, &mut model, &mut round_off);
         }
         let source = model.source;
         let bound = model.bound(&unit, &vertices);
@@ -440,12 +427,12 @@ mod tests {
     use super::*;
     use crate::mass::integrals::volume_integrals;
 
-    /// [`Known::both`] gives the bits of the two separate integrations it replaces, about
-    /// [`crate::mass::integrals::bounding_box_centre`] and about the box's lowest corner: on a box
-    /// with no side at zero (the centre from the pooled box), with sides at 0.0 and at −0.0 (the
-    /// serial centre), and on a mesh of more than two of the kernel's chunks.
+    /// [`Known::of`] gives the bits of the integration it replaces, about
+    /// [`crate::mass::integrals::bounding_box_centre`], and the vertices' box: on a box with no
+    /// side at zero (the centre from the pooled box), with sides at 0.0 and at −0.0 (the serial
+    /// centre), and on a mesh of more than two of the kernel's chunks.
     #[test]
-    fn both_integrals_are_the_separate_passes() {
+    fn known_integrals_are_the_separate_pass() {
         let cube = |lo: [f64; 3], hi: [f64; 3]| {
             let v: Vec<[f64; 3]> = (0..8)
                 .map(|i| [0, 1, 2].map(|k| if i >> k & 1 == 1 { hi[k] } else { lo[k] }))
@@ -478,8 +465,8 @@ mod tests {
             cube([-2.0, -1.0, -0.0], [2.0, 0.0, 4.0]),
             torus,
         ] {
-            let k = Known::both(&v, &f);
-            let (b, corner) = k.corner.expect("both");
+            let k = Known::of(&v, &f);
+            let b = k.bounds.expect("box");
             // The box it carries, against the coordinates' own extremes.
             for k in 0..3 {
                 let c = || v.iter().map(|p| p[k]);
@@ -487,12 +474,7 @@ mod tests {
                 assert_eq!(b.hi[k], c().fold(f64::NEG_INFINITY, f64::max), "axis {k}");
             }
             let accurate = IntegrationOptions::accurate();
-            let about_lo = IntegrationOptions {
-                reference: Some(b.lo),
-                ..accurate
-            };
             assert_eq!(bits(&k.integrals), bits(&volume_integrals(&v, &f, &accurate)));
-            assert_eq!(bits(&corner), bits(&volume_integrals(&v, &f, &about_lo)));
         }
     }
 

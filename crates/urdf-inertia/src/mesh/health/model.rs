@@ -3,8 +3,8 @@
 
 use super::geometry::{dist, polygon_area};
 use super::{ModelError, ROUND_OFF_FLOOR, ZERO_VOLUME_ROUNDOFFS};
-use crate::geometry::{cross, dot, sub, Aabb};
-use crate::mass::integrals::two_sum;
+use crate::geometry::Aabb;
+use crate::mass::integrals::Rounding;
 use crate::mass::{frobenius, MassProperties, Polygons};
 use crate::mesh::MeshError;
 use std::path::Path;
@@ -250,127 +250,25 @@ fn chunked_area(vertices: &[[f64; 3]], faces: &Polygons) -> Option<f64> {
     })
 }
 
-/// A bound on the kernel's round-off, for solids whose faces the winding number decided: the
-/// relative error of volume and central inertia that the triangle kernel's arithmetic, about
-/// `reference` (the point it integrated about), can make on `faces`, first order in ε with
-/// generous constants, never below [`ROUND_OFF_FLOOR`].
+/// A bound on the kernel's round-off: the relative error of volume and central inertia that the
+/// triangle kernel's arithmetic, about `reference` (the point it integrated about), can make, from
+/// the bounds on its ten integrals that the same pass added up face by face ([`Rounding`]), first
+/// order in ε with generous constants, never below [`ROUND_OFF_FLOOR`].
 ///
-/// [`round_off_against`] compares two evaluations; it sees how much the faces' contributions cancel, but
-/// only as one sample of the error. Where the winding number leaves a thin solid of large faces
-/// (two shells an ulp apart, one wound outward and one inward, leave a slab between them), the
-/// contributions about the reference cancel by a factor of a thousand and the sample fell 1.2 to
-/// 2.75 times below the error (sweep cases 587, 1654, 1725 and 4371 of `tests/union_sweep.rs`).
-/// This bound adds up, face by face, what each step of the kernel can round
-/// (`mass::integrals::triangles`):
-/// - the shift of each corner by `-reference`, rounded (by the exact error of a two-sum): on a
-///   closed surface the corners move together, so the integrals change by at most each face's
-///   area times that move times the integrand's largest value on it;
-/// - `d`, six times the signed tetrahedron with the reference: 8ε times the sum of the absolute
-///   values of its products where the kernel takes it plainly, 4ε|d| (and ε² of its products)
-///   where it re-evaluates it with error-free products (the same test as the kernel);
-/// - the corners' sums and products that multiply `d`, and the product, each ε of the sum of
-///   their absolute values;
-/// - the double-double sums and the central tensor taken from them
-///   ([`MassProperties::from_integrals`]): the errors of the ten integrals carried through it,
-///   and 4ε of every value it adds.
-///
-/// One pass over the faces; [`super::ladder::Ladder::finish`] takes it only for the solids whose
-/// shells were classified, which pay far more for that.
-pub(super) fn round_off_bound(
-    vertices: &[[f64; 3]],
-    faces: &Polygons,
-    reference: [f64; 3],
-    unit: &MassProperties,
-) -> f64 {
-    // The bounds on the ten integrals (1, x, y, z, x², y², z², xy, yz, zx) before the divisions
-    // by 6, 24 and 120, and the sums of their terms' absolute values.
-    let mut out = ([0.0f64; 10], [0.0f64; 10]);
-    let mut triangles = 0usize;
-    // Each vertex shifted as the kernel shifts it, and how far the rounding moved it (exactly: the
-    // error of a two-sum), once for the faces that share it.
-    let shifted: Vec<([f64; 3], f64)> = vertices
-        .iter()
-        .map(|v| {
-            let mut moved = 0.0f64;
-            let p: [f64; 3] = std::array::from_fn(|k| {
-                let (s, e) = two_sum(v[k], -reference[k]);
-                moved = moved.max(e.abs());
-                s
-            });
-            (p, moved)
-        })
-        .collect();
-    let shifted = |i: u32| shifted[i as usize];
-    for face in faces.iter() {
-        let Some((&first, rest)) = face.split_first() else {
-            continue;
-        };
-        let (a, moved_a) = shifted(first);
-        for pair in rest.windows(2) {
-            triangles += 1;
-            let ((b, moved_b), (c, moved_c)) = (shifted(pair[0]), shifted(pair[1]));
-            triangle_rounding([a, b, c], moved_a.max(moved_b).max(moved_c), &mut out);
-        }
-    }
-    // The double-double sums: their own error is of order ε² per term; the divisions of `finish`.
-    let summed = 4.0 * EPS * EPS * triangles as f64;
-    let scale = [6.0, 24.0, 24.0, 24.0, 120.0, 120.0, 120.0, 120.0, 120.0, 120.0];
-    let t: [f64; 10] = std::array::from_fn(|k| (out.0[k] + summed * out.1[k]) / scale[k] * 1.01);
-    central_rounding(&t, reference, unit)
+/// [`round_off_against`] compares two evaluations; it sees how much the faces' contributions
+/// cancel, but only as one sample of the error. Where the winding number leaves a thin solid of
+/// large faces (two shells an ulp apart, one wound outward and one inward, leave a slab between
+/// them), the contributions about the reference cancel by a factor of a thousand and the sample
+/// fell 1.2 to 2.75 times below the error (sweep cases 587, 1654, 1725 and 4371 of
+/// `tests/union_sweep.rs`); on clean closed surfaces far from the origin 1.10 and 1.49 times
+/// (cases 10598 and 25299). So every solid reports this bound, and the sample serves only to find
+/// decided faces that do not close ([`super::ladder::Ladder::finish`]).
+pub(super) fn round_off_bound(rounding: &Rounding, reference: [f64; 3], unit: &MassProperties) -> f64 {
+    central_rounding(&rounding.bounds(), reference, unit)
 }
 
 /// Half an ulp of 1.
 const EPS: f64 = f64::EPSILON / 2.0;
-
-/// [`round_off_bound`] of one triangle, its corners `a, b, c` shifted as the kernel shifts them
-/// and moved by at most `moved` in each coordinate by that shift: adds to `out.0` what the kernel
-/// can round in each of its ten raw integrals, to `out.1` their terms' absolute values.
-fn triangle_rounding([a, b, c]: [[f64; 3]; 3], moved: f64, out: &mut ([f64; 10], [f64; 10])) {
-    // As the kernel evaluates them (the same operations in the same order).
-    let (e1, e2) = (sub(b, a), sub(c, a));
-    let d = dot(a, cross(e1, e2));
-    // The cross product's products, absolute.
-    let cross = [
-        (e1[1] * e2[2]).abs() + (e1[2] * e2[1]).abs(),
-        (e1[2] * e2[0]).abs() + (e1[0] * e2[2]).abs(),
-        (e1[0] * e2[1]).abs() + (e1[1] * e2[0]).abs(),
-    ];
-    let products = a[0].abs() * cross[0] + a[1].abs() * cross[1] + a[2].abs() * cross[2];
-    let largest = [a, b, c]
-        .iter()
-        .flat_map(|p| p.iter())
-        .fold(0.0f64, |m, x| m.max(x.abs()));
-    // The kernel's test for re-evaluating d with error-free products.
-    let (aa, ee) = (dot(a, a), dot(e1, e1) * dot(e2, e2));
-    let slow = d * d * 16_777_216.0 < aa * ee;
-    let evaluated = if slow {
-        4.0 * EPS * d.abs() + 64.0 * EPS * EPS * largest.powi(3)
-    } else {
-        8.0 * EPS * products
-    };
-    // The corners' shift: each corner moves by the rounding of its coordinates (at most √3
-    // times the largest), all faces at a corner alike, so a closed surface's integrals move
-    // by at most each face's area (|n|/2, below Σ cross / 2) times that move times the
-    // integrand's largest value on the face (1, below s_k, below p_k): in units of d,
-    // 6 × (√3/2)·moved, then 24 × and 120 × the same.
-    let moved = moved * (cross[0] + cross[1] + cross[2]);
-    let s: [f64; 3] = std::array::from_fn(|k| a[k].abs() + b[k].abs() + c[k].abs());
-    let q = |i: usize, j: usize| {
-        (a[i] * a[j]).abs() + (b[i] * b[j]).abs() + (c[i] * c[j]).abs() + s[i] * s[j]
-    };
-    let p = [q(0, 0), q(1, 1), q(2, 2), q(0, 1), q(1, 2), q(2, 0)];
-    let d_abs = d.abs();
-    out.0[0] += evaluated + 6.0 * moved;
-    out.1[0] += d_abs;
-    for k in 0..3 {
-        out.0[1 + k] += (evaluated + 4.0 * EPS * d_abs + 21.0 * moved) * s[k];
-        out.1[1 + k] += d_abs * s[k];
-    }
-    for k in 0..6 {
-        out.0[4 + k] += (evaluated + 8.0 * EPS * d_abs + 104.0 * moved) * p[k];
-        out.1[4 + k] += d_abs * p[k];
-    }
-}
 
 /// [`round_off_bound`] from the bounds `t` on the ten integrals about `reference`: the central
 /// tensor is `C_ij = T_ij − r_i·T_j` with `r = T_i / T1` ([`MassProperties::from_integrals`]), so
