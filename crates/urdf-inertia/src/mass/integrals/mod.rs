@@ -411,26 +411,31 @@ impl<'f, I: Iterator<Item = &'f [u32]>> KernelLoop for FanLoopRounding<'_, I> {
         let mut acc = Accumulator::new(options.summation);
         let mut bound = rounding::Lanes::new();
         let mut batch = Batch::new();
-        // How far each lane's corners moved when shifted, exactly ([`rounding::shift`]).
-        let mut moved = [0.0; LANES];
+        // Each lane's corners as stored, for the exact error of their shift ([`rounding::Lanes`]).
+        let mut stored = [[[0.0; LANES]; 3]; 3];
         for face in faces {
             if face.len() < 3 {
                 continue;
             }
-            let (a, moved_a) = rounding::shift(vertices[face[0] as usize], reference);
+            let va = vertices[face[0] as usize];
+            let a = sub(va, reference);
             for k in 1..face.len() - 1 {
-                let (b, moved_b) = rounding::shift(vertices[face[k] as usize], reference);
-                let (c, moved_c) = rounding::shift(vertices[face[k + 1] as usize], reference);
-                moved[batch.len] = moved_a.max(moved_b).max(moved_c);
-                batch.push(a, b, c);
+                let (vb, vc) = (vertices[face[k] as usize], vertices[face[k + 1] as usize]);
+                let l = batch.len;
+                for (corner, v) in [va, vb, vc].into_iter().enumerate() {
+                    for axis in 0..3 {
+                        stored[corner][axis][l] = v[axis];
+                    }
+                }
+                batch.push(a, sub(vb, reference), sub(vc, reference));
                 if batch.len == LANES {
-                    flush::<FMA>(&batch, &moved, (&mut acc, &mut bound), accurate, LANES);
+                    flush::<FMA>(&batch, (&stored, reference), (&mut acc, &mut bound), accurate, LANES);
                     batch.len = 0;
                 }
             }
         }
         if batch.len > 0 {
-            flush::<FMA>(&batch, &moved, (&mut acc, &mut bound), accurate, batch.len);
+            flush::<FMA>(&batch, (&stored, reference), (&mut acc, &mut bound), accurate, batch.len);
         }
         (acc.total(), bound.total())
     }
@@ -441,14 +446,14 @@ impl<'f, I: Iterator<Item = &'f [u32]>> KernelLoop for FanLoopRounding<'_, I> {
 #[inline(always)]
 fn flush<const FMA: bool>(
     batch: &Batch,
-    moved: &[f64; LANES],
+    stored: (&[[[f64; LANES]; 3]; 3], [f64; 3]),
     (acc, bound): (&mut Accumulator, &mut rounding::Lanes),
     accurate: bool,
     len: usize,
 ) {
     let (d, slow) = batch.volumes::<FMA>(accurate);
     acc.add_batch(&batch.terms_of(&d), len);
-    bound.add(batch, &d, slow, moved, len);
+    bound.add(batch, &d, slow, stored, len);
 }
 
 impl VolumeIntegrals {

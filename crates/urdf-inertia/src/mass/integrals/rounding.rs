@@ -9,21 +9,7 @@
 //! another point and costs less than that did (docs/benchmarks.md, "The round-off bound in the
 //! kernel's pass").
 
-use super::exact::two_sum;
 use super::triangles::{Batch, LANES};
-
-/// `v − reference` as the kernel computes it (`geometry::sub`), and how far the rounding moved it:
-/// the largest error of its three coordinates, exactly (the error of a two-sum).
-#[inline(always)]
-pub(super) fn shift(v: [f64; 3], reference: [f64; 3]) -> ([f64; 3], f64) {
-    let mut moved = 0.0f64;
-    let p = std::array::from_fn(|k| {
-        let (s, e) = two_sum(v[k], -reference[k]);
-        moved = moved.max(e.abs());
-        s
-    });
-    (p, moved)
-}
 
 /// Half an ulp of 1: the unit round-off.
 const U: f64 = f64::EPSILON / 2.0;
@@ -84,7 +70,7 @@ impl Lanes {
 
     /// Adds the first `len` lanes of `batch`, whose `d` (six times the signed tetrahedron with the
     /// reference point, as the kernel summed it) and slow-path flags [`Batch::volumes`] gave, and
-    /// `moved`, how far the shift by the reference moved each lane's corners ([`shift`]).
+    /// the lanes' corners as `stored` before their shift by `reference`.
     ///
     /// Per triangle, its corners `a, b, c` as the kernel holds them (shifted by the reference), with
     /// `s_k = |a_k| + |b_k| + |c_k|` and `cross_k` the sum of the absolute values of the two
@@ -107,10 +93,25 @@ impl Lanes {
         batch: &Batch,
         d: &[f64; LANES],
         slow: [bool; LANES],
-        moved: &[f64; LANES],
+        (stored, reference): (&[[[f64; LANES]; 3]; 3], [f64; 3]),
         len: usize,
     ) {
         let [a, b, c] = &batch.p;
+        // How far the shift moved each lane's corners: the largest error of their coordinates,
+        // exactly (the error of the two-sum of the stored coordinate and the reference's negation,
+        // whose sum the kernel holds).
+        let mut moved = [0.0f64; LANES];
+        for (corner, shifted) in batch.p.iter().enumerate() {
+            for k in 0..3 {
+                for l in 0..LANES {
+                    let (v, s) = (stored[corner][k][l], shifted[k][l]);
+                    let r = -reference[k];
+                    let bb = s - v;
+                    let e = (v - (s - bb)) + (r - bb);
+                    moved[l] = moved[l].max(e.abs());
+                }
+            }
+        }
         let mut rounded = [[0.0; LANES]; 10];
         let mut terms = [[0.0; LANES]; 10];
         for l in 0..LANES {
