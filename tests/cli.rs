@@ -1464,3 +1464,42 @@ fn check_format_json_lists_the_problems_of_the_text_output() {
         .unwrap()
         .ends_with(&format!(":{}: link `upper_arm_link`", upper["line"])));
 }
+
+/// An `<inertial>` that already says what `fill` computes (each number within the tolerance it
+/// would round within) keeps its bytes: the demo filled with every bit (`--digits full`), filled
+/// again with the default digits, is the same file, where the default would write shorter
+/// decimals. One that disagrees beyond that tolerance (a mass 0.1% off) is rewritten.
+#[test]
+fn fill_keeps_an_inertial_that_already_agrees() {
+    let (_tmp, copy, map) = demo_copy();
+    let (u, m) = (copy.to_str().unwrap(), map.to_str().unwrap());
+    // The default digits are shorter than every bit for this link.
+    let fresh = String::from_utf8(run(&["fill", u, "--density-map", m, "-o", "-"]).stdout).unwrap();
+    assert!(fresh.contains("izz=\"0.0022447378466093\""), "{fresh}");
+    let full = run(&["fill", u, "--density-map", m, "--digits", "full", "-i"]);
+    assert!(full.status.success());
+    let before = std::fs::read_to_string(&copy).unwrap();
+    assert!(before.contains("izz=\"0.002244737846609265\""), "{before}");
+    let again = run(&["fill", u, "--density-map", m, "-i"]);
+    assert!(again.status.success());
+    assert_eq!(std::fs::read_to_string(&copy).unwrap(), before);
+    // A mass 0.1% off is no longer what `fill` computes: that link is rewritten, only that one.
+    let (mass, _, _) = inertial_of(&before, "upper_arm_link").unwrap();
+    let off = before.replacen(
+        &format!("<mass value=\"{}\"", urdf_inertia::text::shortest(mass)),
+        &format!("<mass value=\"{}\"", mass * 1.001),
+        1,
+    );
+    assert_ne!(off, before);
+    std::fs::write(&copy, &off).unwrap();
+    assert!(run(&["fill", u, "--density-map", m, "-i"]).status.success());
+    let after = std::fs::read_to_string(&copy).unwrap();
+    let (fixed, _, _) = inertial_of(&after, "upper_arm_link").unwrap();
+    assert!((fixed - mass).abs() <= 1e-12 * mass, "{fixed} {mass}");
+    let changed = after
+        .lines()
+        .zip(before.lines())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!((1..=3).contains(&changed), "{changed} lines changed");
+}

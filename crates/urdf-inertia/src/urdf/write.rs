@@ -1,6 +1,6 @@
 //! Writing `<inertial>` back: splice new text into the original bytes; everything else stays identical.
 
-use super::scan::{Link, Robot};
+use super::scan::{InertialSpan, Link, Robot};
 use crate::geometry::ROUND_OFF_FLOOR;
 use crate::mass::{matrix_rpy, validity, MassProperties};
 use crate::text::{self, Digits};
@@ -129,6 +129,32 @@ fn tidy_tensor(tensor: &[[f64; 3]; 3], error: f64) -> [[f64; 3]; 3] {
         rel /= 10.0;
     }
     tensor.map(|row| row.map(|x| text::within(x, 0.0)))
+}
+
+/// Whether a link's one existing `<inertial>` already says what `fill` would write (`--digits
+/// auto`, link axes): each number, as urdfdom reads it, within the tolerance [`written`] rounds the
+/// computed value within (so it is as honest a decimal as the one `fill` would choose), the origin
+/// unrotated, and the tensor valid. Its bytes then stay as they are: a second `fill`, or one after
+/// an upgrade that moved only digits below the estimate, leaves the file as it was.
+fn agrees(update: &LinkUpdate, span: &InertialSpan, opts: &WriteOptions) -> bool {
+    let v = &span.value;
+    let (Some(mass), Some(i)) = (v.mass, v.inertia) else {
+        return false;
+    };
+    if opts.digits != Digits::Auto || opts.principal || span.problem.is_some() {
+        return false;
+    }
+    let mp = &update.props;
+    let error = text::rounding_tolerance(update.error.max(update.input_precision));
+    let length = mp.com.iter().fold(update.size, |m, x| m.max(x.abs()));
+    let scale = largest_entry(&mp.inertia);
+    let tensor = [[i[0], i[1], i[2]], [i[1], i[3], i[4]], [i[2], i[4], i[5]]];
+    let near = |a: f64, b: f64, delta: f64| (a - b).abs() <= delta;
+    v.origin.rpy == [0.0; 3]
+        && near(mass, mp.mass, error * mp.mass)
+        && (0..3).all(|k| near(v.origin.xyz[k], mp.com[k], error * length))
+        && (0..3).all(|r| (0..3).all(|c| near(tensor[r][c], mp.inertia[r][c], error * scale)))
+        && tensor_valid(&tensor)
 }
 
 /// The values to write for `update`, rounded as `opts` says.
@@ -410,6 +436,9 @@ fn link_edits(
             format!("{}{child_indent}{text}", robot.newline),
         )]);
     };
+    if link.extra_inertials.is_empty() && agrees(update, span, opts) {
+        return Ok(Vec::new());
+    }
     // Replace the element itself; its leading indentation stays where it is.
     let own_indent = robot.text[..span.start].rsplit('\n').next().unwrap_or("");
     let indent = if own_indent.chars().all(|c| c == ' ' || c == '\t') {
