@@ -437,7 +437,7 @@ impl<'f, I: Iterator<Item = &'f [u32]>> KernelLoop for FanLoopRounding<'_, I> {
         if batch.len > 0 {
             flush::<FMA>(&batch, (&stored, reference), (&mut acc, &mut bound), accurate, batch.len);
         }
-        (acc.total(), bound.total())
+        (acc.total(), bound.total(options.summation != Summation::Compensated))
     }
 }
 

@@ -22,6 +22,9 @@ pub struct Rounding {
     pub(super) rounded: [f64; 10],
     pub(super) terms: [f64; 10],
     pub(super) triangles: u64,
+    /// Whether the terms were summed one running sum each ([`super::Summation::Plain`], the
+    /// paper's way: tests and the accuracy report only) rather than compensated.
+    pub(super) plain: bool,
 }
 
 impl Rounding {
@@ -35,9 +38,15 @@ impl Rounding {
     ///   at most (n u)² + 4u² n of the terms for n triangles;
     /// - the divisions and the double-double normalisation of `finish`: u² of the value;
     /// - the bound's own plain sums (n u relative, below 1% for n below 10^13): the factor 1.01.
+    ///
+    /// Summed plainly instead, the terms' sums can round by n u of them.
     pub fn bounds(&self) -> [f64; 10] {
         let n = self.triangles as f64;
-        let summed = 8.0 * U + (n * U) * (n * U) + 4.0 * U * U * n;
+        let summed = if self.plain {
+            n * U
+        } else {
+            8.0 * U + (n * U) * (n * U) + 4.0 * U * U * n
+        };
         let scale = [6.0, 24.0, 24.0, 24.0, 120.0, 120.0, 120.0, 120.0, 120.0, 120.0];
         std::array::from_fn(|k| (self.rounded[k] + summed * self.terms[k]) / scale[k] * 1.01)
     }
@@ -48,6 +57,7 @@ impl Rounding {
             rounded: std::array::from_fn(|k| self.rounded[k] + other.rounded[k]),
             terms: std::array::from_fn(|k| self.terms[k] + other.terms[k]),
             triangles: self.triangles + other.triangles,
+            plain: self.plain || other.plain,
         }
     }
 }
@@ -156,12 +166,13 @@ impl Lanes {
         self.triangles += len as u64;
     }
 
-    /// The lanes' sums.
-    pub(super) fn total(&self) -> Rounding {
+    /// The lanes' sums, for terms summed plainly or not (`plain`).
+    pub(super) fn total(&self, plain: bool) -> Rounding {
         Rounding {
             rounded: self.rounded.map(|r| r.iter().sum()),
             terms: self.terms.map(|t| t.iter().sum()),
             triangles: self.triangles,
+            plain,
         }
     }
 }
