@@ -1641,6 +1641,25 @@ fn single_closed_shells_are_within_the_round_off_bound() {
     assert!(checked >= 100, "{checked} checked");
 }
 
+/// A breach until session 42 (sweep case 49295, found by cases 49001–51500, the same on every
+/// earlier build): two inward octahedra cutting each other and two tetrahedra ~2 f32 units across,
+/// an inward and an outward one stored 1.3e-10 apart, 54 km from the origin. The tolerant weld
+/// collapses both tetrahedra; the whole surface is wound inward and flipped. The faces classified
+/// kept the collapsed ones in place while the stored orientation they were compared with did not,
+/// so from the second octahedron on, each face was compared with another's: the first octahedron
+/// was turned back to inward as stored and the second left outward, and the face-by-face decision
+/// integrated their overlap as a hole (0.094 m³ of 74.3, 1.3e-3 off, inertia 2.6e-3, under 2.7e-4).
+/// Now the stored orientation is the faces' own, face for face.
+#[test]
+fn octahedra_behind_collapsed_tetrahedra_keep_their_overlap() {
+    let mut case = random_case(49295).expect("made");
+    let (error, _, turned) = checked_within(&case, "49295");
+    assert!(turned && error < 1e-9, "error {error:e}");
+    case.parts.remove(0);
+    let (error, _, turned) = checked_within(&case, "49295, parts 1-4");
+    assert!(turned && error < 1e-9, "parts 1-4: error {error:e}");
+}
+
 /// Asserts that `case` has a solid whose volume and inertia are within its estimate (against exact
 /// rationals); the larger error, the estimate, and whether the ladder turned faces.
 fn checked_within(case: &Case, what: &str) -> (f64, f64, bool) {
