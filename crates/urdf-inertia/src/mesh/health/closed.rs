@@ -70,7 +70,7 @@ fn welded_note(ladder: &mut Ladder<'_>, rung: &Rung) {
 /// faces of other shells count as turned round (sweep case 49295: two inward octahedra cutting
 /// each other behind two collapsed tetrahedra, one turned back to inward and one left outward,
 /// their overlap integrated as a hole, 0.13% off under 2.7e-4).
-fn stored_orientation(stored: &Polygons, kept: Option<&Polygons>) -> Option<Polygons> {
+pub(super) fn stored_orientation(stored: &Polygons, kept: Option<&Polygons>) -> Option<Polygons> {
     kept.filter(|k| k.len() != stored.len()).map(|_| stored.clone())
 }
 

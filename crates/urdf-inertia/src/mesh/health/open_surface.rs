@@ -1,7 +1,7 @@
 //! The open and non-manifold rungs: integrated as they are, capped, or the convex hull when asked.
 
 use super::caps::{cap_holes, Caps};
-use super::closed::{apply, open_volume, outward};
+use super::closed::{apply, open_volume, outward, stored_orientation};
 use super::geometry::{bbox, signed_volume, unit_props, vector_area};
 use super::ladder::Ladder;
 use super::model::Model;
@@ -227,6 +227,11 @@ pub(super) fn with_caps(
             tolerance: w.tolerant.tolerance.largest,
         };
         let model = spans + caps.bound + plan.cracks;
+        // The faces integrated are `w.stored`: the classification compares them with their own
+        // stored orientation (`stored_orientation`).
+        if let Some(s) = stored_orientation(&w.stored, Some(&w.kept)) {
+            ladder.as_stored.faces = s;
+        }
         return ladder.finish(
             w.vertices,
             w.stored,
