@@ -145,8 +145,7 @@ fn agrees(update: &LinkUpdate, span: &InertialSpan, opts: &WriteOptions) -> bool
         return false;
     }
     let mp = &update.props;
-    let error = text::rounding_tolerance(update.error.max(update.input_precision));
-    let length = mp.com.iter().fold(update.size, |m, x| m.max(x.abs()));
+    let (error, length) = tolerance(update);
     let scale = largest_entry(&mp.inertia);
     let tensor = [[i[0], i[1], i[2]], [i[1], i[3], i[4]], [i[2], i[4], i[5]]];
     let near = |a: f64, b: f64, delta: f64| (a - b).abs() <= delta;
@@ -155,6 +154,14 @@ fn agrees(update: &LinkUpdate, span: &InertialSpan, opts: &WriteOptions) -> bool
         && (0..3).all(|k| near(v.origin.xyz[k], mp.com[k], error * length))
         && (0..3).all(|r| (0..3).all(|c| near(tensor[r][c], mp.inertia[r][c], error * scale)))
         && tensor_valid(&tensor)
+}
+
+/// The relative tolerance `update`'s numbers are written within, and the length its centre of mass
+/// is known relative to: the link's size or its own coordinates, whichever is larger.
+fn tolerance(update: &LinkUpdate) -> (f64, f64) {
+    let error = text::rounding_tolerance(update.error.max(update.input_precision));
+    let length = update.props.com.iter().fold(update.size, |m, x| m.max(x.abs()));
+    (error, length)
 }
 
 /// The values to write for `update`, rounded as `opts` says.
@@ -171,9 +178,7 @@ fn written(update: &LinkUpdate, opts: &WriteOptions) -> Result<Written, String> 
     } else {
         ([0.0; 3], mp.inertia)
     };
-    let error = text::rounding_tolerance(update.error.max(update.input_precision));
-    // The COM is known relative to the link's size or to its own coordinates, whichever is larger.
-    let length = mp.com.iter().fold(update.size, |m, x| m.max(x.abs()));
+    let (error, length) = tolerance(update);
     let floor = |x: f64, scale: f64| text::within(x, ROUND_OFF_FLOOR * scale);
     Ok(match opts.digits {
         Digits::Full => Written {

@@ -7,7 +7,7 @@
 //! health ladder reports as round-off (`mesh::health::model::round_off_bound`). Computed in the
 //! kernel's lanes from the corners the kernel already holds, it replaced a second integration about
 //! another point and costs less than that did (docs/benchmarks.md, "The round-off bound in the
-//! kernel's pass").
+//! integrating pass").
 
 use super::triangles::{Batch, LANES};
 
