@@ -3,7 +3,7 @@
 //! orientation of each. Moved out of the ladder ([`super`]) as it is.
 
 use crate::mass::Polygons;
-use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
+use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// Edge structure of a welded mesh.
 // `boundary_half_edges`: half-edge is the term of the trade, not a repetition of `Edges`.
@@ -141,66 +141,36 @@ pub(super) fn grouped<T: Copy + Default>(
 /// has exactly one twin `v → u` (then each undirected edge has one half-edge each way: closed,
 /// edge-manifold, consistently wound); `None` otherwise.
 ///
-/// Half-edges are bucketed by their start vertex (a counting sort), each entry holding its end and its
-/// face, so a twin is found by scanning the handful of entries of its start: a few linear passes and
-/// no sort. Faces are joined as twins are found (union-find), so no list of face pairs is built.
-/// Measured on a 1.3 M-face sphere (callgrind): 503 → 329 instructions per face for the proof and the
-/// components together.
+/// The corners are bucketed by their vertex (a counting sort of the corner numbers, 4 bytes each).
+/// A corner of `u` in face `f` stands for the half-edge leaving `u` for the corner after it in `f`
+/// and for the one arriving at `u` from the corner before it, so each vertex is decided from its own
+/// bucket ([`decide`]): the twin of `u → v` is a corner of `u` whose face arrives from `v`, and that
+/// face is the twin's. Faces are joined as twins are found (union-find), so no list of face pairs is
+/// built. Buckets of (end, face) pairs searched at the other end, as before, took 8 bytes a
+/// half-edge: at 1.3 M faces the corners take 15.6 MB of fresh memory less, the peak 89 → 74 MB on
+/// one thread (figures: docs/benchmarks.md, "One thread against two").
 pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
     let n = *faces.indices.iter().max()? as usize + 1;
-    let h = faces.indices.len();
-    let (start, mut out) = half_edges(faces, n);
+    let (ends, corners) = corners_by_vertex(faces, n);
     let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
-    let paired = if sort_long(0, &start[..n], &mut out, |&(v, f)| (v, f)) {
-        pair_twins::<true>(&start[..n], &out, &mut parent)
+    let get = |i: usize| corners[i];
+    let paired = if faces.all_triangles() {
+        decide(&ends, get, 0..n, triangle_ring(&faces.indices), &mut parent)
     } else {
-        pair_twins::<false>(&start[..n], &out, &mut parent)
+        let face_of = corner_faces(faces);
+        decide(&ends, get, 0..n, polygon_ring(faces, &face_of), &mut parent)
     }?;
-    (2 * paired == h).then(|| label(parent))
+    (2 * paired == faces.indices.len()).then(|| label(parent))
 }
 
-/// The twin scan of [`closed_consistent`] (`ends`: each vertex's bucket's end in `out`): the pairs
-/// found, faces joined in `parent` as they are; `None` at the first half-edge without exactly one
-/// twin. `LONG` when some bucket is longer than [`SCAN`] (sorted): without, the scan is the one
-/// before long buckets, instruction for instruction.
-#[inline(always)]
-fn pair_twins<const LONG: bool>(ends: &[u32], out: &[(u32, u32)], parent: &mut [u32]) -> Option<usize> {
-    let bucket = |u: usize| {
-        let lo = if u == 0 { 0 } else { ends[u - 1] as usize };
-        &out[lo..ends[u] as usize]
-    };
-    // Each half-edge u → v with u < v must be alone in u's list and find exactly one v → u; when
-    // those pairs account for every half-edge, no half-edge v → u is left without its twin.
-    let mut paired = 0usize;
-    for u in 0..ends.len() {
-        let mine = bucket(u);
-        for (i, &(v, f)) in mine.iter().enumerate() {
-            if v as usize <= u {
-                if v as usize == u {
-                    return None;
-                }
-                continue;
-            }
-            if seen_before::<LONG, _>(mine, i, v, |e| e.0) {
-                return None;
-            }
-            let &(_, g) = only_twin::<LONG, _>(bucket(v as usize), u as u32, |e| e.0)?;
-            union(parent, f, g);
-            paired += 1;
-        }
-    }
-    Some(paired)
-}
-
-/// Half-edges bucketed by their start vertex (a counting sort), each entry holding its end and its
-/// face: after the fill, u's entries are `out[start[u - 1]..start[u]]` (from 0 for u = 0). Out of
-/// line: inlined into [`closed_consistent`] the two cost one thread more instructions (figures:
+/// Corner numbers bucketed by their vertex (a counting sort), in corner order within a bucket:
+/// after the fill, u's corners are `out[ends[u - 1]..ends[u]]` (from 0 for u = 0). Out of line:
+/// inlined into [`closed_consistent`] the two cost one thread more instructions (figures:
 /// docs/benchmarks.md, "One thread against two").
 #[inline(never)]
-fn half_edges(faces: &Polygons, n: usize) -> (Vec<u32>, Vec<(u32, u32)>) {
+fn corners_by_vertex(faces: &Polygons, n: usize) -> (Vec<u32>, Vec<u32>) {
     let idx = &faces.indices;
-    let h = idx.len();
-    // Entries starting at vertex u, after the fill: `out[start[u]..start[u + 1]]`, with start[0] = 0.
+    // Entries of vertex u, after the fill: `out[start[u]..start[u + 1]]`, with start[0] = 0.
     let mut start = vec![0u32; n + 1];
     for &u in idx {
         start[u as usize + 1] += 1;
@@ -210,65 +180,159 @@ fn half_edges(faces: &Polygons, n: usize) -> (Vec<u32>, Vec<(u32, u32)>) {
     }
     // Filling advances start[u] to where u's entries end, which is where u + 1's begin: after the
     // fill, u's entries are `start[u - 1]..start[u]` (a shift instead of a second cursor array).
-    let mut out = vec![(0u32, 0u32); h];
-    let mut put = |u: u32, v: u32, f: u32| {
+    let mut out = vec![0u32; idx.len()];
+    for (c, &u) in idx.iter().enumerate() {
         let s = &mut start[u as usize];
-        out[*s as usize] = (v, f);
+        out[*s as usize] = c as u32;
         *s += 1;
-    };
-    if faces.all_triangles() {
-        for (f, t) in idx.chunks_exact(3).enumerate() {
-            let f = f as u32;
-            put(t[0], t[1], f);
-            put(t[1], t[2], f);
-            put(t[2], t[0], f);
-        }
-    } else {
-        for (f, face) in faces.iter().enumerate() {
-            for k in 0..face.len() {
-                put(face[k], face[(k + 1) % face.len()], f as u32);
-            }
-        }
     }
     (start, out)
 }
 
+/// The face of each corner, for faces that are not all triangles (a triangle's is its corner / 3).
+fn corner_faces(faces: &Polygons) -> Vec<u32> {
+    let mut face_of = vec![0u32; faces.indices.len()];
+    for (f, w) in faces.starts.windows(2).enumerate() {
+        face_of[w[0] as usize..w[1] as usize].fill(f as u32);
+    }
+    face_of
+}
+
+/// A triangle corner's face, the vertex after it and the vertex before it.
+#[inline(always)]
+fn triangle_ring(idx: &[u32]) -> impl Fn(u32) -> (u32, u32, u32) + Copy + '_ {
+    move |c: u32| {
+        let (f, k) = (c / 3, (c % 3) as usize);
+        let base = 3 * f as usize;
+        let t = &idx[base..base + 3];
+        // After corner k comes `ring[k]`, before it `ring[k + 1]`.
+        let ring = [t[1], t[2], t[0], t[1]];
+        (f, ring[k], ring[k + 1])
+    }
+}
+
+/// A polygon corner's face (`face_of`), the vertex after it and the vertex before it.
+#[inline(always)]
+fn polygon_ring<'a>(faces: &'a Polygons, face_of: &'a [u32]) -> impl Fn(u32) -> (u32, u32, u32) + Copy + 'a {
+    move |c: u32| {
+        let f = face_of[c as usize];
+        let (lo, hi) = (faces.starts[f as usize], faces.starts[f as usize + 1]);
+        let next = if c + 1 == hi { lo } else { c + 1 };
+        let prev = if c == lo { hi - 1 } else { c - 1 };
+        (f, faces.indices[next as usize], faces.indices[prev as usize])
+    }
+}
+
+/// Buckets longer than this are sorted before they are matched; shorter ones, nearly all, are
+/// matched by a scan (a vertex of degree d costs d²; figures: docs/benchmarks.md, "Figures behind
+/// choices in the code").
+const SCAN: usize = 32;
+
+/// Decides the vertices `vertices` from their buckets (`ends`: each bucket's end, `get`: the corner
+/// number at a place, `ring`: a corner's face and the vertices after and before it): each half-edge
+/// leaving a vertex `u` for a larger `v` must be the only one from `u` to `v` and find a half-edge
+/// arriving from `v` (its twin), and none may return to `u`. Each face is joined in `parent` with its
+/// twin's face; the pairs found are returned, `None` at the first vertex where these fail. A pair
+/// stands for two half-edges of its edge and an edge has one pair at most, so when the pairs account
+/// for every half-edge, each edge has one half-edge each way: a second `v → u`, or one without its
+/// twin, leaves the count short (see [`closed_consistent`]). A bucket longer than [`SCAN`] is sorted
+/// and must leave for and arrive from the same distinct vertices.
+#[inline(always)]
+fn decide(
+    ends: &[u32],
+    get: impl Fn(usize) -> u32,
+    vertices: std::ops::Range<usize>,
+    ring: impl Fn(u32) -> (u32, u32, u32),
+    parent: &mut [u32],
+) -> Option<usize> {
+    // The short bucket's faces, ends leaving and ends arriving, one array each.
+    let (mut face, mut next, mut prev) = ([0u32; SCAN], [0u32; SCAN], [0u32; SCAN]);
+    let (mut leaving, mut arriving) = (Vec::new(), Vec::new());
+    let mut paired = 0usize;
+    for u in vertices {
+        let lo = if u == 0 { 0 } else { ends[u - 1] as usize };
+        let hi = ends[u] as usize;
+        let u = u as u32;
+        let d = hi - lo;
+        if d <= SCAN {
+            for (k, i) in (lo..hi).enumerate() {
+                (face[k], next[k], prev[k]) = ring(get(i));
+            }
+            for i in 0..d {
+                let v = next[i];
+                if v <= u {
+                    if v == u {
+                        return None;
+                    }
+                    continue;
+                }
+                if next[..i].contains(&v) {
+                    return None;
+                }
+                // A twin, not the only one: a second `v → u` leaves the count short.
+                let k = prev[..d].iter().position(|&p| p == v)?;
+                union(parent, face[i], face[k]);
+                paired += 1;
+            }
+        } else {
+            // Sorted, the ends leaving and arriving must be the same distinct ones, place for place.
+            leaving.clear();
+            arriving.clear();
+            for i in lo..hi {
+                let (f, next, prev) = ring(get(i));
+                leaving.push((next, f));
+                arriving.push((prev, f));
+            }
+            leaving.sort_unstable();
+            arriving.sort_unstable();
+            for (k, (&(v, f), &(p, g))) in leaving.iter().zip(&arriving).enumerate() {
+                if v == u || v != p || (k > 0 && leaving[k - 1].0 == v) {
+                    return None;
+                }
+                if u < v {
+                    union(parent, f, g);
+                    paired += 1;
+                }
+            }
+        }
+    }
+    Some(paired)
+}
+
 /// [`closed_consistent`] for a pool of two threads or more, each stage split in two on `rayon::join`,
-/// `n` the vertices (no face's corner at `n` or beyond). The half-edges are bucketed as
-/// [`half_edges`] buckets them, by two halves of the faces at once: each counts its half-edges by
-/// start vertex, the counts give each half its place in every bucket (the first half's entries
-/// before the second's, so each bucket holds what one pass puts in it, in the same order), and each
-/// half fills its places. The buckets are shared by both halves' writes, hence atomic, written and
-/// read with relaxed ordering (plain loads and stores; `rayon::join` orders the stages); they are
-/// made on the pool, so both threads fault their pages in. Then the twin scan runs in two halves of
-/// the vertices, each joining faces in a union-find forest of its own, and the second forest's sets
-/// are joined into the first afterwards, so the sets and the components numbered from them are the
-/// one scan's. The second forest and the counts of each half are what one thread does not pay for.
-/// (The scan is [`closed_consistent`]'s, written twice: as one function called by both it cost
-/// one thread instructions; figures: docs/benchmarks.md, "One thread against two".)
+/// `n` the vertices (no face's corner at `n` or beyond). The corners are bucketed as
+/// [`corners_by_vertex`] buckets them, by two halves of the corners at once: each counts its corners
+/// by vertex, the counts give each half its place in every bucket (the first half's entries before
+/// the second's, so each bucket holds what one pass puts in it, in the same order), and each half
+/// fills its places. The buckets are shared by both halves' writes, hence atomic, written and read
+/// with relaxed ordering (plain loads and stores; `rayon::join` orders the stages); they are made on
+/// the pool, so both threads fault their pages in. Then the vertices are decided in two halves, each
+/// joining faces in a union-find forest of its own, and the second forest's sets are joined into the
+/// first afterwards, so the sets and the components numbered from them are the one pass's. The second
+/// forest and the counts of each half are what one thread does not pay for.
 pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec<u32>, usize)> {
     use rayon::prelude::*;
     let nfaces = faces.len();
     let h = faces.indices.len();
-    let half = nfaces / 2;
+    let half = h / 2;
     // The first half counts in what becomes the first forest once the buckets are filled: a
     // second array of the vertices' size would be fresh pages.
-    let ((mut parent, mut second), mut other) = rayon::join(
+    let ((mut parent, mut second), (mut other, face_of)) = rayon::join(
         || {
             rayon::join(
                 || {
                     let mut parent = vec![0u32; nfaces.max(n)];
-                    count(faces, 0..half, &mut parent[..n]);
+                    count(&faces.indices[..half], &mut parent[..n]);
                     parent
                 },
                 || {
                     let mut second = vec![0u32; n];
-                    count(faces, half..nfaces, &mut second);
+                    count(&faces.indices[half..], &mut second);
                     second
                 },
             )
         },
-        || identity(nfaces),
+        || (identity(nfaces), (!faces.all_triangles()).then(|| corner_faces(faces))),
     );
     let first = &mut parent[..n];
     // Each half's first place in every bucket.
@@ -279,33 +343,29 @@ pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec
         *b = at + ca;
         at += ca + cb;
     }
-    let mut out: Vec<AtomicU64> = (0..h).into_par_iter().map(|_| AtomicU64::new(0)).collect();
+    let out: Vec<AtomicU32> = (0..h).into_par_iter().map(|_| AtomicU32::new(0)).collect();
     rayon::join(
-        || fill(faces, 0..half, first, &out),
-        || fill(faces, half..nfaces, &mut second, &out),
+        || fill(&faces.indices, 0..half, first, &out),
+        || fill(&faces.indices, half..h, &mut second, &out),
     );
     parent.truncate(nfaces);
-    let key = |e: &AtomicU64| {
-        let e = e.load(Relaxed);
-        (e as u32, (e >> 32) as u32)
-    };
-    let mid = n / 2;
-    let split = if mid == 0 { 0 } else { second[mid - 1] as usize };
-    let (low, high) = out.split_at_mut(split);
-    let long = rayon::join(
-        || sort_long(0, &second[..mid], low, key),
-        || sort_long(split, &second[mid..n], high, key),
-    );
     // Filling advanced each of the second half's places to where its bucket ends: u's entries are
-    // `out[second[u - 1]..second[u]]`, as after [`half_edges`].
-    let buckets = (second.as_slice(), out.as_slice());
-    let scan = if long.0 || long.1 { twins::<true> } else { twins::<false> };
+    // `out[second[u - 1]..second[u]]`, as after [`corners_by_vertex`].
+    let get = |i: usize| out[i].load(Relaxed);
+    let ends = second.as_slice();
+    let mid = n / 2;
     let (a, b) = rayon::join(
         || {
             (parent.iter_mut().zip(0..)).for_each(|(p, f)| *p = f);
-            scan(buckets, 0..mid, &mut parent)
+            match &face_of {
+                None => decide(ends, get, 0..mid, triangle_ring(&faces.indices), &mut parent),
+                Some(fo) => decide(ends, get, 0..mid, polygon_ring(faces, fo), &mut parent),
+            }
         },
-        || scan(buckets, mid..n, &mut other),
+        || match &face_of {
+            None => decide(ends, get, mid..n, triangle_ring(&faces.indices), &mut other),
+            Some(fo) => decide(ends, get, mid..n, polygon_ring(faces, fo), &mut other),
+        },
     );
     let paired = a? + b?;
     // A forest's links span its sets: joining each face to its parent in `other` joins them all.
@@ -318,130 +378,26 @@ pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec
     (2 * paired == h).then(|| label(parent))
 }
 
-/// Buckets longer than this are sorted by end vertex before the twin scan, which then searches
-/// them instead of scanning them: scanned, a vertex of degree d costs d² (figures:
-/// docs/benchmarks.md, "Figures behind choices in the code"). Shorter buckets, nearly all, are
-/// scanned as before.
-const SCAN: usize = 32;
-
-/// Sorts by `key` (end vertex, then face) each bucket of more than [`SCAN`] entries, and says
-/// whether there was one: `ends` are the buckets' ends as the fill left them, counted from entry
-/// `base` of the whole list, whose part from there on is `out`.
-fn sort_long<T>(base: usize, ends: &[u32], out: &mut [T], key: impl Fn(&T) -> (u32, u32) + Copy) -> bool {
-    let (mut lo, mut any) = (0, false);
-    for &end in ends {
-        let hi = end as usize - base;
-        if hi - lo > SCAN {
-            out[lo..hi].sort_unstable_by_key(key);
-            any = true;
-        }
-        lo = hi;
-    }
-    any
-}
-
-/// Whether an entry before the `i`th of `mine` ends at `v`: in a sorted (long) bucket, the one
-/// right before it.
-#[inline(always)]
-fn seen_before<const LONG: bool, T>(mine: &[T], i: usize, v: u32, end: impl Fn(&T) -> u32) -> bool {
-    if LONG && mine.len() > SCAN {
-        i > 0 && end(&mine[i - 1]) == v
-    } else {
-        mine[..i].iter().any(|e| end(e) == v)
-    }
-}
-
-/// The entry of `bucket` ending at `u` when exactly one does: in a sorted (long) bucket, found by
-/// a binary search and the entry after it.
-#[inline(always)]
-fn only_twin<const LONG: bool, T>(bucket: &[T], u: u32, end: impl Fn(&T) -> u32) -> Option<&T> {
-    let near = if LONG && bucket.len() > SCAN {
-        let i = bucket.partition_point(|e| end(e) < u);
-        &bucket[i..bucket.len().min(i + 2)]
-    } else {
-        bucket
-    };
-    let mut twins = near.iter().filter(|e| end(e) == u);
-    let t = twins.next()?;
-    twins.next().is_none().then_some(t)
-}
-
 /// A union-find forest of `n` singletons.
 fn identity(n: usize) -> Vec<u32> {
     (0..n as u32).collect()
 }
 
-/// Adds to `count` how many corners of the faces `range` each vertex has: the half-edges leaving it.
-fn count(faces: &Polygons, range: std::ops::Range<usize>, count: &mut [u32]) {
-    let (lo, hi) = (faces.starts[range.start], faces.starts[range.end]);
-    for &u in &faces.indices[lo as usize..hi as usize] {
+/// Adds to `count` how many of the corners `corners` each vertex has.
+fn count(corners: &[u32], count: &mut [u32]) {
+    for &u in corners {
         count[u as usize] += 1;
     }
 }
 
-/// Puts the half-edges of the faces `range` into their buckets at `place` (each vertex's next free
-/// entry, advanced as it fills), each entry its end and its face packed as `end | face << 32`.
-fn fill(faces: &Polygons, range: std::ops::Range<usize>, place: &mut [u32], out: &[AtomicU64]) {
-    let mut put = |u: u32, v: u32, f: u32| {
+/// Puts the corners `range` of `corners` (the faces' vertex indices) into their vertices' buckets at
+/// `place` (each vertex's next free entry, advanced as it fills).
+fn fill(corners: &[u32], range: std::ops::Range<usize>, place: &mut [u32], out: &[AtomicU32]) {
+    for (c, &u) in range.clone().zip(&corners[range]) {
         let s = &mut place[u as usize];
-        out[*s as usize].store(u64::from(v) | u64::from(f) << 32, Relaxed);
+        out[*s as usize].store(c as u32, Relaxed);
         *s += 1;
-    };
-    let starts = &faces.starts[range.start..=range.end];
-    let (lo, hi) = (starts[0] as usize, starts[starts.len() - 1] as usize);
-    if 3 * range.len() == hi - lo && starts.windows(2).all(|w| w[1] - w[0] == 3) {
-        for (f, t) in faces.indices[lo..hi].chunks_exact(3).enumerate() {
-            let f = (range.start + f) as u32;
-            put(t[0], t[1], f);
-            put(t[1], t[2], f);
-            put(t[2], t[0], f);
-        }
-    } else {
-        for f in range {
-            let face = faces.face(f);
-            for k in 0..face.len() {
-                put(face[k], face[(k + 1) % face.len()], f as u32);
-            }
-        }
     }
-}
-
-/// The twin scan of [`closed_consistent_split`] over the half-edges leaving `vertices` (the buckets
-/// as its fill left them: the end of each vertex's, and the entries): the number of pairs found,
-/// faces joined in `parent` as they are; `None` at the first half-edge without exactly one twin.
-fn twins<const LONG: bool>(
-    (end, out): (&[u32], &[AtomicU64]),
-    vertices: std::ops::Range<usize>,
-    parent: &mut [u32],
-) -> Option<usize> {
-    let bucket = |u: usize| {
-        let lo = if u == 0 { 0 } else { end[u - 1] as usize };
-        &out[lo..end[u] as usize]
-    };
-    let target = |e: &AtomicU64| e.load(Relaxed) as u32;
-    // Each half-edge u → v with u < v must be alone in u's list and find exactly one v → u; when
-    // those pairs account for every half-edge, no half-edge v → u is left without its twin.
-    let mut paired = 0usize;
-    for u in vertices {
-        let mine = bucket(u);
-        for (i, e) in mine.iter().enumerate() {
-            let e = e.load(Relaxed);
-            let (v, f) = (e as u32, (e >> 32) as u32);
-            if v as usize <= u {
-                if v as usize == u {
-                    return None;
-                }
-                continue;
-            }
-            if seen_before::<LONG, _>(mine, i, v, target) {
-                return None;
-            }
-            let g = (only_twin::<LONG, _>(bucket(v as usize), u as u32, target)?.load(Relaxed) >> 32) as u32;
-            union(parent, f, g);
-            paired += 1;
-        }
-    }
-    Some(paired)
 }
 
 /// The root of `x` in a union-find forest, halving the path on the way.
@@ -631,27 +587,6 @@ mod tests {
         }
     }
 
-    /// On a sorted bucket longer than [`SCAN`], `seen_before` and `only_twin` answer what a scan of
-    /// the whole bucket answers: random buckets of ends with repeats, every entry and end asked.
-    #[test]
-    fn searched_buckets_answer_as_scanned_ones() {
-        let mut rng = 0x0b0c_4e75_u64;
-        let mut rand = |n: usize| crate::xorshift(&mut rng) as usize % n;
-        for _ in 0..300 {
-            let len = SCAN + 1 + rand(60);
-            let mut bucket: Vec<(u32, u32)> = (0..len).map(|f| (rand(len) as u32, f as u32)).collect();
-            bucket.sort_unstable();
-            for (i, &(v, _)) in bucket.iter().enumerate() {
-                assert_eq!(seen_before::<true, _>(&bucket, i, v, |e| e.0), bucket[..i].iter().any(|e| e.0 == v));
-            }
-            for u in 0..=len as u32 {
-                let scanned: Vec<_> = bucket.iter().filter(|e| e.0 == u).collect();
-                let want = (scanned.len() == 1).then(|| scanned[0]);
-                assert_eq!(only_twin::<true, _>(&bucket, u, |e| e.0), want, "{bucket:?} {u}");
-            }
-        }
-    }
-
     /// The proof with long buckets against the full analysis (a sort of every edge's half-edges,
     /// [`edge_analysis`]): cones of 40 and 200 sides changed at random (faces reversed, stored twice,
     /// stored twice reversed, removed, a corner moved to another vertex), on one thread and split.
@@ -691,6 +626,88 @@ mod tests {
         }
         // Both answers were met: proofs and failures.
         assert!(found[0] > 100 && found[1] > 100, "{found:?}");
+    }
+
+    /// Short buckets and polygons against the full analysis: 2,000 soups of tetrahedra and cubes of
+    /// quads (some quads split in two, some cubes sharing a corner with the one before), faces in a
+    /// mixed order, changed at random (a face reversed, stored twice, stored twice reversed,
+    /// removed, a corner moved to another vertex, a corner repeated), on one thread and split.
+    #[test]
+    fn the_proof_is_what_the_full_analysis_finds() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("pool");
+        let cube: [[u32; 4]; 6] = [
+            [0, 3, 2, 1],
+            [4, 5, 6, 7],
+            [0, 1, 5, 4],
+            [1, 2, 6, 5],
+            [2, 3, 7, 6],
+            [3, 0, 4, 7],
+        ];
+        let mut rng = 0x00c0_ffee_u64;
+        let mut rand = |n: usize| crate::xorshift(&mut rng) as usize % n;
+        let mut found = [0usize; 2];
+        for trial in 0..2_000 {
+            let mut v: Vec<Vec<u32>> = Vec::new();
+            let mut next = 0u32;
+            for _ in 0..=rand(6) {
+                if rand(2) == 0 {
+                    v.extend(TET.iter().map(|f| f.map(|x| x + next).to_vec()));
+                    next += 4;
+                } else {
+                    // Every other cube shares its first corner with the last vertex before it.
+                    let shared = next > 0 && rand(2) == 0;
+                    let at = |x: u32| if x == 0 && shared { next - 1 } else { x + next };
+                    for q in cube {
+                        let q = q.map(at);
+                        if rand(3) == 0 {
+                            v.extend([vec![q[0], q[1], q[2]], vec![q[0], q[2], q[3]]]);
+                        } else {
+                            v.push(q.to_vec());
+                        }
+                    }
+                    next += 8;
+                }
+            }
+            let m = v.len();
+            let step = [1, 7, 13][trial % 3];
+            if m % step != 0 {
+                v = (0..m).map(|i| v[(i * step) % m].clone()).collect();
+            }
+            for _ in 0..rand(3) {
+                let f = rand(v.len());
+                let k = rand(v[f].len());
+                match rand(6) {
+                    0 => v[f].reverse(),
+                    1 => v.push(v[f].clone()),
+                    2 => v.push(v[f].iter().rev().copied().collect()),
+                    3 => drop(v.remove(f)),
+                    4 => v[f][k] = rand(next as usize) as u32,
+                    _ => {
+                        let c = v[f][k];
+                        v[f].insert(k, c);
+                    }
+                }
+                if v.is_empty() {
+                    break;
+                }
+            }
+            if v.is_empty() {
+                continue;
+            }
+            let f = faces(&v);
+            let full = edge_analysis(&f);
+            let want = (full.boundary == 0 && full.nonmanifold == 0 && full.inconsistent == 0)
+                .then(|| components(v.len(), &full.pairs));
+            found[usize::from(want.is_some())] += 1;
+            assert_eq!(closed_consistent(&f), want, "trial {trial}: {v:?}");
+            let nv = next as usize;
+            assert_eq!(pool.install(|| closed_consistent_split(&f, nv)), want, "trial {trial}: {v:?}");
+        }
+        // Both answers were met: proofs and failures.
+        assert!(found[0] > 300 && found[1] > 300, "{found:?}");
     }
 
     #[test]
