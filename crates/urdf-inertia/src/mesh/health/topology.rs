@@ -148,7 +148,7 @@ pub(super) fn grouped<T: Copy + Default>(
 /// face is the twin's. Faces are joined as twins are found (union-find), so no list of face pairs is
 /// built. Buckets of (end, face) pairs searched at the other end, as before, took 8 bytes a
 /// half-edge: at 1.3 M faces the corners take 15.6 MB of fresh memory less, the peak 89 → 74 MB on
-/// one thread (figures: docs/benchmarks.md, "One thread against two").
+/// one thread (figures: docs/benchmarks.md, "Peak memory against file size, every format").
 pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
     let n = *faces.indices.iter().max()? as usize + 1;
     let (ends, corners) = corners_by_vertex(faces, n);
@@ -164,9 +164,9 @@ pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
 }
 
 /// Corner numbers bucketed by their vertex (a counting sort), in corner order within a bucket:
-/// after the fill, u's corners are `out[ends[u - 1]..ends[u]]` (from 0 for u = 0). Out of line:
-/// inlined into [`closed_consistent`] the two cost one thread more instructions (figures:
-/// docs/benchmarks.md, "One thread against two").
+/// after the fill, u's corners are `out[ends[u - 1]..ends[u]]` (from 0 for u = 0). Out of line, as
+/// the half-edge buckets it replaced were: inlined into [`closed_consistent`], those cost one
+/// thread more instructions (figures: docs/benchmarks.md, "One thread against two").
 #[inline(never)]
 fn corners_by_vertex(faces: &Polygons, n: usize) -> (Vec<u32>, Vec<u32>) {
     let idx = &faces.indices;
