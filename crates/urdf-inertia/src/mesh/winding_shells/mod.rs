@@ -598,6 +598,17 @@ fn copied(copies: &Polygons, clusters: &Clusters, relevant: &[bool]) -> Vec<(usi
 
 /// Per face: whether it is `stored`'s face at the same place turned round.
 fn turned_round(faces: &Polygons, stored: &Polygons) -> Vec<bool> {
+    // Face for face (faces added after the stored ones, such as caps, have no stored orientation):
+    // a stored orientation of other faces would count faces of other shells as turned (sweep case
+    // 49295, `health/closed.rs`'s `stored_orientation`).
+    debug_assert!(
+        stored.len() <= faces.len()
+            && (0..stored.len()).all(|i| {
+                let (f, s) = (faces.face(i), stored.face(i));
+                f == s || f.iter().eq(s.iter().rev())
+            }),
+        "the stored orientation is not the classified faces' own"
+    );
     (0..faces.len())
         .map(|i| {
             i < stored.len() && {
