@@ -51,6 +51,9 @@ pub(super) struct Grid {
     /// The box of each entry of `items`, beside it: a ray or a box query rejects most entries by
     /// their boxes, and reading them in cell order is cheaper than looking each triangle up.
     item_boxes: Vec<Aabb>,
+    /// Per cell, for a row along x and one along y: the entries of the cells before it in its row
+    /// ([`Grid::row_entries`]; a row along z is a run of consecutive cells, counted from `start`).
+    row_before: Vec<[u32; 2]>,
     /// The box of every triangle in the grid.
     pub(super) bounds: Aabb,
 }
@@ -143,6 +146,7 @@ impl Grid {
                 start: Vec::new(),
                 items: Vec::new(),
                 item_boxes: Vec::new(),
+                row_before: Vec::new(),
                 bounds,
             }
         };
@@ -200,6 +204,19 @@ impl Grid {
             item_boxes[fill[c] as usize] = boxes[i];
             fill[c] += 1;
         });
+        let [_, d1, d2] = dims;
+        let mut row_before = vec![[0u32; 2]; cells];
+        for c in 0..cells {
+            // The cell before `c` along x, then along y, when there is one.
+            for (k, back) in [(0, d1 * d2), (1, d2)] {
+                let first_in_row = if k == 0 { c < back } else { (c / d2) % d1 == 0 };
+                if !first_in_row {
+                    let b = c - back;
+                    row_before[c][k] = row_before[b][k] + (count[b + 1] - count[b]);
+                }
+            }
+        }
+        grid.row_before = row_before;
         grid.start = count;
         grid.items = items;
         grid.item_boxes = item_boxes;
@@ -324,12 +341,16 @@ impl Grid {
         if stride == 1 {
             return (self.start[first + cells.end] - self.start[first + cells.start]) as usize;
         }
-        cells
-            .map(|i| {
-                let c = first + i * stride;
-                (self.start[c + 1] - self.start[c]) as usize
-            })
-            .sum()
+        // The entries of the row's cells before its `i`-th, for `i` up to the row's length.
+        let before = |i: usize| {
+            if i < self.dims[axis] {
+                self.row_before[first + i * stride][axis]
+            } else {
+                let c = first + (i - 1) * stride;
+                self.row_before[c][axis] + (self.start[c + 1] - self.start[c])
+            }
+        };
+        (before(cells.end) - before(cells.start)) as usize
     }
 
     /// The cells a ray from `p` along `sign`·e_`axis` passes, from `p`'s to the grid's end: cell
