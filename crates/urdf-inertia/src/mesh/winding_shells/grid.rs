@@ -106,6 +106,23 @@ impl<O: Iterator<Item = std::ops::Range<usize>>, M: Iterator<Item = std::ops::Ra
     }
 }
 
+/// [`Grid::row_before`] of a grid of `dims` cells whose entries start at `start`.
+fn rows_before([_, d1, d2]: [usize; 3], start: &[u32]) -> Vec<[u32; 2]> {
+    let cells = start.len() - 1;
+    let mut row_before = vec![[0u32; 2]; cells];
+    for c in 0..cells {
+        // The cell before `c` along x, then along y, when there is one.
+        for (k, back) in [(0, d1 * d2), (1, d2)] {
+            let first_in_row = if k == 0 { c < back } else { (c / d2) % d1 == 0 };
+            if !first_in_row {
+                let b = c - back;
+                row_before[c][k] = row_before[b][k] + (start[b + 1] - start[b]);
+            }
+        }
+    }
+    row_before
+}
+
 /// What an axis-parallel segment does at a triangle.
 pub(super) enum Crossing {
     Miss,
@@ -204,19 +221,7 @@ impl Grid {
             item_boxes[fill[c] as usize] = boxes[i];
             fill[c] += 1;
         });
-        let [_, d1, d2] = dims;
-        let mut row_before = vec![[0u32; 2]; cells];
-        for c in 0..cells {
-            // The cell before `c` along x, then along y, when there is one.
-            for (k, back) in [(0, d1 * d2), (1, d2)] {
-                let first_in_row = if k == 0 { c < back } else { (c / d2) % d1 == 0 };
-                if !first_in_row {
-                    let b = c - back;
-                    row_before[c][k] = row_before[b][k] + (count[b + 1] - count[b]);
-                }
-            }
-        }
-        grid.row_before = row_before;
+        grid.row_before = rows_before(dims, &count);
         grid.start = count;
         grid.items = items;
         grid.item_boxes = item_boxes;
