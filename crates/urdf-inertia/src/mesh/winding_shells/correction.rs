@@ -1070,8 +1070,8 @@ impl Faces<'_> {
         self.grid.overlapping(&b, None, seen, &mut near);
         near.iter().all(|&u| {
             let plane = &self.planes[u as usize];
-            let corners = self.corners[u as usize];
-            let meets = |(s, e): ([f64; 3], [f64; 3])| edge_meets(s, e, plane.side(s), plane.side(e), &corners);
+            let corners = &self.corners[u as usize];
+            let meets = |(s, e): ([f64; 3], [f64; 3])| edge_meets(s, e, plane.side(s), plane.side(e), corners);
             (but.contains(&u) || !meets((p, q))) && (u == but[0] || starts.clone().all(|&s| !meets(s)))
         })
     }

@@ -51,6 +51,9 @@ pub(super) struct Grid {
     /// The box of each entry of `items`, beside it: a ray or a box query rejects most entries by
     /// their boxes, and reading them in cell order is cheaper than looking each triangle up.
     item_boxes: Vec<Aabb>,
+    /// Per cell, for a row along x and one along y: the entries of the cells before it in its row
+    /// ([`Grid::row_entries`]; a row along z is a run of consecutive cells, counted from `start`).
+    row_before: Vec<[u32; 2]>,
     /// The box of every triangle in the grid.
     pub(super) bounds: Aabb,
 }
@@ -84,6 +87,40 @@ impl Seen {
         *m = self.round;
         new
     }
+}
+
+/// One range of entries or many, as one iterator ([`Grid::winding_along`]).
+enum Either<O, M> {
+    One(O),
+    Many(M),
+}
+
+impl<O: Iterator<Item = std::ops::Range<usize>>, M: Iterator<Item = std::ops::Range<usize>>> Iterator for Either<O, M> {
+    type Item = std::ops::Range<usize>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        match self {
+            Either::One(o) => o.next(),
+            Either::Many(m) => m.next(),
+        }
+    }
+}
+
+/// [`Grid::row_before`] of a grid of `dims` cells whose entries start at `start`.
+fn rows_before([_, d1, d2]: [usize; 3], start: &[u32]) -> Vec<[u32; 2]> {
+    let cells = start.len() - 1;
+    let mut row_before = vec![[0u32; 2]; cells];
+    for c in 0..cells {
+        // The cell before `c` along x, then along y, when there is one.
+        for (k, back) in [(0, d1 * d2), (1, d2)] {
+            let first_in_row = if k == 0 { c < back } else { (c / d2) % d1 == 0 };
+            if !first_in_row {
+                let b = c - back;
+                row_before[c][k] = row_before[b][k] + (start[b + 1] - start[b]);
+            }
+        }
+    }
+    row_before
 }
 
 /// What an axis-parallel segment does at a triangle.
@@ -126,6 +163,7 @@ impl Grid {
                 start: Vec::new(),
                 items: Vec::new(),
                 item_boxes: Vec::new(),
+                row_before: Vec::new(),
                 bounds,
             }
         };
@@ -183,6 +221,7 @@ impl Grid {
             item_boxes[fill[c] as usize] = boxes[i];
             fill[c] += 1;
         });
+        grid.row_before = rows_before(dims, &count);
         grid.start = count;
         grid.items = items;
         grid.item_boxes = item_boxes;
@@ -307,12 +346,16 @@ impl Grid {
         if stride == 1 {
             return (self.start[first + cells.end] - self.start[first + cells.start]) as usize;
         }
-        cells
-            .map(|i| {
-                let c = first + i * stride;
-                (self.start[c + 1] - self.start[c]) as usize
-            })
-            .sum()
+        // The entries of the row's cells before its `i`-th, for `i` up to the row's length.
+        let before = |i: usize| {
+            if i < self.dims[axis] {
+                self.row_before[first + i * stride][axis]
+            } else {
+                let c = first + (i - 1) * stride;
+                self.row_before[c][axis] + (self.start[c + 1] - self.start[c])
+            }
+        };
+        (before(cells.end) - before(cells.start)) as usize
     }
 
     /// The cells a ray from `p` along `sign`·e_`axis` passes, from `p`'s to the grid's end: cell
@@ -339,52 +382,78 @@ impl Grid {
     /// begin (seen from `p`) no further along `axis` than `near`'s coordinate are listed there.
     pub(super) fn winding(
         &self,
-        (corners, planes): (&[Corners], &[Plane]),
+        tris: (&[Corners], &[Plane]),
         p: [f64; 3],
         axis: usize,
+        sign: f64,
+        skip: &[u32],
+        seen: &mut Seen,
+        near: Option<(f64, &mut Vec<u32>)>,
+    ) -> Option<i64> {
+        // One loop per axis and way, so that the box test compares fixed fields.
+        match (axis, sign > 0.0) {
+            (0, true) => self.winding_along::<0, true>(tris, p, sign, skip, seen, near),
+            (0, false) => self.winding_along::<0, false>(tris, p, sign, skip, seen, near),
+            (1, true) => self.winding_along::<1, true>(tris, p, sign, skip, seen, near),
+            (1, false) => self.winding_along::<1, false>(tris, p, sign, skip, seen, near),
+            (_, true) => self.winding_along::<2, true>(tris, p, sign, skip, seen, near),
+            (_, false) => self.winding_along::<2, false>(tris, p, sign, skip, seen, near),
+        }
+    }
+
+    /// [`Grid::winding`] along `sign`·e_`A`, `UP` whether `sign` > 0.
+    fn winding_along<const A: usize, const UP: bool>(
+        &self,
+        (corners, planes): (&[Corners], &[Plane]),
+        p: [f64; 3],
         sign: f64,
         skip: &[u32],
         seen: &mut Seen,
         mut near: Option<(f64, &mut Vec<u32>)>,
     ) -> Option<i64> {
         let mut end = p;
-        let margin = self.cell[axis];
-        end[axis] = if sign > 0.0 {
-            self.bounds.hi[axis].max(p[axis]) + margin
+        let margin = self.cell[A];
+        end[A] = if UP {
+            self.bounds.hi[A].max(p[A]) + margin
         } else {
-            self.bounds.lo[axis].min(p[axis]) - margin
+            self.bounds.lo[A].min(p[A]) - margin
         };
         seen.next();
-        // The ray's box: its start's point on the other two axes, from its start on along `axis`.
-        let (mut lo, mut hi) = (p, p);
-        if sign > 0.0 {
-            hi[axis] = f64::INFINITY;
-        } else {
-            lo[axis] = f64::NEG_INFINITY;
-        }
         // The row of cells from the start's on, in either order: which triangles the ray meets,
-        // and whether one of them only touches it, do not depend on the order.
-        let (first, stride, cells) = self.row(p, axis, sign);
-        let (j, l) = ((axis + 1) % 3, (axis + 2) % 3);
+        // and whether one of them only touches it, do not depend on the order. Along z the row's
+        // cells are consecutive, and so are their entries.
+        let (first, stride, cells) = self.row(p, A, sign);
+        let runs = if stride == 1 {
+            let run = self.start[first + cells.start] as usize..self.start[first + cells.end] as usize;
+            Either::One(std::iter::once(run))
+        } else {
+            Either::Many(cells.map(move |ck| {
+                let c = first + ck * stride;
+                self.start[c] as usize..self.start[c + 1] as usize
+            }))
+        };
+        let (j, l) = ((A + 1) % 3, (A + 2) % 3);
+        let (pj, pl, pa) = (p[j], p[l], p[A]);
         let mut w = 0;
-        for ck in cells {
-            let (items, boxes) = self.cell_items(first + ck * stride);
-            for (&i, b) in items.iter().zip(boxes) {
+        for run in runs {
+            let items = &self.items[run.clone()];
+            for (k, b) in self.item_boxes[run].iter().enumerate() {
                 // A triangle whose box misses the ray's line, or lies wholly behind its start, is
                 // missed (exact comparisons; a NaN corner is not rejected here). The line first:
-                // most boxes of the row miss it; along `axis` only the start's side can reject.
-                if b.hi[j] < p[j] || b.lo[j] > p[j] || b.hi[l] < p[l] || b.lo[l] > p[l] || b.hi[axis] < lo[axis] || b.lo[axis] > hi[axis] {
+                // most boxes of the row miss it; along `A` only the start's side can reject.
+                if b.hi[j] < pj || b.lo[j] > pj || b.hi[l] < pl || b.lo[l] > pl || (UP && b.hi[A] < pa) || (!UP && b.lo[A] > pa) {
                     continue;
                 }
+                let i = items[k];
                 if skip.contains(&i) || !seen.first(i) {
                     continue;
                 }
-                match crossing(p, end, axis, &corners[i as usize], &planes[i as usize]) {
+                match crossing(p, end, A, &corners[i as usize], &planes[i as usize]) {
                     Crossing::Miss => {}
                     Crossing::Through(d) => {
                         w += d;
                         if let Some((reach, list)) = near.as_mut() {
-                            if (sign > 0.0 && b.lo[axis] <= *reach) || (sign < 0.0 && b.hi[axis] >= *reach) {
+                            if (sign > 0.0 && b.lo[A] <= *reach) || (sign < 0.0 && b.hi[A] >= *reach) {
                                 list.push(i);
                             }
                         }
@@ -597,6 +666,13 @@ impl Plane {
         if det > errbound || -det > errbound {
             return -det;
         }
+        self.exact_side(d)
+    }
+
+    /// [`Plane::side`] where the filter cannot certify the sign: the crate's exact `orient3d`, out
+    /// of line, so that the callers' inlined filter stays small (its value is unchanged).
+    #[inline(never)]
+    fn exact_side(&self, d: [f64; 3]) -> f64 {
         robust::orient3d(c3(self.a), c3(self.b), c3(self.c), c3(d))
     }
 }
@@ -615,7 +691,12 @@ pub(super) fn crossing(s: [f64; 3], e: [f64; 3], axis: usize, t: &Corners, plane
     let (j, l) = ((axis + 1) % 3, (axis + 2) % 3);
     let p2 = |x: [f64; 3]| Coord { x: x[j], y: x[l] };
     let (a, b, c, sp) = (p2(t[0]), p2(t[1]), p2(t[2]), p2(s));
-    let q = [orient2d(a, b, sp), orient2d(b, c, sp), orient2d(c, a, sp)];
+    // Two of the three signs apart already mean a miss: the third is then not asked.
+    let (q0, q1) = (orient2d(a, b, sp), orient2d(b, c, sp));
+    if (q0 > 0.0 && q1 < 0.0) || (q0 < 0.0 && q1 > 0.0) {
+        return Crossing::Miss;
+    }
+    let q = [q0, q1, orient2d(c, a, sp)];
     if q.iter().any(|x| *x > 0.0) && q.iter().any(|x| *x < 0.0) {
         return Crossing::Miss;
     }

@@ -1115,6 +1115,10 @@ pub(super) fn corners_touch(
 
 /// Whether the closed segment `s e` meets the closed triangle `t` (coplanar: yes, conservatively),
 /// given `s`'s and `e`'s sides of `t`'s plane (`orient3d` of `t`'s corners and each).
+///
+/// Inlined: most segments have both ends on one side and end here, before any copy of the corners;
+/// the rest go on in [`edge_crosses`].
+#[inline(always)]
 pub(super) fn edge_meets(s: [f64; 3], e: [f64; 3], o1: f64, o2: f64, t: &[[f64; 3]; 3]) -> bool {
     if (o1 > 0.0 && o2 > 0.0) || (o1 < 0.0 && o2 < 0.0) {
         return false;
@@ -1122,6 +1126,13 @@ pub(super) fn edge_meets(s: [f64; 3], e: [f64; 3], o1: f64, o2: f64, t: &[[f64; 
     if o1 == 0.0 && o2 == 0.0 {
         return true;
     }
+    edge_crosses(&s, &e, t)
+}
+
+/// [`edge_meets`] of a segment whose ends are not both on one side of `t`'s plane, nor both in it.
+#[inline(never)]
+fn edge_crosses(s: &[f64; 3], e: &[f64; 3], t: &[[f64; 3]; 3]) -> bool {
+    let (s, e) = (*s, *e);
     let (a, b, c) = (c3(t[0]), c3(t[1]), c3(t[2]));
     let (cs, ce) = (c3(s), c3(e));
     // The line passes beside the triangle when two of its edges see it on opposite sides: the
