@@ -521,6 +521,9 @@ mod tests {
     /// A tetrahedron wound outward (every edge traversed once each way), and the same offset by 4.
     const TET: [[u32; 3]; 4] = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
 
+    /// A cube of six quads wound outward.
+    const CUBE: [[u32; 4]; 6] = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]];
+
     fn tets(n: u32) -> Vec<Vec<u32>> {
         (0..n)
             .flat_map(|t| TET.iter().map(move |f| f.map(|v| v + 4 * t).to_vec()))
@@ -638,14 +641,6 @@ mod tests {
             .num_threads(2)
             .build()
             .expect("pool");
-        let cube: [[u32; 4]; 6] = [
-            [0, 3, 2, 1],
-            [4, 5, 6, 7],
-            [0, 1, 5, 4],
-            [1, 2, 6, 5],
-            [2, 3, 7, 6],
-            [3, 0, 4, 7],
-        ];
         let mut rng = 0x00c0_ffee_u64;
         let mut rand = |n: usize| crate::xorshift(&mut rng) as usize % n;
         let mut found = [0usize; 2];
@@ -660,7 +655,7 @@ mod tests {
                     // Every other cube shares its first corner with the last vertex before it.
                     let shared = next > 0 && rand(2) == 0;
                     let at = |x: u32| if x == 0 && shared { next - 1 } else { x + next };
-                    for q in cube {
+                    for q in CUBE {
                         let q = q.map(at);
                         if rand(3) == 0 {
                             v.extend([vec![q[0], q[1], q[2]], vec![q[0], q[2], q[3]]]);
@@ -743,17 +738,9 @@ mod tests {
         v[n - 1].reverse();
         assert_eq!(pool.install(|| closed_consistent_split(&faces(&v), 80_000)), None);
         // Quads and triangles: cubes of six quads, every other one with a face split in two.
-        let cube: [[u32; 4]; 6] = [
-            [0, 3, 2, 1],
-            [4, 5, 6, 7],
-            [0, 1, 5, 4],
-            [1, 2, 6, 5],
-            [2, 3, 7, 6],
-            [3, 0, 4, 7],
-        ];
         let mut cubes: Vec<Vec<u32>> = Vec::new();
         for c in 0..10_000u32 {
-            for (k, q) in cube.iter().enumerate() {
+            for (k, q) in CUBE.iter().enumerate() {
                 let q = q.map(|v| v + 8 * c);
                 if k == 1 && c % 2 == 1 {
                     cubes.extend([vec![q[0], q[1], q[2]], vec![q[0], q[2], q[3]]]);
