@@ -265,3 +265,77 @@ fn boxes_covering_part_of_a_face() {
         assert_estimate_at_most(&s, 1e-11);
     }
 }
+
+/// Known, not fixed (docs/accuracy.md, "Known, not fixed: a lone closed shell that cuts itself"): a
+/// square bar bent four times whose last leg passes through its first, stored as one closed,
+/// consistently wound shell (every edge shared once each way). w is 2 in the unit cube where the
+/// legs cross, so the stored integral ∫w is 20 m³ where Ω is 19 m³, and the estimate is the
+/// round-off of a clean mesh (1.1e-14). Finding where one shell meets itself is a test of every
+/// pair of its triangles whose boxes overlap, which clean meshes do not pay; run with `--ignored` to
+/// see the failure.
+#[test]
+#[ignore = "known: a lone closed shell through itself is integrated as ∫w (docs/accuracy.md)"]
+fn a_bar_through_itself_counts_the_crossing_once() {
+    // Mitred corners of a bar of side 1 along (0,0) → (6,0) → (6,4) → (3,4) → (3,−3) at z = 0.
+    let path = [[0.0, 0.0], [6.0, 0.0], [6.0, 4.0], [3.0, 4.0], [3.0, -3.0]];
+    let mut vertices = Vec::new();
+    for (i, p) in path.iter().enumerate() {
+        let left = |a: &[f64; 2], b: &[f64; 2]| {
+            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+            let l = dx.hypot(dy);
+            [-dy / l, dx / l]
+        };
+        let n = match i {
+            0 => left(&path[0], &path[1]),
+            4 => left(&path[3], &path[4]),
+            _ => {
+                let (a, b) = (left(&path[i - 1], p), left(p, &path[i + 1]));
+                [a[0] + b[0], a[1] + b[1]]
+            }
+        };
+        let (x, y) = (p[0], p[1]);
+        vertices.extend([
+            [x + 0.5 * n[0], y + 0.5 * n[1], -0.5],
+            [x - 0.5 * n[0], y - 0.5 * n[1], -0.5],
+            [x - 0.5 * n[0], y - 0.5 * n[1], 0.5],
+            [x + 0.5 * n[0], y + 0.5 * n[1], 0.5],
+        ]);
+    }
+    let mut faces = Vec::new();
+    for s in 0..4u32 {
+        for k in 0..4 {
+            let (a, b) = (4 * s, 4 * (s + 1));
+            let k2 = (k + 1) % 4;
+            faces.extend([[a + k, a + k2, b + k2], [a + k, b + k2, b + k]]);
+        }
+    }
+    faces.extend([[3, 2, 1], [3, 1, 0], [16, 17, 18], [16, 18, 19]]);
+    // Wound outward (the rings above run the other way round).
+    for f in &mut faces {
+        f.swap(1, 2);
+    }
+    let bar: Mesh = (vertices, faces);
+    let s = solid(&bar);
+    // Ω as boxes: the four legs, less the four unit cubes two of them share (corners and crossing).
+    let z = (-0.5, 0.5);
+    let b = |x: (f64, f64), y: (f64, f64)| common::box_at([x.0, y.0, z.0], [x.1, y.1, z.1]);
+    let legs = [
+        b((0.0, 6.5), (-0.5, 0.5)),
+        b((5.5, 6.5), (-0.5, 4.5)),
+        b((2.5, 6.5), (3.5, 4.5)),
+        b((2.5, 3.5), (-3.0, 4.5)),
+    ];
+    let shared = [
+        b((5.5, 6.5), (-0.5, 0.5)),
+        b((5.5, 6.5), (3.5, 4.5)),
+        b((2.5, 3.5), (3.5, 4.5)),
+        b((2.5, 3.5), (-0.5, 0.5)),
+    ];
+    let terms: Vec<(i32, &Mesh)> = legs
+        .iter()
+        .map(|m| (1, m))
+        .chain(shared.iter().map(|m| (-1, m)))
+        .collect();
+    let exact = exact_sum(&terms);
+    within_estimate("a bar through itself", &s, &exact);
+}
