@@ -153,13 +153,8 @@ pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
     let n = *faces.indices.iter().max()? as usize + 1;
     let (ends, corners) = corners_by_vertex(faces, n);
     let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
-    let get = |i: usize| corners[i];
-    let paired = if faces.all_triangles() {
-        decide(&ends, get, 0..n, triangle_ring(&faces.indices), &mut parent)
-    } else {
-        let face_of = corner_faces(faces);
-        decide(&ends, get, 0..n, polygon_ring(faces, &face_of), &mut parent)
-    }?;
+    let face_of = (!faces.all_triangles()).then(|| corner_faces(faces));
+    let paired = decide_faces(faces, face_of.as_deref(), (&ends, |i| corners[i]), 0..n, &mut parent)?;
     (2 * paired == faces.indices.len()).then(|| label(parent))
 }
 
@@ -196,6 +191,22 @@ fn corner_faces(faces: &Polygons) -> Vec<u32> {
         face_of[w[0] as usize..w[1] as usize].fill(f as u32);
     }
     face_of
+}
+
+/// [`decide`] with the ring of `faces`' corners: a triangle's from its corner number, a polygon's
+/// through `face_of` ([`corner_faces`], `None` when every face is a triangle).
+#[inline(always)]
+fn decide_faces(
+    faces: &Polygons,
+    face_of: Option<&[u32]>,
+    (ends, get): (&[u32], impl Fn(usize) -> u32),
+    vertices: std::ops::Range<usize>,
+    parent: &mut [u32],
+) -> Option<usize> {
+    match face_of {
+        None => decide(ends, get, vertices, triangle_ring(&faces.indices), parent),
+        Some(fo) => decide(ends, get, vertices, polygon_ring(faces, fo), parent),
+    }
 }
 
 /// A triangle corner's face, the vertex after it and the vertex before it.
@@ -357,15 +368,9 @@ pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec
     let (a, b) = rayon::join(
         || {
             (parent.iter_mut().zip(0..)).for_each(|(p, f)| *p = f);
-            match &face_of {
-                None => decide(ends, get, 0..mid, triangle_ring(&faces.indices), &mut parent),
-                Some(fo) => decide(ends, get, 0..mid, polygon_ring(faces, fo), &mut parent),
-            }
+            decide_faces(faces, face_of.as_deref(), (ends, get), 0..mid, &mut parent)
         },
-        || match &face_of {
-            None => decide(ends, get, mid..n, triangle_ring(&faces.indices), &mut other),
-            Some(fo) => decide(ends, get, mid..n, polygon_ring(faces, fo), &mut other),
-        },
+        || decide_faces(faces, face_of.as_deref(), (ends, get), mid..n, &mut other),
     );
     let paired = a? + b?;
     // A forest's links span its sets: joining each face to its parent in `other` joins them all.

@@ -1,6 +1,7 @@
 //! A uniform grid of triangles: which triangles may meet a box, and the winding number in front of a
 //! point on a face, counted by exact crossings (`orient3d`) of an axis-parallel ray.
 
+use either::Either;
 use crate::geometry::{cross, dot, sub, Aabb};
 use robust::{orient2d, Coord, Coord3D};
 
@@ -86,23 +87,6 @@ impl Seen {
         let new = *m != self.round;
         *m = self.round;
         new
-    }
-}
-
-/// One range of entries or many, as one iterator ([`Grid::winding_along`]).
-enum Either<O, M> {
-    One(O),
-    Many(M),
-}
-
-impl<O: Iterator<Item = std::ops::Range<usize>>, M: Iterator<Item = std::ops::Range<usize>>> Iterator for Either<O, M> {
-    type Item = std::ops::Range<usize>;
-
-    fn next(&mut self) -> Option<Self::Item> {
-        match self {
-            Either::One(o) => o.next(),
-            Either::Many(m) => m.next(),
-        }
     }
 }
 
@@ -425,9 +409,9 @@ impl Grid {
         let (first, stride, cells) = self.row(p, A, sign);
         let runs = if stride == 1 {
             let run = self.start[first + cells.start] as usize..self.start[first + cells.end] as usize;
-            Either::One(std::iter::once(run))
+            Either::Left(std::iter::once(run))
         } else {
-            Either::Many(cells.map(move |ck| {
+            Either::Right(cells.map(move |ck| {
                 let c = first + ck * stride;
                 self.start[c] as usize..self.start[c + 1] as usize
             }))
