@@ -95,6 +95,9 @@ pub struct ShellOutcome {
     pub turned_back: usize,
     /// Faces of cancelling pairs (walls of no thickness) put back to decide the shells.
     pub walls_restored: usize,
+    /// Shells with a wall put back among their faces turned round or dropped whole (by their
+    /// nesting, not face by face): see [`classify`].
+    pub wall_shells_changed_whole: usize,
     pub cracks_welded: bool,
     /// Faces the ladder turned round, in all (where shells were decided face by face): when
     /// `turned_back` is all of them, the ladder's orientation enters the solid nowhere.
@@ -144,16 +147,25 @@ struct Shell {
 /// edges balance only so, with the faces the ladder turned round turned back (`stored.faces`).
 pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> ShellOutcome {
     if stored.pairs.is_empty() || faces.len() != stored.faces.len() {
-        return classify_faces(vertices, faces, stored);
+        return classify_faces(vertices, faces, stored, faces.len());
     }
     // The walls put back, at the end of both lists (so that the faces stay aligned with their
     // stored orientation): the bodies they separate become shells of their own, open along the
     // walls' rims, whose clusters balance and are decided face by face. That answer is taken where
-    // it decided faces so and turned or dropped the same shells as the classification without the
-    // walls: pieces of a wall can also make shells closed up to cracks that nesting would turn on
-    // their own, leaving the wall's other faces as they were (sweep case 4137: 1.9e-8 off under
-    // 1.3e-8). Otherwise the faces are classified without the pairs (which cancel).
-    let without = classify_faces(vertices, faces, &AsStored { pairs: Polygons::new(), ..stored.clone() });
+    // it decided faces so, unless a shell with a wall among its faces was turned or dropped whole
+    // and the answer without the walls turned or dropped other shells: pieces of a wall can also
+    // make shells closed up to cracks that nesting would turn on their own, leaving the wall's other
+    // faces as they were (sweep case 4137: 1.9e-8 off under 1.3e-8). Shells without a wall may be
+    // dropped whole in one answer and decided face by face in the other, both right (sweep case
+    // 63171: a small prism inside one of two that cut each other over a dropped wall, whose answer
+    // was refused for it until session 44). Otherwise the faces are classified without the pairs
+    // (which cancel).
+    let without = classify_faces(
+        vertices,
+        faces,
+        &AsStored { pairs: Polygons::new(), ..stored.clone() },
+        faces.len(),
+    );
     let mut with = faces.clone();
     let mut stored_with = stored.clone();
     for face in stored.pairs.iter() {
@@ -161,10 +173,10 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
         stored_with.faces.push(face);
     }
     stored_with.pairs = Polygons::new();
-    let mut out = classify_faces(vertices, &with, &stored_with);
+    let mut out = classify_faces(vertices, &with, &stored_with, faces.len());
     let decided = out.resolved_pairs > 0 || out.copies_restored > 0;
     let same = (out.turned_shells, out.dropped_shells) == (without.turned_shells, without.dropped_shells);
-    if decided && same {
+    if decided && (same || out.wall_shells_changed_whole == 0) {
         out.walls_restored = stored.pairs.len();
         return out;
     }
@@ -181,7 +193,9 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
     without
 }
 
-fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> ShellOutcome {
+/// `walls`: the first face that is a wall put back (`faces.len()` when none is), for
+/// [`ShellOutcome::wall_shells_changed_whole`].
+fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored, walls: usize) -> ShellOutcome {
     let (shells, uses) = shells(vertices, faces);
     let unchanged = |undecided_pairs, overlap_bound| ShellOutcome {
         faces: faces.clone(),
@@ -232,11 +246,11 @@ fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) ->
             out.overlap_bound += box_overlap(&shells[a], &shells[b]);
         }
     }
-    let mut keep = vec![true; faces.len()];
-    let mut turn = vec![false; faces.len()];
+    let (mut keep, mut turn) = (vec![true; faces.len()], vec![false; faces.len()]);
     let sign = orient(&shells, &decided, &w_out, &mut keep, &mut turn, &mut out);
     out.changed = out.dropped_shells > 0 || out.turned_shells > 0;
     let resolving = relevant.iter().any(|&r| r);
+    out.wall_shells_changed_whole = changed_whole_with_walls(&shells, &relevant, &sign, walls);
     if resolving {
         for (i, s) in shells.iter().enumerate() {
             if relevant[i] {
@@ -524,6 +538,14 @@ fn orient(
         }
     }
     sign
+}
+
+/// How many shells with a face from `walls` on are turned round or dropped whole (`sign` not 1),
+/// not decided face by face (`relevant`).
+fn changed_whole_with_walls(shells: &[Shell], relevant: &[bool], sign: &[i64], walls: usize) -> usize {
+    (shells.iter().zip(relevant).zip(sign))
+        .filter(|((s, &r), &g)| !r && g != 1 && s.faces.iter().any(|&f| f as usize >= walls))
+        .count()
 }
 
 /// The shells, their triangles, which are decided face by face and their orientation as classified.
