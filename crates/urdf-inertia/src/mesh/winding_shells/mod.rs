@@ -159,13 +159,9 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
     // dropped whole in one answer and decided face by face in the other, both right (sweep case
     // 63171: a small prism inside one of two that cut each other over a dropped wall, whose answer
     // was refused for it until session 44). Otherwise the faces are classified without the pairs
-    // (which cancel).
-    let without = classify_faces(
-        vertices,
-        faces,
-        &AsStored { pairs: Polygons::new(), ..stored.clone() },
-        faces.len(),
-    );
+    // (which cancel). The answer without the walls is found only where it is needed: where the
+    // walls' answer changed a shell with a wall whole (to compare) or decided nothing (to be taken);
+    // each answer decides the overlapping shells face by face, which is most of the cost.
     let mut with = faces.clone();
     let mut stored_with = stored.clone();
     for face in stored.pairs.iter() {
@@ -175,8 +171,18 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
     stored_with.pairs = Polygons::new();
     let mut out = classify_faces(vertices, &with, &stored_with, faces.len());
     let decided = out.resolved_pairs > 0 || out.copies_restored > 0;
+    if decided && out.wall_shells_changed_whole == 0 {
+        out.walls_restored = stored.pairs.len();
+        return out;
+    }
+    let mut without = classify_faces(
+        vertices,
+        faces,
+        &AsStored { pairs: Polygons::new(), ..stored.clone() },
+        faces.len(),
+    );
     let same = (out.turned_shells, out.dropped_shells) == (without.turned_shells, without.dropped_shells);
-    if decided && (same || out.wall_shells_changed_whole == 0) {
+    if decided && same {
         out.walls_restored = stored.pairs.len();
         return out;
     }
@@ -185,7 +191,6 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
     // leaning into each other over a dropped wall, 7.9e-4 off under 6.2e-15). What they may count
     // twice lies in the intersections of the boxes of the pairs that touch or cut, which enter the
     // bound as undecided pairs.
-    let mut without = without;
     if out.resolved_pairs > 0 {
         without.undecided_pairs += out.resolved_pairs;
         without.overlap_bound += out.resolved_box_overlap;
