@@ -95,9 +95,6 @@ pub struct ShellOutcome {
     pub turned_back: usize,
     /// Faces of cancelling pairs (walls of no thickness) put back to decide the shells.
     pub walls_restored: usize,
-    /// Shells with a wall put back among their faces turned round or dropped whole (by their
-    /// nesting, not face by face): see [`classify`].
-    pub wall_shells_changed_whole: usize,
     pub cracks_welded: bool,
     /// Faces the ladder turned round, in all (where shells were decided face by face): when
     /// `turned_back` is all of them, the ladder's orientation enters the solid nowhere.
@@ -147,21 +144,16 @@ struct Shell {
 /// edges balance only so, with the faces the ladder turned round turned back (`stored.faces`).
 pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> ShellOutcome {
     if stored.pairs.is_empty() || faces.len() != stored.faces.len() {
-        return classify_faces(vertices, faces, stored, faces.len());
+        return classify_faces(vertices, faces, stored);
     }
     // The walls put back, at the end of both lists (so that the faces stay aligned with their
     // stored orientation): the bodies they separate become shells of their own, open along the
     // walls' rims, whose clusters balance and are decided face by face. That answer is taken where
-    // it decided faces so, unless a shell with a wall among its faces was turned or dropped whole
-    // and the answer without the walls turned or dropped other shells: pieces of a wall can also
-    // make shells closed up to cracks that nesting would turn on their own, leaving the wall's other
-    // faces as they were (sweep case 4137: 1.9e-8 off under 1.3e-8). Shells without a wall may be
-    // dropped whole in one answer and decided face by face in the other, both right (sweep case
-    // 63171: a small prism inside one of two that cut each other over a dropped wall, whose answer
-    // was refused for it until session 44). Otherwise the faces are classified without the pairs
-    // (which cancel). The answer without the walls is found only where it is needed: where the
-    // walls' answer changed a shell with a wall whole (to compare) or decided nothing (to be taken);
-    // each answer decides the overlapping shells face by face, which is most of the cost.
+    // it decided faces so and turned or dropped the same shells as the classification without the
+    // walls: pieces of a wall can also make shells closed up to cracks that nesting would turn on
+    // their own, leaving the wall's other faces as they were (sweep case 4137: 1.9e-8 off under
+    // 1.3e-8). Otherwise the faces are classified without the pairs (which cancel).
+    let without = classify_faces(vertices, faces, &AsStored { pairs: Polygons::new(), ..stored.clone() });
     let mut with = faces.clone();
     let mut stored_with = stored.clone();
     for face in stored.pairs.iter() {
@@ -169,18 +161,8 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
         stored_with.faces.push(face);
     }
     stored_with.pairs = Polygons::new();
-    let mut out = classify_faces(vertices, &with, &stored_with, faces.len());
+    let mut out = classify_faces(vertices, &with, &stored_with);
     let decided = out.resolved_pairs > 0 || out.copies_restored > 0;
-    if decided && out.wall_shells_changed_whole == 0 {
-        out.walls_restored = stored.pairs.len();
-        return out;
-    }
-    let mut without = classify_faces(
-        vertices,
-        faces,
-        &AsStored { pairs: Polygons::new(), ..stored.clone() },
-        faces.len(),
-    );
     let same = (out.turned_shells, out.dropped_shells) == (without.turned_shells, without.dropped_shells);
     if decided && same {
         out.walls_restored = stored.pairs.len();
@@ -191,6 +173,7 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
     // leaning into each other over a dropped wall, 7.9e-4 off under 6.2e-15). What they may count
     // twice lies in the intersections of the boxes of the pairs that touch or cut, which enter the
     // bound as undecided pairs.
+    let mut without = without;
     if out.resolved_pairs > 0 {
         without.undecided_pairs += out.resolved_pairs;
         without.overlap_bound += out.resolved_box_overlap;
@@ -198,9 +181,7 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
     without
 }
 
-/// `walls`: the first face that is a wall put back (`faces.len()` when none is), for
-/// [`ShellOutcome::wall_shells_changed_whole`].
-fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored, walls: usize) -> ShellOutcome {
+fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> ShellOutcome {
     let (shells, uses) = shells(vertices, faces);
     let unchanged = |undecided_pairs, overlap_bound| ShellOutcome {
         faces: faces.clone(),
@@ -251,11 +232,11 @@ fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored, wa
             out.overlap_bound += box_overlap(&shells[a], &shells[b]);
         }
     }
-    let (mut keep, mut turn) = (vec![true; faces.len()], vec![false; faces.len()]);
+    let mut keep = vec![true; faces.len()];
+    let mut turn = vec![false; faces.len()];
     let sign = orient(&shells, &decided, &w_out, &mut keep, &mut turn, &mut out);
     out.changed = out.dropped_shells > 0 || out.turned_shells > 0;
     let resolving = relevant.iter().any(|&r| r);
-    out.wall_shells_changed_whole = changed_whole_with_walls(&shells, &relevant, &sign, walls);
     if resolving {
         for (i, s) in shells.iter().enumerate() {
             if relevant[i] {
@@ -543,14 +524,6 @@ fn orient(
         }
     }
     sign
-}
-
-/// How many shells with a face from `walls` on are turned round or dropped whole (`sign` not 1),
-/// not decided face by face (`relevant`).
-fn changed_whole_with_walls(shells: &[Shell], relevant: &[bool], sign: &[i64], walls: usize) -> usize {
-    (shells.iter().zip(relevant).zip(sign))
-        .filter(|((s, &r), &g)| !r && g != 1 && s.faces.iter().any(|&f| f as usize >= walls))
-        .count()
 }
 
 /// The shells, their triangles, which are decided face by face and their orientation as classified.
