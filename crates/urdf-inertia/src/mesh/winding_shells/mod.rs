@@ -144,7 +144,7 @@ struct Shell {
 /// edges balance only so, with the faces the ladder turned round turned back (`stored.faces`).
 pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> ShellOutcome {
     if stored.pairs.is_empty() || faces.len() != stored.faces.len() {
-        return classify_faces(vertices, faces, stored);
+        return classify_faces(vertices, faces, stored, true);
     }
     // The walls put back, at the end of both lists (so that the faces stay aligned with their
     // stored orientation): the bodies they separate become shells of their own, open along the
@@ -152,8 +152,9 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
     // it decided faces so and turned or dropped the same shells as the classification without the
     // walls: pieces of a wall can also make shells closed up to cracks that nesting would turn on
     // their own, leaving the wall's other faces as they were (sweep case 4137: 1.9e-8 off under
-    // 1.3e-8). Otherwise the faces are classified without the pairs (which cancel).
-    let without = classify_faces(vertices, faces, &AsStored { pairs: Polygons::new(), ..stored.clone() });
+    // 1.3e-8). Otherwise the faces are classified without the pairs (which cancel). The guard needs
+    // of each answer only what is known before any face is decided (the counts); the face-by-face
+    // decision, most of the cost, is made for the answer taken alone.
     let mut with = faces.clone();
     let mut stored_with = stored.clone();
     for face in stored.pairs.iter() {
@@ -161,27 +162,33 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
         stored_with.faces.push(face);
     }
     stored_with.pairs = Polygons::new();
-    let mut out = classify_faces(vertices, &with, &stored_with);
-    let decided = out.resolved_pairs > 0 || out.copies_restored > 0;
-    let same = (out.turned_shells, out.dropped_shells) == (without.turned_shells, without.dropped_shells);
-    if decided && same {
-        out.walls_restored = stored.pairs.len();
-        return out;
+    let stored_without = AsStored { pairs: Polygons::new(), ..stored.clone() };
+    let counts = classify_faces(vertices, &with, &stored_with, false);
+    if counts.resolved_pairs > 0 || counts.copies_restored > 0 {
+        let other = classify_faces(vertices, faces, &stored_without, false);
+        if (counts.turned_shells, counts.dropped_shells) == (other.turned_shells, other.dropped_shells) {
+            let mut out = classify_faces(vertices, &with, &stored_with, true);
+            out.walls_restored = stored.pairs.len();
+            return out;
+        }
     }
     // Refused: the bodies the walls joined may cut each other, and the answer without the walls
     // integrates such a body as one shell, its own overlap twice (sweep case 63171: two prisms
     // leaning into each other over a dropped wall, 7.9e-4 off under 6.2e-15). What they may count
     // twice lies in the intersections of the boxes of the pairs that touch or cut, which enter the
     // bound as undecided pairs.
-    let mut without = without;
-    if out.resolved_pairs > 0 {
-        without.undecided_pairs += out.resolved_pairs;
-        without.overlap_bound += out.resolved_box_overlap;
+    let mut without = classify_faces(vertices, faces, &stored_without, true);
+    if counts.resolved_pairs > 0 {
+        without.undecided_pairs += counts.resolved_pairs;
+        without.overlap_bound += counts.resolved_box_overlap;
     }
     without
 }
 
-fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> ShellOutcome {
+/// The shells' classification; `decide`: whether the faces of the shells that touch or cut are
+/// decided face by face, or only what comes before (the counts of shells turned and dropped, the
+/// pairs to be decided and the copies put back; [`classify`] compares those).
+fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored, decide: bool) -> ShellOutcome {
     let (shells, uses) = shells(vertices, faces);
     let unchanged = |undecided_pairs, overlap_bound| ShellOutcome {
         faces: faces.clone(),
@@ -219,24 +226,15 @@ fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) ->
     // shells around sealed ones keep their pairs' bounds).
     let (clusters, flip, welded) = clusters(vertices, faces, stored, &shells, (&pairs, &decided), &uses);
     let mut relevant = clusters.relevant.clone();
-    for &(a, b) in &pairs {
-        if decided[a] && decided[b] {
-            continue;
-        }
-        if relevant[a] || (shells[a].sealed && shells[b].sealed) {
-            (relevant[a], relevant[b]) = (true, true);
-            out.resolved_pairs += 1;
-            out.resolved_box_overlap += box_overlap(&shells[a], &shells[b]);
-        } else {
-            out.undecided_pairs += 1;
-            out.overlap_bound += box_overlap(&shells[a], &shells[b]);
-        }
-    }
-    let mut keep = vec![true; faces.len()];
-    let mut turn = vec![false; faces.len()];
+    undecided_pairs(&shells, (&pairs, &decided), &mut relevant, &mut out);
+    let (mut keep, mut turn) = (vec![true; faces.len()], vec![false; faces.len()]);
     let sign = orient(&shells, &decided, &w_out, &mut keep, &mut turn, &mut out);
     out.changed = out.dropped_shells > 0 || out.turned_shells > 0;
     let resolving = relevant.iter().any(|&r| r);
+    if !decide {
+        out.copies_restored = if resolving { copied(&stored.copies, &clusters, &relevant).len() } else { 0 };
+        return out;
+    }
     if resolving {
         for (i, s) in shells.iter().enumerate() {
             if relevant[i] {
@@ -272,6 +270,30 @@ fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) ->
         out.changed |= out.turned_back > 0 || out.copies_restored > 0;
     }
     out
+}
+
+/// Sorts the pairs with an undecided side: decided face by face where a shell of the pair is
+/// `relevant` (its cluster a closed cycle) or both are sealed, which makes both relevant; bounded
+/// otherwise (see [`classify_faces`]).
+fn undecided_pairs(
+    shells: &[Shell],
+    (pairs, decided): (&[(usize, usize)], &[bool]),
+    relevant: &mut [bool],
+    out: &mut ShellOutcome,
+) {
+    for &(a, b) in pairs {
+        if decided[a] && decided[b] {
+            continue;
+        }
+        if relevant[a] || (shells[a].sealed && shells[b].sealed) {
+            (relevant[a], relevant[b]) = (true, true);
+            out.resolved_pairs += 1;
+            out.resolved_box_overlap += box_overlap(&shells[a], &shells[b]);
+        } else {
+            out.undecided_pairs += 1;
+            out.overlap_bound += box_overlap(&shells[a], &shells[b]);
+        }
+    }
 }
 
 /// The surface as the file stores it, where the ladder's repairs changed it: its winding number
