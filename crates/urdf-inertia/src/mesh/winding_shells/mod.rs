@@ -144,7 +144,7 @@ struct Shell {
 /// edges balance only so, with the faces the ladder turned round turned back (`stored.faces`).
 pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> ShellOutcome {
     if stored.pairs.is_empty() || faces.len() != stored.faces.len() {
-        return classify_faces(vertices, faces, stored, true);
+        return classify_faces(vertices, faces, stored);
     }
     // The walls put back, at the end of both lists (so that the faces stay aligned with their
     // stored orientation): the bodies they separate become shells of their own, open along the
@@ -163,32 +163,63 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
     }
     stored_with.pairs = Polygons::new();
     let stored_without = AsStored { pairs: Polygons::new(), ..stored.clone() };
-    let counts = classify_faces(vertices, &with, &stored_with, false);
-    if counts.resolved_pairs > 0 || counts.copies_restored > 0 {
-        let other = classify_faces(vertices, faces, &stored_without, false);
-        if (counts.turned_shells, counts.dropped_shells) == (other.turned_shells, other.dropped_shells) {
-            let mut out = classify_faces(vertices, &with, &stored_with, true);
-            out.walls_restored = stored.pairs.len();
-            return out;
-        }
+    let (with_sorted, without_sorted) = (sort(vertices, &with, &stored_with), sort(vertices, faces, &stored_without));
+    let counts = |r: &Result<Sorted, ShellOutcome>| match r {
+        Ok(s) => (s.out.turned_shells, s.out.dropped_shells, s.out.resolved_pairs, s.out.copies_restored),
+        Err(o) => (o.turned_shells, o.dropped_shells, o.resolved_pairs, o.copies_restored),
+    };
+    let (turned, dropped, resolved, copies) = counts(&with_sorted);
+    let (turned_without, dropped_without, _, _) = counts(&without_sorted);
+    let charge = match &with_sorted {
+        Ok(s) => s.out.resolved_box_overlap,
+        Err(o) => o.resolved_box_overlap,
+    };
+    if (resolved > 0 || copies > 0) && (turned, dropped) == (turned_without, dropped_without) {
+        let mut out = decided(vertices, &with, &stored_with, with_sorted);
+        out.walls_restored = stored.pairs.len();
+        return out;
     }
     // Refused: the bodies the walls joined may cut each other, and the answer without the walls
     // integrates such a body as one shell, its own overlap twice (sweep case 63171: two prisms
     // leaning into each other over a dropped wall, 7.9e-4 off under 6.2e-15). What they may count
     // twice lies in the intersections of the boxes of the pairs that touch or cut, which enter the
     // bound as undecided pairs.
-    let mut without = classify_faces(vertices, faces, &stored_without, true);
-    if counts.resolved_pairs > 0 {
-        without.undecided_pairs += counts.resolved_pairs;
-        without.overlap_bound += counts.resolved_box_overlap;
+    let mut without = decided(vertices, faces, &stored_without, without_sorted);
+    if resolved > 0 {
+        without.undecided_pairs += resolved;
+        without.overlap_bound += charge;
     }
     without
 }
 
-/// The shells' classification; `decide`: whether the faces of the shells that touch or cut are
-/// decided face by face, or only what comes before (the counts of shells turned and dropped, the
-/// pairs to be decided and the copies put back; [`classify`] compares those).
-fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored, decide: bool) -> ShellOutcome {
+/// The shells' classification: [`sort`], then the faces of the shells that touch or cut decided
+/// face by face.
+fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> ShellOutcome {
+    decided(vertices, faces, stored, sort(vertices, faces, stored))
+}
+
+/// What the classification knows before any face is decided: the shells, which are decided face by
+/// face (`relevant`) and how the others are turned or dropped whole, with the counts that
+/// [`classify`] compares in `out`.
+struct Sorted {
+    shells: Vec<Shell>,
+    tris: Vec<Vec<[u32; 3]>>,
+    clusters: Clusters,
+    flip: Vec<bool>,
+    welded: Option<Vec<u32>>,
+    relevant: Vec<bool>,
+    copied: Vec<(usize, Vec<[u32; 3]>)>,
+    keep: Vec<bool>,
+    turn: Vec<bool>,
+    sign: Vec<i64>,
+    out: ShellOutcome,
+}
+
+/// The classification up to the face-by-face decision: `Err` with the outcome where no face is
+/// decided so (one shell, no pairs, too many, or none to decide).
+// Both variants are large and made once or twice per surface, moved, never stored in bulk.
+#[allow(clippy::result_large_err)]
+fn sort(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> Result<Sorted, ShellOutcome> {
     let (shells, uses) = shells(vertices, faces);
     let unchanged = |undecided_pairs, overlap_bound| ShellOutcome {
         faces: faces.clone(),
@@ -197,17 +228,10 @@ fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored, de
         ..ShellOutcome::default()
     };
     if shells.len() < 2 {
-        return unchanged(0, 0.0);
+        return Err(unchanged(0, 0.0));
     }
     let Some(pairs) = overlapping_pairs(&shells) else {
-        return unchanged(MAX_BOX_PAIRS + 1, f64::INFINITY);
-    };
-    let bounded = |pairs: &[(usize, usize)]| {
-        let bound = pairs
-            .iter()
-            .map(|&(a, b)| box_overlap(&shells[a], &shells[b]))
-            .sum();
-        unchanged(pairs.len(), bound)
+        return Err(unchanged(MAX_BOX_PAIRS + 1, f64::INFINITY));
     };
     let tris: Vec<Vec<[u32; 3]>> = shells.iter().map(|s| fan(faces, &s.faces)).collect();
     // w_out per shell (the others' winding numbers on it), and whether every pair around it is
@@ -218,7 +242,8 @@ fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored, de
         nesting::nestings(vertices, &shells, &tris, &pairs)
     };
     let Some((w_out, decided)) = nestings else {
-        return bounded(&pairs);
+        let bound = pairs.iter().map(|&(a, b)| box_overlap(&shells[a], &shells[b])).sum();
+        return Err(unchanged(pairs.len(), bound));
     };
     let mut out = ShellOutcome::default();
     // A pair with an undecided side is bounded whatever the other side's classification, unless
@@ -230,45 +255,79 @@ fn classify_faces(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored, de
     let (mut keep, mut turn) = (vec![true; faces.len()], vec![false; faces.len()]);
     let sign = orient(&shells, &decided, &w_out, &mut keep, &mut turn, &mut out);
     out.changed = out.dropped_shells > 0 || out.turned_shells > 0;
-    let resolving = relevant.iter().any(|&r| r);
-    if !decide {
-        out.copies_restored = if resolving { copied(&stored.copies, &clusters, &relevant).len() } else { 0 };
-        return out;
+    if !relevant.iter().any(|&r| r) {
+        out.faces = rebuilt(faces, &keep, &turn);
+        return Err(out);
     }
-    if resolving {
-        for (i, s) in shells.iter().enumerate() {
-            if relevant[i] {
-                s.faces.iter().for_each(|&f| keep[f as usize] = false);
-            }
+    let copied = copied(&stored.copies, &clusters, &relevant);
+    out.copies_restored = copied.len();
+    Ok(Sorted {
+        shells,
+        tris,
+        clusters,
+        flip,
+        welded,
+        relevant,
+        copied,
+        keep,
+        turn,
+        sign,
+        out,
+    })
+}
+
+/// The faces of the `relevant` shells of `sorted` decided face by face ([`resolve_pairs`]), the
+/// others as sorted.
+fn decided(
+    vertices: &[[f64; 3]],
+    faces: &Polygons,
+    stored: &AsStored,
+    sorted: Result<Sorted, ShellOutcome>,
+) -> ShellOutcome {
+    let Sorted {
+        shells,
+        tris,
+        clusters,
+        flip,
+        welded,
+        relevant,
+        copied,
+        mut keep,
+        turn,
+        sign,
+        mut out,
+    } = match sorted {
+        Ok(s) => s,
+        Err(out) => return out,
+    };
+    for (i, s) in shells.iter().enumerate() {
+        if relevant[i] {
+            s.faces.iter().for_each(|&f| keep[f as usize] = false);
         }
     }
     out.faces = rebuilt(faces, &keep, &turn);
-    if resolving {
-        let welded = welded.as_deref();
-        let copied = copied(&stored.copies, &clusters, &relevant);
-        out.copies_restored = copied.len();
-        out.cracks_welded = welded.is_some();
-        let (tris, turned) = as_stored(faces, &shells, &tris, &clusters.unflip, &flip);
-        out.turned_back = turned;
-        out.turned = flip.iter().filter(|&&f| f).count();
-        out.whole_as_stored = (shells.iter().enumerate()).all(|(i, s)| relevant[i] || s.sealed)
-            && copied.len() == stored.copies.len()
-            && out.turned_back == out.turned
-            && faces.len() == stored.faces.len();
-        let set = ShellSet {
-            shells: &shells,
-            tris: &tris,
-            relevant: &relevant,
-            sign: &sign,
-        };
-        resolve_pairs(vertices, &set, &copied, welded, &mut out);
-        // The decided faces differ from those given wherever faces were turned back or copies put
-        // back, even where every face is kept as it came to `resolve` (which compares with those):
-        // otherwise the faces given, turned, were integrated (sweep case 29472: an inward box
-        // inside an outward one, turned by the ladder and decided as stored, counted outward,
-        // 5.7% off under an estimate of 3e-14).
-        out.changed |= out.turned_back > 0 || out.copies_restored > 0;
-    }
+    let welded = welded.as_deref();
+    out.cracks_welded = welded.is_some();
+    let (tris, turned) = as_stored(faces, &shells, &tris, &clusters.unflip, &flip);
+    out.turned_back = turned;
+    out.turned = flip.iter().filter(|&&f| f).count();
+    out.whole_as_stored = (shells.iter().enumerate()).all(|(i, s)| relevant[i] || s.sealed)
+        && copied.len() == stored.copies.len()
+        && out.turned_back == out.turned
+        && faces.len() == stored.faces.len();
+    let set = ShellSet {
+        shells: &shells,
+        tris: &tris,
+        relevant: &relevant,
+        sign: &sign,
+    };
+    resolve_pairs(vertices, &set, &copied, welded, &mut out);
+    // The decided faces differ from those given wherever faces were turned back or copies put
+    // back, even where every face is kept as it came to `resolve` (which compares with those):
+    // otherwise the faces given, turned, were integrated (sweep case 29472: an inward box
+    // inside an outward one, turned by the ladder and decided as stored, counted outward,
+    // 5.7% off under an estimate of 3e-14).
+    out.changed |= out.turned_back > 0 || out.copies_restored > 0;
     out
 }
 
