@@ -24,7 +24,9 @@ pub(super) fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
 /// pieces of `piece` bytes ([`ASCII_PIECE`]; chunks of `chunk`, [`ASCII_CHUNK`]): memory is the
 /// mesh and two pieces (a line longer than a piece is held whole), not the file. The next piece is read while the chunks
 /// of the one before are parsed (`rayon::join`), so that on two threads the kernel's copy of the
-/// file is not a serial stretch. The result, errors included, is [`ascii`]'s on the whole text.
+/// file is not a serial stretch; on one thread, where the two would run in turn anyway, pieces of
+/// one chunk are read one after the other into one buffer. The result, errors included, is
+/// [`ascii`]'s on the whole text.
 pub(super) fn ascii_stream(
     head: Vec<u8>,
     mut source: impl std::io::Read + Send,
@@ -36,21 +38,28 @@ pub(super) fn ascii_stream(
     let mut reader = Ascii::new(path, chunk);
     reader.reserve(usize::try_from(len).unwrap_or(usize::MAX));
     // Both buffers at their size from the start: growing them by doubling would copy and fault in
-    // every smaller size on the way.
+    // every smaller size on the way. On one thread the next piece would be read after this one is
+    // parsed (`rayon::join` runs the two in turn), so there is one buffer of one chunk: a second
+    // buffer, and pieces of two chunks, only faulted in more pages (the 101.6 MB torus of
+    // `validation/threads.sh`, one thread: 6,735 page faults against 5,712, a fault costing about
+    // what 20,000 instructions do on this machine; docs/benchmarks.md, round twelve).
+    let pipelined = rayon::current_num_threads() > 1;
+    let piece = if pipelined { piece } else { piece.min(chunk) };
     let mut buf = head;
     buf.reserve(piece.saturating_sub(buf.len()));
-    let mut next = Vec::with_capacity(piece);
+    let mut next = if pipelined { Vec::with_capacity(piece) } else { Vec::new() };
     let mut end = top_up(&mut buf, &mut source, piece, path)?;
     loop {
         if end {
             reader.feed(&buf);
             return reader.finish();
         }
-        // Whole chunks only, the last one cut at a `facet` line; the rest waits for the next piece,
-        // so that no chunk begins inside a facet (to be parsed again from the state before it).
+        // Whole chunks only, the last one (or the only one) cut at a `facet` line; the rest waits
+        // for the next piece, so that no chunk begins inside a facet (to be parsed again from the
+        // state before it).
         let lines = memchr::memrchr(b'\n', &buf).map(|i| i + 1);
         let mut chunks = lines.map_or_else(Vec::new, |l| facet_chunks(&buf[..l], reader.chunk));
-        let rest = chunks.pop().filter(|_| !chunks.is_empty());
+        let rest = chunks.pop();
         let (Some(lines), Some(mut rest)) = (lines, rest) else {
             end = top_up(&mut buf, &mut source, piece, path)?;
             continue;
@@ -62,9 +71,23 @@ pub(super) fn ascii_stream(
             chunks.push(&rest[..cut]);
             rest = &rest[cut..];
         }
+        if chunks.is_empty() {
+            end = top_up(&mut buf, &mut source, piece, path)?;
+            continue;
+        }
+        let parsed = lines - rest.len();
+        if !pipelined {
+            reader.feed_chunks(&chunks);
+            if reader.utf8.is_some() {
+                return reader.finish();
+            }
+            buf.drain(..parsed);
+            end = top_up(&mut buf, &mut source, piece, path)?;
+            continue;
+        }
         // The next piece begins with the rest of this one, and is read while this one is parsed.
         next.clear();
-        next.extend_from_slice(&buf[lines - rest.len()..]);
+        next.extend_from_slice(&buf[parsed..]);
         let ((), read) = rayon::join(
             || reader.feed_chunks(&chunks),
             || top_up(&mut next, &mut source, piece, path),
