@@ -618,6 +618,7 @@ impl<'t> SeenLines<'t> {
 
     /// Records that `key` (not yet seen) gave `vertex`, in the `slot` [`Self::find`] gave, unless
     /// its probe was too long (no slot): then the line is simply parsed again wherever it comes back.
+    #[inline(always)]
     fn insert(&mut self, slot: Option<usize>, key: &'t [u8], h: u64, vertex: u32) {
         let Some(s) = slot else {
             return;
@@ -625,15 +626,22 @@ impl<'t> SeenLines<'t> {
         self.lines.push((key, vertex, s as u32));
         self.slots[s] = (h << 32) | self.lines.len() as u64;
         if 2 * self.lines.len() > self.slots.len() {
-            let size = 2 * self.slots.len();
-            self.slots = vec![0; size];
-            self.shift = 64 - size.trailing_zeros();
-            self.grown = true;
-            for (i, &(text, _, _)) in self.lines.iter().enumerate() {
-                let h = line_hash(text);
-                if let (Some(s), _) = self.find(text, h) {
-                    self.slots[s] = (h << 32) | (i as u64 + 1);
-                }
+            self.grow();
+        }
+    }
+
+    /// Twice the slots, the lines put in them again.
+    #[cold]
+    #[inline(never)]
+    fn grow(&mut self) {
+        let size = 2 * self.slots.len();
+        self.slots = vec![0; size];
+        self.shift = 64 - size.trailing_zeros();
+        self.grown = true;
+        for (i, &(text, _, _)) in self.lines.iter().enumerate() {
+            let h = line_hash(text);
+            if let (Some(s), _) = self.find(text, h) {
+                self.slots[s] = (h << 32) | (i as u64 + 1);
             }
         }
     }
