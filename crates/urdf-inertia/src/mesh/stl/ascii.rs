@@ -117,7 +117,7 @@ fn top_up(
     Ok(buf.len() == before)
 }
 
-/// Bytes of ASCII STL read at a time by [`ascii_stream`].
+/// Bytes of ASCII STL read at a time by [`ascii_stream`] on more than one thread (on one, a chunk).
 pub(super) const ASCII_PIECE: usize = 4 << 20;
 
 /// Bytes of ASCII STL parsed as one chunk (in parallel, each on its own, as binary records).
