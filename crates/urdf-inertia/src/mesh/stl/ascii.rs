@@ -171,10 +171,18 @@ struct AsciiChunk {
     utf8: Option<usize>,
 }
 
-/// Parses whole lines of ASCII STL starting in `start`, numbering new vertices from `base`.
-/// `slots` is a table's empty slots from a chunk before, or none (see [`SeenLines::with_slots`]);
-/// this chunk's, empty again, are left in it.
-fn ascii_chunk(text: &[u8], start: AsciiState, base: u32, slots: &mut Vec<u64>) -> AsciiChunk {
+/// Parses whole lines of ASCII STL starting in `start`, numbering new vertices from `base` plus
+/// the length of `vertices`, to which they are added (and the corners to `indices`: both empty
+/// but for the reader's own lists when the chunks are parsed in turn). `slots` is a table's empty
+/// slots from a chunk before, or none (see [`SeenLines::with_slots`]); this chunk's, empty again,
+/// are left in it.
+fn ascii_chunk(
+    text: &[u8],
+    start: AsciiState,
+    base: u32,
+    slots: &mut Vec<u64>,
+    (vertices, indices): (Vec<[f64; 3]>, Vec<u32>),
+) -> AsciiChunk {
     let empty = |end: AsciiState| AsciiChunk {
         vertices: Vec::new(),
         indices: Vec::new(),
@@ -196,11 +204,14 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32, slots: &mut Vec<u64>) 
     // one before parsed again in it (a third more on a closed mesh written row by row): a vertex
     // for every 320 bytes holds them all without growing the lists (a copy of each on every chunk
     // at 400) and takes as many slots (4 Ki for a 512 KiB chunk).
+    out.indices = indices;
     out.indices.reserve(text.len() / 80);
     out.sizes.reserve(text.len() / 240);
+    let mut vertices = vertices;
+    vertices.reserve(text.len() / 320 + 16);
     let mut p = ChunkParse {
         out,
-        vertices: Vec::with_capacity(text.len() / 320 + 16),
+        vertices,
         seen: SeenLines::with_slots(text.len() / 320 + 16, std::mem::take(slots)),
         in_loop: start.in_loop,
         current: start.current.clone(),
@@ -797,9 +808,17 @@ impl<'p> Ascii<'p> {
             }
             return;
         }
+        if rayon::current_num_threads() == 1 {
+            self.feed_in_turn(chunks, offset);
+            return;
+        }
         let parsed: Vec<AsciiChunk> = chunks
             .par_iter()
-            .map(|c| SLOTS.with_borrow_mut(|slots| ascii_chunk(c, AsciiState::default(), 0, slots)))
+            .map(|c| {
+                SLOTS.with_borrow_mut(|slots| {
+                    ascii_chunk(c, AsciiState::default(), 0, slots, Default::default())
+                })
+            })
             .collect();
         let mut at = offset;
         for (text, mut chunk) in chunks.iter().zip(parsed) {
@@ -810,7 +829,8 @@ impl<'p> Ascii<'p> {
             if self.error.is_none() {
                 if chunk.dependent && self.state != AsciiState::default() {
                     let start = std::mem::take(&mut self.state);
-                    chunk = ascii_chunk(text, start, self.vertices.len() as u32, &mut Vec::new());
+                    let base = self.vertices.len() as u32;
+                    chunk = ascii_chunk(text, start, base, &mut Vec::new(), Default::default());
                 } else {
                     rebase = self.vertices.len() as u32;
                     chunk.end.current.iter_mut().for_each(|i| *i += rebase);
@@ -839,6 +859,44 @@ impl<'p> Ascii<'p> {
             if chunk.outer || chunk.dependent {
                 self.state = chunk.end;
             }
+            self.lines += chunk.lines;
+        }
+    }
+
+    /// [`Self::feed_chunks`] on one thread: each chunk parsed from the state the one before left,
+    /// its vertices and corners added to the reader's lists as it parses them, where chunks parsed
+    /// apart (for the threads) are parsed from the state outside a facet, parsed again when that
+    /// was wrong, and copied into the lists with their corners renumbered.
+    fn feed_in_turn(&mut self, chunks: &[&[u8]], mut at: usize) {
+        for text in chunks {
+            let here = at;
+            at += text.len();
+            if self.error.is_some() {
+                if let Err(e) = std::str::from_utf8(text) {
+                    self.utf8 = Some(here + e.valid_up_to());
+                    return;
+                }
+                continue;
+            }
+            let start = std::mem::take(&mut self.state);
+            let lists = (std::mem::take(&mut self.vertices), std::mem::take(&mut self.indices));
+            let chunk = SLOTS.with_borrow_mut(|slots| ascii_chunk(text, start, 0, slots, lists));
+            if let Some(u) = chunk.utf8 {
+                self.utf8 = Some(here + u);
+                return;
+            }
+            self.vertices = chunk.vertices;
+            self.indices = chunk.indices;
+            if let Some((line, kind)) = chunk.error {
+                self.error = Some((self.lines + line, kind));
+                continue;
+            }
+            let mut s = *self.starts.last().unwrap_or(&0);
+            for &n in &chunk.sizes {
+                s += n;
+                self.starts.push(s);
+            }
+            self.state = chunk.end;
             self.lines += chunk.lines;
         }
     }

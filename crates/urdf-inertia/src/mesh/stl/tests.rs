@@ -272,6 +272,13 @@ fn check(bytes: &[u8], what: &str) {
             &tiny.finish(),
             &format!("{what}, chunks of {chunk}"),
         );
+        let mut tiny = Ascii::new(path, chunk);
+        one_thread().install(|| tiny.feed(bytes));
+        same(
+            &reference,
+            &tiny.finish(),
+            &format!("{what}, one thread, chunks of {chunk}"),
+        );
         let head = bytes[..bytes.len().min(5)].to_vec();
         let rest = &bytes[bytes.len().min(5)..];
         let streamed = ascii_stream(head.clone(), rest, bytes.len() as u64, path, piece, chunk);
