@@ -737,7 +737,8 @@ impl AsciiWords<'_> {
 /// first `outer`, in a file with `facet` inside a loop) and did not hold is parsed again from the
 /// state the one before left. The chunks' vertices are welded across chunks at the end
 /// ([`crate::mesh::weld::join`]): the result is the one sequential parse's, bit for bit, for any thread
-/// count.
+/// count. On one thread the chunks are parsed in turn instead, each from the state the one before
+/// left, into the reader's own lists ([`Self::feed_in_turn`]).
 pub(super) struct Ascii<'p> {
     path: &'p Path,
     /// Bytes a chunk: [`ASCII_CHUNK`], but for the tests.
