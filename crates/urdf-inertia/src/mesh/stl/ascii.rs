@@ -24,7 +24,9 @@ pub(super) fn ascii(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
 /// pieces of `piece` bytes ([`ASCII_PIECE`]; chunks of `chunk`, [`ASCII_CHUNK`]): memory is the
 /// mesh and two pieces (a line longer than a piece is held whole), not the file. The next piece is read while the chunks
 /// of the one before are parsed (`rayon::join`), so that on two threads the kernel's copy of the
-/// file is not a serial stretch. The result, errors included, is [`ascii`]'s on the whole text.
+/// file is not a serial stretch; on one thread, where the two would run in turn anyway, pieces of
+/// one chunk are read one after the other into one buffer. The result, errors included, is
+/// [`ascii`]'s on the whole text.
 pub(super) fn ascii_stream(
     head: Vec<u8>,
     mut source: impl std::io::Read + Send,
@@ -36,21 +38,28 @@ pub(super) fn ascii_stream(
     let mut reader = Ascii::new(path, chunk);
     reader.reserve(usize::try_from(len).unwrap_or(usize::MAX));
     // Both buffers at their size from the start: growing them by doubling would copy and fault in
-    // every smaller size on the way.
+    // every smaller size on the way. On one thread the next piece would be read after this one is
+    // parsed (`rayon::join` runs the two in turn), so there is one buffer of one chunk: a second
+    // buffer, and pieces of two chunks, only faulted in more pages (the 101.6 MB torus of
+    // `validation/threads.sh`, one thread: 6,735 page faults against 5,712, a fault costing about
+    // what 20,000 instructions do on this machine; docs/benchmarks.md, round twelve).
+    let pipelined = rayon::current_num_threads() > 1;
+    let piece = if pipelined { piece } else { piece.min(chunk) };
     let mut buf = head;
     buf.reserve(piece.saturating_sub(buf.len()));
-    let mut next = Vec::with_capacity(piece);
+    let mut next = if pipelined { Vec::with_capacity(piece) } else { Vec::new() };
     let mut end = top_up(&mut buf, &mut source, piece, path)?;
     loop {
         if end {
             reader.feed(&buf);
             return reader.finish();
         }
-        // Whole chunks only, the last one cut at a `facet` line; the rest waits for the next piece,
-        // so that no chunk begins inside a facet (to be parsed again from the state before it).
+        // Whole chunks only, the last one (or the only one) cut at a `facet` line; the rest waits
+        // for the next piece, so that no chunk begins inside a facet (to be parsed again from the
+        // state before it).
         let lines = memchr::memrchr(b'\n', &buf).map(|i| i + 1);
         let mut chunks = lines.map_or_else(Vec::new, |l| facet_chunks(&buf[..l], reader.chunk));
-        let rest = chunks.pop().filter(|_| !chunks.is_empty());
+        let rest = chunks.pop();
         let (Some(lines), Some(mut rest)) = (lines, rest) else {
             end = top_up(&mut buf, &mut source, piece, path)?;
             continue;
@@ -62,9 +71,23 @@ pub(super) fn ascii_stream(
             chunks.push(&rest[..cut]);
             rest = &rest[cut..];
         }
+        if chunks.is_empty() {
+            end = top_up(&mut buf, &mut source, piece, path)?;
+            continue;
+        }
+        let parsed = lines - rest.len();
+        if !pipelined {
+            reader.feed_chunks(&chunks);
+            if reader.utf8.is_some() {
+                return reader.finish();
+            }
+            buf.drain(..parsed);
+            end = top_up(&mut buf, &mut source, piece, path)?;
+            continue;
+        }
         // The next piece begins with the rest of this one, and is read while this one is parsed.
         next.clear();
-        next.extend_from_slice(&buf[lines - rest.len()..]);
+        next.extend_from_slice(&buf[parsed..]);
         let ((), read) = rayon::join(
             || reader.feed_chunks(&chunks),
             || top_up(&mut next, &mut source, piece, path),
@@ -94,7 +117,7 @@ fn top_up(
     Ok(buf.len() == before)
 }
 
-/// Bytes of ASCII STL read at a time by [`ascii_stream`].
+/// Bytes of ASCII STL read at a time by [`ascii_stream`] on more than one thread (on one, a chunk).
 pub(super) const ASCII_PIECE: usize = 4 << 20;
 
 /// Bytes of ASCII STL parsed as one chunk (in parallel, each on its own, as binary records).
@@ -148,10 +171,18 @@ struct AsciiChunk {
     utf8: Option<usize>,
 }
 
-/// Parses whole lines of ASCII STL starting in `start`, numbering new vertices from `base`.
-/// `slots` is a table's empty slots from a chunk before, or none (see [`SeenLines::with_slots`]);
-/// this chunk's, empty again, are left in it.
-fn ascii_chunk(text: &[u8], start: AsciiState, base: u32, slots: &mut Vec<u64>) -> AsciiChunk {
+/// Parses whole lines of ASCII STL starting in `start`, numbering new vertices from `base` plus
+/// the length of `vertices`, to which they are added (and the corners to `indices`: both empty
+/// but for the reader's own lists when the chunks are parsed in turn). `slots` is a table's empty
+/// slots from a chunk before, or none (see [`SeenLines::with_slots`]); this chunk's, empty again,
+/// are left in it.
+fn ascii_chunk(
+    text: &[u8],
+    start: AsciiState,
+    base: u32,
+    slots: &mut Vec<u64>,
+    (vertices, indices): (Vec<[f64; 3]>, Vec<u32>),
+) -> AsciiChunk {
     let empty = |end: AsciiState| AsciiChunk {
         vertices: Vec::new(),
         indices: Vec::new(),
@@ -173,11 +204,14 @@ fn ascii_chunk(text: &[u8], start: AsciiState, base: u32, slots: &mut Vec<u64>) 
     // one before parsed again in it (a third more on a closed mesh written row by row): a vertex
     // for every 320 bytes holds them all without growing the lists (a copy of each on every chunk
     // at 400) and takes as many slots (4 Ki for a 512 KiB chunk).
+    out.indices = indices;
     out.indices.reserve(text.len() / 80);
     out.sizes.reserve(text.len() / 240);
+    let mut vertices = vertices;
+    vertices.reserve(text.len() / 320 + 16);
     let mut p = ChunkParse {
         out,
-        vertices: Vec::with_capacity(text.len() / 320 + 16),
+        vertices,
         seen: SeenLines::with_slots(text.len() / 320 + 16, std::mem::take(slots)),
         in_loop: start.in_loop,
         current: start.current.clone(),
@@ -595,6 +629,7 @@ impl<'t> SeenLines<'t> {
 
     /// Records that `key` (not yet seen) gave `vertex`, in the `slot` [`Self::find`] gave, unless
     /// its probe was too long (no slot): then the line is simply parsed again wherever it comes back.
+    #[inline(always)]
     fn insert(&mut self, slot: Option<usize>, key: &'t [u8], h: u64, vertex: u32) {
         let Some(s) = slot else {
             return;
@@ -602,15 +637,22 @@ impl<'t> SeenLines<'t> {
         self.lines.push((key, vertex, s as u32));
         self.slots[s] = (h << 32) | self.lines.len() as u64;
         if 2 * self.lines.len() > self.slots.len() {
-            let size = 2 * self.slots.len();
-            self.slots = vec![0; size];
-            self.shift = 64 - size.trailing_zeros();
-            self.grown = true;
-            for (i, &(text, _, _)) in self.lines.iter().enumerate() {
-                let h = line_hash(text);
-                if let (Some(s), _) = self.find(text, h) {
-                    self.slots[s] = (h << 32) | (i as u64 + 1);
-                }
+            self.grow();
+        }
+    }
+
+    /// Twice the slots, the lines put in them again.
+    #[cold]
+    #[inline(never)]
+    fn grow(&mut self) {
+        let size = 2 * self.slots.len();
+        self.slots = vec![0; size];
+        self.shift = 64 - size.trailing_zeros();
+        self.grown = true;
+        for (i, &(text, _, _)) in self.lines.iter().enumerate() {
+            let h = line_hash(text);
+            if let (Some(s), _) = self.find(text, h) {
+                self.slots[s] = (h << 32) | (i as u64 + 1);
             }
         }
     }
@@ -695,7 +737,8 @@ impl AsciiWords<'_> {
 /// first `outer`, in a file with `facet` inside a loop) and did not hold is parsed again from the
 /// state the one before left. The chunks' vertices are welded across chunks at the end
 /// ([`crate::mesh::weld::join`]): the result is the one sequential parse's, bit for bit, for any thread
-/// count.
+/// count. On one thread the chunks are parsed in turn instead, each from the state the one before
+/// left, into the reader's own lists ([`Self::feed_in_turn`]).
 pub(super) struct Ascii<'p> {
     path: &'p Path,
     /// Bytes a chunk: [`ASCII_CHUNK`], but for the tests.
@@ -766,9 +809,17 @@ impl<'p> Ascii<'p> {
             }
             return;
         }
+        if rayon::current_num_threads() == 1 {
+            self.feed_in_turn(chunks, offset);
+            return;
+        }
         let parsed: Vec<AsciiChunk> = chunks
             .par_iter()
-            .map(|c| SLOTS.with_borrow_mut(|slots| ascii_chunk(c, AsciiState::default(), 0, slots)))
+            .map(|c| {
+                SLOTS.with_borrow_mut(|slots| {
+                    ascii_chunk(c, AsciiState::default(), 0, slots, Default::default())
+                })
+            })
             .collect();
         let mut at = offset;
         for (text, mut chunk) in chunks.iter().zip(parsed) {
@@ -779,7 +830,8 @@ impl<'p> Ascii<'p> {
             if self.error.is_none() {
                 if chunk.dependent && self.state != AsciiState::default() {
                     let start = std::mem::take(&mut self.state);
-                    chunk = ascii_chunk(text, start, self.vertices.len() as u32, &mut Vec::new());
+                    let base = self.vertices.len() as u32;
+                    chunk = ascii_chunk(text, start, base, &mut Vec::new(), Default::default());
                 } else {
                     rebase = self.vertices.len() as u32;
                     chunk.end.current.iter_mut().for_each(|i| *i += rebase);
@@ -808,6 +860,44 @@ impl<'p> Ascii<'p> {
             if chunk.outer || chunk.dependent {
                 self.state = chunk.end;
             }
+            self.lines += chunk.lines;
+        }
+    }
+
+    /// [`Self::feed_chunks`] on one thread: each chunk parsed from the state the one before left,
+    /// its vertices and corners added to the reader's lists as it parses them, where chunks parsed
+    /// apart (for the threads) are parsed from the state outside a facet, parsed again when that
+    /// was wrong, and copied into the lists with their corners renumbered.
+    fn feed_in_turn(&mut self, chunks: &[&[u8]], mut at: usize) {
+        for text in chunks {
+            let here = at;
+            at += text.len();
+            if self.error.is_some() {
+                if let Err(e) = std::str::from_utf8(text) {
+                    self.utf8 = Some(here + e.valid_up_to());
+                    return;
+                }
+                continue;
+            }
+            let start = std::mem::take(&mut self.state);
+            let lists = (std::mem::take(&mut self.vertices), std::mem::take(&mut self.indices));
+            let chunk = SLOTS.with_borrow_mut(|slots| ascii_chunk(text, start, 0, slots, lists));
+            if let Some(u) = chunk.utf8 {
+                self.utf8 = Some(here + u);
+                return;
+            }
+            self.vertices = chunk.vertices;
+            self.indices = chunk.indices;
+            if let Some((line, kind)) = chunk.error {
+                self.error = Some((self.lines + line, kind));
+                continue;
+            }
+            let mut s = *self.starts.last().unwrap_or(&0);
+            for &n in &chunk.sizes {
+                s += n;
+                self.starts.push(s);
+            }
+            self.state = chunk.end;
             self.lines += chunk.lines;
         }
     }

@@ -247,6 +247,17 @@ pub(super) fn same(a: &Result<RawMesh, MeshError>, b: &Result<RawMesh, MeshError
     }
 }
 
+/// A pool of one thread, where the streamed reader reads its pieces in turn into one buffer.
+fn one_thread() -> &'static rayon::ThreadPool {
+    static POOL: std::sync::OnceLock<rayon::ThreadPool> = std::sync::OnceLock::new();
+    POOL.get_or_init(|| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .expect("a pool of one thread")
+    })
+}
+
 /// Every way in: in memory (one chunk, and tiny chunks), streamed in tiny pieces and chunks (lines
 /// longer than a piece, chunk borders everywhere), and through `read_split` as a file is read.
 fn check(bytes: &[u8], what: &str) {
@@ -261,13 +272,26 @@ fn check(bytes: &[u8], what: &str) {
             &tiny.finish(),
             &format!("{what}, chunks of {chunk}"),
         );
+        let mut tiny = Ascii::new(path, chunk);
+        one_thread().install(|| tiny.feed(bytes));
+        same(
+            &reference,
+            &tiny.finish(),
+            &format!("{what}, one thread, chunks of {chunk}"),
+        );
         let head = bytes[..bytes.len().min(5)].to_vec();
         let rest = &bytes[bytes.len().min(5)..];
-        let streamed = ascii_stream(head, rest, bytes.len() as u64, path, piece, chunk);
+        let streamed = ascii_stream(head.clone(), rest, bytes.len() as u64, path, piece, chunk);
         same(
             &reference,
             &streamed,
             &format!("{what}, pieces of {piece}, chunks of {chunk}"),
+        );
+        let streamed = one_thread().install(|| ascii_stream(head, rest, bytes.len() as u64, path, piece, chunk));
+        same(
+            &reference,
+            &streamed,
+            &format!("{what}, one thread, pieces of {piece}, chunks of {chunk}"),
         );
     }
     if looks_ascii(bytes) && is_text(&bytes[..bytes.len().min(4096)]) {
@@ -581,16 +605,18 @@ fn streamed_ascii_read_error_while_parsing() {
     let facet = "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n";
     let text = format!("solid a\n{}", facet.repeat(50));
     let path = Path::new("t.stl");
-    for (piece, chunk) in [(300, 100), (1000, 200)] {
-        let source = FailingAfter { bytes: &text.as_bytes()[5..] };
-        let len = text.len() as u64;
-        let read = ascii_stream(text.as_bytes()[..5].to_vec(), source, len, path, piece, chunk);
+    for (piece, chunk, threads) in [(300, 100, 0), (1000, 200, 0), (300, 100, 1), (1000, 200, 1)] {
+        let stream = |head: &[u8], source| {
+            let len = text.len() as u64;
+            let read = || ascii_stream(head.to_vec(), source, len, path, piece, chunk);
+            if threads == 1 { one_thread().install(read) } else { read() }
+        };
+        let read = stream(&text.as_bytes()[..5], FailingAfter { bytes: &text.as_bytes()[5..] });
         let err = read.expect_err("the read fails");
         assert!(matches!(err.kind, MeshErrorKind::Io(_)), "{err:?}");
         let mut bad = text.clone().into_bytes();
         bad[40] = 0xff;
-        let source = FailingAfter { bytes: &bad[5..] };
-        let read = ascii_stream(bad[..5].to_vec(), source, len, path, piece, chunk);
+        let read = stream(&bad[..5], FailingAfter { bytes: &bad[5..] });
         let err = read.expect_err("not UTF-8");
         assert!(
             format!("{err}").contains("not valid UTF-8 at byte 40"),
