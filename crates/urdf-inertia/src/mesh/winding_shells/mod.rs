@@ -164,17 +164,9 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
     stored_with.pairs = Polygons::new();
     let stored_without = AsStored { pairs: Polygons::new(), ..stored.clone() };
     let (with_sorted, without_sorted) = (sort(vertices, &with, &stored_with), sort(vertices, faces, &stored_without));
-    let counts = |r: &Result<Sorted, ShellOutcome>| match r {
-        Ok(s) => (s.out.turned_shells, s.out.dropped_shells, s.out.resolved_pairs, s.out.copies_restored),
-        Err(o) => (o.turned_shells, o.dropped_shells, o.resolved_pairs, o.copies_restored),
-    };
-    let (turned, dropped, resolved, copies) = counts(&with_sorted);
-    let (turned_without, dropped_without, _, _) = counts(&without_sorted);
-    let charge = match &with_sorted {
-        Ok(s) => s.out.resolved_box_overlap,
-        Err(o) => o.resolved_box_overlap,
-    };
-    if (resolved > 0 || copies > 0) && (turned, dropped) == (turned_without, dropped_without) {
+    let (a, b) = (known(&with_sorted), known(&without_sorted));
+    let (resolved, charge) = (a.resolved_pairs, a.resolved_box_overlap);
+    if (resolved > 0 || a.copies_restored > 0) && (a.turned_shells, a.dropped_shells) == (b.turned_shells, b.dropped_shells) {
         let mut out = decided(vertices, &with, &stored_with, with_sorted);
         out.walls_restored = stored.pairs.len();
         return out;
@@ -190,6 +182,14 @@ pub fn classify(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> S
         without.overlap_bound += charge;
     }
     without
+}
+
+/// What a classification [`sort`]ed knows before any face is decided.
+fn known(sorted: &Result<Sorted, ShellOutcome>) -> &ShellOutcome {
+    match sorted {
+        Ok(s) => &s.out,
+        Err(out) => out,
+    }
 }
 
 /// The shells' classification: [`sort`], then the faces of the shells that touch or cut decided
