@@ -1337,12 +1337,16 @@ fn copies_welded_from_apart_are_within_the_estimate() {
 /// the face it copies. And case 2616 whole (see `a_wall_between_bodies_that_overlap_is_put_back`),
 /// and case 4137, which putting walls back first broke: pieces of a wall made shells closed up to
 /// cracks that nesting turned on their own (1.9e-8 off under 1.3e-8); the walls' answer is now
-/// taken only where it turns and drops the same shells as the one without them. And case 56891,
-/// which a narrower guard broke (session 44, reverted: the walls' answer refused only where a shell
-/// with a wall was turned or dropped whole): three grid boxes within 1e-10 of each other, f32,
-/// wound inward, outward and inward, whose faces the weld drops in 384 cancelling pairs, with two
-/// inward boxes; the walls' answer there is 3.3e-5 off under 2.3e-12, the one without them right
-/// to 4.5e-17.
+/// refused where a shell with a wall among its faces was turned or dropped whole (and the counts
+/// of shells turned and dropped differ from the answer without them). And case 56891, which that
+/// guard broke in session 44: three grid boxes within 1e-10 of each other, f32, wound inward,
+/// outward and inward, whose faces the weld drops in 384 cancelling pairs, with two inward boxes.
+/// With the walls put back every edge of the three boxes is used six times, so each of their faces
+/// is a shell of its own, and an inward box inside them was decided by nesting with none of those
+/// faces' boxes around it: counted once more, 3.3e-5 off under 2.3e-12. The faces' group (open
+/// shells joined by their shared edges, balanced) now reaches over its box, and the inward box is
+/// decided face by face with it: right to 1e-9 (the answer without the walls, with the counts
+/// guard, was right too but charged 26 pairs).
 #[test]
 fn sweep_cases_once_off_are_within_the_estimate() {
     let mut tally = Tally::default();
@@ -1350,6 +1354,11 @@ fn sweep_cases_once_off_are_within_the_estimate() {
         tally.case(seed, false);
     }
     assert!(tally.breaches.is_empty(), "{}", tally.breaches.join("\n"));
+    let (error, estimate, _) = checked_within(&random_case(56891).expect("made"), "56891");
+    assert!(
+        error < 1e-9,
+        "56891: error {error:e} (estimate {estimate:e})"
+    );
     assert_eq!(tally.breaches_turned, 0);
     assert_eq!(tally.checked, 6);
 }
@@ -1362,26 +1371,32 @@ fn sweep_cases_once_off_are_within_the_estimate() {
 /// estimate that compares two reference points. The bound added up face by face
 /// (`health::model::round_off_bound`) is taken where the winding number decided the faces: every
 /// error within it, and the bound above the floor (it is what carries the case) but below 1e-9.
+/// Since session 44 case 1725 takes the walls' answer (20 faces of cancelling pairs put back, 29
+/// triangles cut; before, the pairs were charged and its estimate was unbounded): its faces are cut at
+/// rounded points, so its surface is Ω's boundary up to the cuts' rounding, within the model term
+/// (inertia 4.0e-11 against 1.4e-9), and its value still within the round-off bound.
 #[test]
 fn thin_solids_of_turned_shells_are_within_the_round_off_bound() {
     for seed in [587, 1654, 1725, 4371] {
         let case = random_case(seed).expect("made");
         let exact = common::exact_mass(&omega_integrals(&case.parts));
         let s = solid(&case).expect("a solid");
-        // The emitted surface is Ω's boundary: its exact integrals are Ω's to 1e-15.
+        // The emitted surface is Ω's boundary: its exact integrals are Ω's to 1e-15, or within the
+        // model term where faces were cut at rounded points.
         let tris = s.faces.triangles();
         let surface = common::exact_mass(&common::exact_integrals(&s.vertices, &tris));
         let surface_inertia: [[f64; 3]; 3] = std::array::from_fn(|i| {
             std::array::from_fn(|j| surface.inertia[i][j].to_f64().unwrap())
         });
         let volume = surface.volume.to_f64().unwrap();
+        let cut = s.warnings.iter().any(|w| w.text.contains("cut by others"));
+        assert_eq!(cut, seed == 1725, "seed {seed}");
+        let allowed = if cut { s.error.model } else { 1e-15 };
+        let surface_error = common::rel_error(volume, &exact.volume)
+            .max(common::inertia_error(&surface_inertia, &exact.inertia));
         assert!(
-            common::rel_error(volume, &exact.volume) < 1e-15,
-            "seed {seed}"
-        );
-        assert!(
-            common::inertia_error(&surface_inertia, &exact.inertia) < 1e-15,
-            "seed {seed}"
+            surface_error < allowed,
+            "seed {seed}: surface {surface_error:e}, allowed {allowed:e}"
         );
         let inertia = common::inertia_error(&s.unit.inertia, &exact.inertia);
         let volume = common::rel_error(s.unit.mass, &exact.volume);
@@ -1576,13 +1591,21 @@ fn a_face_one_f32_unit_inside_a_box_is_decided_with_it() {
 /// many whole shells as the answer without the walls (`winding_shells::classify`, for case 4137);
 /// here it is not, and the shell that cuts itself was integrated as ∫w, the prisms' overlap counted
 /// twice: 7.9e-4 of the volume off under an estimate of 6.2e-15 (the whole case: 7.5e-4 under
-/// 2.5e-14). Now, where the walls' answer is refused, the pairs it decided face by face are charged
-/// as undecided pairs (their boxes' intersections): the value is the same, within its estimate.
+/// 2.5e-14). Session 43 charged the pairs the walls' answer decided (their boxes' intersections:
+/// within, but an estimate of 2.7e-2 for an error of 7.5e-4). Now the walls' answer is refused only
+/// where a shell with a wall among its faces was turned or dropped whole, which case 4137 was; here
+/// the small prism is decided face by face with the walls and dropped whole without them, so the
+/// counts differ but no wall is in a shell changed whole: the prisms' overlap is decided face by face
+/// and the value is right to 1e-9 (exact rationals), with and without the small prism.
 #[test]
 fn prisms_leaning_into_each_other_over_a_dropped_wall_are_within_the_estimate() {
     for keep in [4, 5] {
         let case = case_with(63171, |i| i < keep);
-        checked_within(&case, &format!("63171, {keep} parts"));
+        let (error, estimate, _) = checked_within(&case, &format!("63171, {keep} parts"));
+        assert!(
+            error < 1e-9,
+            "{keep} parts: error {error:e} (estimate {estimate:e})"
+        );
     }
 }
 
