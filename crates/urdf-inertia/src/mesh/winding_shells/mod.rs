@@ -1076,17 +1076,22 @@ fn nesting(
     if closed_boxes_meeting(&boxes_a, &boxes_b, touch).is_break() {
         return None;
     }
-    let wa = integer(winding(
-        vertices,
-        &tris[b],
-        vertices[tris[a][0][0] as usize],
-    ))?;
-    let wb = integer(winding(
-        vertices,
-        &tris[a],
-        vertices[tris[b][0][0] as usize],
-    ))?;
+    let wa = winding_on(vertices, shells, tris, a, b)?;
+    let wb = winding_on(vertices, shells, tris, b, a)?;
     Some((wa, wb))
+}
+
+/// The winding number of the closed shell `b` on the shell `a`, which does not touch it: one
+/// integer on all of `a` (a connected surface), so any corner of `a` gives it. A sealed `b` has 0
+/// outside its box, where a corner of `a` lies unless `a`'s box is within `b`'s (the corner with
+/// `a`'s coordinate beyond it): no sum is needed. Otherwise, and for a `b` closed only up to
+/// cracks (whose solid angles need not be whole near a crack, nor 0 outside its box), the solid
+/// angles of `b`'s triangles at `a`'s first corner, rounded within [`NOT_INTEGER`].
+fn winding_on(vertices: &[[f64; 3]], shells: &[Shell], tris: &[Vec<[u32; 3]>], a: usize, b: usize) -> Option<i64> {
+    if shells[b].sealed && !shells[b].bounds.contains(&shells[a].bounds) {
+        return Some(0);
+    }
+    integer(winding(vertices, &tris[b], vertices[tris[a][0][0] as usize]))
 }
 
 /// Each pair of a box of `a` and a box of `b` that meet as closed boxes (touching counts), found
@@ -1417,6 +1422,68 @@ mod tests {
         let out = classify(&vertices, &faces, &AsStored::default());
         assert_eq!(out.undecided_pairs, 0);
         assert!(out.resolved_pairs >= 2, "{}", out.resolved_pairs);
+    }
+
+    /// A prism over `outline` (counter-clockwise seen from +z) from `z.0` to `z.1`, its caps fanned
+    /// from the outline's first corner (a corner that sees every other one), outward or inward.
+    fn prism(vertices: &mut Vec<[f64; 3]>, faces: &mut Polygons, outline: &[[f64; 2]], z: (f64, f64), outward: bool) {
+        let (n, base) = (outline.len() as u32, vertices.len() as u32);
+        for h in [z.0, z.1] {
+            vertices.extend(outline.iter().map(|p| [p[0], p[1], h]));
+        }
+        let mut add = |mut f: Vec<u32>| {
+            if !outward {
+                f.reverse();
+            }
+            faces.push(&f);
+        };
+        for k in 1..n - 1 {
+            add(vec![base + n, base + n + k, base + n + k + 1]);
+            add(vec![base, base + k + 1, base + k]);
+        }
+        for i in 0..n {
+            let j = (i + 1) % n;
+            add(vec![base + i, base + j, base + n + j, base + n + i]);
+        }
+    }
+
+    /// Issue #22: a pair's winding numbers are those of the geometry, and those the solid angles
+    /// give at every corner, whichever way they are found (a sealed shell outside whose box the
+    /// other reaches has 0 there, with no sum). An L-shaped prism (its box holds the notch
+    /// between its arms) and a cube in its arm (w = 1, or −1 with the L inward), in the notch
+    /// (0: within the L's box but outside the L), or reaching from the notch out of the L's box
+    /// (0); the cube is outside the L, and the L, reaching beyond the cube's box, outside it.
+    #[test]
+    fn nesting_is_the_solid_angles_at_every_corner_issue_22() {
+        let l = [[1.0, 1.0], [1.0, 2.0], [0.0, 2.0], [0.0, 0.0], [2.0, 0.0], [2.0, 1.0]];
+        let square = |x: (f64, f64), y: (f64, f64)| [[x.0, y.0], [x.1, y.0], [x.1, y.1], [x.0, y.1]];
+        for (cube, outward, w) in [
+            (square((0.2, 0.8), (0.2, 0.8)), true, 1),
+            (square((0.2, 0.8), (0.2, 0.8)), false, -1),
+            (square((0.2, 0.8), (1.2, 1.8)), true, 1),
+            (square((1.2, 1.8), (1.2, 1.8)), true, 0),
+            (square((1.2, 1.8), (1.2, 1.8)), false, 0),
+            (square((1.2, 2.5), (1.2, 1.8)), true, 0),
+        ] {
+            let (mut vertices, mut faces) = (Vec::new(), Polygons::new());
+            prism(&mut vertices, &mut faces, &l, (0.0, 1.0), outward);
+            prism(&mut vertices, &mut faces, &cube, (0.25, 0.75), true);
+            let (shells, _) = shells(&vertices, &faces);
+            assert_eq!(shells.len(), 2);
+            assert!(shells.iter().all(|s| s.sealed));
+            let pairs = overlapping_pairs(&shells).expect("within the limits");
+            assert_eq!(pairs, [(0, 1)]);
+            let tris: Vec<Vec<[u32; 3]>> = shells.iter().map(|s| fan(&faces, &s.faces)).collect();
+            // The L's winding number on the cube, the cube's on the L.
+            let want = [0, w];
+            assert_eq!(pair_by_pair(&vertices, &shells, &tris, &pairs), (want.to_vec(), vec![true; 2]));
+            for (a, b) in [(0, 1), (1, 0)] {
+                for v in tris[a].iter().flatten() {
+                    let sum = integer(winding(&vertices, &tris[b], vertices[*v as usize]));
+                    assert_eq!(sum, Some(want[a]), "{cube:?} {outward} {a}");
+                }
+            }
+        }
     }
 
     /// Pair by pair and all at once decide alike: nested boxes (all outward, or alternating), some
