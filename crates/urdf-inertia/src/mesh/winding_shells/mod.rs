@@ -1084,14 +1084,54 @@ fn nesting(
 /// The winding number of the closed shell `b` on the shell `a`, which does not touch it: one
 /// integer on all of `a` (a connected surface), so any corner of `a` gives it. A sealed `b` has 0
 /// outside its box, where a corner of `a` lies unless `a`'s box is within `b`'s (the corner with
-/// `a`'s coordinate beyond it): no sum is needed. Otherwise, and for a `b` closed only up to
+/// `a`'s coordinate beyond it): no sum is needed. Within `b`'s box, an exact ray from `a`'s first
+/// corner counts it ([`ray_winding`]). Where every ray grazes, and for a `b` closed only up to
 /// cracks (whose solid angles need not be whole near a crack, nor 0 outside its box), the solid
 /// angles of `b`'s triangles at `a`'s first corner, rounded within [`NOT_INTEGER`].
 fn winding_on(vertices: &[[f64; 3]], shells: &[Shell], tris: &[Vec<[u32; 3]>], a: usize, b: usize) -> Option<i64> {
-    if shells[b].sealed && !shells[b].bounds.contains(&shells[a].bounds) {
-        return Some(0);
+    let (sb, p) = (&shells[b], vertices[tris[a][0][0] as usize]);
+    if sb.sealed {
+        if !sb.bounds.contains(&shells[a].bounds) {
+            return Some(0);
+        }
+        if let Some(w) = ray_winding(vertices, &tris[b], &sb.bounds, p) {
+            return Some(w);
+        }
     }
-    integer(winding(vertices, &tris[b], vertices[tris[a][0][0] as usize]))
+    integer(winding(vertices, &tris[b], p))
+}
+
+/// The winding number at `p` (off them) of the triangles `tris` of a sealed shell within
+/// `bounds`, counted exactly along a ray parallel to an axis ([`grid::crossing`]): the first of
+/// the six that grazes no edge, corner or plane of a triangle. `None` when all six graze.
+fn ray_winding(vertices: &[[f64; 3]], tris: &[[u32; 3]], bounds: &Aabb, p: [f64; 3]) -> Option<i64> {
+    'rays: for (axis, sign) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0), (2, 1.0), (2, -1.0)] {
+        let (j, l) = ((axis + 1) % 3, (axis + 2) % 3);
+        // An end beyond every triangle.
+        let mut end = p;
+        end[axis] = sign * 2.0 * (bounds.hi[axis].abs().max(bounds.lo[axis].abs()).max(p[axis].abs()) + 1.0);
+        let mut w = 0;
+        for t in tris {
+            let c = t.map(|i| vertices[i as usize]);
+            // A triangle wholly to one side of the ray's line, or behind its start, it cannot meet.
+            let beyond = |k: usize, x: f64| c.iter().all(|q| q[k] > x) || c.iter().all(|q| q[k] < x);
+            let behind = if sign > 0.0 {
+                c.iter().all(|q| q[axis] < p[axis])
+            } else {
+                c.iter().all(|q| q[axis] > p[axis])
+            };
+            if beyond(j, p[j]) || beyond(l, p[l]) || behind {
+                continue;
+            }
+            match grid::crossing(p, end, axis, &c, &grid::Plane::new(&c)) {
+                grid::Crossing::Miss => {}
+                grid::Crossing::Through(d) => w += d,
+                grid::Crossing::Degenerate => continue 'rays,
+            }
+        }
+        return Some(w);
+    }
+    None
 }
 
 /// Each pair of a box of `a` and a box of `b` that meet as closed boxes (touching counts), found
@@ -1479,11 +1519,22 @@ mod tests {
             assert_eq!(pair_by_pair(&vertices, &shells, &tris, &pairs), (want.to_vec(), vec![true; 2]));
             for (a, b) in [(0, 1), (1, 0)] {
                 for v in tris[a].iter().flatten() {
-                    let sum = integer(winding(&vertices, &tris[b], vertices[*v as usize]));
+                    let p = vertices[*v as usize];
+                    let sum = integer(winding(&vertices, &tris[b], p));
                     assert_eq!(sum, Some(want[a]), "{cube:?} {outward} {a}");
+                    // The first ray from each corner that grazes nothing counts the same.
+                    let ray = ray_winding(&vertices, &tris[b], &shells[b].bounds, p);
+                    assert_eq!(ray, Some(want[a]), "{cube:?} {outward} {a}");
                 }
             }
         }
+        // From the centre of a box every ray meets a face on its diagonal: no ray counts. Off
+        // the diagonals the first one does, inside and out.
+        let (vertices, faces, _) = nested_boxes(1, false);
+        let tris = fan(&faces, &[0, 1, 2, 3, 4, 5]);
+        let bounds = Aabb::of(vertices.iter().copied());
+        let ray = |p| ray_winding(&vertices, &tris, &bounds, p);
+        assert_eq!([ray([0.0; 3]), ray([0.5, 0.25, 0.1]), ray([0.5, 0.25, 1.5])], [None, Some(1), Some(0)]);
     }
 
     /// Pair by pair and all at once decide alike: nested boxes (all outward, or alternating), some
