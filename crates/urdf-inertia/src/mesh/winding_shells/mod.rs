@@ -1027,8 +1027,20 @@ fn pair_by_pair(
 ) -> (Vec<i64>, Vec<bool>) {
     let mut w_out = vec![0i64; shells.len()];
     let mut decided = vec![true; shells.len()];
+    // The triangles' boxes of each closed shell in a pair of closed shells, once: a shell is in
+    // many pairs (b1's trunk.dae: 882 pairs, 3.9 M triangles' boxes made again for each).
+    let mut boxes: Vec<Vec<Aabb>> = vec![Vec::new(); shells.len()];
     for &(a, b) in pairs {
-        if let Some((wa, wb)) = nesting(vertices, shells, tris, a, b) {
+        if shells[a].closed && shells[b].closed {
+            for s in [a, b] {
+                if boxes[s].is_empty() {
+                    boxes[s] = tris[s].iter().map(|t| Aabb::of(t.map(|i| vertices[i as usize]))).collect();
+                }
+            }
+        }
+    }
+    for &(a, b) in pairs {
+        if let Some((wa, wb)) = nesting(vertices, shells, (tris, &boxes), a, b) {
             w_out[a] += wa;
             w_out[b] += wb;
         } else {
@@ -1040,11 +1052,12 @@ fn pair_by_pair(
 }
 
 /// For two closed shells that do not touch: the winding number of `b` on `a` and of `a` on `b`.
-/// `None` when either is open, they touch or cut each other, or the test is too large.
+/// `None` when either is open, they touch or cut each other, or the test is too large. `boxes`:
+/// the triangles' boxes of each closed shell.
 fn nesting(
     vertices: &[[f64; 3]],
     shells: &[Shell],
-    tris: &[Vec<[u32; 3]>],
+    (tris, boxes): (&[Vec<[u32; 3]>], &[Vec<Aabb>]),
     a: usize,
     b: usize,
 ) -> Option<(i64, i64)> {
@@ -1054,13 +1067,13 @@ fn nesting(
     }
     // The triangles whose boxes meet the two shells' common box, with their boxes.
     let common = sa.bounds.intersection(sb.bounds);
-    let near = |ts: &[[u32; 3]]| -> (Vec<[u32; 3]>, Vec<Aabb>) {
-        ts.iter()
-            .map(|t| (*t, Aabb::of(t.map(|i| vertices[i as usize]))))
+    let near = |s: usize| -> (Vec<[u32; 3]>, Vec<Aabb>) {
+        (tris[s].iter().zip(&boxes[s]))
             .filter(|(_, b)| overlap(b, &common))
+            .map(|(t, b)| (*t, *b))
             .unzip()
     };
-    let ((ta, boxes_a), (tb, boxes_b)) = (near(&tris[a]), near(&tris[b]));
+    let ((ta, boxes_a), (tb, boxes_b)) = (near(a), near(b));
     if ta.len().saturating_mul(tb.len()) > MAX_TESTS {
         return None;
     }
