@@ -871,6 +871,8 @@ fn groups(shells: &mut [Shell], uses: &[EdgeUse], index: &[u32], parent: &mut [u
     let shell_of = |parent: &mut [u32], f: u32| index[root(parent, f) as usize];
     let mut group: Vec<u32> = (0..shells.len() as u32).collect();
     let mut shared = false;
+    // A shell on each edge that does not balance: its group is not a closed cycle.
+    let mut unbalanced = Vec::new();
     for users in uses.chunk_by(|x, y| x.key == y.key) {
         if users.len() == 2 && users[0].forward != users[1].forward {
             continue;
@@ -881,29 +883,24 @@ fn groups(shells: &mut [Shell], uses: &[EdgeUse], index: &[u32], parent: &mut [u
             shared |= other != first;
             join(&mut group, first, other);
         }
+        if users.iter().map(|e| if e.forward { 1i64 } else { -1 }).sum::<i64>() != 0 {
+            unbalanced.push(first);
+        }
     }
     if !shared {
         return;
     }
     // Per group root: balanced, members, box.
     let mut balanced = vec![true; shells.len()];
-    for users in uses.chunk_by(|x, y| x.key == y.key) {
-        if users.len() == 2 && users[0].forward != users[1].forward {
-            continue;
-        }
-        let net: i64 = users.iter().map(|e| if e.forward { 1 } else { -1 }).sum();
-        if net != 0 {
-            let r = root(&mut group, shell_of(parent, users[0].face));
-            balanced[r as usize] = false;
-        }
+    for s in unbalanced {
+        balanced[root(&mut group, s) as usize] = false;
     }
     let mut members = vec![0u32; shells.len()];
     let mut reach = vec![Aabb::EMPTY; shells.len()];
     for i in 0..shells.len() {
         let r = root(&mut group, i as u32) as usize;
         members[r] += 1;
-        reach[r].add(shells[i].bounds.lo);
-        reach[r].add(shells[i].bounds.hi);
+        reach[r] = reach[r].union(shells[i].bounds);
     }
     for i in 0..shells.len() {
         let r = root(&mut group, i as u32) as usize;
