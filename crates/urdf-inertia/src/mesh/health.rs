@@ -46,6 +46,9 @@ use ladder::Ladder;
 use open_surface::open_or_nonmanifold;
 use std::borrow::Cow;
 use std::path::Path;
+// The proof on its own, for the tests, benchmarks and examples (`internals`); the healing proves
+// through `closed::prove`.
+#[cfg(any(test, feature = "internals"))]
 pub use topology::closed_consistent;
 use topology::{edge_analysis, edges, orient};
 use welding::tolerant_welding;

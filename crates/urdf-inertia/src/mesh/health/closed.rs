@@ -5,8 +5,7 @@ use super::geometry::{
 };
 use super::ladder::{Known, Ladder};
 use super::model::Model;
-use super::closed_consistent;
-use super::topology::{closed_consistent_split, Edges, Orientation};
+use super::topology::{closed_consistent_of, closed_consistent_split, identity, Edges, Orientation};
 use super::welding::Welding;
 use super::{HealthKind, ModelError, Rung, Solid};
 use crate::geometry::{cross, dot, sub, x_sweep};
@@ -14,32 +13,71 @@ use crate::mass::integrals::bounding_box_centre;
 use crate::mass::Polygons;
 use crate::mesh::MeshError;
 use std::ops::ControlFlow;
+use std::sync::{Mutex, PoisonError};
 
-/// [`closed_consistent`] on `faces`, and beside it, when the pool has more than one thread, the
-/// integrals of `faces` as stored that [`consistent_closed`] starts from.
+/// [`closed_consistent`](super::topology::closed_consistent) on `faces` (of `vertices`, so that their number needs no pass over the
+/// corners), and beside it, when the pool has more than one thread, the integrals of `faces` as
+/// stored that [`consistent_closed`] starts from.
 ///
 /// The proof is mostly serial and the kernel parallel: run one after the other, the second thread
-/// idles through the proof; run side by side (`rayon::join`), with the proof's scan split in two
-/// halves ([`closed_consistent_split`]), the threads share the halves and the kernel's chunks.
-/// Integrals are the same bits on any thread (fixed chunks summed in order). On one thread nothing
-/// runs beside the proof, so a mesh that fails it pays for no integral; on more, a failed proof
-/// wastes the integral unless the tolerant weld leaves the stored faces as they are (the common
-/// case of cracks only), where it is used.
+/// idles through the proof; run side by side (`rayon::join`), the threads share them. On a pool of
+/// two threads the proof runs whole on one thread while the other makes the proof's union-find
+/// forest (when the proof has not yet asked for it) and then takes the kernel's chunks: the proof
+/// takes a little longer than the kernel on one thread, and its scan split in two halves
+/// ([`closed_consistent_split`]: a second forest, counts per half, a serial join of the forests)
+/// cost more than it saved (the 1.3 M-face torus of `validation/threads.sh`, two threads, wall
+/// median: 101.0 ms split, 94.6 ms whole; the 10 M-face torus 842.6 ms and 796.7 ms;
+/// docs/benchmarks.md, "Round fourteen"). On more threads, where the kernel's chunks go to the
+/// others, the split proof's halves keep two of them on it (not measured: this machine has two
+/// cores). Integrals are the same bits on any thread (fixed chunks summed in order), and the proof's
+/// answer is the same on any path. On one thread nothing runs beside the proof, so a mesh that
+/// fails it pays for no integral; on more, a failed proof wastes the integral unless the tolerant
+/// weld leaves the stored faces as they are (the common case of cracks only), where it is used.
 pub(super) fn prove(
     vertices: &[[f64; 3]],
     faces: &Polygons,
 ) -> (Option<(Vec<u32>, usize)>, Option<Known>) {
+    let n = vertices.len();
+    let whole = || closed_consistent_of(faces, n, || identity(faces.len()));
     // Below two of the kernel's chunks the integral is one sequence anyway.
     if faces.len() < 1 << 16 {
-        return (closed_consistent(faces), None);
+        return (whole(), None);
     }
     crate::threads::install(|| {
-        if rayon::current_num_threads() < 2 {
-            return (closed_consistent(faces), None);
+        let threads = rayon::current_num_threads();
+        if threads < 2 {
+            return (whole(), None);
         }
+        if threads > 2 {
+            let (proof, t) = rayon::join(
+                || closed_consistent_split(faces, n),
+                || Known::of(vertices, faces),
+            );
+            return (proof, Some(t));
+        }
+        // The forest, made by the kernel's side unless the proof asked for it first (then the
+        // proof makes its own: neither side waits for the other, which on a pool busy elsewhere
+        // may run both closures in turn on one thread).
+        let forest = Mutex::new((false, None::<Vec<u32>>));
+        let lock = || forest.lock().unwrap_or_else(PoisonError::into_inner);
         let (proof, t) = rayon::join(
-            || closed_consistent_split(faces, vertices.len()),
-            || Known::of(vertices, faces),
+            || {
+                closed_consistent_of(faces, n, || {
+                    let mut f = lock();
+                    f.0 = true;
+                    f.1.take().unwrap_or_else(|| identity(faces.len()))
+                })
+            },
+            || {
+                if !lock().0 {
+                    let made = identity(faces.len());
+                    let mut f = lock();
+                    if !f.0 {
+                        f.1 = Some(made);
+                    }
+                }
+                Known::of(vertices, faces)
+            },
         );
         (proof, Some(t))
     })
@@ -472,10 +510,12 @@ mod tests {
         (s.rung.name(), format!("{s:?}"))
     }
 
-    /// The proof beside the kernel, its scan split in two (more than one thread, 2^16 faces and
-    /// more), gives the solid one thread gives, bit for bit: clean, two components, wound inward,
-    /// and closed only by the tolerant weld, with and without a duplicate face dropped (the
-    /// integrals computed beside the proof are used only without).
+    /// The proof beside the kernel (more than one thread, 2^16 faces and more), whole with its forest
+    /// made by the kernel's side (two threads) or its scan split in two (three), gives the solid one
+    /// thread gives, bit for bit: clean, clean with a vertex no face uses (the proof's vertices are
+    /// all those stored), two components, wound inward, and closed only by the tolerant weld, with
+    /// and without a duplicate face dropped (the integrals computed beside the proof are used only
+    /// without).
     #[test]
     fn the_proof_beside_the_kernel_gives_the_one_thread_solid() {
         let (v, t) = torus(256, 160);
@@ -502,8 +542,11 @@ mod tests {
             .iter()
             .flat_map(|f| [[f[0], f[2], f[1]].map(|i| i + shift), *f])
             .collect();
+        let mut unused = v.clone();
+        unused.push([9.0, 9.0, 9.0]);
         let cases = [
             ("clean", mesh(&v, &t), "exact"),
+            ("clean, a vertex unused", mesh(&unused, &t), "exact"),
             ("two tori", mesh(&two_v, &two), "reoriented"),
             ("inward", mesh(&v, &inward), "inverted"),
             ("cracked", mesh(&cracked_v, &cracked), "welded"),
@@ -512,7 +555,9 @@ mod tests {
         for (name, m, rung) in cases {
             let one = healed(1, &m);
             assert_eq!(one.0, rung, "{name}");
-            assert_eq!(healed(3, &m), one, "{name}");
+            for threads in [2, 3] {
+                assert_eq!(healed(threads, &m), one, "{name}, {threads} threads");
+            }
         }
     }
 }

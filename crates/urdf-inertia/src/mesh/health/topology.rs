@@ -151,8 +151,21 @@ pub(super) fn grouped<T: Copy + Default>(
 /// one thread (figures: docs/benchmarks.md, "Peak memory against file size, every format").
 pub fn closed_consistent(faces: &Polygons) -> Option<(Vec<u32>, usize)> {
     let n = *faces.indices.iter().max()? as usize + 1;
+    closed_consistent_of(faces, n, || identity(faces.len()))
+}
+
+/// [`closed_consistent`] of `faces` on `n` vertices (no corner at `n` or beyond; a vertex no face
+/// uses has an empty bucket), its union-find forest `parent()` (`faces.len()` singletons, asked for
+/// once the corners are bucketed): the caller knows `n` without a pass over the corners, and may
+/// have made the forest on another thread.
+pub(super) fn closed_consistent_of(
+    faces: &Polygons,
+    n: usize,
+    parent: impl FnOnce() -> Vec<u32>,
+) -> Option<(Vec<u32>, usize)> {
     let (ends, corners) = corners_by_vertex(faces, n);
-    let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
+    let mut parent = parent();
+    debug_assert_eq!(parent.len(), faces.len());
     let face_of = (!faces.all_triangles()).then(|| corner_faces(faces));
     let paired = decide_faces(faces, face_of.as_deref(), (&ends, |i| corners[i]), 0..n, &mut parent)?;
     (2 * paired == faces.indices.len()).then(|| label(parent))
@@ -384,7 +397,7 @@ pub(super) fn closed_consistent_split(faces: &Polygons, n: usize) -> Option<(Vec
 }
 
 /// A union-find forest of `n` singletons.
-fn identity(n: usize) -> Vec<u32> {
+pub(super) fn identity(n: usize) -> Vec<u32> {
     (0..n as u32).collect()
 }
 
