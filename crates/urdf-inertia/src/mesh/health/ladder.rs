@@ -308,12 +308,7 @@ impl<'a> Ladder<'a> {
                 s.cut_faces
             )
         };
-        let which = if s.resolved_pairs > 0 {
-            format!("{} pair(s) of closed shells touch or cut each other", s.resolved_pairs)
-        } else {
-            // Shells that neither touch nor cut: decided face by face for the copies alone.
-            "closed shells stored with copies of their faces overlap other shells (the copies add to the winding number inside them)".to_string()
-        };
+        let which = which_pairs(s);
         self.warn(HealthKind::Repaired, format!("{which}: {how}{bound}"));
     }
 
@@ -420,6 +415,28 @@ fn thousands(n: usize) -> String {
         out.push(c);
     }
     out
+}
+
+/// What the shells decided face by face are, for [`Ladder::resolved`]'s warning. Pairs with an open
+/// shell are decided where their boxes overlap, touching or not.
+fn which_pairs(s: &winding_shells::ShellOutcome) -> String {
+    let closed = s.resolved_pairs - s.resolved_open;
+    if s.resolved_open > 0 && closed == 0 {
+        format!(
+            "{} pair(s) of shells overlap, each with an open shell that the shells around it close up",
+            s.resolved_pairs
+        )
+    } else if s.resolved_open > 0 {
+        format!(
+            "{} pair(s) of shells overlap ({closed} of closed shells that touch or cut each other, {} with an open shell that the shells around it close up)",
+            s.resolved_pairs, s.resolved_open
+        )
+    } else if s.resolved_pairs > 0 {
+        format!("{} pair(s) of closed shells touch or cut each other", s.resolved_pairs)
+    } else {
+        // Shells that neither touch nor cut: decided face by face for the copies alone.
+        "closed shells stored with copies of their faces overlap other shells (the copies add to the winding number inside them)".to_string()
+    }
 }
 
 #[cfg(test)]

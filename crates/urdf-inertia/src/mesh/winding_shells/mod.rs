@@ -83,8 +83,11 @@ pub struct ShellOutcome {
     pub undecided_pairs: usize,
     /// Bound on the volume those pairs can count twice or cancel, m³: their boxes' intersections.
     pub overlap_bound: f64,
-    /// Pairs of closed shells that touch or cut each other, decided face by face.
+    /// Pairs of shells decided face by face: two closed shells that touch or cut each other, or a
+    /// pair with an open shell whose cluster of open shells closes up (see [`classify_faces`]).
     pub resolved_pairs: usize,
+    /// Of `resolved_pairs`, those with an open shell.
+    pub resolved_open: usize,
     /// Their boxes' intersections, m³: what those pairs could count twice were they not decided.
     pub resolved_box_overlap: f64,
     /// Their triangles that other triangles cut (split into pieces).
@@ -384,6 +387,7 @@ fn undecided_pairs(
         if relevant[a] || (shells[a].sealed && shells[b].sealed) {
             (relevant[a], relevant[b]) = (true, true);
             out.resolved_pairs += 1;
+            out.resolved_open += usize::from(!shells[a].closed || !shells[b].closed);
             out.resolved_box_overlap += box_overlap(&shells[a], &shells[b]);
         } else {
             out.undecided_pairs += 1;
@@ -1602,6 +1606,9 @@ mod tests {
             }
         }
         assert!((volume - 63.0).abs() < 1e-12, "{volume}");
+        // Its pairs are of open shells (the faces) with the closed box: counted as such in the
+        // message, not as pairs of closed shells.
+        assert!(out.resolved_pairs > 0 && out.resolved_open == out.resolved_pairs, "{out:?}");
     }
 
     /// The same boxes with every other one moved so that it cuts its neighbours: those pairs
@@ -1616,6 +1623,7 @@ mod tests {
         let out = classify(&vertices, &faces, &AsStored::default());
         assert_eq!(out.undecided_pairs, 0);
         assert!(out.resolved_pairs >= 2, "{}", out.resolved_pairs);
+        assert_eq!(out.resolved_open, 0);
     }
 
     /// A prism over `outline` (counter-clockwise seen from +z) from `z.0` to `z.1`, its caps fanned
