@@ -419,6 +419,7 @@ fn fill(corners: &[u32], range: std::ops::Range<usize>, place: &mut [u32], out: 
 }
 
 /// The root of `x` in a union-find forest, halving the path on the way.
+#[inline]
 pub(super) fn root(parent: &mut [u32], mut x: u32) -> u32 {
     while parent[x as usize] != x {
         let up = parent[parent[x as usize] as usize];
@@ -429,6 +430,7 @@ pub(super) fn root(parent: &mut [u32], mut x: u32) -> u32 {
 }
 
 /// Joins the sets of `a` and `b`; the smaller root becomes the root.
+#[inline]
 pub(super) fn union(parent: &mut [u32], a: u32, b: u32) {
     let (ra, rb) = (root(parent, a), root(parent, b));
     if ra != rb {
