@@ -274,7 +274,7 @@ fn sort(vertices: &[[f64; 3]], faces: &Polygons, stored: &AsStored) -> Result<So
     // w_out per shell (the others' winding numbers on it), and whether every pair around it is
     // decided: for all pairs at once ([`nesting`]).
     let nestings = if pairs.len() <= FEW_PAIRS {
-        Some(pair_by_pair(vertices, &shells, &tris, &pairs))
+        Some(pair_by_pair(vertices, &shells, (&tris, &uses), &pairs))
     } else {
         nesting::nestings(vertices, &shells, &tris, &pairs)
     };
@@ -1119,11 +1119,11 @@ fn fan(faces: &Polygons, which: &[u32]) -> Vec<[u32; 3]> {
 }
 
 /// Per shell: the others' winding numbers on it, and whether every pair around it is decided, pair
-/// by pair ([`nesting`]).
+/// by pair ([`nesting`]). `uses`: the faces' edge uses ([`edge_uses`]).
 fn pair_by_pair(
     vertices: &[[f64; 3]],
     shells: &[Shell],
-    tris: &[Vec<[u32; 3]>],
+    (tris, uses): (&[Vec<[u32; 3]>], &[EdgeUse]),
     pairs: &[(usize, usize)],
 ) -> (Vec<i64>, Vec<bool>) {
     let mut w_out = vec![0i64; shells.len()];
@@ -1140,8 +1140,29 @@ fn pair_by_pair(
             }
         }
     }
+    // The caps of each shell closed only up to cracks in a pair of closed shells, once.
+    let mut shell_of = Vec::new();
     for &(a, b) in pairs {
-        if let Some((wa, wb)) = nesting(vertices, shells, (tris, &boxes), a, b) {
+        if shells[a].closed && shells[b].closed {
+            for s in [a, b] {
+                if !shells[s].sealed {
+                    if shell_of.is_empty() {
+                        shell_of = vec![u32::MAX; shells.iter().map(|s| s.faces.len()).sum()];
+                    }
+                    for &f in &shells[s].faces {
+                        shell_of[f as usize] = s as u32;
+                    }
+                }
+            }
+        }
+    }
+    let caps = if shell_of.is_empty() {
+        vec![Vec::new(); shells.len()]
+    } else {
+        cracks::caps(uses, &shell_of, shells.len())
+    };
+    for &(a, b) in pairs {
+        if let Some((wa, wb)) = nesting(vertices, shells, (tris, &boxes, &caps), a, b) {
             w_out[a] += wa;
             w_out[b] += wb;
         } else {
@@ -1154,11 +1175,12 @@ fn pair_by_pair(
 
 /// For two closed shells that do not touch: the winding number of `b` on `a` and of `a` on `b`.
 /// `None` when either is open, they touch or cut each other, or the test is too large. `boxes`:
-/// the triangles' boxes of each closed shell.
+/// the triangles' boxes of each closed shell; `caps`: those that close each shell's cracks
+/// ([`cracks::caps`]).
 fn nesting(
     vertices: &[[f64; 3]],
     shells: &[Shell],
-    (tris, boxes): (&[Vec<[u32; 3]>], &[Vec<Aabb>]),
+    (tris, boxes, caps): (&[Vec<[u32; 3]>], &[Vec<Aabb>], &[Vec<[u32; 3]>]),
     a: usize,
     b: usize,
 ) -> Option<(i64, i64)> {
@@ -1190,8 +1212,8 @@ fn nesting(
     if closed_boxes_meeting(&boxes_a, &boxes_b, touch).is_break() {
         return None;
     }
-    let wa = winding_on(vertices, shells, tris, a, b)?;
-    let wb = winding_on(vertices, shells, tris, b, a)?;
+    let wa = winding_on(vertices, shells, (tris, caps), a, b)?;
+    let wb = winding_on(vertices, shells, (tris, caps), b, a)?;
     Some((wa, wb))
 }
 
@@ -1199,33 +1221,66 @@ fn nesting(
 /// integer on all of `a` (a connected surface), so any corner of `a` gives it. A sealed `b` has 0
 /// outside its box, where a corner of `a` lies unless `a`'s box is within `b`'s (the corner with
 /// `a`'s coordinate beyond it): no sum is needed. Within `b`'s box, an exact ray from `a`'s first
-/// corner counts it ([`ray_winding`]). Where every ray grazes, and for a `b` closed only up to
-/// cracks (whose solid angles need not be whole near a crack, nor 0 outside its box), the solid
-/// angles of `b`'s triangles at `a`'s first corner, rounded within [`NOT_INTEGER`].
-fn winding_on(vertices: &[[f64; 3]], shells: &[Shell], tris: &[Vec<[u32; 3]>], a: usize, b: usize) -> Option<i64> {
+/// corner counts it ([`ray_winding`]). A `b` closed only up to cracks has solid angles that need
+/// not be whole near a crack, nor 0 outside its box; where its caps ([`capped`]) show that the sum
+/// at `a`'s first corner is within half of [`NOT_INTEGER`] of the count of `b` and its caps, that
+/// count. Otherwise (every ray grazes, or a cap is in sight), the solid angles of `b`'s triangles at
+/// `a`'s first corner, rounded within [`NOT_INTEGER`].
+fn winding_on(
+    vertices: &[[f64; 3]],
+    shells: &[Shell],
+    (tris, caps): (&[Vec<[u32; 3]>], &[Vec<[u32; 3]>]),
+    a: usize,
+    b: usize,
+) -> Option<i64> {
     let (sb, p) = (&shells[b], vertices[tris[a][0][0] as usize]);
     if sb.sealed {
         if !sb.bounds.contains(&shells[a].bounds) {
             return Some(0);
         }
-        if let Some(w) = ray_winding(vertices, &tris[b], &sb.bounds, p) {
+        if let Some(w) = ray_winding(vertices, [&tris[b], &[]], &sb.bounds, p) {
             return Some(w);
         }
+    } else if let Some(w) = capped(vertices, (&tris[b], &caps[b]), &sb.bounds, p) {
+        return Some(w);
     }
     integer(winding(vertices, &tris[b], p))
 }
 
-/// The winding number at `p` (off them) of the triangles `tris` of a sealed shell within
-/// `bounds`, counted exactly along a ray parallel to an axis ([`grid::crossing`]): the first of
-/// the six that grazes no edge, corner or plane of a triangle. `None` when all six graze.
-fn ray_winding(vertices: &[[f64; 3]], tris: &[[u32; 3]], bounds: &Aabb, p: [f64; 3]) -> Option<i64> {
+/// The integer that the solid angles of the triangles `tris` of a shell closed up to cracks, capped
+/// by `cap` ([`cracks::caps`]) within `bounds`, round to at `p` (off them), without their sum: the
+/// shell and its caps are a closed cycle, whose winding number at `p` is an integer, counted
+/// exactly by a ray ([`ray_winding`]; 0 outside `bounds`, along the axis that leaves them), and
+/// the shell's sum is that less the caps' solid angles. Where those are within half of
+/// [`NOT_INTEGER`] (the sum of their sizes), the sum rounds to the count, with room for its own
+/// rounding. `None` when the caps are larger at `p`, or every ray grazes.
+fn capped(vertices: &[[f64; 3]], (tris, cap): (&[[u32; 3]], &[[u32; 3]]), bounds: &Aabb, p: [f64; 3]) -> Option<i64> {
+    let mut seen = 0.0;
+    for t in cap {
+        let [a, b, c] = t.map(|v| sub(vertices[v as usize], p));
+        seen += solid_angle(a, b, c, norm(a), norm(b), norm(c)).abs();
+    }
+    if !(seen <= 0.5 * NOT_INTEGER * 4.0 * std::f64::consts::PI) {
+        return None;
+    }
+    if (0..3).any(|k| p[k] < bounds.lo[k] || p[k] > bounds.hi[k]) {
+        return Some(0);
+    }
+    ray_winding(vertices, [tris, cap], bounds, p)
+}
+
+/// The winding number at `p` (off them) of the triangles of a closed cycle within `bounds` (a
+/// sealed shell's, or a shell's and its caps: the two lists of `parts`), counted exactly along a
+/// ray parallel to an axis ([`grid::crossing`]): the first of the six that grazes no edge, corner
+/// or plane of a triangle. `None` when all six graze.
+fn ray_winding(vertices: &[[f64; 3]], parts: [&[[u32; 3]]; 2], bounds: &Aabb, p: [f64; 3]) -> Option<i64> {
     'rays: for (axis, sign) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0), (2, 1.0), (2, -1.0)] {
         let (j, l) = ((axis + 1) % 3, (axis + 2) % 3);
         // An end beyond every triangle.
         let mut end = p;
         end[axis] = sign * 2.0 * (bounds.hi[axis].abs().max(bounds.lo[axis].abs()).max(p[axis].abs()) + 1.0);
         let mut w = 0;
-        for t in tris {
+        for t in parts.into_iter().flatten() {
             let c = t.map(|i| vertices[i as usize]);
             // A triangle wholly to one side of the ray's line, or behind its start, it cannot meet.
             let beyond = |k: usize, x: f64| c.iter().all(|q| q[k] > x) || c.iter().all(|q| q[k] < x);
@@ -1662,7 +1717,7 @@ mod tests {
             let (mut vertices, mut faces) = (Vec::new(), Polygons::new());
             prism(&mut vertices, &mut faces, &l, (0.0, 1.0), outward);
             prism(&mut vertices, &mut faces, &cube, (0.25, 0.75), true);
-            let (shells, _) = shells(&vertices, &faces);
+            let (shells, uses) = shells(&vertices, &faces);
             assert_eq!(shells.len(), 2);
             assert!(shells.iter().all(|s| s.sealed));
             let pairs = overlapping_pairs(&shells).expect("within the limits");
@@ -1670,14 +1725,14 @@ mod tests {
             let tris: Vec<Vec<[u32; 3]>> = shells.iter().map(|s| fan(&faces, &s.faces)).collect();
             // The L's winding number on the cube, the cube's on the L.
             let want = [0, w];
-            assert_eq!(pair_by_pair(&vertices, &shells, &tris, &pairs), (want.to_vec(), vec![true; 2]));
+            assert_eq!(pair_by_pair(&vertices, &shells, (&tris, &uses), &pairs), (want.to_vec(), vec![true; 2]));
             for (a, b) in [(0, 1), (1, 0)] {
                 for v in tris[a].iter().flatten() {
                     let p = vertices[*v as usize];
                     let sum = integer(winding(&vertices, &tris[b], p));
                     assert_eq!(sum, Some(want[a]), "{cube:?} {outward} {a}");
                     // The first ray from each corner that grazes nothing counts the same.
-                    let ray = ray_winding(&vertices, &tris[b], &shells[b].bounds, p);
+                    let ray = ray_winding(&vertices, [&tris[b], &[]], &shells[b].bounds, p);
                     assert_eq!(ray, Some(want[a]), "{cube:?} {outward} {a}");
                 }
             }
@@ -1687,7 +1742,7 @@ mod tests {
         let (vertices, faces, _) = nested_boxes(1, false);
         let tris = fan(&faces, &[0, 1, 2, 3, 4, 5]);
         let bounds = Aabb::of(vertices.iter().copied());
-        let ray = |p| ray_winding(&vertices, &tris, &bounds, p);
+        let ray = |p| ray_winding(&vertices, [&tris, &[]], &bounds, p);
         assert_eq!([ray([0.0; 3]), ray([0.5, 0.25, 0.1]), ray([0.5, 0.25, 1.5])], [None, Some(1), Some(0)]);
     }
 
@@ -1714,7 +1769,7 @@ mod tests {
                     faces.push(f);
                 }
             }
-            let (shells, _) = shells(&vertices, &faces);
+            let (shells, uses) = shells(&vertices, &faces);
             let pairs = overlapping_pairs(&shells).expect("within the limits");
             assert!(pairs.len() >= count - 1, "{}", pairs.len());
             let tris: Vec<Vec<[u32; 3]>> = shells.iter().map(|s| fan(&faces, &s.faces)).collect();
@@ -1722,7 +1777,7 @@ mod tests {
             let kept = |(w, d): (Vec<i64>, Vec<bool>)| -> Vec<Option<i64>> {
                 w.iter().zip(&d).map(|(&w, &d)| d.then_some(w)).collect()
             };
-            let one = kept(pair_by_pair(&vertices, &shells, &tris, &pairs));
+            let one = kept(pair_by_pair(&vertices, &shells, (&tris, &uses), &pairs));
             let all = kept(nesting::nestings(&vertices, &shells, &tris, &pairs).expect("within the caps"));
             assert_eq!(one, all, "{count} {alternate} {moved:?} {open}");
             // An open shell leaves every pair around it undecided: all of them, nested.
