@@ -1212,8 +1212,8 @@ fn nesting(
     if closed_boxes_meeting(&boxes_a, &boxes_b, touch).is_break() {
         return None;
     }
-    let wa = winding_on(vertices, shells, (tris, caps), a, b)?;
-    let wb = winding_on(vertices, shells, (tris, caps), b, a)?;
+    let wa = winding_on(vertices, shells, (tris, boxes, caps), a, b)?;
+    let wb = winding_on(vertices, shells, (tris, boxes, caps), b, a)?;
     Some((wa, wb))
 }
 
@@ -1229,7 +1229,7 @@ fn nesting(
 fn winding_on(
     vertices: &[[f64; 3]],
     shells: &[Shell],
-    (tris, caps): (&[Vec<[u32; 3]>], &[Vec<[u32; 3]>]),
+    (tris, boxes, caps): (&[Vec<[u32; 3]>], &[Vec<Aabb>], &[Vec<[u32; 3]>]),
     a: usize,
     b: usize,
 ) -> Option<i64> {
@@ -1238,23 +1238,23 @@ fn winding_on(
         if !sb.bounds.contains(&shells[a].bounds) {
             return Some(0);
         }
-        if let Some(w) = ray_winding(vertices, [&tris[b], &[]], &sb.bounds, p) {
+        if let Some(w) = ray_winding(vertices, (&tris[b], &boxes[b]), &[], &sb.bounds, p) {
             return Some(w);
         }
-    } else if let Some(w) = capped(vertices, (&tris[b], &caps[b]), &sb.bounds, p) {
+    } else if let Some(w) = capped(vertices, (&tris[b], &boxes[b]), &caps[b], &sb.bounds, p) {
         return Some(w);
     }
     integer(winding(vertices, &tris[b], p))
 }
 
-/// The integer that the solid angles of the triangles `tris` of a shell closed up to cracks, capped
+/// The integer that the solid angles of the triangles `tris` (their boxes beside) of a shell closed up to cracks, capped
 /// by `cap` ([`cracks::caps`]) within `bounds`, round to at `p` (off them), without their sum: the
 /// shell and its caps are a closed cycle, whose winding number at `p` is an integer, counted
 /// exactly by a ray ([`ray_winding`]; 0 outside `bounds`, along the axis that leaves them), and
 /// the shell's sum is that less the caps' solid angles. Where those are within half of
 /// [`NOT_INTEGER`] (the sum of their sizes), the sum rounds to the count, with room for its own
 /// rounding. `None` when the caps are larger at `p`, or every ray grazes.
-fn capped(vertices: &[[f64; 3]], (tris, cap): (&[[u32; 3]], &[[u32; 3]]), bounds: &Aabb, p: [f64; 3]) -> Option<i64> {
+fn capped(vertices: &[[f64; 3]], tris: (&[[u32; 3]], &[Aabb]), cap: &[[u32; 3]], bounds: &Aabb, p: [f64; 3]) -> Option<i64> {
     let mut seen = 0.0;
     for t in cap {
         let [a, b, c] = t.map(|v| sub(vertices[v as usize], p));
@@ -1266,32 +1266,36 @@ fn capped(vertices: &[[f64; 3]], (tris, cap): (&[[u32; 3]], &[[u32; 3]]), bounds
     if (0..3).any(|k| p[k] < bounds.lo[k] || p[k] > bounds.hi[k]) {
         return Some(0);
     }
-    ray_winding(vertices, [tris, cap], bounds, p)
+    ray_winding(vertices, tris, cap, bounds, p)
 }
 
 /// The winding number at `p` (off them) of the triangles of a closed cycle within `bounds` (a
-/// sealed shell's, or a shell's and its caps: the two lists of `parts`), counted exactly along a
-/// ray parallel to an axis ([`grid::crossing`]): the first of the six that grazes no edge, corner
+/// sealed shell's `tris` with their boxes, and a shell's `cap` of its cracks), counted exactly along
+/// a ray parallel to an axis ([`grid::crossing`]): the first of the six that grazes no edge, corner
 /// or plane of a triangle. `None` when all six graze.
-fn ray_winding(vertices: &[[f64; 3]], parts: [&[[u32; 3]]; 2], bounds: &Aabb, p: [f64; 3]) -> Option<i64> {
+fn ray_winding(
+    vertices: &[[f64; 3]],
+    (tris, boxes): (&[[u32; 3]], &[Aabb]),
+    cap: &[[u32; 3]],
+    bounds: &Aabb,
+    p: [f64; 3],
+) -> Option<i64> {
+    let corners = |t: &[u32; 3]| t.map(|i| vertices[i as usize]);
+    let capped = cap.iter().map(|t| (t, Aabb::of(corners(t))));
     'rays: for (axis, sign) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0), (2, 1.0), (2, -1.0)] {
         let (j, l) = ((axis + 1) % 3, (axis + 2) % 3);
         // An end beyond every triangle.
         let mut end = p;
         end[axis] = sign * 2.0 * (bounds.hi[axis].abs().max(bounds.lo[axis].abs()).max(p[axis].abs()) + 1.0);
         let mut w = 0;
-        for t in parts.into_iter().flatten() {
-            let c = t.map(|i| vertices[i as usize]);
-            // A triangle wholly to one side of the ray's line, or behind its start, it cannot meet.
-            let beyond = |k: usize, x: f64| c.iter().all(|q| q[k] > x) || c.iter().all(|q| q[k] < x);
-            let behind = if sign > 0.0 {
-                c.iter().all(|q| q[axis] < p[axis])
-            } else {
-                c.iter().all(|q| q[axis] > p[axis])
-            };
-            if beyond(j, p[j]) || beyond(l, p[l]) || behind {
+        for (t, b) in tris.iter().zip(boxes.iter().copied()).chain(capped.clone()) {
+            // A triangle whose box is wholly to one side of the ray's line, or behind its start, it
+            // cannot meet (its box from its corners: the same comparisons of the same numbers).
+            let behind = if sign > 0.0 { b.hi[axis] < p[axis] } else { b.lo[axis] > p[axis] };
+            if (b.lo[j] > p[j]) | (b.hi[j] < p[j]) | (b.lo[l] > p[l]) | (b.hi[l] < p[l]) | behind {
                 continue;
             }
+            let c = corners(t);
             match grid::crossing(p, end, axis, &c, &grid::Plane::new(&c)) {
                 grid::Crossing::Miss => {}
                 grid::Crossing::Through(d) => w += d,
@@ -1732,7 +1736,7 @@ mod tests {
                     let sum = integer(winding(&vertices, &tris[b], p));
                     assert_eq!(sum, Some(want[a]), "{cube:?} {outward} {a}");
                     // The first ray from each corner that grazes nothing counts the same.
-                    let ray = ray_winding(&vertices, [&tris[b], &[]], &shells[b].bounds, p);
+                    let ray = ray_winding(&vertices, (&tris[b], &boxes_of(&vertices, &tris[b])), &[], &shells[b].bounds, p);
                     assert_eq!(ray, Some(want[a]), "{cube:?} {outward} {a}");
                 }
             }
@@ -1742,8 +1746,14 @@ mod tests {
         let (vertices, faces, _) = nested_boxes(1, false);
         let tris = fan(&faces, &[0, 1, 2, 3, 4, 5]);
         let bounds = Aabb::of(vertices.iter().copied());
-        let ray = |p| ray_winding(&vertices, [&tris, &[]], &bounds, p);
+        let boxes = boxes_of(&vertices, &tris);
+        let ray = |p| ray_winding(&vertices, (&tris, &boxes), &[], &bounds, p);
         assert_eq!([ray([0.0; 3]), ray([0.5, 0.25, 0.1]), ray([0.5, 0.25, 1.5])], [None, Some(1), Some(0)]);
+    }
+
+    /// The boxes of triangles.
+    fn boxes_of(vertices: &[[f64; 3]], tris: &[[u32; 3]]) -> Vec<Aabb> {
+        tris.iter().map(|t| Aabb::of(t.map(|i| vertices[i as usize]))).collect()
     }
 
     /// The faces with a corner put into edge `k` of face `f` (its midpoint moved by `offset`), so
@@ -1815,7 +1825,7 @@ mod tests {
                 for (a, b) in [(0, 1), (1, 0)] {
                     for v in tris[a].iter().flatten() {
                         let p = vertices[*v as usize];
-                        let counted = capped(&vertices, (&tris[b], &caps[b]), &shells[b].bounds, p);
+                        let counted = capped(&vertices, (&tris[b], &boxes_of(&vertices, &tris[b])), &caps[b], &shells[b].bounds, p);
                         assert_eq!(counted, Some(want[a]), "{cube:?} {outward} {width} {a}");
                         assert_eq!(integer(winding(&vertices, &tris[b], p)), Some(want[a]), "{cube:?} {outward} {width} {a}");
                     }
@@ -1826,7 +1836,8 @@ mod tests {
                     let p = [1.0 + 1e-4, 1.5, -3e-4];
                     let stray = winding(&vertices, &tris[0], p);
                     assert!((stray - stray.round()).abs() > NOT_INTEGER, "{stray}");
-                    assert_eq!(capped(&vertices, (&tris[0], &caps[0]), &shells[0].bounds, p), None);
+                    let boxes = boxes_of(&vertices, &tris[0]);
+                    assert_eq!(capped(&vertices, (&tris[0], &boxes), &caps[0], &shells[0].bounds, p), None);
                 }
             }
         }
