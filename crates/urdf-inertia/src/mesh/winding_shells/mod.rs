@@ -1141,24 +1141,16 @@ fn pair_by_pair(
         }
     }
     // The caps of each shell closed only up to cracks in a pair of closed shells, once.
-    let mut shell_of = Vec::new();
-    for &(a, b) in pairs {
-        if shells[a].closed && shells[b].closed {
-            for s in [a, b] {
-                if !shells[s].sealed {
-                    if shell_of.is_empty() {
-                        shell_of = vec![u32::MAX; shells.iter().map(|s| s.faces.len()).sum()];
-                    }
-                    for &f in &shells[s].faces {
-                        shell_of[f as usize] = s as u32;
-                    }
-                }
-            }
-        }
-    }
-    let caps = if shell_of.is_empty() {
+    let cracked: Vec<usize> = (0..shells.len()).filter(|&s| !shells[s].sealed && !boxes[s].is_empty()).collect();
+    let caps = if cracked.is_empty() {
         vec![Vec::new(); shells.len()]
     } else {
+        let mut shell_of = vec![u32::MAX; shells.iter().map(|s| s.faces.len()).sum()];
+        for &s in &cracked {
+            for &f in &shells[s].faces {
+                shell_of[f as usize] = s as u32;
+            }
+        }
         cracks::caps(uses, &shell_of, shells.len())
     };
     for &(a, b) in pairs {
@@ -1247,13 +1239,14 @@ fn winding_on(
     integer(winding(vertices, &tris[b], p))
 }
 
-/// The integer that the solid angles of the triangles `tris` (their boxes beside) of a shell closed up to cracks, capped
-/// by `cap` ([`cracks::caps`]) within `bounds`, round to at `p` (off them), without their sum: the
-/// shell and its caps are a closed cycle, whose winding number at `p` is an integer, counted
-/// exactly by a ray ([`ray_winding`]; 0 outside `bounds`, along the axis that leaves them), and
-/// the shell's sum is that less the caps' solid angles. Where those are within half of
-/// [`NOT_INTEGER`] (the sum of their sizes), the sum rounds to the count, with room for its own
-/// rounding. `None` when the caps are larger at `p`, or every ray grazes.
+/// What the solid angles at `p` of the triangles `tris` (with their boxes) of a shell closed only up
+/// to cracks round to, without their sum. The shell and its caps `cap` ([`cracks::caps`], within
+/// `bounds`) are a closed cycle, whose winding number at `p` (off the shell) is an integer counted
+/// exactly by a ray ([`ray_winding`]; 0 outside `bounds`, along the axis that leaves them); the
+/// shell's own is that less the caps', which is at most the sum of the sizes of their solid angles
+/// over 4π. Where that is within half of [`NOT_INTEGER`], the shell's sum rounds to the count, with
+/// room to spare for its rounding. `None` when the caps are larger at `p` (a corner close to a
+/// crack), or every ray grazes.
 fn capped(vertices: &[[f64; 3]], tris: (&[[u32; 3]], &[Aabb]), cap: &[[u32; 3]], bounds: &Aabb, p: [f64; 3]) -> Option<i64> {
     let mut seen = 0.0;
     for t in cap {
