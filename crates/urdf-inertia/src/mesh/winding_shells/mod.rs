@@ -1154,7 +1154,8 @@ fn pair_by_pair(
         cracks::caps(uses, &shell_of, shells.len())
     };
     for &(a, b) in pairs {
-        if let Some((wa, wb)) = nesting(vertices, shells, (tris, &boxes, &caps), a, b) {
+        let closed = Closed { tris, boxes: &boxes, caps: &caps };
+        if let Some((wa, wb)) = nesting(vertices, shells, &closed, a, b) {
             w_out[a] += wa;
             w_out[b] += wb;
         } else {
@@ -1165,17 +1166,18 @@ fn pair_by_pair(
     (w_out, decided)
 }
 
+/// Per shell: its triangles, and for each closed shell in a pair of closed shells their boxes and
+/// the triangles that close its cracks ([`cracks::caps`]; none for a sealed shell).
+struct Closed<'a> {
+    tris: &'a [Vec<[u32; 3]>],
+    boxes: &'a [Vec<Aabb>],
+    caps: &'a [Vec<[u32; 3]>],
+}
+
 /// For two closed shells that do not touch: the winding number of `b` on `a` and of `a` on `b`.
-/// `None` when either is open, they touch or cut each other, or the test is too large. `boxes`:
-/// the triangles' boxes of each closed shell; `caps`: those that close each shell's cracks
-/// ([`cracks::caps`]).
-fn nesting(
-    vertices: &[[f64; 3]],
-    shells: &[Shell],
-    (tris, boxes, caps): (&[Vec<[u32; 3]>], &[Vec<Aabb>], &[Vec<[u32; 3]>]),
-    a: usize,
-    b: usize,
-) -> Option<(i64, i64)> {
+/// `None` when either is open, they touch or cut each other, or the test is too large.
+fn nesting(vertices: &[[f64; 3]], shells: &[Shell], closed: &Closed, a: usize, b: usize) -> Option<(i64, i64)> {
+    let (tris, boxes) = (closed.tris, closed.boxes);
     let (sa, sb) = (&shells[a], &shells[b]);
     if !sa.closed || !sb.closed {
         return None;
@@ -1204,8 +1206,8 @@ fn nesting(
     if closed_boxes_meeting(&boxes_a, &boxes_b, touch).is_break() {
         return None;
     }
-    let wa = winding_on(vertices, shells, (tris, boxes, caps), a, b)?;
-    let wb = winding_on(vertices, shells, (tris, boxes, caps), b, a)?;
+    let wa = winding_on(vertices, shells, closed, a, b)?;
+    let wb = winding_on(vertices, shells, closed, b, a)?;
     Some((wa, wb))
 }
 
@@ -1218,13 +1220,8 @@ fn nesting(
 /// at `a`'s first corner is within half of [`NOT_INTEGER`] of the count of `b` and its caps, that
 /// count. Otherwise (every ray grazes, or a cap is in sight), the solid angles of `b`'s triangles at
 /// `a`'s first corner, rounded within [`NOT_INTEGER`].
-fn winding_on(
-    vertices: &[[f64; 3]],
-    shells: &[Shell],
-    (tris, boxes, caps): (&[Vec<[u32; 3]>], &[Vec<Aabb>], &[Vec<[u32; 3]>]),
-    a: usize,
-    b: usize,
-) -> Option<i64> {
+fn winding_on(vertices: &[[f64; 3]], shells: &[Shell], closed: &Closed, a: usize, b: usize) -> Option<i64> {
+    let Closed { tris, boxes, caps } = *closed;
     let (sb, p) = (&shells[b], vertices[tris[a][0][0] as usize]);
     if sb.sealed {
         if !sb.bounds.contains(&shells[a].bounds) {
@@ -1253,7 +1250,7 @@ fn capped(vertices: &[[f64; 3]], tris: (&[[u32; 3]], &[Aabb]), cap: &[[u32; 3]],
         let [a, b, c] = t.map(|v| sub(vertices[v as usize], p));
         seen += solid_angle(a, b, c, norm(a), norm(b), norm(c)).abs();
     }
-    if !(seen <= 0.5 * NOT_INTEGER * 4.0 * std::f64::consts::PI) {
+    if seen.is_nan() || seen > 0.5 * NOT_INTEGER * 4.0 * std::f64::consts::PI {
         return None;
     }
     if (0..3).any(|k| p[k] < bounds.lo[k] || p[k] > bounds.hi[k]) {
@@ -1285,7 +1282,7 @@ fn ray_winding(
             // A triangle whose box is wholly to one side of the ray's line, or behind its start, it
             // cannot meet (its box from its corners: the same comparisons of the same numbers).
             let behind = if sign > 0.0 { b.hi[axis] < p[axis] } else { b.lo[axis] > p[axis] };
-            if (b.lo[j] > p[j]) | (b.hi[j] < p[j]) | (b.lo[l] > p[l]) | (b.hi[l] < p[l]) | behind {
+            if b.lo[j] > p[j] || b.hi[j] < p[j] || b.lo[l] > p[l] || b.hi[l] < p[l] || behind {
                 continue;
             }
             let c = corners(t);
