@@ -4,6 +4,9 @@
 //! weld) they are closed cycles, which the face-by-face decision counts exactly. The welded
 //! triangles differ from the stored ones by at most the volume they sweep moving to the welded
 //! corners, which enters the bound.
+//!
+//! Nesting pair by pair counts such a shell's winding number without its solid angles by closing
+//! its cracks with caps of its own corners ([`caps`]).
 
 use rustc_hash::FxHashMap;
 
@@ -40,8 +43,8 @@ pub(super) fn welded_triangles(
     (out, swept)
 }
 
-/// Per shell marked in `wanted` (by each face's shell, `shell_of`, `u32::MAX` for none): triangles
-/// that close its cracks, so that the shell's triangles and these are a closed cycle. The shell's
+/// Per shell of `shells` that has faces in `shell_of` (each face's shell, `u32::MAX` for none):
+/// triangles that close its cracks, so that the shell's triangles and these are a closed cycle. The shell's
 /// boundary (its faces' edges, each direction counted against the other, over the edges that do not
 /// join exactly two of its faces in opposite directions) falls into loops; each connected loop is
 /// capped by the cone from one of its corners (a triangle per edge, reversed, those through the

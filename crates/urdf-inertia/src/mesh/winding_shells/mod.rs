@@ -1153,8 +1153,8 @@ fn pair_by_pair(
         }
         cracks::caps(uses, &shell_of, shells.len())
     };
+    let closed = Closed { tris, boxes: &boxes, caps: &caps };
     for &(a, b) in pairs {
-        let closed = Closed { tris, boxes: &boxes, caps: &caps };
         if let Some((wa, wb)) = nesting(vertices, shells, &closed, a, b) {
             w_out[a] += wa;
             w_out[b] += wb;
