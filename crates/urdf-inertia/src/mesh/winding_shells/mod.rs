@@ -1243,11 +1243,18 @@ fn winding_on(vertices: &[[f64; 3]], shells: &[Shell], closed: &Closed, a: usize
 /// shell's own is that less the caps', which is at most the sum of the sizes of their solid angles
 /// over 4π. Where that is within half of [`NOT_INTEGER`], the shell's sum rounds to the count, with
 /// room to spare for its rounding. `None` when the caps are larger at `p` (a corner close to a
-/// crack), or every ray grazes.
+/// crack), `p` is within a cap's box, or every ray grazes.
 fn capped(vertices: &[[f64; 3]], tris: (&[[u32; 3]], &[Aabb]), cap: &[[u32; 3]], bounds: &Aabb, p: [f64; 3]) -> Option<i64> {
     let mut seen = 0.0;
     for t in cap {
-        let [a, b, c] = t.map(|v| sub(vertices[v as usize], p));
+        let corners = t.map(|v| vertices[v as usize]);
+        // Within a millionth of a cap's size of its box, its solid angle's formula may lose its
+        // digits (near an edge, where a ray still counts): the sum is taken instead.
+        let (near, margin) = (Aabb::of(corners), 1e-6 * Aabb::of(corners).diagonal());
+        if (0..3).all(|k| p[k] >= near.lo[k] - margin && p[k] <= near.hi[k] + margin) {
+            return None;
+        }
+        let [a, b, c] = corners.map(|q| sub(q, p));
         seen += solid_angle(a, b, c, norm(a), norm(b), norm(c)).abs();
     }
     if seen.is_nan() || seen > 0.5 * NOT_INTEGER * 4.0 * std::f64::consts::PI {
