@@ -4,7 +4,13 @@
 //! weld) they are closed cycles, which the face-by-face decision counts exactly. The welded
 //! triangles differ from the stored ones by at most the volume they sweep moving to the welded
 //! corners, which enters the bound.
+//!
+//! Nesting pair by pair counts such a shell's winding number without its solid angles by closing
+//! its cracks with caps of its own corners ([`caps`]).
 
+use rustc_hash::FxHashMap;
+
+use super::{root, EdgeUse};
 use crate::geometry::{dot, sub};
 use crate::mesh::weld;
 
@@ -35,6 +41,72 @@ pub(super) fn welded_triangles(
         }
     }
     (out, swept)
+}
+
+/// Per shell of `shells` that has faces in `shell_of` (each face's shell, `u32::MAX` for none):
+/// triangles that close its cracks, so that the shell's triangles and these are a closed cycle. The shell's
+/// boundary (its faces' edges, each direction counted against the other, over the edges that do not
+/// join exactly two of its faces in opposite directions) falls into loops; each connected loop is
+/// capped by the cone from one of its corners (a triangle per edge, reversed, those through the
+/// apex left out). A cap lies within the convex hull of its loop, so within the shell's box; a crack
+/// of corners a rounding apart is capped by slivers.
+pub(super) fn caps(uses: &[EdgeUse], shell_of: &[u32], shells: usize) -> Vec<Vec<[u32; 3]>> {
+    // Per shell: its boundary's directed edges.
+    let mut edges: Vec<Vec<(u32, u32)>> = vec![Vec::new(); shells];
+    let mut net: Vec<(u32, i64)> = Vec::new();
+    for users in uses.chunk_by(|x, y| x.key == y.key) {
+        if users.len() == 2 && users[0].forward != users[1].forward {
+            continue;
+        }
+        net.clear();
+        for e in users {
+            let s = shell_of[e.face as usize];
+            if s == u32::MAX {
+                continue;
+            }
+            let d = if e.forward { 1 } else { -1 };
+            match net.iter_mut().find(|x| x.0 == s) {
+                Some(x) => x.1 += d,
+                None => net.push((s, d)),
+            }
+        }
+        let (lo, hi) = ((users[0].key >> 32) as u32, users[0].key as u32);
+        if lo == hi {
+            continue;
+        }
+        for &(s, d) in &net {
+            let edge = if d > 0 { (lo, hi) } else { (hi, lo) };
+            edges[s as usize].extend(std::iter::repeat_n(edge, d.unsigned_abs() as usize));
+        }
+    }
+    edges
+        .iter()
+        .map(|edges| {
+            // The loops' corners, numbered in order of first use, joined by their edges.
+            let mut local: FxHashMap<u32, u32> = FxHashMap::default();
+            let mut corner = Vec::new();
+            let mut number = |v: u32| {
+                *local.entry(v).or_insert_with(|| {
+                    corner.push(v);
+                    corner.len() as u32 - 1
+                })
+            };
+            let ends: Vec<(u32, u32)> = edges.iter().map(|&(u, v)| (number(u), number(v))).collect();
+            let mut parent: Vec<u32> = (0..corner.len() as u32).collect();
+            for &(u, v) in &ends {
+                let (a, b) = (root(&mut parent, u), root(&mut parent, v));
+                parent[a.max(b) as usize] = a.min(b);
+            }
+            let mut cap = Vec::new();
+            for (&(u, v), &(lu, _)) in edges.iter().zip(&ends) {
+                let apex = corner[root(&mut parent, lu) as usize];
+                if apex != u && apex != v {
+                    cap.push([apex, v, u]);
+                }
+            }
+            cap
+        })
+        .collect()
 }
 
 /// The volume a triangle sweeps while its corners move in straight lines from `a` to `b`: each
