@@ -1705,6 +1705,25 @@ mod tests {
         }
     }
 
+    /// The outline of an L-shaped prism (counter-clockwise seen from +z): its box holds the notch
+    /// between its arms.
+    const L_OUTLINE: [[f64; 2]; 6] = [[1.0, 1.0], [1.0, 2.0], [0.0, 2.0], [0.0, 0.0], [2.0, 0.0], [2.0, 1.0]];
+
+    /// A cube's outline beside the L of [`L_OUTLINE`], whether the L is wound outward, and the L's
+    /// winding number on the cube: in its arm (±1), in the notch (0: within the L's box, outside the
+    /// L), and reaching from the notch out of the L's box (0).
+    fn l_and_cube() -> [([[f64; 2]; 4], bool, i64); 6] {
+        let square = |x: (f64, f64), y: (f64, f64)| [[x.0, y.0], [x.1, y.0], [x.1, y.1], [x.0, y.1]];
+        [
+            (square((0.2, 0.8), (0.2, 0.8)), true, 1),
+            (square((0.2, 0.8), (0.2, 0.8)), false, -1),
+            (square((0.2, 0.8), (1.2, 1.8)), true, 1),
+            (square((1.2, 1.8), (1.2, 1.8)), true, 0),
+            (square((1.2, 1.8), (1.2, 1.8)), false, 0),
+            (square((1.2, 2.5), (1.2, 1.8)), true, 0),
+        ]
+    }
+
     /// Issue #22: a pair's winding numbers are those of the geometry, and those the solid angles
     /// give at every corner, whichever way they are found (a sealed shell outside whose box the
     /// other reaches has 0 there, with no sum). An L-shaped prism (its box holds the notch
@@ -1713,16 +1732,8 @@ mod tests {
     /// (0); the cube is outside the L, and the L, reaching beyond the cube's box, outside it.
     #[test]
     fn nesting_is_the_solid_angles_at_every_corner_issue_22() {
-        let l = [[1.0, 1.0], [1.0, 2.0], [0.0, 2.0], [0.0, 0.0], [2.0, 0.0], [2.0, 1.0]];
-        let square = |x: (f64, f64), y: (f64, f64)| [[x.0, y.0], [x.1, y.0], [x.1, y.1], [x.0, y.1]];
-        for (cube, outward, w) in [
-            (square((0.2, 0.8), (0.2, 0.8)), true, 1),
-            (square((0.2, 0.8), (0.2, 0.8)), false, -1),
-            (square((0.2, 0.8), (1.2, 1.8)), true, 1),
-            (square((1.2, 1.8), (1.2, 1.8)), true, 0),
-            (square((1.2, 1.8), (1.2, 1.8)), false, 0),
-            (square((1.2, 2.5), (1.2, 1.8)), true, 0),
-        ] {
+        let l = L_OUTLINE;
+        for (cube, outward, w) in l_and_cube() {
             let (mut vertices, mut faces) = (Vec::new(), Polygons::new());
             prism(&mut vertices, &mut faces, &l, (0.0, 1.0), outward);
             prism(&mut vertices, &mut faces, &cube, (0.25, 0.75), true);
@@ -1788,16 +1799,8 @@ mod tests {
     /// the sliver its cap is in sight, and the count is not taken.
     #[test]
     fn cracked_shells_nest_by_their_caps() {
-        let l = [[1.0, 1.0], [1.0, 2.0], [0.0, 2.0], [0.0, 0.0], [2.0, 0.0], [2.0, 1.0]];
-        let square = |x: (f64, f64), y: (f64, f64)| [[x.0, y.0], [x.1, y.0], [x.1, y.1], [x.0, y.1]];
-        for (cube, outward, w) in [
-            (square((0.2, 0.8), (0.2, 0.8)), true, 1),
-            (square((0.2, 0.8), (0.2, 0.8)), false, -1),
-            (square((0.2, 0.8), (1.2, 1.8)), true, 1),
-            (square((1.2, 1.8), (1.2, 1.8)), true, 0),
-            (square((1.2, 1.8), (1.2, 1.8)), false, 0),
-            (square((1.2, 2.5), (1.2, 1.8)), true, 0),
-        ] {
+        let l = L_OUTLINE;
+        for (cube, outward, w) in l_and_cube() {
             for width in [0.0, 1e-3] {
                 let (mut vertices, mut faces) = (Vec::new(), Polygons::new());
                 prism(&mut vertices, &mut faces, &l, (0.0, 1.0), outward);
