@@ -10,7 +10,7 @@
 
 use rustc_hash::FxHashMap;
 
-use super::{root, EdgeUse};
+use super::{join, root, EdgeUse};
 use crate::geometry::{dot, sub};
 use crate::mesh::weld;
 
@@ -94,8 +94,7 @@ pub(super) fn caps(uses: &[EdgeUse], shell_of: &[u32], shells: usize) -> Vec<Vec
             let ends: Vec<(u32, u32)> = edges.iter().map(|&(u, v)| (number(u), number(v))).collect();
             let mut parent: Vec<u32> = (0..corner.len() as u32).collect();
             for &(u, v) in &ends {
-                let (a, b) = (root(&mut parent, u), root(&mut parent, v));
-                parent[a.max(b) as usize] = a.min(b);
+                join(&mut parent, u, v);
             }
             let mut cap = Vec::new();
             for (&(u, v), &(lu, _)) in edges.iter().zip(&ends) {

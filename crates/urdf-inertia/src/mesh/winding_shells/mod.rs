@@ -604,7 +604,7 @@ fn copied_edges(
     (copy_shell, extra)
 }
 
-fn join(parent: &mut [u32], a: u32, b: u32) {
+pub(super) fn join(parent: &mut [u32], a: u32, b: u32) {
     let (a, b) = (root(parent, a), root(parent, b));
     parent[a.max(b) as usize] = a.min(b);
 }
@@ -1231,7 +1231,7 @@ fn winding_on(vertices: &[[f64; 3]], shells: &[Shell], closed: &Closed, a: usize
         if !sb.bounds.contains(&shells[a].bounds) {
             return Some(0);
         }
-        if let Some(w) = ray_winding(vertices, (&tris[b], &boxes[b]), &[], &sb.bounds, p) {
+        if let Some(w) = ray_winding(vertices, (&tris[b], &boxes[b]), (&[], &[]), &sb.bounds, p) {
             return Some(w);
         }
     } else if let Some(w) = capped(vertices, (&tris[b], &boxes[b]), &caps[b], &sb.bounds, p) {
@@ -1250,11 +1250,12 @@ fn winding_on(vertices: &[[f64; 3]], shells: &[Shell], closed: &Closed, a: usize
 /// crack), `p` is within a cap's box, or every ray grazes.
 fn capped(vertices: &[[f64; 3]], tris: (&[[u32; 3]], &[Aabb]), cap: &[[u32; 3]], bounds: &Aabb, p: [f64; 3]) -> Option<i64> {
     let mut seen = 0.0;
-    for t in cap {
+    let cap_boxes: Vec<Aabb> = cap.iter().map(|t| Aabb::of(t.map(|v| vertices[v as usize]))).collect();
+    for (t, near) in cap.iter().zip(&cap_boxes) {
         let corners = t.map(|v| vertices[v as usize]);
         // Within a millionth of a cap's size of its box, its solid angle's formula may lose its
         // digits (near an edge, where a ray still counts): the sum is taken instead.
-        let (near, margin) = (Aabb::of(corners), 1e-6 * Aabb::of(corners).diagonal());
+        let margin = 1e-6 * near.diagonal();
         if (0..3).all(|k| p[k] >= near.lo[k] - margin && p[k] <= near.hi[k] + margin) {
             return None;
         }
@@ -1267,22 +1268,22 @@ fn capped(vertices: &[[f64; 3]], tris: (&[[u32; 3]], &[Aabb]), cap: &[[u32; 3]],
     if (0..3).any(|k| p[k] < bounds.lo[k] || p[k] > bounds.hi[k]) {
         return Some(0);
     }
-    ray_winding(vertices, tris, cap, bounds, p)
+    ray_winding(vertices, tris, (cap, &cap_boxes), bounds, p)
 }
 
 /// The winding number at `p` (off them) of the triangles of a closed cycle within `bounds` (a
-/// sealed shell's `tris` with their boxes, and a shell's `cap` of its cracks), counted exactly along
-/// a ray parallel to an axis ([`grid::crossing`]): the first of the six that grazes no edge, corner
-/// or plane of a triangle. `None` when all six graze.
+/// sealed shell's `tris`, and a shell's `cap` of its cracks, each with their boxes), counted
+/// exactly along a ray parallel to an axis ([`grid::crossing`]): the first of the six that grazes
+/// no edge, corner or plane of a triangle. `None` when all six graze.
 fn ray_winding(
     vertices: &[[f64; 3]],
     (tris, boxes): (&[[u32; 3]], &[Aabb]),
-    cap: &[[u32; 3]],
+    (cap, cap_boxes): (&[[u32; 3]], &[Aabb]),
     bounds: &Aabb,
     p: [f64; 3],
 ) -> Option<i64> {
     let corners = |t: &[u32; 3]| t.map(|i| vertices[i as usize]);
-    let capped = cap.iter().map(|t| (t, Aabb::of(corners(t))));
+    let capped = cap.iter().zip(cap_boxes.iter().copied());
     'rays: for (axis, sign) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0), (2, 1.0), (2, -1.0)] {
         let (j, l) = ((axis + 1) % 3, (axis + 2) % 3);
         // An end beyond every triangle.
@@ -1752,7 +1753,7 @@ mod tests {
                     let sum = integer(winding(&vertices, &tris[b], p));
                     assert_eq!(sum, Some(want[a]), "{cube:?} {outward} {a}");
                     // The first ray from each corner that grazes nothing counts the same.
-                    let ray = ray_winding(&vertices, (&tris[b], &boxes_of(&vertices, &tris[b])), &[], &shells[b].bounds, p);
+                    let ray = ray_winding(&vertices, (&tris[b], &boxes_of(&vertices, &tris[b])), (&[], &[]), &shells[b].bounds, p);
                     assert_eq!(ray, Some(want[a]), "{cube:?} {outward} {a}");
                 }
             }
@@ -1763,7 +1764,7 @@ mod tests {
         let tris = fan(&faces, &[0, 1, 2, 3, 4, 5]);
         let bounds = Aabb::of(vertices.iter().copied());
         let boxes = boxes_of(&vertices, &tris);
-        let ray = |p| ray_winding(&vertices, (&tris, &boxes), &[], &bounds, p);
+        let ray = |p| ray_winding(&vertices, (&tris, &boxes), (&[], &[]), &bounds, p);
         assert_eq!([ray([0.0; 3]), ray([0.5, 0.25, 0.1]), ray([0.5, 0.25, 1.5])], [None, Some(1), Some(0)]);
     }
 
