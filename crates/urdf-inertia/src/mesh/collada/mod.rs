@@ -32,7 +32,7 @@ fn syntax_at(path: &Path, line: usize, msg: String) -> MeshError {
 
 /// Parses a COLLADA document into one mesh in the file's frame (see the module docs for the convention).
 pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
-    let doc = parse_tree(bytes, path)?;
+    let (doc, tail) = parse_tree(bytes, path)?;
     let root = doc
         .children
         .iter()
@@ -67,6 +67,11 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, MeshError> {
         },
         notes: Vec::new(),
     };
+    if let Some(line) = tail {
+        inst.notes.push(format!(
+            "warning: the file goes on after its </COLLADA> end tag (line {line}): that text is not read, as assimp (RViz, Gazebo, pinocchio) does not read it; it may be the end of an older, longer file saved over, so check that the mesh is whole"
+        ));
+    }
     if let Some(scene) = visual_scene(root, &by_id) { add_scene(scene, &by_id, &mut inst)? } else {
         if let Some(lib) = root.child("library_geometries") {
             for g in lib.children_named("geometry") {
@@ -187,6 +192,30 @@ mod tests {
         let spaced = tetra("0 2 1 0 1<!-- c --> <!-- d -->3 0 3 2 1 2 3", "");
         let m = parse(spaced.as_bytes(), Path::new("t.dae")).unwrap();
         assert_eq!(m.faces.indices, [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]);
+    }
+
+    /// Text after the root's end tag (an older file's end left by a shorter one saved over it) is not
+    /// read, with a warning at its line, as assimp reads such files; comments and whitespace there
+    /// are XML and say nothing.
+    #[test]
+    fn the_document_ends_at_the_root_end_tag() {
+        let doc = tetra(FACES, "");
+        let m = parse(format!("{doc}\n<!-- c -->\n\n").as_bytes(), Path::new("t.dae")).unwrap();
+        assert_eq!(m.faces.len(), 4);
+        assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+        let tail = format!("{doc}\n\n  0 1 2 3</p>\n</triangles></mesh></geometry>\n</library_geometries></COLLADA>\n");
+        let m = parse(tail.as_bytes(), Path::new("t.dae")).unwrap();
+        assert_eq!(m.faces.indices, [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]);
+        let lines = doc.lines().count();
+        assert_eq!(m.warnings.len(), 1, "{:?}", m.warnings);
+        assert!(
+            m.warnings[0].contains(&format!("goes on after its </COLLADA> end tag (line {})", lines + 2)),
+            "{:?}",
+            m.warnings
+        );
+        // A second root element is such a tail too.
+        let m = parse(format!("{doc}<COLLADA></COLLADA>").as_bytes(), Path::new("t.dae")).unwrap();
+        assert!(m.warnings[0].contains(&format!("(line {lines})")), "{:?}", m.warnings);
     }
 
     /// Sources no VERTEX input names (normals, texture coordinates) are never parsed.

@@ -102,8 +102,14 @@ fn element(e: &quick_xml::events::BytesStart<'_>, line: usize) -> El {
 }
 
 /// Reads the document into a tree of elements, with each element's text kept as a span of the file
-/// where it can be.
-pub(super) fn parse_tree(bytes: &[u8], path: &Path) -> Result<El, MeshError> {
+/// where it can be; and the line of what follows the root element's end tag, if anything but
+/// whitespace, comments and processing instructions does.
+///
+/// Such a tail is not read. A file saved over a longer one sometimes keeps the old file's end after
+/// its own `</COLLADA>` (rtb-data 2.0.0's KUKA `lbr_iiwa_14_r820/visual/base_link2.dae`: a stray
+/// `</p>` and more at line 495); assimp, and so RViz, Gazebo and pinocchio, read the document up to
+/// that end tag and ignore the rest, and so does this reader (the caller says so in a warning).
+pub(super) fn parse_tree(bytes: &[u8], path: &Path) -> Result<(El, Option<usize>), MeshError> {
     let mut reader = Reader::from_reader(bytes);
     reader.config_mut().trim_text(false);
     let mut stack: Vec<El> = vec![El {
@@ -116,6 +122,20 @@ pub(super) fn parse_tree(bytes: &[u8], path: &Path) -> Result<El, MeshError> {
     };
     loop {
         let pos = reader.buffer_position() as usize;
+        if stack.len() == 1 && !stack[0].children.is_empty() {
+            // The root element is closed: only what XML allows after it may follow.
+            match reader.read_event() {
+                Ok(Event::Eof) => break,
+                Ok(Event::Comment(_) | Event::PI(_)) => continue,
+                Ok(Event::Text(t)) if t.iter().all(u8::is_ascii_whitespace) => continue,
+                _ => {
+                    let rest = bytes.get(pos..).unwrap_or_default();
+                    let skip = rest.iter().take_while(|b| b.is_ascii_whitespace()).count();
+                    let tail = Some(line_of(bytes, pos + skip));
+                    return Ok((stack.pop().unwrap_or_default(), tail));
+                }
+            }
+        }
         let event = reader.read_event().map_err(|e| {
             syntax(
                 reader.error_position() as usize,
@@ -163,7 +183,7 @@ pub(super) fn parse_tree(bytes: &[u8], path: &Path) -> Result<El, MeshError> {
             MeshErrorKind::Syntax("the XML ends before its elements are closed".into()),
         ));
     }
-    Ok(stack.pop().unwrap_or_default())
+    Ok((stack.pop().unwrap_or_default(), None))
 }
 
 /// Adds a piece of text to `top`: a span of `bytes` while it is one piece borrowed from the file at `pos`,
