@@ -435,6 +435,72 @@ fn overflow_and_underflow_fail_the_link() {
     );
 }
 
+/// An open ring (a U-shaped channel swept round, its inner lip 2 mm below its outer one, as
+/// gymnasium-robotics' `stoverim.stl` is) under `--open-mesh caps`: the two flat caps overlap over
+/// the inner disc, which the capped integral counts negatively, and its principal moments break the
+/// triangle inequality (I3 = 3.0109e-6 > I1 + I2 = 3.0018e-6). That is the geometry, not f64's range:
+/// the error says so (it once said "overflow/underflow ... beyond f64"), in `mesh` and in `fill`.
+#[test]
+fn caps_that_make_no_body_are_not_called_an_overflow() {
+    use std::fmt::Write as _;
+    let tmp = tempfile::tempdir().unwrap();
+    let profile = [
+        (0.135, 0.0),
+        (0.135, 0.0148),
+        (0.1146, 0.0148),
+        (0.1146, -0.002),
+    ];
+    let n = 16;
+    let mut obj = String::new();
+    for (r, z) in profile {
+        for k in 0..n {
+            let a = 2.0 * std::f64::consts::PI * f64::from(k) / f64::from(n);
+            writeln!(obj, "v {} {} {z}", r * a.cos(), r * a.sin()).unwrap();
+        }
+    }
+    for p in 0..3 {
+        for k in 0..n {
+            let (a, b) = (p * n + k + 1, p * n + (k + 1) % n + 1);
+            let (c, d) = (b + n, a + n);
+            writeln!(obj, "f {a} {b} {c}\nf {a} {c} {d}").unwrap();
+        }
+    }
+    let rim = tmp.path().join("rim.obj");
+    std::fs::write(&rim, obj).unwrap();
+    let out = run(&["mesh", s(&rim), "--open-mesh", "caps"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("the computed inertial is no body's") && err.contains("triangle inequality"),
+        "{err}"
+    );
+    assert!(
+        err.contains("flat caps over an open band or dish") && !err.contains("overflow"),
+        "{err}"
+    );
+    // By default the caps are not trusted (UI108), and the hull is a body.
+    assert!(stderr(&run(&["mesh", s(&rim)])).contains("UI108"));
+    assert_eq!(
+        run(&["mesh", s(&rim), "--open-mesh", "hull"]).status.code(),
+        Some(0)
+    );
+    let urdf = tmp.path().join("r.urdf");
+    std::fs::write(
+        &urdf,
+        "<robot name=\"r\">\n  <link name=\"x\">\n    <collision><geometry><mesh filename=\"rim.obj\"/></geometry></collision>\n  </link>\n</robot>\n",
+    )
+    .unwrap();
+    let out = run(&["fill", s(&urdf), "--density", "1000", "--open-mesh", "caps"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("error[UI705]")
+            && err.contains("link `x`: the computed inertial is no body's"),
+        "{err}"
+    );
+    assert!(out.stdout.is_empty());
+}
+
 // ---------------------------------------------------------------------------------------------------
 // Item 6: only regular files, and no more than a limit.
 

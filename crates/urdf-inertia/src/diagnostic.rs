@@ -144,7 +144,7 @@ pub enum Code {
     ErrorMesh,
     /// UI704: a mass target below what the parts with their own rules weigh.
     ErrorMassTarget,
-    /// UI705: values beyond f64.
+    /// UI705: values that cannot be written: beyond f64, or no body's (a geometry that is no solid).
     ErrorUnrepresentable,
     /// UI706: `--keep-mass` on a `<mass>` that is no positive number.
     ErrorKeptMass,
@@ -552,7 +552,7 @@ pub enum LinkErrorKind {
         mass: f64,
         own_mass: f64,
     },
-    /// Values beyond f64 (overflow or underflow), with the reasons.
+    /// Values that cannot be written: beyond f64 (overflow or underflow), or no body's; with the reasons.
     Unrepresentable(String),
     /// `--keep-mass` on a `<mass>` (at `line`) that is no positive finite number: `value` as read.
     KeptMassInvalid { line: usize, value: String },

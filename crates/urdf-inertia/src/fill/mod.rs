@@ -494,7 +494,11 @@ fn compute_link(
 }
 
 /// Why computed mass properties cannot be written, if they cannot: every check of
-/// `validity::check`, plus finite principal axes (what `--principal` writes).
+/// `validity::check`, plus finite principal axes (what `--principal` writes). The message names the
+/// cause: values beyond f64 (not finite, or a mass or moment near the ends of its range), or else a
+/// geometry that is no solid of positive density (gymnasium-robotics' `stoverim.stl`, an open ring
+/// under `--open-mesh caps`: its caps count part of it negatively, and its principal moments break
+/// the triangle inequality by 0.33%; that is no overflow).
 pub fn unrepresentable(mp: &MassProperties) -> Option<String> {
     let mut problems: Vec<String> = validity::check(mp, validity::DEFAULT_TOLERANCE)
         .iter()
@@ -520,9 +524,25 @@ pub fn unrepresentable(mp: &MassProperties) -> Option<String> {
             problems.push("its principal axes are not finite".into());
         }
     }
-    (!problems.is_empty()).then(|| {
+    if problems.is_empty() {
+        return None;
+    }
+    // Far from both ends of f64, the values are what the geometry gives.
+    let in_range = |x: f64| (1e-250..=1e250).contains(&x.abs());
+    let finite = mp.mass.is_finite() && mp.inertia.iter().flatten().all(|x| x.is_finite());
+    let extreme = !finite
+        || !in_range(mp.mass)
+        || !in_range(largest_moment)
+        || mp.com.iter().any(|x| x.abs() > 1e250)
+        || problems.iter().any(|p| p.contains("principal axes"));
+    Some(if extreme {
         format!(
             "overflow/underflow: the computed inertial is not usable ({}); sizes, positions, scales or densities this large or small are beyond f64",
+            problems.join("; ")
+        )
+    } else {
+        format!(
+            "the computed inertial is no body's ({}): the geometry, as computed, is not a solid of positive density (flat caps over an open band or dish count part of it negatively); close the mesh, choose another model for open meshes (`--open-mesh hull`: an upper bound), or give the link a primitive collision shape",
             problems.join("; ")
         )
     })

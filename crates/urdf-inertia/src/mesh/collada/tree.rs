@@ -107,7 +107,7 @@ fn element(e: &quick_xml::events::BytesStart<'_>, line: usize) -> El {
 ///
 /// Such a tail is not read. A file saved over a longer one sometimes keeps the old file's end after
 /// its own `</COLLADA>` (rtb-data 2.0.0's KUKA `lbr_iiwa_14_r820/visual/base_link2.dae`: a stray
-/// `</p>` and more at line 495); assimp, and so RViz, Gazebo and pinocchio, read the document up to
+/// `</p>` and more at line 495); assimp, and so `RViz`, Gazebo and pinocchio, read the document up to
 /// that end tag and ignore the rest, and so does this reader (the caller says so in a warning).
 pub(super) fn parse_tree(bytes: &[u8], path: &Path) -> Result<(El, Option<usize>), MeshError> {
     let mut reader = Reader::from_reader(bytes);
