@@ -48,8 +48,8 @@ RESAMPLE = 10
 
 
 def triangles(path, scale):
-    """Vertices (float64) and triangles as coal's MeshLoader (assimp) reads them, except an OBJ that coal
-    reads with vertices no triangle uses: trimesh reads those. assimp splits an OBJ with several materials
+    """Vertices (float64) and triangles as coal's MeshLoader (assimp) reads them, except an OBJ or COLLADA file
+    that coal reads with vertices no triangle uses: trimesh reads those (COLLADA: `collada_unit`). assimp splits an OBJ with several materials
     into several meshes, and coal 3.0.3 indexes the second and later ones without their vertex offset (as
     for glTF primitives, validation/gltf_coal.py), so their triangles land on the first mesh's vertices:
     robosuite's schunk_svh_hand `d13.obj` (two materials) has 2.3e-6 m³ as coal reads it and 6.2e-6 as
@@ -60,13 +60,30 @@ def triangles(path, scale):
     for i in range(model.num_tris):
         t = model.tri_indices(i)
         f[i] = (t[0], t[1], t[2])
-    if Path(path).suffix.lower() == ".obj" and len(np.unique(f)) < len(v):
+    suffix = Path(path).suffix.lower()
+    if suffix in (".obj", ".dae") and len(np.unique(f)) < len(v):
         import trimesh
 
         mesh = trimesh.load(str(path), force="mesh", process=False)
         v = np.asarray(mesh.vertices, dtype=np.float64) * np.asarray(scale, dtype=np.float64)
         f = np.asarray(mesh.faces, dtype=np.int64)
+        if suffix == ".dae":
+            v = v * collada_unit(path)
     return v, f
+
+
+def collada_unit(path):
+    """The `<unit meter>` of a COLLADA file (1 without one), which trimesh's reader (pycollada) does not apply.
+    The same coal bug as above hits a COLLADA mesh of several `<triangles>` or `<polylist>` (assimp makes a
+    mesh per material): rtb-data's KUKA `lbr_iiwa_14_r820/visual/link_2.dae` (two) comes out with 1,862 of
+    its 2,623 vertices used and 2.5e-3 m³ of solid where the file's triangles enclose 3.9e-3 m³; trimesh
+    reads them all, in the file's unit (`kr210l150/visual/base_link.dae` is in inches)."""
+    import xml.etree.ElementTree as ET
+
+    for el in ET.parse(str(path)).getroot().iter():
+        if el.tag.rsplit("}", 1)[-1] == "unit" and el.get("meter"):
+            return float(el.get("meter"))
+    return 1.0
 
 
 def solid_volume(v, f, points, rng):
@@ -90,7 +107,10 @@ def solid_volume(v, f, points, rng):
     a, b = inside
     volume = cell_volume * float(np.sum(a + b)) / 2.0
     # Per cell, the mean of two points has variance s^2/2, and (a-b)^2/2 estimates s^2 without bias.
-    sigma = cell_volume * float(np.sqrt(np.sum((a - b) ** 2) / 4.0))
+    # At least one cell's volume: where no cell's two points disagree the estimate is 0, though slivers
+    # thinner than the points can see are there (gymnasium-robotics' `microwindow.stl`, a box a few ulps
+    # from square: every point inside, the bounding box's volume, 6.7e-7 above the solid's, "3 sigma" 0).
+    sigma = cell_volume * max(1.0, float(np.sqrt(np.sum((a - b) ** 2) / 4.0)))
     return volume, sigma
 
 

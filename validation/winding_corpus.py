@@ -2,7 +2,7 @@
 """The winding-number validation (validation/winding.py) on meshes it was not tuned on: the PyPI robot wheels.
 
 Every wheel pinned in validation/corpus-requirements.txt except example-robot-data (validation/winding.sh covers
-it): every (file, scale) a <collision> of the wheel's URDFs uses, `package://` resolved inside the wheel as
+it), and those of validation/winding-corpus-wheels.txt (packages of meshes that only this validation reads): every (file, scale) a <collision> of the wheel's URDFs uses, `package://` resolved inside the wheel as
 validation/corpus.py does, and every mesh file of a meshes-only package at scale 1. Each mesh whose rung is not
 exact or welded is measured as winding.py measures it (libigl's fast winding number on the triangles coal reads,
 glTF excepted: trimesh reads those, see reference_triangles; stratified sampling in the bounding box; pass: |ours - reference| <= estimate x ours + 3 sigma). Meshes refused
@@ -157,7 +157,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--binary", required=True)
     ap.add_argument("--wheels", required=True, help="directory of the downloaded wheels")
-    ap.add_argument("--requirements", required=True)
+    ap.add_argument("--requirements", required=True, action="append", help="a file of pinned wheels (repeatable)")
     ap.add_argument("--work", required=True, help="directory to unzip the wheels into (emptied as it goes)")
     ap.add_argument("--out", required=True)
     ap.add_argument("--points", type=int, default=POINTS)
@@ -170,7 +170,8 @@ def main():
     work = Path(args.work).resolve()
     start = time.monotonic()
     packages, rows = [], []
-    for name, version, meshes_only in parse_requirements(args.requirements):
+    wheels = [w for r in args.requirements for w in parse_requirements(r)]
+    for name, version, meshes_only in wheels:
         if name in SKIP:
             continue
         count, rs = measure_package(args, name, version, meshes_only, work)

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The winding-number validation on meshes it was not tuned on: every collision mesh of the PyPI robot wheels
-# pinned in validation/corpus-requirements.txt (example-robot-data aside: validation/winding.sh) that the
+# pinned in validation/corpus-requirements.txt (example-robot-data aside: validation/winding.sh) and every
+# mesh of the packages of validation/winding-corpus-wheels.txt that the
 # health ladder repairs, against libigl's fast winding number (validation/winding_corpus.py). .ci/run runs
 # it with WINDING_JOBS=2: about 340 meshes (docs/accuracy.md, "Open and overlapping meshes", gives its cost).
 # Usage: bash validation/winding_corpus.sh [OUT.md]
@@ -24,9 +25,10 @@ fi
 # --platform/--python-version: pybullet is the one binary wheel; the others are py3-none-any (as corpus.sh).
 "$venv/bin/python" -m pip download --quiet --disable-pip-version-check --no-deps --only-binary=:all: \
   --platform manylinux2014_x86_64 --python-version 3.11 --implementation cp --abi cp311 \
-  -d "$work/wheels" -r validation/corpus-requirements.txt
+  -d "$work/wheels" -r validation/corpus-requirements.txt -r validation/winding-corpus-wheels.txt
 cargo build --release --quiet
 echo "== winding corpus: work directory $work, report $out"
 "$venv/bin/python" validation/winding_corpus.py --binary "${CARGO_TARGET_DIR:-target}/release/urdf-inertia" \
-  --wheels "$work/wheels" --requirements validation/corpus-requirements.txt --work "$work" --out "$out" \
+  --wheels "$work/wheels" --requirements validation/corpus-requirements.txt \
+  --requirements validation/winding-corpus-wheels.txt --work "$work" --out "$out" \
   ${WINDING_POINTS:+--points "$WINDING_POINTS"} ${WINDING_JOBS:+--jobs "$WINDING_JOBS"}
