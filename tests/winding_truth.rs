@@ -195,8 +195,79 @@ fn flat_plates_have_no_volume() {
                 matches!(e.kind, MeshErrorKind::ZeroVolume { .. }),
                 "{model:?}: {e}"
             );
+            // Every face stored twice, once each way, is said to be so.
+            assert_eq!(e.is_two_sided(), faces.len() == 4, "{model:?}: {e}");
         }
     }
+}
+
+/// A cube stored double-sided (as `SketchUp` exports: rtb-data's KUKA kr210 visual meshes) has no
+/// volume either, its two sides cancelling face by face; the error says why and what to do.
+#[test]
+fn a_cube_stored_double_sided_has_no_volume() {
+    let cube: Vec<[f64; 3]> = (0..8)
+        .map(|i| {
+            [
+                f64::from(i & 1),
+                f64::from((i >> 1) & 1),
+                f64::from((i >> 2) & 1),
+            ]
+        })
+        .collect();
+    let out = [
+        [0, 2, 3],
+        [0, 3, 1],
+        [4, 5, 7],
+        [4, 7, 6],
+        [0, 1, 5],
+        [0, 5, 4],
+        [2, 6, 7],
+        [2, 7, 3],
+        [0, 4, 6],
+        [0, 6, 2],
+        [1, 3, 7],
+        [1, 7, 5],
+    ];
+    let closed = solid(&cube, &out, OpenMeshModel::Trusted).expect("a cube");
+    assert!((closed.unit.mass.abs() - 1.0).abs() < 1e-15);
+    let both: Vec<[u32; 3]> = out
+        .iter()
+        .flat_map(|&[a, b, c]| [[a, b, c], [a, c, b]])
+        .collect();
+    for model in [
+        OpenMeshModel::Trusted,
+        OpenMeshModel::Caps,
+        OpenMeshModel::Hull,
+    ] {
+        let e = solid(&cube, &both, model).expect_err("two-sided");
+        assert!(e.is_two_sided(), "{model:?}: {e}");
+        assert!(
+            e.to_string()
+                .contains("every face is stored twice, once each way (a double-sided export")
+                && e.to_string().contains("export it single-sided"),
+            "{e}"
+        );
+    }
+    // In `fill` it contributes nothing, as a flat plate does, with a warning that says why: the
+    // link is its box alone (m = 1000 · 0.1 · 0.2 · 0.3 = 6 kg).
+    let tmp = tempfile::tempdir().expect("tempdir");
+    write_obj(&tmp.path().join("two.obj"), &cube, &both);
+    let urdf = tmp.path().join("r.urdf");
+    std::fs::write(
+        &urdf,
+        "<robot name=\"r\"><link name=\"a\"><collision><geometry><box size=\"0.1 0.2 0.3\"/></geometry></collision><collision><geometry><mesh filename=\"two.obj\"/></geometry></collision></link></robot>\n",
+    )
+    .expect("write");
+    let o = run(&["fill", urdf.to_str().expect("utf-8"), "--density", "1000"]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("warning[UI109]")
+            && stderr.contains("a double-sided export, whose two sides cancel"),
+        "{stderr}"
+    );
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("<mass value=\"6\""), "{stdout}");
 }
 
 /// Writes `(v, f)` as OBJ text (`{:?}` is the shortest text that reads back as the same f64).

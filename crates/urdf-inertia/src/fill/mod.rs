@@ -386,16 +386,24 @@ fn link_parts(
         match geometry_part(link, c, ctx, solids) {
             Ok(p) => parts.push(p),
             Err(e) => {
-                let Some((path, volume, bbox)) = is_flat(&e) else {
+                let Some((path, volume, bbox, two_sided)) = is_flat(&e) else {
                     return Err(e);
                 };
-                let message = format!(
-                    "collision {}: {} encloses no volume ({} m³ against a bounding box of {} m³: a flat plate or a two-sided sheet); it contributes nothing, as a zero-size shape does",
-                    c.index,
-                    crate::text::escape_control(&path),
-                    crate::text::significant(volume, 4),
-                    crate::text::significant(bbox, 4)
-                );
+                let message = if two_sided {
+                    format!(
+                        "collision {}: {} encloses no volume (every face is stored twice, once each way: a double-sided export, whose two sides cancel); it contributes nothing, as a zero-size shape does; if it stands for a solid, export it single-sided",
+                        c.index,
+                        crate::text::escape_control(&path),
+                    )
+                } else {
+                    format!(
+                        "collision {}: {} encloses no volume ({} m³ against a bounding box of {} m³: a flat plate or a two-sided sheet); it contributes nothing, as a zero-size shape does",
+                        c.index,
+                        crate::text::escape_control(&path),
+                        crate::text::significant(volume, 4),
+                        crate::text::significant(bbox, 4)
+                    )
+                };
                 let warning = Diagnostic::new(Code::MeshNoVolume, message);
                 flat.push(warning.at(part_location(link, c)));
             }
@@ -422,15 +430,16 @@ fn no_volume(link: &Link, flat: &[Diagnostic]) -> Diagnostic {
     })
 }
 
-/// The mesh (its path, volume and bounding-box volume) when a part failed only because its mesh
-/// encloses no volume (not because it is beyond f64's range: that is another error).
-fn is_flat(e: &LinkError) -> Option<(String, f64, f64)> {
+/// The mesh (its path, volume, bounding-box volume and whether it is stored double-sided) when a
+/// part failed only because its mesh encloses no volume (not because it is beyond f64's range: that
+/// is another error).
+fn is_flat(e: &LinkError) -> Option<(String, f64, f64, bool)> {
     match &*e.kind {
         LinkErrorKind::Mesh(m) => match m.kind {
             crate::mesh::MeshErrorKind::ZeroVolume {
                 volume,
                 bbox_volume,
-            } => Some((m.path.display().to_string(), volume, bbox_volume)),
+            } => Some((m.path.display().to_string(), volume, bbox_volume, m.is_two_sided())),
             _ => None,
         },
         _ => None,

@@ -416,7 +416,10 @@ pub fn heal(
             tolerance: w.tolerant.tolerance.largest,
         };
         let components = te.components(w.topology.len());
-        return welded_closed(ladder, w, components, rung, stored_integrals);
+        // Every face dropped with its reverse: a double-sided export, which the error names.
+        let two_sided = w.topology.is_empty() && w.cancelled > 0;
+        return welded_closed(ladder, w, components, rung, stored_integrals)
+            .map_err(|e| if two_sided { e.stored_two_sided() } else { e });
     }
     if te.closed() {
         if let Some(o) = orient(w.topology.len(), &te.pairs) {

@@ -91,6 +91,9 @@ pub struct MeshError {
     /// healing by then, and finding the extent before it was a pass over every vertex that only a
     /// mesh of no volume needs). Not part of the error's identity.
     extent: Option<f64>,
+    /// For [`MeshErrorKind::ZeroVolume`]: every face was stored twice, once each way (a
+    /// double-sided export), and the pairs cancelled ([`MeshError::is_two_sided`]).
+    two_sided: bool,
 }
 
 impl PartialEq for MeshError {
@@ -155,6 +158,10 @@ impl fmt::Display for MeshError {
                 write!(f, "a face refers to vertex {index}, but the file has {vertices} vertices")
             }
             MeshErrorKind::Empty => write!(f, "the mesh has no faces"),
+            MeshErrorKind::ZeroVolume { .. } if self.two_sided => write!(
+                f,
+                "the mesh encloses no volume: every face is stored twice, once each way (a double-sided export, as SketchUp writes), so its two sides cancel; export it single-sided, or give the link a primitive collision shape"
+            ),
             MeshErrorKind::ZeroVolume { volume, bbox_volume } => write!(
                 f,
                 "the mesh encloses no volume ({} m³ against a bounding box of {} m³): it is flat or degenerate; give the link a primitive collision shape or a closed mesh",
@@ -187,6 +194,21 @@ impl MeshError {
             line,
             kind,
             extent: None,
+            two_sided: false,
+        }
+    }
+
+    /// Whether the mesh encloses no volume because every face is stored twice, once each way (a
+    /// double-sided export: as `SketchUp` writes, rtb-data's `kuka_kr210/.../visual/link_1.dae`).
+    pub fn is_two_sided(&self) -> bool {
+        self.two_sided
+    }
+
+    /// This error, said of a mesh whose every face was stored twice, once each way.
+    pub(crate) fn stored_two_sided(self) -> Self {
+        MeshError {
+            two_sided: matches!(self.kind, MeshErrorKind::ZeroVolume { .. }),
+            ..self
         }
     }
 
