@@ -205,29 +205,7 @@ fn flat_plates_have_no_volume() {
 /// volume either, its two sides cancelling face by face; the error says why and what to do.
 #[test]
 fn a_cube_stored_double_sided_has_no_volume() {
-    let cube: Vec<[f64; 3]> = (0..8)
-        .map(|i| {
-            [
-                f64::from(i & 1),
-                f64::from((i >> 1) & 1),
-                f64::from((i >> 2) & 1),
-            ]
-        })
-        .collect();
-    let out = [
-        [0, 2, 3],
-        [0, 3, 1],
-        [4, 5, 7],
-        [4, 7, 6],
-        [0, 1, 5],
-        [0, 5, 4],
-        [2, 6, 7],
-        [2, 7, 3],
-        [0, 4, 6],
-        [0, 6, 2],
-        [1, 3, 7],
-        [1, 7, 5],
-    ];
+    let (cube, out) = common::box_mesh([1.0; 3]);
     let closed = solid(&cube, &out, OpenMeshModel::Trusted).expect("a cube");
     assert!((closed.unit.mass.abs() - 1.0).abs() < 1e-15);
     let both: Vec<[u32; 3]> = out
