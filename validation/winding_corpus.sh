@@ -3,7 +3,7 @@
 # pinned in validation/corpus-requirements.txt (example-robot-data aside: validation/winding.sh) and every
 # mesh of the packages of validation/winding-corpus-wheels.txt that the
 # health ladder repairs, against libigl's fast winding number (validation/winding_corpus.py). .ci/run runs
-# it with WINDING_JOBS=2: about 340 meshes (docs/accuracy.md, "Open and overlapping meshes", gives its cost).
+# it with WINDING_JOBS=2: about 1,250 rows (docs/accuracy.md, "Open and overlapping meshes", gives its cost).
 # Usage: bash validation/winding_corpus.sh [OUT.md]
 #   OUT.md defaults to a file in the work directory, so the tree stays clean; the figures in docs/accuracy.md
 #   are regenerated on purpose from that report.
