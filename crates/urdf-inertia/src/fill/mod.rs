@@ -551,7 +551,7 @@ pub fn unrepresentable(mp: &MassProperties) -> Option<String> {
         )
     } else {
         format!(
-            "the computed inertial is no body's ({}): the geometry, as computed, is not a solid of positive density (flat caps over an open band or dish count part of it negatively); close the mesh, choose another model for open meshes (`--open-mesh hull`: an upper bound), or give the link a primitive collision shape",
+            "the computed inertial is no body's ({}): the geometry, as computed, is not a solid of positive density (as where flat caps over an open band or dish count part of it negatively); close the mesh, choose another model for open meshes (`--open-mesh hull`: an upper bound), or give the link a primitive collision shape",
             problems.join("; ")
         )
     })
