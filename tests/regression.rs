@@ -438,7 +438,8 @@ fn overflow_and_underflow_fail_the_link() {
 /// An open ring (a U-shaped channel swept round, its inner lip 2 mm below its outer one, as
 /// gymnasium-robotics' `stoverim.stl` is) under `--open-mesh caps`: the two flat caps overlap over
 /// the inner disc, which the capped integral counts negatively, and its principal moments break the
-/// triangle inequality (I3 = 3.0109e-6 > I1 + I2 = 3.0018e-6). That is the geometry, not f64's range:
+/// triangle inequality (I3 = 3.0109e-6 > I1 + I2 = 3.0018e-6, as trimesh 5.2.0 also integrates the
+/// ring with the same caps, fans from a corner of each hole). That is the geometry, not f64's range:
 /// the error says so (it once said "overflow/underflow ... beyond f64"), in `mesh` and in `fill`.
 #[test]
 fn caps_that_make_no_body_are_not_called_an_overflow() {

@@ -509,46 +509,35 @@ fn compute_link(
 /// under `--open-mesh caps`: its caps count part of it negatively, and its principal moments break
 /// the triangle inequality by 0.33%; that is no overflow).
 pub fn unrepresentable(mp: &MassProperties) -> Option<String> {
-    let mut problems: Vec<String> = validity::check(mp, validity::DEFAULT_TOLERANCE)
-        .iter()
-        .map(ToString::to_string)
-        .collect();
+    let beyond_f64 = |why: &str| {
+        format!(
+            "overflow/underflow: the computed inertial is not usable ({why}); sizes, positions, scales or densities this large or small are beyond f64"
+        )
+    };
+    let violations = validity::check(mp, validity::DEFAULT_TOLERANCE);
     let largest_moment = (0..3).fold(0.0f64, |a, k| a.max(mp.inertia[k][k].abs()));
-    if problems.is_empty() && (mp.mass < f64::MIN_POSITIVE || largest_moment < f64::MIN_POSITIVE) {
-        // Subnormal: representable, but with most of its digits gone.
-        problems.push(format!(
-            "mass {:e} kg and largest moment {largest_moment:e} kg·m² are below the smallest normal f64 ({:e})",
-            mp.mass,
-            f64::MIN_POSITIVE
-        ));
-    }
-    if problems.is_empty() {
-        let p = mp.principal();
-        if !p
-            .moments
-            .iter()
-            .chain(p.axes.iter().flatten())
-            .all(|x| x.is_finite())
-        {
-            problems.push("its principal axes are not finite".into());
+    if violations.is_empty() {
+        if mp.mass < f64::MIN_POSITIVE || largest_moment < f64::MIN_POSITIVE {
+            // Subnormal: representable, but with most of its digits gone.
+            return Some(beyond_f64(&format!(
+                "mass {:e} kg and largest moment {largest_moment:e} kg·m² are below the smallest normal f64 ({:e})",
+                mp.mass,
+                f64::MIN_POSITIVE
+            )));
         }
+        let p = mp.principal();
+        let finite = p.moments.iter().chain(p.axes.iter().flatten()).all(|x| x.is_finite());
+        return (!finite).then(|| beyond_f64("its principal axes are not finite"));
     }
-    if problems.is_empty() {
-        return None;
-    }
+    let problems: Vec<String> = violations.iter().map(ToString::to_string).collect();
     // Far from both ends of f64, the values are what the geometry gives.
     let in_range = |x: f64| (1e-250..=1e250).contains(&x.abs());
-    let finite = mp.mass.is_finite() && mp.inertia.iter().flatten().all(|x| x.is_finite());
-    let extreme = !finite
+    let extreme = violations.contains(&validity::Violation::NotFinite)
         || !in_range(mp.mass)
         || !in_range(largest_moment)
-        || mp.com.iter().any(|x| x.abs() > 1e250)
-        || problems.iter().any(|p| p.contains("principal axes"));
+        || mp.com.iter().any(|x| x.abs() > 1e250);
     Some(if extreme {
-        format!(
-            "overflow/underflow: the computed inertial is not usable ({}); sizes, positions, scales or densities this large or small are beyond f64",
-            problems.join("; ")
-        )
+        beyond_f64(&problems.join("; "))
     } else {
         format!(
             "the computed inertial is no body's ({}): the geometry, as computed, is not a solid of positive density (as where flat caps over an open band or dish count part of it negatively); close the mesh, choose another model for open meshes (`--open-mesh hull`: an upper bound), or give the link a primitive collision shape",
