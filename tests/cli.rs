@@ -1503,3 +1503,162 @@ fn fill_keeps_an_inertial_that_already_agrees() {
         .count();
     assert!((1..=3).contains(&changed), "{changed} lines changed");
 }
+
+/// A capsule about its centre, along `axis` (0, 1 or 2): cylinder of radius `r` and length `l`
+/// (mass `mc`) plus a ball of radius `r` (mass `ms`) split over its ends, density `rho`; the
+/// textbook formula: `mc (l²/12 + r²/4) + ms (2r²/5 + l²/4 + 3lr/8)` across, `mc r²/2 + 2 ms r²/5`
+/// along.
+fn capsule_i(rho: f64, r: f64, l: f64, axis: usize) -> (f64, [f64; 6]) {
+    let (mc, ms) = (rho * PI * r * r * l, rho * 4.0 / 3.0 * PI * r * r * r);
+    let across =
+        mc * (l * l / 12.0 + r * r / 4.0) + ms * (0.4 * r * r + l * l / 4.0 + 0.375 * l * r);
+    let along = mc * r * r / 2.0 + ms * 0.4 * r * r;
+    let mut d = [across; 3];
+    d[axis] = along;
+    (mc + ms, [d[0], 0.0, 0.0, d[1], 0.0, d[2]])
+}
+
+/// One link of collisions (origin xyz, rpy, geometry element).
+fn collisions_link(name: &str, parts: &[(&str, &str, &str)]) -> String {
+    let mut text = format!("<link name=\"{name}\">\n");
+    for (xyz, rpy, g) in parts {
+        let c = format!("<collision><origin xyz=\"{xyz}\" rpy=\"{rpy}\"/><geometry>{g}</geometry></collision>\n");
+        text.push_str(&c);
+    }
+    text + "</link>\n"
+}
+
+/// Links of a cylinder with spheres of its radius on its ends (capsules), and three that are not.
+fn capsule_links() -> String {
+    let cyl = |r: f64, l: f64| format!("<cylinder radius=\"{r}\" length=\"{l}\"/>");
+    let ball = |r: f64| format!("<sphere radius=\"{r}\"/>");
+    [
+        // example-robot-data's panda_link1, its sphere centres as the file writes them (3e-17 m
+        // from the ends as f64 computes them).
+        collisions_link(
+            "panda",
+            &[
+                ("0 0 -0.1915", "0 0 0", &cyl(0.09, 0.283)),
+                ("0 0 -0.05000000000000002", "0 0 0", &ball(0.09)),
+                ("0 0 -0.33299999999999996", "0 0 0", &ball(0.09)),
+            ],
+        ),
+        // Franka's collision_capsule macro along x (pitch π/2), spheres listed first.
+        collisions_link(
+            "along_x",
+            &[
+                ("-0.06 0 0.06", "0 0 0", &ball(0.06)),
+                ("-0.09 0 0.06", "0 0 0", &ball(0.06)),
+                ("-0.075 0 0.06", "0 1.5707963267948966 0", &cyl(0.06, 0.03)),
+            ],
+        ),
+        // Shorter than its radius: the spheres overlap each other, and the union is still the capsule.
+        collisions_link(
+            "short",
+            &[
+                ("1 2 3", "0 0 0", &cyl(1.0, 0.5)),
+                ("1 2 3.25", "0 0 0", &ball(1.0)),
+                ("1 2 2.75", "0 0 0", &ball(1.0)),
+            ],
+        ),
+        // π/2 written as 1.57: the ends are 6e-5 m from the spheres, which stay parts of their own.
+        collisions_link(
+            "sloppy",
+            &[
+                ("0 0 0.03", "1.57 0 0", &cyl(0.05, 0.15)),
+                ("0 -0.075 0.03", "0 0 0", &ball(0.05)),
+                ("0 0.075 0.03", "0 0 0", &ball(0.05)),
+            ],
+        ),
+        // One sphere: not a capsule.
+        collisions_link(
+            "one_end",
+            &[
+                ("0 0 0", "0 0 0", &cyl(0.1, 0.4)),
+                ("0 0 0.2", "0 0 0", &ball(0.1)),
+            ],
+        ),
+    ]
+    .concat()
+}
+
+/// `fill` of a robot of `links` with `args`: the filled URDF and the summary.
+fn fill_links(links: &str, args: &[&str]) -> (String, String) {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("c.urdf");
+    std::fs::write(&path, format!("<robot name=\"c\">\n{links}</robot>\n")).unwrap();
+    let mut all = vec!["fill", path.to_str().unwrap()];
+    all.extend(args);
+    let out = run(&all);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{stderr}");
+    (String::from_utf8(out.stdout).unwrap(), stderr)
+}
+
+#[test]
+fn a_cylinder_with_a_sphere_on_each_end_is_its_capsule() {
+    let (filled, stderr) = fill_links(&capsule_links(), &["--density", "1000", "--verbose"]);
+    for (name, centre, r, l, axis) in [
+        ("panda", [0.0, 0.0, -0.1915], 0.09, 0.283, 2),
+        ("along_x", [-0.075, 0.0, 0.06], 0.06, 0.03, 0),
+        ("short", [1.0, 2.0, 3.0], 1.0, 0.5, 2),
+    ] {
+        let (m, i) = capsule_i(1000.0, r, l, axis);
+        assert_inertial(&filled, name, m, centre, i, 1e-12);
+        assert!(
+            stderr.contains(&format!(
+                "note[UI402]: link `{name}`: collisions 1, 2 and 3 are a capsule"
+            )),
+            "{stderr}"
+        );
+        assert!(
+            !stderr.contains(&format!("link `{name}`: parts")),
+            "{stderr}"
+        );
+    }
+    // Not capsules: the parts summed, their overlap counted twice and said (UI401).
+    let sphere_mass = |r: f64| 1000.0 * 4.0 / 3.0 * PI * r * r * r;
+    let cyl_mass = |r: f64, l: f64| 1000.0 * PI * r * r * l;
+    let (m, _, _) = inertial_of(&filled, "sloppy").unwrap();
+    close(
+        m,
+        cyl_mass(0.05, 0.15) + 2.0 * sphere_mass(0.05),
+        1e-12,
+        m,
+        "sloppy mass",
+    );
+    assert!(
+        stderr.contains("warning[UI401]: link `sloppy`: parts 1, 2 and 3 overlap"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("collisions 1, 2 and 3 are nearly a capsule: its spheres miss the cylinder's end centres (or radius) by up to 6e-5 m"), "{stderr}");
+    let (m, _, _) = inertial_of(&filled, "one_end").unwrap();
+    close(
+        m,
+        cyl_mass(0.1, 0.4) + sphere_mass(0.1),
+        1e-12,
+        m,
+        "one_end mass",
+    );
+    assert!(
+        stderr.contains("warning[UI401]: link `one_end`: parts 1 and 2 overlap"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("link `one_end`: collisions"), "{stderr}");
+}
+
+#[test]
+fn a_kept_mass_is_spread_over_a_capsule() {
+    // The capsule's shape at 3 kg: the mass over the union's volume, not the parts'.
+    let kept = capsule_links().replacen("</link>", "<inertial><mass value=\"3\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial>\n</link>", 1);
+    let (filled, _) = fill_links(&kept, &["--keep-mass", "--density", "1000"]);
+    let (m, i) = capsule_i(1000.0, 0.09, 0.283, 2);
+    assert_inertial(
+        &filled,
+        "panda",
+        3.0,
+        [0.0, 0.0, -0.1915],
+        i.map(|x| x * 3.0 / m),
+        1e-12,
+    );
+}

@@ -4,7 +4,8 @@
 For every URDF: strip all <inertial>, run `urdf-inertia fill --density RHO`, load the result with
 pinocchio, and compare each joint's inertia (pinocchio merges links joined by fixed joints) with an
 independent reference: pinocchio's own collision model of the original URDF, each geometry's coal
-volume / COM / inertia about the COM at the same density, moved by its placement and summed per joint.
+volume / COM / inertia about the COM at the same density, moved by its placement and summed per joint
+(a cylinder with a sphere of its radius on each end as one coal.Capsule, their union).
 
 Joints whose parts are all closed, outward meshes or primitives must agree to 1e-9 (STL, primitives)
 or 1e-6 (OBJ/DAE: assimp keeps vertices in float32). Every other joint is reported with the reason our
@@ -23,6 +24,7 @@ import sys
 import time
 from pathlib import Path
 
+import coal
 import numpy as np
 import pinocchio as pin
 
@@ -72,11 +74,43 @@ def rel_inertia_diff(a, b):
     return dm, dc, di
 
 
+def capsules(objects):
+    """The geometry objects with each capsule written as a cylinder and a sphere of its radius centred
+    on each end (example-robot-data's panda_collision.urdf) replaced by one coal.Capsule at the
+    cylinder's placement: their union, which urdf-inertia computes (note UI402). A sphere within 1e-9
+    of the radius of an end centre (and of the radius) counts; each sphere joins one capsule."""
+    objects = list(objects)
+    used = set()
+    out = []
+    for i, go in enumerate(objects):
+        g = go.geometry
+        if type(g).__name__ != "Cylinder" or i in used:
+            continue
+        r, h = g.radius, g.halfLength
+        ends = []
+        for s in (1.0, -1.0):
+            e = go.placement.act(np.array([0.0, 0.0, s * h]))
+            match = next((j for j, o in enumerate(objects)
+                          if j not in used and j != i and o.parentFrame == go.parentFrame
+                          and type(o.geometry).__name__ == "Sphere"
+                          and np.linalg.norm(o.placement.translation - e) + abs(o.geometry.radius - r) <= 1e-9 * r),
+                         None)
+            if match is None:
+                break
+            used.add(match)
+            ends.append(match)
+        if len(ends) == 2:
+            used.add(i)
+            out.append((go, coal.Capsule(r, 2 * h)))
+        else:
+            used.difference_update(ends)
+    return [(go, go.geometry) for i, go in enumerate(objects) if i not in used] + out
+
+
 def reference_inertias(model, urdf, package_dirs):
     geom = pin.buildGeomFromUrdf(model, str(urdf), pin.GeometryType.COLLISION, package_dirs=package_dirs)
     per_joint = {}
-    for go in geom.geometryObjects:
-        g = go.geometry
+    for go, g in capsules(geom.geometryObjects):
         vol = g.computeVolume()
         com = np.array(g.computeCOM()).reshape(3)
         inertia_com = np.array(g.computeMomentofInertiaRelatedToCOM()) * DENSITY
@@ -342,7 +376,9 @@ def main():
         f"{DENSITY:g} kg/m³). Each URDF is stripped of its `<inertial>` elements, filled by urdf-inertia, "
         "loaded with `pinocchio.buildModelFromUrdf`, and each joint's inertia is compared with pinocchio's "
         "own collision model of the original URDF (coal volume, COM and inertia per geometry, moved by its "
-        "placement and summed per joint). The difference is the largest of the relative mass, COM "
+        "placement and summed per joint; a `<cylinder>` with a `<sphere>` of its radius centred on each "
+        "end, as `panda_collision.urdf` writes its capsules, is one `coal.Capsule`, their union, as "
+        "urdf-inertia computes it). The difference is the largest of the relative mass, COM "
         "(against the radius of gyration) and central-inertia (Frobenius) differences. The filled URDF, "
         "with its geometry removed so that only the inertials are judged, is also loaded in MuJoCo "
         f"{mujoco.__version__ if SIMULATORS else '(not installed)'} (`MjModel.from_xml_path`: mass above "

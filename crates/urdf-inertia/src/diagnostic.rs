@@ -117,6 +117,8 @@ pub enum Code {
     VisualGeometryUsed,
     /// UI401: parts of a link overlap: their common volume is counted twice.
     PartsOverlap,
+    /// UI402: a cylinder and a sphere of its radius on each end, counted as the capsule they make.
+    PartsCapsule,
     /// UI501: links that failed were left as they were (`--keep-going`).
     OutputNotWritten,
     /// UI208: a warning of the xacro expansion (an unknown builtin, a deprecated form).
@@ -161,7 +163,7 @@ pub enum Code {
 
 impl Code {
     /// Every code, in table order.
-    pub const ALL: [Code; 41] = [
+    pub const ALL: [Code; 42] = [
         Code::MeshRepaired,
         Code::MeshFacesDropped,
         Code::MeshWelded,
@@ -186,6 +188,7 @@ impl Code {
         Code::NoCollisionGeometry,
         Code::VisualGeometryUsed,
         Code::PartsOverlap,
+        Code::PartsCapsule,
         Code::OutputNotWritten,
         Code::OutputNotInSource,
         Code::RunThreads,
@@ -230,6 +233,7 @@ impl Code {
             Code::NoCollisionGeometry => "UI210",
             Code::VisualGeometryUsed => "UI211",
             Code::PartsOverlap => "UI401",
+            Code::PartsCapsule => "UI402",
             Code::OutputNotWritten => "UI501",
             Code::XacroWarning => "UI208",
             Code::XacroNoLinks => "UI209",
@@ -278,6 +282,7 @@ impl Code {
             | Code::UrdfXacroNamespace
             | Code::UrdfFrameInertial
             | Code::XacroNoLinks
+            | Code::PartsCapsule
             | Code::RunConfig => Severity::Note,
             Code::CheckMissingInertial
             | Code::CheckInvalidInertial

@@ -18,9 +18,11 @@ use crate::overlap::{self, Overlap, PlacedPart};
 use crate::urdf::resolve::{NotFound, PackageResolver};
 use crate::urdf::{Geometry, Link, Robot};
 use std::collections::HashMap;
+use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Duration;
 
+mod capsules;
 mod densities;
 mod parts;
 mod select;
@@ -457,6 +459,8 @@ fn compute_link(
     map: &DensityMap,
     opts: &FillOptions,
 ) -> LinkResult {
+    // Before the densities: a link mass target is spread over the union.
+    let (capsules, nearly) = capsules::join(&mut parts);
     let Some(densities) = densities(link, &parts, map, opts)? else {
         return Ok(LinkOutcome::NoDensity);
     };
@@ -471,7 +475,14 @@ fn compute_link(
             "computed from its visual geometry (it has no collision geometry; --geometry collision,visual)",
         ));
     }
-    let (overlap, message) = overlap_estimate(&mut parts);
+    for cap in &capsules {
+        let [a, b, c] = collisions(&parts, [cap.cylinder, cap.spheres[0], cap.spheres[1]]);
+        diagnostics.push(Diagnostic::new(
+            Code::PartsCapsule,
+            format!("collisions {a}, {b} and {c} are a capsule (a cylinder with a sphere of its radius centred on each end): counted as their union, each sphere's half inside the cylinder once"),
+        ));
+    }
+    let (overlap, message) = overlap_estimate(&parts, (&capsules, &nearly));
     if let Some(message) = message {
         diagnostics.push(Diagnostic::new(Code::PartsOverlap, message));
     }
@@ -566,8 +577,19 @@ fn reject_unrepresentable(report: &mut FillReport) {
 /// The volume the link's parts count more than once (their volumes less their union's, estimated by
 /// [`overlap::estimate`]), which parts and the grid, with the warning that says so; or only a warning
 /// when the estimate was skipped.
-fn overlap_estimate(parts: &mut [Part]) -> (Option<LinkOverlap>, Option<String>) {
-    let mut placed: Vec<PlacedPart> = parts.iter().map(|p| p.placed.clone()).collect();
+/// The collision numbers of three parts, in order.
+fn collisions(parts: &[Part], which: [usize; 3]) -> [usize; 3] {
+    let mut c = which.map(|i| parts[i].collision);
+    c.sort_unstable();
+    c
+}
+
+fn overlap_estimate(
+    parts: &[Part],
+    (capsules, nearly): (&[capsules::Capsule], &[capsules::Nearly]),
+) -> (Option<LinkOverlap>, Option<String>) {
+    // A capsule's three parts as one solid: their union, which the parts now sum to.
+    let (mut placed, index): (Vec<PlacedPart>, Vec<usize>) = capsules::placed(parts, capsules);
     let e = match crate::threads::install(|| overlap::estimate(&mut placed)) {
         Overlap::None => return (None, None),
         Overlap::Skipped(why) => {
@@ -581,7 +603,7 @@ fn overlap_estimate(parts: &mut [Part]) -> (Option<LinkOverlap>, Option<String>)
     let names: Vec<String> = e
         .parts
         .iter()
-        .map(|&i| parts[i].collision.to_string())
+        .map(|&i| parts[index[i]].collision.to_string())
         .collect();
     let which = match names.len() {
         0..=6 => match names.split_last() {
@@ -605,8 +627,18 @@ fn overlap_estimate(parts: &mut [Part]) -> (Option<LinkOverlap>, Option<String>)
     } else {
         String::new()
     };
+    // Three parts that are a capsule but for how their numbers were written say so.
+    let mut near = String::new();
+    for n in nearly {
+        let [a, b, c] = collisions(parts, n.parts);
+        let _ = write!(
+            near,
+            "; collisions {a}, {b} and {c} are nearly a capsule: its spheres miss the cylinder's end centres (or radius) by up to {} m (as an rpy of 1.57 for π/2 does); within a billionth of the radius they would count as their union",
+            crate::text::significant(n.miss, 2)
+        );
+    }
     let message = format!(
-        "parts {which} overlap: about {} m³ ({:.1}% of the link's volume) {how}; the parts' volumes less their union's, estimated on a {n}³ grid per part{capped}, within ±{} m³",
+        "parts {which} overlap: about {} m³ ({:.1}% of the link's volume) {how}; the parts' volumes less their union's, estimated on a {n}³ grid per part{capped}, within ±{} m³{near}",
         crate::text::significant(v, 4),
         100.0 * v / total,
         crate::text::significant(e.bound, 2),

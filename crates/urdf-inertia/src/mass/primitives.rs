@@ -43,6 +43,19 @@ pub fn sphere(radius: f64, density: f64) -> MassProperties {
     diagonal(m, [i, i, i])
 }
 
+/// The half of a solid sphere of `radius` centred at the origin on the side of +Z (its flat face in
+/// the XY plane): COM 3r/8 above the face; 2/5 m r² about Z, and about X and Y through the COM
+/// 2/5 m r² less m (3r/8)², that is 83/320 m r².
+pub fn hemisphere(radius: f64, density: f64) -> MassProperties {
+    let r2 = radius * radius;
+    let m = density * 2.0 / 3.0 * PI * r2 * radius;
+    let ixx = m * r2 * 83.0 / 320.0;
+    MassProperties {
+        com: [0.0, 0.0, 0.375 * radius],
+        ..diagonal(m, [ixx, ixx, 0.4 * m * r2])
+    }
+}
+
 /// A capsule along Z: a cylinder of `radius` and `length` capped by two hemispheres.
 pub fn capsule(radius: f64, length: f64, density: f64) -> MassProperties {
     let r2 = radius * radius;
