@@ -1662,3 +1662,56 @@ fn a_kept_mass_is_spread_over_a_capsule() {
         1e-12,
     );
 }
+
+#[test]
+fn a_capsule_whose_spheres_miss_by_rounding_is_within_its_estimate() {
+    // Radius 1, length 2: the top sphere's radius 5e-10 too large, the bottom one's centre 5e-10
+    // beyond its end. The union's volume in closed form: the cylinder, each ball, less each ball's
+    // part inside the cylinder (the top ball's, whose radius exceeds the cylinder's, clipped to it;
+    // the bottom ball's a cap of height 1 − 5e-10).
+    let (r, l, rs, d) = (1.0f64, 2.0f64, 1.000_000_000_5f64, 5e-10f64);
+    let sphere = |xyz: &str, r: f64| (xyz.to_string(), format!("<sphere radius=\"{r}\"/>"));
+    let (top, bottom) = (sphere("0 0 1", rs), sphere(&format!("0 0 {}", -1.0 - d), r));
+    let link = collisions_link(
+        "a",
+        &[
+            ("0 0 0", "0 0 0", "<cylinder radius=\"1\" length=\"2\"/>"),
+            (&top.0, "0 0 0", &top.1),
+            (&bottom.0, "0 0 0", &bottom.1),
+        ],
+    );
+    let z0 = (rs * rs - r * r).sqrt();
+    let top_inside = PI * r * r * z0
+        + PI * ((rs * rs * rs - rs.powi(3) / 3.0) - (rs * rs * z0 - z0.powi(3) / 3.0));
+    let bottom_inside = PI * (r - d).powi(2) * (2.0 * r + d) / 3.0;
+    let union =
+        PI * r * r * l + 4.0 / 3.0 * PI * (rs.powi(3) + r.powi(3)) - top_inside - bottom_inside;
+    let tmp = tempfile::tempdir().unwrap();
+    let (path, out) = (tmp.path().join("a.urdf"), tmp.path().join("out.urdf"));
+    std::fs::write(&path, format!("<robot name=\"a\">\n{link}</robot>\n")).unwrap();
+    let o = run(&[
+        "fill",
+        path.to_str().unwrap(),
+        "--density",
+        "1",
+        "--digits",
+        "full",
+        "--format",
+        "json",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let link = &json["links"][0];
+    let (ours, estimate) = (
+        link["computed"]["mass"].as_f64().unwrap(),
+        link["error_estimate"].as_f64().unwrap(),
+    );
+    let error = (ours - union).abs() / union;
+    assert!(
+        error <= estimate && estimate < 1e-7,
+        "error {error:e}, estimate {estimate:e}"
+    );
+    assert!(link["notes"].to_string().contains("UI402"), "{link}");
+}
