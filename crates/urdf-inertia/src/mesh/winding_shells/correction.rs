@@ -12,8 +12,8 @@
 
 use super::bvh::Bvh;
 use super::cells::{area, cells, centroid, largest_coordinate, leaves_whole, overhang, split, CellWork, Cut, CutPlane};
-use super::grid::{crossing, Corners, Crossing, Grid, Plane, Seen};
-use super::{corners_touch, edge_meets, in_order, overlap, EdgeUse};
+use super::grid::{crossing, orient3d, Corners, Crossing, Grid, Plane, Seen};
+use super::{c3, corners_touch, edge_meets, in_order, overlap, EdgeUse};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
 use crate::mass::Polygons;
 use robust::{orient2d, Coord};
@@ -62,7 +62,7 @@ const NEAR: f64 = 1e-7;
 /// Seeds of the weights of the last points [`Faces::decide_where`] tries in a piece.
 const GENERIC: [f64; 2] = [0.137, 0.571];
 
-/// Grid cells beyond which a segment is not tested for a join ([`Faces::segment_clear`] answers no,
+/// Grid cells beyond which a segment is not tested for a join ([`Faces::segment_count`] answers no,
 /// and rays decide): a long segment's box crosses cells of triangles far from it, and the test read
 /// more entries than the rays it saves (UR5 `visual/upperarm.dae`: 6,009 M instructions unlimited,
 /// 4,355 M at 8 cells, 4,279 M at 2, 4,327 M at 1; centauro's wheel 4,315, 4,268, 4,236 and 4,258 M).
@@ -156,7 +156,7 @@ struct Faces<'a> {
     margin: f64,
     /// Per triangle: the last of its pieces decided at the first try, and how ([`Faces::decide_linked`]).
     origins: RefCell<Vec<Option<(Origin, i64)>>>,
-    /// The triangles near a ray's start or a join's segment ([`Faces::before`], [`Faces::segment_clear`]), kept between calls.
+    /// The triangles near a ray's start or a join's segment ([`Faces::before`], [`Faces::segment_count`]), kept between calls.
     scratch: RefCell<Vec<u32>>,
     /// Whether every edge of the triangles is used as often one way as the other: a closed
     /// cycle, on which [`Faces::joined`] holds.
@@ -864,7 +864,11 @@ impl Faces<'_> {
             // (cells are cut along their edges, and seams change no lower one's covering): it
             // carries the jumps, whatever the count in front, so no ray is asked.
             if skip.iter().any(|&u| u < t) {
-                return Some(Decided { kappa: 0, from: None });
+                return Some(Decided {
+                    kappa: 0,
+                    from: None,
+                    front: 0,
+                });
             }
             // The count in front of the piece along axis k: counted forward, or counted behind
             // it and less the jump when that way reads fewer of the grid's entries.
@@ -915,6 +919,7 @@ impl Faces<'_> {
             return Some(Decided {
                 kappa: solid(front + jump) - solid(front),
                 from,
+                front,
             });
         }
         None
@@ -937,48 +942,59 @@ impl Faces<'_> {
     ) -> Option<i64> {
         let mid = centroid(piece);
         let last = self.origins.borrow()[t as usize];
+        // A piece with no coplanar triangle over it jumps by 1 across `t`: how it bounds Ω
+        // follows from the count in front of it.
+        let solid = |w: i64| i64::from(w.abs() >= 1);
+        let kappa = |front: i64| solid(front + 1) - solid(front);
         if self.closed && coplanar.is_empty() && usable(mid) {
-            if let Some((from, kappa)) = last {
-                if self.joined(t, &from, mid, seen) {
-                    return Some(kappa);
+            if let Some((from, front)) = last {
+                if let Some(change) = self.joined(t, &from, mid, seen) {
+                    return Some(kappa(front + change));
                 }
             }
             for (e, &u) in self.across[t as usize].iter().enumerate() {
-                let Some(Some((from, kappa))) = self.origins.borrow().get(u as usize).copied() else {
+                let Some(Some((from, front))) = self.origins.borrow().get(u as usize).copied() else {
                     continue;
                 };
-                if self.joined_across(t, e, u, &from, mid, seen) {
+                if let Some(change) = self.joined_across(t, e, u, &from, mid, seen) {
                     self.joins_across.set(self.joins_across.get() + 1);
-                    // Rays from `mid` along `from`'s axes count what those from `from.p` did.
-                    self.origins.borrow_mut()[t as usize] = Some((Origin { p: mid, axes: from.axes }, kappa));
-                    return Some(kappa);
+                    // Rays from `mid` along `from`'s axes count what those from `from.p` did,
+                    // changed where the segment between passes through triangles.
+                    let front = front + change;
+                    self.origins.borrow_mut()[t as usize] = Some((Origin { p: mid, axes: from.axes }, front));
+                    return Some(kappa(front));
                 }
             }
         }
         let d = self.decide_where(piece, t, seen, usable, coplanar)?;
         if let Some(from) = d.from {
-            self.origins.borrow_mut()[t as usize] = Some((from, d.kappa));
+            self.origins.borrow_mut()[t as usize] = Some((from, d.front));
         }
         Some(d.kappa)
     }
 
-    /// Whether the piece of triangle `t` around `q` is decided as the one whose rays counted
-    /// `from` (see [`Origin`]): the rays from `q` along the same axes would count the same.
+    /// How much the rays from `q`, in the piece of triangle `t` around it, along `from`'s axes
+    /// count more than those from `from.p` (see [`Origin`]); `None` when that is not known
+    /// without rays of their own.
     ///
     /// A ray's count from a point x (all triangles but `t`) changes as x moves only where x
     /// passes through a triangle other than `t`, or where the ray sweeps across an edge that does
     /// not balance: the surface decided here is a closed cycle, whose only such edges, once `t`
-    /// is left out, are `t`'s own. So the count is the same from both ends of a segment that no
-    /// other triangle meets (exact, and conservative: a triangle in the segment's plane meets
-    /// it) and whose ends lie strictly inside `t` seen along the ray (exact `orient2d`, which
-    /// keeps the swept strip off `t`'s edges).
-    fn joined(&self, t: u32, from: &Origin, q: [f64; 3], seen: &mut Seen) -> bool {
+    /// is left out, are `t`'s own. Passing through a triangle's interior from its front to its
+    /// back, x leaves or enters the part of it the ray sees: the count grows by 1 along every
+    /// axis and way (a triangle facing the ray's way is crossed leaving through its front, +1,
+    /// while x is in front of it and not once x is behind; one facing against it is entered
+    /// through its front, −1, only once x is in front); from back to front it falls by 1. So the
+    /// count changes by those steps along a segment that meets other triangles only through
+    /// their interiors (exact: [`Faces::segment_count`]) and whose ends lie strictly inside `t`
+    /// seen along the ray (exact `orient2d`, which keeps the swept strip off `t`'s edges).
+    fn joined(&self, t: u32, from: &Origin, q: [f64; 3], seen: &mut Seen) -> Option<i64> {
         let c = self.corners[t as usize];
         let p = from.p;
         if !from.axes.iter().flatten().all(|&k| strictly_inside(c, p, k) && strictly_inside(c, q, k)) {
-            return false;
+            return None;
         }
-        self.segment_clear(p, q, [t, t], from, seen)
+        self.segment_count(p, q, [t, t], from, seen)
     }
 
     /// A segment along axis `k` through `p`, a rounded point of `t` (a centre, a weighted mean of
@@ -1046,17 +1062,20 @@ impl Faces<'_> {
         Some((fix, clear))
     }
 
-    /// Whether no triangle but those of `but` meets the closed segment `p q` (exact, conservative:
-    /// a triangle in the segment's plane meets it, and a segment whose box spans more than
-    /// [`MAX_SEGMENT_CELLS`] cells of the grid is not asked), and none but `but[0]` (the triangle
-    /// `q` is a point of) meets [`Faces::straddle`]'s segment at `q` along any of `from`'s axes:
-    /// rays from `q` then count what rays from that triangle there would.
-    fn segment_clear(&self, p: [f64; 3], q: [f64; 3], but: [u32; 2], from: &Origin, seen: &mut Seen) -> bool {
+    /// The triangles but those of `but` that the closed segment `p q` passes through, each
+    /// through its interior with `p` and `q` strictly on either side of its plane (exact), counted
+    /// +1 where `q` is behind it and −1 where in front (see [`Faces::joined`]); `None` where one
+    /// meets the segment otherwise (an edge, a corner, its plane: exact, conservative), where a
+    /// triangle but `but[0]` (the triangle `q` is a point of) meets [`Faces::straddle`]'s segment
+    /// at `q` along any of `from`'s axes, or where the segment's box spans more than
+    /// [`MAX_SEGMENT_CELLS`] cells of the grid: rays from `q` then count what rays from `p`
+    /// counted, plus this.
+    fn segment_count(&self, p: [f64; 3], q: [f64; 3], but: [u32; 2], from: &Origin, seen: &mut Seen) -> Option<i64> {
         let mut starts = [None; 2];
         for (s, k) in starts.iter_mut().zip(from.axes) {
             if let Some(k) = k {
                 let Some((lo, hi)) = self.straddle(but[0], q, k) else {
-                    return false;
+                    return None;
                 };
                 *s = Some((lo, hi));
             }
@@ -1064,21 +1083,52 @@ impl Faces<'_> {
         let starts = starts.iter().flatten();
         let b = Aabb::of(starts.clone().flat_map(|&(lo, hi)| [lo, hi]).chain([p, q]));
         if self.grid.cells_in(&b) > MAX_SEGMENT_CELLS {
-            return false;
+            return None;
         }
         let mut near = self.scratch.borrow_mut();
         self.grid.overlapping(&b, None, seen, &mut near);
-        near.iter().all(|&u| {
+        let (cp, cq) = (c3(p), c3(q));
+        let mut change = 0;
+        for &u in near.iter() {
             let plane = &self.planes[u as usize];
             let corners = &self.corners[u as usize];
             let meets = |(s, e): ([f64; 3], [f64; 3])| edge_meets(s, e, plane.side(s), plane.side(e), corners);
-            (but.contains(&u) || !meets((p, q))) && (u == but[0] || starts.clone().all(|&s| !meets(s)))
-        })
+            if u != but[0] && starts.clone().any(|&s| meets(s)) {
+                return None;
+            }
+            if but.contains(&u) {
+                continue;
+            }
+            let (sp, sq) = (plane.side(p), plane.side(q));
+            if (sp > 0.0 && sq > 0.0) || (sp < 0.0 && sq < 0.0) {
+                continue;
+            }
+            if sp == 0.0 || sq == 0.0 {
+                if edge_meets(p, q, sp, sq, corners) {
+                    return None;
+                }
+                continue;
+            }
+            // The segment's line against the triangle's edges: all on one side strictly, it
+            // passes through the interior; on both sides, beside it; a zero, through an edge or
+            // a corner.
+            let [a, bb, c] = corners.map(c3);
+            let o = [orient3d(cp, cq, a, bb), orient3d(cp, cq, bb, c), orient3d(cp, cq, c, a)];
+            if o.iter().any(|x| *x > 0.0) && o.iter().any(|x| *x < 0.0) {
+                continue;
+            }
+            if o.iter().any(|x| *x == 0.0) {
+                return None;
+            }
+            change += if sq > 0.0 { 1 } else { -1 };
+        }
+        Some(change)
     }
-    /// Whether the piece of triangle `t` around `q` is decided as the one of triangle `u` whose
-    /// rays counted `from`, `u` lying across `t`'s edge `e` (corner e to the next), which only the
-    /// two use, one each way: along each of `from`'s axes, rays from `q` would count in front of
-    /// `t` what rays from `from.p` counted in front of `u`.
+
+    /// How much rays from `q`, in the piece of triangle `t` around it, count in front of `t` more
+    /// than rays from `from.p` counted in front of triangle `u`, `u` lying across `t`'s edge `e`
+    /// (corner e to the next), which only the two use, one each way, along each of `from`'s axes;
+    /// `None` when that is not known without rays of their own.
     ///
     /// Leave both triangles out: the rest's count from x changes as x moves only where x passes
     /// through one of its triangles or where the ray sweeps across an edge of the rest that does
@@ -1088,15 +1138,17 @@ impl Faces<'_> {
     /// same way), `from.p` strictly inside `u`, `q` strictly inside `t`, and the segment between
     /// them cross the shared edge strictly between its ends: each half then lies in one
     /// triangle's open projection, so the strip the ray sweeps keeps off the four other edges.
-    /// With no other triangle meeting the segment, the rest counts the same from both ends; and a
-    /// ray from a point strictly inside one triangle's projection misses the other, so the count in
-    /// front of `t` at `q` is the rest's, which is the count in front of `u` at `from.p`.
-    fn joined_across(&self, t: u32, e: usize, u: u32, from: &Origin, q: [f64; 3], seen: &mut Seen) -> bool {
+    /// The rest's count then changes from one end of the segment to the other by the steps of
+    /// the triangles it passes through ([`Faces::joined`], [`Faces::segment_count`]); and a ray
+    /// from a point strictly inside one triangle's projection misses the other, so the count in
+    /// front of `t` at `q` is the rest's, which is the count in front of `u` at `from.p` plus those
+    /// steps.
+    fn joined_across(&self, t: u32, e: usize, u: u32, from: &Origin, q: [f64; 3], seen: &mut Seen) -> Option<i64> {
         let (ct, cu) = (self.corners[t as usize], self.corners[u as usize]);
         let (a, b, c) = (ct[e], ct[NEXT[e]], ct[NEXT[NEXT[e]]]);
         let shared = [self.tris[t as usize][e], self.tris[t as usize][NEXT[e]]];
         let Some(i) = self.tris[u as usize].iter().position(|v| !shared.contains(v)) else {
-            return false;
+            return None;
         };
         let d = cu[i];
         let p = from.p;
@@ -1108,7 +1160,10 @@ impl Faces<'_> {
                 && strictly_inside(ct, q, k)
                 && orient2d(p2, q2, a2) * orient2d(p2, q2, b2) < 0.0
         };
-        from.axes.iter().flatten().all(|&k| fits(k)) && self.segment_clear(p, q, [t, u], from, seen)
+        if !from.axes.iter().flatten().all(|&k| fits(k)) {
+            return None;
+        }
+        self.segment_count(p, q, [t, u], from, seen)
     }
 
     /// Per coplanar triangle, which of its edges a piece of `t` need not be cut along, where
@@ -1467,6 +1522,8 @@ fn rounded(piece: &Corners, nt: [f64; 3], (cuts, which): (&[Cut], &[usize]), sla
 struct Decided {
     kappa: i64,
     from: Option<Origin>,
+    /// With `from`: the rays' count in front of the piece there (its jump is 1).
+    front: i64,
 }
 
 /// The point whose rays decided a piece at the first try (its centre, no ray refused, no
