@@ -1074,10 +1074,7 @@ impl Faces<'_> {
         let mut starts = [None; 2];
         for (s, k) in starts.iter_mut().zip(from.axes) {
             if let Some(k) = k {
-                let Some((lo, hi)) = self.straddle(but[0], q, k) else {
-                    return None;
-                };
-                *s = Some((lo, hi));
+                *s = Some(self.straddle(but[0], q, k)?);
             }
         }
         let starts = starts.iter().flatten();
@@ -1117,7 +1114,7 @@ impl Faces<'_> {
             if o.iter().any(|x| *x > 0.0) && o.iter().any(|x| *x < 0.0) {
                 continue;
             }
-            if o.iter().any(|x| *x == 0.0) {
+            if o.contains(&0.0) {
                 return None;
             }
             change += if sq > 0.0 { 1 } else { -1 };
@@ -1147,9 +1144,7 @@ impl Faces<'_> {
         let (ct, cu) = (self.corners[t as usize], self.corners[u as usize]);
         let (a, b, c) = (ct[e], ct[NEXT[e]], ct[NEXT[NEXT[e]]]);
         let shared = [self.tris[t as usize][e], self.tris[t as usize][NEXT[e]]];
-        let Some(i) = self.tris[u as usize].iter().position(|v| !shared.contains(v)) else {
-            return None;
-        };
+        let i = self.tris[u as usize].iter().position(|v| !shared.contains(v))?;
         let d = cu[i];
         let p = from.p;
         let fits = |k: usize| {
