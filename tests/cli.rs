@@ -1570,6 +1570,16 @@ fn capsule_links() -> String {
                 ("0 0.075 0.03", "0 0 0", &ball(0.05)),
             ],
         ),
+        // A capsule and a box through its middle: their overlap is the capsule's with the box.
+        collisions_link(
+            "with_box",
+            &[
+                ("0 0 0", "0 0 0", &cyl(0.1, 0.4)),
+                ("0 0 0.2", "0 0 0", &ball(0.1)),
+                ("0 0 -0.2", "0 0 0", &ball(0.1)),
+                ("0 0 0", "0 0 0", "<box size=\"0.5 0.05 0.05\"/>"),
+            ],
+        ),
         // One sphere: not a capsule.
         collisions_link(
             "one_end",
@@ -1645,6 +1655,14 @@ fn a_cylinder_with_a_sphere_on_each_end_is_its_capsule() {
         "{stderr}"
     );
     assert!(!stderr.contains("link `one_end`: collisions"), "{stderr}");
+    // The box's middle, inside the capsule's cylinder, counts twice: the capsule is named with its
+    // three collisions.
+    assert!(
+        stderr.contains(
+            "warning[UI401]: link `with_box`: parts 1 (a capsule with 2 and 3) and 4 overlap"
+        ),
+        "{stderr}"
+    );
 }
 
 #[test]

@@ -574,9 +574,6 @@ fn reject_unrepresentable(report: &mut FillReport) {
     }
 }
 
-/// The volume the link's parts count more than once (their volumes less their union's, estimated by
-/// [`overlap::estimate`]), which parts and the grid, with the warning that says so; or only a warning
-/// when the estimate was skipped.
 /// The collision numbers of three parts, in order.
 fn collisions(parts: &[Part], which: [usize; 3]) -> [usize; 3] {
     let mut c = which.map(|i| parts[i].collision);
@@ -584,6 +581,9 @@ fn collisions(parts: &[Part], which: [usize; 3]) -> [usize; 3] {
     c
 }
 
+/// The volume the link's parts count more than once (their volumes less their union's, estimated by
+/// [`overlap::estimate`]), which parts and the grid, with the warning that says so; or only a warning
+/// when the estimate was skipped. A capsule's three parts count as one solid, named by its cylinder.
 fn overlap_estimate(
     parts: &[Part],
     (capsules, nearly): (&[capsules::Capsule], &[capsules::Nearly]),
@@ -603,7 +603,16 @@ fn overlap_estimate(
     let names: Vec<String> = e
         .parts
         .iter()
-        .map(|&i| parts[index[i]].collision.to_string())
+        .map(|&i| {
+            let c = parts[index[i]].collision;
+            match capsules.iter().find(|cap| cap.cylinder == index[i]) {
+                Some(cap) => {
+                    let [a, b] = cap.spheres.map(|s| parts[s].collision);
+                    format!("{c} (a capsule with {} and {})", a.min(b), a.max(b))
+                }
+                None => c.to_string(),
+            }
+        })
         .collect();
     let which = match names.len() {
         0..=6 => match names.split_last() {
