@@ -3,11 +3,11 @@
 //! URDF had no capsule until urdfdom 4, so robot descriptions write one as three collisions, a
 //! `<cylinder>` and two `<sphere>`s centred on its end faces (example-robot-data's
 //! `panda_collision.urdf`, Franka's `collision_capsule` macro). Summed as parts, each sphere's half
-//! inside the cylinder counts twice: 20 to 44% of the Panda's links (UI401). Their union is the
-//! capsule exactly, whatever the length (a point of one sphere beyond the far end face is nearer
-//! that end's centre, so inside the other sphere), and it is the cylinder plus each sphere's outer
-//! half: each sphere part becomes that half, and the three count as one solid in the overlap
-//! estimate with the link's other parts.
+//! inside the cylinder counts twice: 23 to 44% of each Panda link's summed volume (UI401). Their
+//! union is the capsule exactly, whatever the length (a point of one sphere beyond the far end face
+//! is nearer that end's centre, so inside the other sphere), and it is the cylinder plus each
+//! sphere's outer half: each sphere part becomes that half, and the three count as one solid in the
+//! overlap estimate with the link's other parts.
 //!
 //! Only primitives take part, and a primitive's density is always the link's (the density map's
 //! `[meshes]` rules name mesh files), so the three are of one material; a link mass target is
