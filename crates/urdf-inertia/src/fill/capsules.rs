@@ -106,7 +106,19 @@ fn sphere_miss(p: &PlacedPart, e: [f64; 3], radius: f64) -> f64 {
 /// The capsules within `tolerance` among the parts not `used` (marked as they are taken), each with
 /// the misses of its two spheres.
 fn find_in(parts: &[Part], tolerance: f64, used: &mut [bool]) -> Vec<(Capsule, [f64; 2])> {
+    // The spheres by the x of their centres: one within `tolerance` of an end has its x within
+    // that of the end's, so each end looks at a window of them, not at every part (a link of 5,000
+    // cylinders and 10,000 spheres took 1.1 s more than without capsules when each end looked at
+    // every part).
+    let mut spheres: Vec<(f64, usize)> = (parts.iter().enumerate())
+        .filter(|(_, p)| matches!(p.placed.shape, PartShape::Sphere(_)))
+        .map(|(j, p)| (p.placed.translation[0], j))
+        .collect();
+    spheres.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut capsules = Vec::new();
+    if spheres.len() < 2 {
+        return capsules;
+    }
     for c in 0..parts.len() {
         if used[c] {
             continue;
@@ -115,13 +127,18 @@ fn find_in(parts: &[Part], tolerance: f64, used: &mut [bool]) -> Vec<(Capsule, [
             continue;
         };
         let (rot, centre) = (parts[c].placed.rotation, parts[c].placed.translation);
-        // The first sphere not used ending the cylinder within the tolerance, and its miss.
+        // The first sphere (in part order) not used ending the cylinder within the tolerance, and
+        // its miss.
         let sphere_at = |flip: bool, used: &[bool]| {
             let e = end(centre, &rot, half, flip);
-            (0..parts.len())
-                .filter(|&j| !used[j] && j != c)
-                .map(|j| (j, sphere_miss(&parts[j].placed, e, radius)))
-                .find(|&(_, miss)| miss <= tolerance * radius)
+            let reach = tolerance * radius;
+            let from = spheres.partition_point(|s| s.0 < e[0] - reach);
+            (spheres[from..].iter())
+                .take_while(|s| s.0 <= e[0] + reach)
+                .filter(|&&(_, j)| !used[j] && j != c)
+                .map(|&(_, j)| (j, sphere_miss(&parts[j].placed, e, radius)))
+                .filter(|&(_, miss)| miss <= reach)
+                .min_by_key(|&(j, _)| j)
         };
         let Some(top) = sphere_at(false, used) else {
             continue;
