@@ -600,14 +600,19 @@ fn overlap_estimate(
         }
         Overlap::Estimated(e) => e,
     };
+    // Each capsule's spheres by its cylinder, which names it.
+    let mut spheres_of = vec![None; parts.len()];
+    for cap in capsules {
+        spheres_of[cap.cylinder] = Some(cap.spheres);
+    }
     let names: Vec<String> = e
         .parts
         .iter()
         .map(|&i| {
             let c = parts[index[i]].collision;
-            match capsules.iter().find(|cap| cap.cylinder == index[i]) {
-                Some(cap) => {
-                    let [a, b] = cap.spheres.map(|s| parts[s].collision);
+            match spheres_of[index[i]] {
+                Some(spheres) => {
+                    let [a, b] = spheres.map(|s| parts[s].collision);
                     format!("{c} (a capsule with {} and {})", a.min(b), a.max(b))
                 }
                 None => c.to_string(),

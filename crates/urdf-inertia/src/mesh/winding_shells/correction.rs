@@ -12,8 +12,8 @@
 
 use super::bvh::Bvh;
 use super::cells::{area, cells, centroid, largest_coordinate, leaves_whole, overhang, split, CellWork, Cut, CutPlane};
-use super::grid::{crossing, orient3d, Corners, Crossing, Grid, Plane, Seen};
-use super::{c3, corners_touch, edge_meets, in_order, overlap, EdgeUse};
+use super::grid::{crossing, Corners, Crossing, Grid, Plane, Seen};
+use super::{corners_touch, edge_meets, in_order, line_passes, overlap, EdgeUse, LinePass};
 use crate::geometry::{cross, dot, norm, sub, Aabb};
 use crate::mass::Polygons;
 use robust::{orient2d, Coord};
@@ -94,6 +94,8 @@ pub(super) struct Resolved {
     pub(super) changed: bool,
     /// Pieces decided from a neighbouring triangle's rays across an edge ([`Faces::joined_across`]).
     pub(super) joined_across: usize,
+    /// Pieces decided by a join whose segment passed through triangles ([`Faces::segment_count`]).
+    pub(super) joins_counted: usize,
     /// Per triangle: how far the corners of its emitted pieces may lie from the exact pieces'
     /// (rounded cut points and midpoints), m, and the area of the bands about its cuts, m²
     /// ([`Faces::moved`]).
@@ -154,7 +156,8 @@ struct Faces<'a> {
     centre: [f64; 3],
     /// Distances below this are not trusted to f64 plane tests.
     margin: f64,
-    /// Per triangle: the last of its pieces decided at the first try, and how ([`Faces::decide_linked`]).
+    /// Per triangle: the last of its pieces decided at the first try, and the rays' count in front
+    /// of it there ([`Faces::decide_linked`]).
     origins: RefCell<Vec<Option<(Origin, i64)>>>,
     /// The triangles near a ray's start or a join's segment ([`Faces::before`], [`Faces::segment_count`]), kept between calls.
     scratch: RefCell<Vec<u32>>,
@@ -170,8 +173,11 @@ struct Faces<'a> {
     pairs: std::cell::OnceCell<Vec<[u32; 3]>>,
     /// Every use of an edge by the triangles, sorted by edge ([`super::edge_uses`]).
     uses: &'a [EdgeUse],
-    /// Pieces decided by [`Faces::joined_across`].
+    /// Whether pieces take decisions from other pieces' rays ([`Faces::decide_linked`]).
+    joins: bool,
+    /// Pieces decided by [`Faces::joined_across`], and joins that counted triangles passed through.
     joins_across: std::cell::Cell<usize>,
+    joins_counted: std::cell::Cell<usize>,
     /// [`Faces::cut`]'s lists, kept between calls: made afresh, their allocations and growth were
     /// about a tenth of the instructions of a mesh of coincident shells (centauro's
     /// `mesh_wheel23.stl`: 0.49 M allocations and 0.22 M reallocations for 34.9 k cuts).
@@ -284,14 +290,14 @@ fn certified_ends(corners: &[Corners], planes: &[Plane], sealed: &[Range<usize>]
     end
 }
 
-/// [`resolve`], joining pieces across edges ([`Faces::joined_across`]) when `join_across`, and
+/// [`resolve`], deciding pieces from other pieces' rays ([`Faces::decide_linked`]) when `joins`, and
 /// finding the pairs of triangles that meet from a tree past `crowded` ([`Faces::all_blockers`]).
 fn resolve_with(
     vertices: &[[f64; 3]],
     tris: &[[u32; 3]],
     sign: &[i64],
     (centre, target): ([f64; 3], f64),
-    (join_across, crowded, grouped): (bool, u64, usize),
+    (joins, crowded, grouped): (bool, u64, usize),
     sealed: &[Range<usize>],
 ) -> Resolved {
     let corners: Vec<Corners> = tris
@@ -308,7 +314,7 @@ fn resolve_with(
     let numbered = (0..tris.len()).map(|i| (i as u32, &tris[i][..]));
     let uses = super::edge_uses(vertices.len(), &numbered, None);
     let closed = balanced(&uses);
-    let across = if join_across {
+    let across = if joins {
         across(tris, &uses)
     } else {
         vec![[u32::MAX; 3]; tris.len()]
@@ -328,7 +334,9 @@ fn resolve_with(
         across,
         pairs: std::cell::OnceCell::new(),
         uses: &uses,
+        joins,
         joins_across: std::cell::Cell::new(0),
+        joins_counted: std::cell::Cell::new(0),
         cut_work: RefCell::new(CutWork::default()),
     };
     let mut seen = Seen::new(tris.len());
@@ -344,6 +352,7 @@ fn resolve_with(
         crowded: lists.is_none(),
         changed: false,
         joined_across: 0,
+        joins_counted: 0,
         moved: vec![(0.0, 0.0); tris.len()],
     };
     let Some(lists) = lists else {
@@ -365,6 +374,7 @@ fn resolve_with(
     }
     f.refine(heap, target, &mut seen, &mut out);
     out.joined_across = f.joins_across.get();
+    out.joins_counted = f.joins_counted.get();
     out.rounding = f.moved(&out.moved);
     out
 }
@@ -864,11 +874,7 @@ impl Faces<'_> {
             // (cells are cut along their edges, and seams change no lower one's covering): it
             // carries the jumps, whatever the count in front, so no ray is asked.
             if skip.iter().any(|&u| u < t) {
-                return Some(Decided {
-                    kappa: 0,
-                    from: None,
-                    front: 0,
-                });
+                return Some(Decided { kappa: 0, from: None });
             }
             // The count in front of the piece along axis k: counted forward, or counted behind
             // it and less the jump when that way reads fewer of the grid's entries.
@@ -911,15 +917,13 @@ impl Faces<'_> {
                 first = false;
                 continue;
             }
-            let solid = |w: i64| i64::from(w.abs() >= 1);
-            let from = (first && skip.len() == 1).then_some(Origin {
+            let origin = Origin {
                 p,
                 axes: [Some(k), again.map(|(k, _)| k)],
-            });
+            };
             return Some(Decided {
-                kappa: solid(front + jump) - solid(front),
-                from,
-                front,
+                kappa: bounds(front, jump),
+                from: (first && skip.len() == 1).then_some((origin, front)),
             });
         }
         None
@@ -944,12 +948,16 @@ impl Faces<'_> {
         let last = self.origins.borrow()[t as usize];
         // A piece with no coplanar triangle over it jumps by 1 across `t`: how it bounds Ω
         // follows from the count in front of it.
-        let solid = |w: i64| i64::from(w.abs() >= 1);
-        let kappa = |front: i64| solid(front + 1) - solid(front);
-        if self.closed && coplanar.is_empty() && usable(mid) {
+        let kappa = |front: i64, change: i64| {
+            if change != 0 {
+                self.joins_counted.set(self.joins_counted.get() + 1);
+            }
+            bounds(front + change, 1)
+        };
+        if self.joins && self.closed && coplanar.is_empty() && usable(mid) {
             if let Some((from, front)) = last {
                 if let Some(change) = self.joined(t, &from, mid, seen) {
-                    return Some(kappa(front + change));
+                    return Some(kappa(front, change));
                 }
             }
             for (e, &u) in self.across[t as usize].iter().enumerate() {
@@ -960,15 +968,14 @@ impl Faces<'_> {
                     self.joins_across.set(self.joins_across.get() + 1);
                     // Rays from `mid` along `from`'s axes count what those from `from.p` did,
                     // changed where the segment between passes through triangles.
-                    let front = front + change;
-                    self.origins.borrow_mut()[t as usize] = Some((Origin { p: mid, axes: from.axes }, front));
-                    return Some(kappa(front));
+                    self.origins.borrow_mut()[t as usize] = Some((Origin { p: mid, axes: from.axes }, front + change));
+                    return Some(kappa(front, change));
                 }
             }
         }
         let d = self.decide_where(piece, t, seen, usable, coplanar)?;
-        if let Some(from) = d.from {
-            self.origins.borrow_mut()[t as usize] = Some((from, d.front));
+        if d.from.is_some() {
+            self.origins.borrow_mut()[t as usize] = d.from;
         }
         Some(d.kappa)
     }
@@ -1084,7 +1091,6 @@ impl Faces<'_> {
         }
         let mut near = self.scratch.borrow_mut();
         self.grid.overlapping(&b, None, seen, &mut near);
-        let (cp, cq) = (c3(p), c3(q));
         let mut change = 0;
         for &u in near.iter() {
             let plane = &self.planes[u as usize];
@@ -1106,18 +1112,11 @@ impl Faces<'_> {
                 }
                 continue;
             }
-            // The segment's line against the triangle's edges: all on one side strictly, it
-            // passes through the interior; on both sides, beside it; a zero, through an edge or
-            // a corner.
-            let [a, bb, c] = corners.map(c3);
-            let o = [orient3d(cp, cq, a, bb), orient3d(cp, cq, bb, c), orient3d(cp, cq, c, a)];
-            if o.iter().any(|x| *x > 0.0) && o.iter().any(|x| *x < 0.0) {
-                continue;
+            match line_passes(&p, &q, corners) {
+                LinePass::Beside => {}
+                LinePass::Edge => return None,
+                LinePass::Through => change += if sq > 0.0 { 1 } else { -1 },
             }
-            if o.contains(&0.0) {
-                return None;
-            }
-            change += if sq > 0.0 { 1 } else { -1 };
         }
         Some(change)
     }
@@ -1512,13 +1511,19 @@ fn rounded(piece: &Corners, nt: [f64; 3], (cuts, which): (&[Cut], &[usize]), sla
     (band, slack + 8.0 * f64::EPSILON * (largest_coordinate(piece) + diameter))
 }
 
+/// How a piece bounds Ω (1 outward, −1 inward, 0 not at all) from the count in front of it and the
+/// jump across it: whether each side is in Ω (|w| ≥ 1), behind less in front.
+fn bounds(front: i64, jump: i64) -> i64 {
+    let solid = |w: i64| i64::from(w.abs() >= 1);
+    solid(front + jump) - solid(front)
+}
+
 /// How a piece bounds Ω (1 outward, −1 inward, 0 not at all), and where its rays started when
 /// they decided it at the first try.
 struct Decided {
     kappa: i64,
-    from: Option<Origin>,
-    /// With `from`: the rays' count in front of the piece there (its jump is 1).
-    front: i64,
+    /// Where its rays started, with their count in front of the piece (whose jump is then 1).
+    from: Option<(Origin, i64)>,
 }
 
 /// The point whose rays decided a piece at the first try (its centre, no ray refused, no
@@ -2350,9 +2355,10 @@ mod tests {
         assert_eq!((plain.bound, plain.cut), (given.bound, given.cut));
     }
 
-    /// Two spheres that cut each other: the pieces decided from a neighbouring triangle's rays
-    /// across a shared edge are decided as their own rays decide them (the same faces, in the same
-    /// order, with nothing left undecided), and they are most first pieces of the cut triangles.
+    /// Two spheres that cut each other: the pieces decided from another piece's rays (of their own
+    /// triangle, or across a shared edge, counting the triangles between) are decided as their own
+    /// rays decide them (the same faces, in the same order, with nothing left undecided), and
+    /// those across an edge are most first pieces of the cut triangles.
     #[test]
     fn pieces_joined_across_edges_are_decided_as_their_own_rays_decide() {
         let (mut vertices, mut tris) = (Vec::new(), Vec::new());
@@ -2362,6 +2368,9 @@ mod tests {
         let joined = resolve_with(&vertices, &tris, &signs, ([0.4, 0.1, 0.1], 0.0), (true, CROWDED_GRID, MAX_GROUPED), &[]);
         let alone = resolve_with(&vertices, &tris, &signs, ([0.4, 0.1, 0.1], 0.0), (false, CROWDED_GRID, MAX_GROUPED), &[]);
         assert_eq!(alone.joined_across, 0);
+        // Joins that pass through the other sphere count its triangles (`alone` asks rays for
+        // every piece): the same decisions.
+        assert!(joined.joins_counted > 0 && alone.joins_counted == 0);
         assert!(joined.joined_across * 2 > joined.cut, "{} of {}", joined.joined_across, joined.cut);
         assert_eq!((joined.bound, alone.bound), (0.0, 0.0));
         let faces = |r: &Resolved| r.faces.iter().map(<[u32]>::to_vec).collect::<Vec<_>>();

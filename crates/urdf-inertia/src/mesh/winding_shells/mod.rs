@@ -1445,17 +1445,40 @@ pub(super) fn edge_meets(s: [f64; 3], e: [f64; 3], o1: f64, o2: f64, t: &[[f64; 
 /// [`edge_meets`] of a segment whose ends are not both on one side of `t`'s plane, nor both in it.
 #[inline(never)]
 fn edge_crosses(s: &[f64; 3], e: &[f64; 3], t: &[[f64; 3]; 3]) -> bool {
-    let (s, e) = (*s, *e);
+    line_passes(s, e, t) != LinePass::Beside
+}
+
+/// Where the line through `s` and `e` passes a triangle `t` (exact `orient3d` of the line against
+/// its three edges).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum LinePass {
+    /// Two edges see it on opposite sides.
+    Beside,
+    /// Through an edge or a corner: a zero among the three, the others of one sign.
+    Edge,
+    /// Through the interior: all three of one sign, strictly.
+    Through,
+}
+
+/// [`LinePass`] of the line through `s` and `e` and triangle `t`.
+#[inline]
+pub(super) fn line_passes(s: &[f64; 3], e: &[f64; 3], t: &[[f64; 3]; 3]) -> LinePass {
     let (a, b, c) = (c3(t[0]), c3(t[1]), c3(t[2]));
-    let (cs, ce) = (c3(s), c3(e));
+    let (cs, ce) = (c3(*s), c3(*e));
     // The line passes beside the triangle when two of its edges see it on opposite sides: the
     // first two often do, and the third is then not asked.
     let (q0, q1) = (orient3d(cs, ce, a, b), orient3d(cs, ce, b, c));
     if (q0 > 0.0 && q1 < 0.0) || (q0 < 0.0 && q1 > 0.0) {
-        return false;
+        return LinePass::Beside;
     }
     let q = [q0, q1, orient3d(cs, ce, c, a)];
-    !(q.iter().any(|x| *x > 0.0) && q.iter().any(|x| *x < 0.0))
+    if q.iter().any(|x| *x > 0.0) && q.iter().any(|x| *x < 0.0) {
+        LinePass::Beside
+    } else if q.contains(&0.0) {
+        LinePass::Edge
+    } else {
+        LinePass::Through
+    }
 }
 
 /// The winding number of triangles at `p`: their solid angles (van Oosterom and Strackee) over 4π.
