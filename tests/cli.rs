@@ -1005,6 +1005,60 @@ fn diff_names_origin_and_mirror_mistakes() {
     );
 }
 
+/// The diff's table keeps its columns under a link name longer than the link column's 28
+/// characters (Robotiq's `robotiq_85_right_inner_knuckle_link` has 35): each number ends where its
+/// header does, on every row.
+#[test]
+fn diff_columns_stay_aligned_under_long_link_names() {
+    let tmp = tempfile::tempdir().unwrap();
+    let link = |name: &str, inertial: &str| {
+        format!("<link name=\"{name}\">{inertial}<collision><geometry><box size=\"1 2 3\"/></geometry></collision></link>")
+    };
+    // 1 × 2 × 3 at 1000 kg/m³: 6000 kg, central tensor diag(6500, 5000, 2500).
+    let weighed = "<inertial><mass value=\"5000\"/><inertia ixx=\"6500\" ixy=\"0\" ixz=\"0\" iyy=\"5000\" iyz=\"0\" izz=\"2500\"/></inertial>";
+    let text = format!(
+        "<robot name=\"r\">{}{}{}</robot>",
+        link("a", weighed),
+        link(
+            "robotiq_85_right_inner_knuckle_link_of_the_left_hand",
+            weighed
+        ),
+        link("b_without_inertial", "")
+    );
+    let path = tmp.path().join("long.urdf");
+    std::fs::write(&path, text).unwrap();
+    let out = run(&["diff", path.to_str().unwrap(), "--density", "1000"]);
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = stdout.lines().collect();
+    let header = lines[0];
+    let end = |h: &str| header.find(h).unwrap() + h.len();
+    let rows: Vec<&str> = lines[1..]
+        .iter()
+        .copied()
+        .filter(|l| !l.starts_with(' '))
+        .collect();
+    assert_eq!(rows.len(), 3, "{stdout}");
+    for row in rows {
+        // The byte where each number ends: the existing and computed masses, and the ratio.
+        for (h, value) in [
+            (
+                "existing kg",
+                if row.starts_with("b_") { "-" } else { "5000" },
+            ),
+            ("computed kg", "6000"),
+            ("ratio", if row.starts_with("b_") { "-" } else { "0.8333" }),
+        ] {
+            let at = end(h);
+            assert_eq!(
+                &row[at - value.len()..at],
+                value,
+                "{h} in {row:?}\n{stdout}"
+            );
+            assert!(row[at..].starts_with(' '), "{h} in {row:?}\n{stdout}");
+        }
+    }
+}
+
 /// Regression: `-i` on a symlinked URDF once replaced the link with a regular file.
 #[cfg(unix)]
 /// What a pre-commit fixing hook runs: several URDFs in place in one process. Each file ends as a

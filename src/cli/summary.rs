@@ -432,13 +432,13 @@ pub fn diff_records(robot: &Robot, report: &FillReport, tolerance: f64) -> Vec<L
 
 /// One link of the diff's table: its masses and relative differences, then both sides' principal
 /// moments.
-fn diff_row(r: &LinkRecord) {
+fn diff_row(r: &LinkRecord, w: usize) {
     let Some(computed) = &r.computed else {
         return;
     };
     let (Some(e), Some(c)) = (&r.existing, &r.comparison) else {
         outln!(
-            "{:<28} {:>12} {:>12} {:>9} {:>10} {:>10}  no existing <inertial>",
+            "{:<w$} {:>12} {:>12} {:>9} {:>10} {:>10}  no existing <inertial>",
             r.link,
             "-",
             significant(computed.mass, 6),
@@ -450,7 +450,7 @@ fn diff_row(r: &LinkRecord) {
     };
     let tolerance = text::rounding_tolerance(r.error_estimate.unwrap_or(0.0));
     outln!(
-        "{:<28} {:>12} {:>12} {:>9} {:>10} {:>10}  {}",
+        "{:<w$} {:>12} {:>12} {:>9} {:>10} {:>10}  {}",
         r.link,
         significant(e.mass, 6),
         significant(computed.mass, 6),
@@ -464,7 +464,7 @@ fn diff_row(r: &LinkRecord) {
     let pe = e.principal_moments.map(|x| significant(x, 7));
     let pc = computed.principal_moments.map(|x| significant(x, 7));
     outln!(
-        "{:<28} principal moments existing {} {} {}, computed {} {} {}",
+        "{:<w$} principal moments existing {} {} {}, computed {} {} {}",
         "",
         pe[0],
         pe[1],
@@ -495,8 +495,16 @@ pub fn diff(
             totals: totals(robot, report),
         }),
         Format::Text => {
+            // The link column as wide as the longest name (28 at least), so that the numbers stay
+            // in their columns: Robotiq's `robotiq_85_right_inner_knuckle_link` has 35 characters.
+            let w = records
+                .iter()
+                .map(|r| r.link.chars().count())
+                .max()
+                .unwrap_or(0)
+                .max(28);
             outln!(
-                "{:<28} {:>12} {:>12} {:>9} {:>10} {:>10}  notes",
+                "{:<w$} {:>12} {:>12} {:>9} {:>10} {:>10}  notes",
                 "link",
                 "existing kg",
                 "computed kg",
@@ -505,7 +513,7 @@ pub fn diff(
                 "inertia Δ"
             );
             for r in &records {
-                diff_row(r);
+                diff_row(r, w);
             }
         }
     }
