@@ -162,8 +162,17 @@ fn causes(
     let scaled = existing.scaled(1.0 / mass_ratio.max(f64::MIN_POSITIVE));
     let about_origin = computed.inertia_about([0.0; 3]);
     let to_origin = relative(&scaled.inertia, &about_origin);
-    if to_origin < 0.5 * relative(&scaled.inertia, &computed.inertia) && to_origin < 0.05 {
+    let as_computed = relative(&scaled.inertia, &computed.inertia);
+    if to_origin < 0.5 * as_computed && to_origin < 0.05 {
         out.push("inertia looks like it is about the link origin, not the COM".into());
+    }
+    // Scaled to one mass the tensors agree: the geometry matches, and the mass (a density, a
+    // weighed mass) is all that differs. No sign slip can then be told apart from the tensor itself.
+    if as_computed < 0.05 {
+        out.push(
+            "scaled to the computed mass, the inertia agrees within 5%: only the mass differs (density?)".into(),
+        );
+        return out;
     }
     // Mirrored products only mean something when there are products: two diagonal tensors cannot be
     // told apart from their mirror images.
@@ -178,7 +187,13 @@ fn causes(
         negated[i][j] = -negated[i][j];
         negated[j][i] = -negated[j][i];
     }
-    if relative(&scaled.inertia, &negated) < 0.05 {
+    // A sign slip is named only where it explains the difference: the tensor with its products
+    // flipped agrees, and at most half as far off as the tensor as computed.
+    let explains = |m: &Mat3| {
+        let d = relative(&scaled.inertia, m);
+        d < 0.05 && d < 0.5 * as_computed
+    };
+    if explains(&negated) {
         out.push("products of inertia have the opposite sign (CAD convention: +∫xy dm)".into());
     }
     for (axis, name) in [(0usize, "x"), (1, "y"), (2, "z")] {
@@ -187,7 +202,7 @@ fn causes(
             m[axis][j] = -m[axis][j];
             m[j][axis] = -m[j][axis];
         }
-        if relative(&scaled.inertia, &m) < 0.05 {
+        if explains(&m) {
             out.push(format!(
                 "products of inertia look mirrored in {name} (mesh mirrored, or scale sign lost?)"
             ));
@@ -314,5 +329,32 @@ mod tests {
         );
         assert!(c.causes[0].contains("opposite sign"), "{:?}", c.causes);
         assert!(c.causes[1..].iter().all(|n| n.contains("mirrored")));
+    }
+
+    /// Robotiq's 2F-85 base link under `check --density 1000`: the tensor is the computed one at
+    /// 2.149 times the mass, with products of about 1e-3 of its size. Each sign slip then also
+    /// agrees within 5% at one mass, and all four were named, though only the mass differs.
+    #[test]
+    fn a_tensor_that_agrees_at_one_mass_names_the_mass_alone() {
+        let b = primitives::cuboid([0.1, 0.2, 0.3], 1000.0);
+        let computed = b.transformed(&crate::mass::rpy_matrix([0.001, -0.0015, 0.002]), [0.0; 3]);
+        let products = [(0, 1), (0, 2), (1, 2)].map(|(i, j)| computed.inertia[i][j].abs());
+        let size = frobenius(&computed.inertia);
+        assert!(products.iter().all(|&p| p > 1e-5 * size && p < 1e-2 * size), "{products:?}");
+        let heavier = computed.scaled(2.149);
+        // The products flipped agree within 5% too: the old rule named every slip.
+        assert!(relative(&with_product_signs(&computed, [-1.0; 3]).inertia, &computed.inertia) < 0.05);
+        let c = compare(&heavier, &computed, 0.37);
+        assert!(c.differs(0.05));
+        assert_eq!(
+            c.causes,
+            vec!["scaled to the computed mass, the inertia agrees within 5%: only the mass differs (density?)".to_string()]
+        );
+        // A real slip at another mass is still named by itself: the turned box mirrored in y, 1.5
+        // times heavier.
+        let mirrored = with_product_signs(&turned_box(), [-1.0, 1.0, -1.0]).scaled(1.5);
+        let c = compare(&mirrored, &turned_box(), 0.37);
+        assert_eq!(c.causes.len(), 1, "{:?}", c.causes);
+        assert!(c.causes[0].contains("mirrored in y"), "{:?}", c.causes);
     }
 }
