@@ -181,7 +181,7 @@ fn fill_in_place_writes_literal_links_into_their_files() {
     let stderr = text(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(
-        stderr.contains("warning[UI502]: arms/arm_macro.xacro:4: link `left_shoulder_link` (macro arm called at robots/robot.urdf.xacro:11): not written into the xacro source: it is written in the body of macro arm; `urdf-inertia fill robots/robot.urdf.xacro -o filled.urdf` writes the filled expansion"),
+        stderr.contains("warning[UI502]: arms/arm_macro.xacro:4: link `left_shoulder_link` (macro arm called at robots/robot.urdf.xacro:11): not written into the xacro source: it is written in the body of macro arm with values xacro computes inside it (`${…}` or `$(…)`), which may differ from call to call; `urdf-inertia fill robots/robot.urdf.xacro -o filled.urdf` writes the filled expansion"),
         "{stderr}"
     );
     // The summary counts what was written: the macro's link was computed, not filled.
@@ -235,6 +235,127 @@ fn fill_in_place_writes_literal_links_into_their_files() {
         std::fs::read_to_string(dir.join("robots/robot.urdf.xacro")).expect("read"),
         top
     );
+}
+
+/// Pads and fingers made by macros that compute nothing inside their links but the names, and a tip
+/// whose box size is a macro parameter ([`fill_in_place_writes_a_macro_body_that_computes_nothing`]).
+const PADS: &str = "<?xml version=\"1.0\"?>
+<robot name=\"pads\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">
+  <xacro:macro name=\"pad\" params=\"side\">
+    <link name=\"${side}_pad\">
+      <collision>
+        <origin xyz=\"0 0 0.01\" rpy=\"0 0 0\"/>
+        <geometry><box size=\"0.03 0.07 0.0075\"/></geometry>
+      </collision>
+    </link>
+  </xacro:macro>
+  <xacro:macro name=\"finger\" params=\"side\">
+    <link name=\"${side}_finger\">
+      <collision><geometry><cylinder radius=\"0.01\" length=\"0.05\"/></geometry></collision>
+    </link>
+  </xacro:macro>
+  <xacro:macro name=\"tip\" params=\"side length\">
+    <link name=\"${side}_tip\">
+      <collision><geometry><box size=\"0.01 0.01 ${length}\"/></geometry></collision>
+    </link>
+  </xacro:macro>
+  <xacro:pad side=\"left\"/>
+  <xacro:pad side=\"right\"/>
+  <xacro:finger side=\"left\"/>
+  <xacro:finger side=\"right\"/>
+  <xacro:tip side=\"left\" length=\"0.02\"/>
+</robot>
+";
+
+/// A macro whose link has nothing computed inside it but its name (Robotiq's 2F-85 writes the
+/// whole gripper so) expands to the same link on every call: `fill -i` writes its `<inertial>` into
+/// the macro body, once for a macro called twice, and the expansion then carries the values `fill`
+/// gives on the expansion. A macro link whose density a `[links]` rule gives by the name one call
+/// made stays as it was, named, with every link made from that place (another call, another name);
+/// so does one with `${…}` inside it.
+#[test]
+fn fill_in_place_writes_a_macro_body_that_computes_nothing() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = tmp.path();
+    std::fs::write(dir.join("pads.urdf.xacro"), PADS).expect("write");
+    std::fs::write(
+        dir.join("densities.toml"),
+        "default = 1000\n[links]\nright_finger = 2000\n",
+    )
+    .expect("write");
+    // The reference: fill of the expansion.
+    let out = run_in(dir, &["xacro", "pads.urdf.xacro"]);
+    assert!(out.status.success());
+    std::fs::write(dir.join("expanded.urdf"), &out.stdout).expect("write");
+    let out = run_in(
+        dir,
+        &["fill", "expanded.urdf", "--density-map", "densities.toml"],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let filled = text(&out.stdout);
+
+    let out = run_in(
+        dir,
+        &[
+            "fill",
+            "-i",
+            "pads.urdf.xacro",
+            "--density-map",
+            "densities.toml",
+        ],
+    );
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("wrote 2 of 5 computed link(s) into 1 xacro source file(s) (2 of them from macro bodies with nothing computed inside the link, the same for every call)"),
+        "{stderr}"
+    );
+    for side in ["left", "right"] {
+        assert!(
+            stderr.contains(&format!("link `{side}_finger` (macro finger called at pads.urdf.xacro:{}): not written into the xacro source: the density of `right_finger` comes from the density map's [links] \"right_finger\", matched by the name this call of macro finger gives it, and another call may give it another name", if side == "left" { 23 } else { 24 })),
+            "{stderr}"
+        );
+    }
+    assert!(
+        stderr.contains("link `left_tip` (macro tip called at pads.urdf.xacro:25): not written into the xacro source: it is written in the body of macro tip with values xacro computes inside it"),
+        "{stderr}"
+    );
+    // One <inertial> written, in the pad macro's body; nothing else changed.
+    let source = std::fs::read_to_string(dir.join("pads.urdf.xacro")).expect("read");
+    assert_eq!(source.matches("<inertial>").count(), 1, "{source}");
+    let a = source.find("      <inertial>\n").expect("written");
+    assert!(
+        source[..a].ends_with("<link name=\"${side}_pad\">\n"),
+        "{source}"
+    );
+    let b = source[a..].find("</inertial>\n").expect("end") + a + "</inertial>\n".len();
+    assert_eq!(format!("{}{}", &source[..a], &source[b..]), PADS);
+    // Both pads expand with the inertial fill gives on the expansion: 0.03 × 0.07 × 0.0075 m of
+    // 1000 kg/m³, 0.01575 kg at (0, 0, 0.01).
+    let out = run_in(dir, &["xacro", "pads.urdf.xacro"]);
+    let again = text(&out.stdout);
+    for side in ["left", "right"] {
+        let link = format!("{side}_pad");
+        assert_eq!(
+            inertial_of(&again, &link),
+            inertial_of(&filled, &link),
+            "{link}"
+        );
+        assert!(inertial_of(&again, &link).contains("<mass value=\"0.01575\"/>"));
+    }
+    // And check passes on the written source.
+    let out = run_in(
+        dir,
+        &[
+            "check",
+            "pads.urdf.xacro",
+            "--density-map",
+            "densities.toml",
+            "--only",
+            "*_pad",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
 }
 
 #[test]

@@ -167,8 +167,12 @@ def same_inertial(a, b):
 
 def literal_links(repo):
     """Link names written literally in the repository's xacro files: outside any macro body, a plain
-    name (no `${`, no `$(`). The write-back must write these."""
+    name (no `${`, no `$(`), no xacro element inside (a macro call there makes part of the link).
+    The write-back must write these."""
     names = set()
+
+    def from_xacro(e):
+        return any(isinstance(c.tag, str) and c.tag.startswith(f"{{{XACRO_NS}}}") for c in e.iter())
 
     def walk(e, in_macro):
         if not isinstance(e.tag, str):
@@ -176,7 +180,7 @@ def literal_links(repo):
         in_macro = in_macro or e.tag == f"{{{XACRO_NS}}}macro"
         if e.tag == "link" and not in_macro:
             name = e.attrib.get("name", "")
-            if "$" not in name:
+            if "$" not in name and not from_xacro(e):
                 names.add(name)
         for c in e:
             walk(c, in_macro)
@@ -223,14 +227,16 @@ def main():
     lines = []
     started = time.perf_counter()
     t_ref = t_ours = 0.0
-    n_top = n_macro = n_rt_written = n_rt_named = n_rt_literal = n_flat_written = 0
+    n_top = n_macro = n_rt_written = n_rt_macro = n_rt_named = n_rt_literal = n_flat_written = 0
 
     for i, (repo, f, args) in enumerate([] if a.speed_only else cases(corpus)):
         case = rel(f, corpus) + ("" if not args else " " + " ".join(args))
         d = work / f"case{i:02}"
         d.mkdir(exist_ok=True)
         ref_path, ours_path = d / "ref.urdf", d / "ours.urdf"
-        rc_r, _, err_r, s_r = run([xacrodoc, "-d", str(corpus), str(f), "-o", str(ref_path)] + args)
+        # From the file's folder: xacrodoc hands xacro the file's text, so a relative include in the
+        # top-level file is looked up from the working directory (xacro itself looks beside the file).
+        rc_r, _, err_r, s_r = run([xacrodoc, "-d", str(corpus), str(f), "-o", str(ref_path)] + args, cwd=f.parent)
         rc_o, out_o, err_o, s_o = run([binary, "xacro", str(f)] + args + package_args(pkgs))
         t_ref += s_r
         t_ours += s_o
@@ -311,7 +317,7 @@ def main():
         rc_fi, out_fi, err_fi, _ = run([binary, "fill", "-i", str(cf), "--keep-going"] + common + package_args(cpkgs) + [f"--arg={x}" for x in args])
         said = out_fi + err_fi
         re_path = d / "re.urdf"
-        rc_re, _, err_re, _ = run([xacrodoc, "-d", str(copy_root), str(cf), "-o", str(re_path)] + args)
+        rc_re, _, err_re, _ = run([xacrodoc, "-d", str(copy_root), str(cf), "-o", str(re_path)] + args, cwd=cf.parent)
         if rc_fi != rc_fr:
             report.fail(case, f"fill -i exits {rc_fi}, fill of the reference expansion {rc_fr}")
         if rc_re != 0:
@@ -330,6 +336,7 @@ def main():
             else:
                 report.fail(case, f"link {n}: fill -i neither wrote the inertial fill gives nor named it")
         n_rt_written += len(written)
+        n_rt_macro += sum(1 for n in written if n not in literal)
         n_rt_named += len(named)
         n_rt_literal += sum(1 for n in computed if n in literal)
 
@@ -344,7 +351,7 @@ def main():
         flat.write_text(text, encoding="utf-8")
         rc_ff, _, _, _ = run([binary, "fill", "-i", str(flat), "--keep-going"] + common)
         re_flat = d / "re-flat.urdf"
-        rc_rf, _, err_rf, _ = run([xacrodoc, "-d", str(copy_root), str(flat), "-o", str(re_flat)])
+        rc_rf, _, err_rf, _ = run([xacrodoc, "-d", str(copy_root), str(flat), "-o", str(re_flat)], cwd=flat.parent)
         if rc_ff != rc_fr or rc_rf != 0:
             report.fail(case, f"fill -i of the saved expansion exits {rc_ff} (fill: {rc_fr}); xacrodoc after it exits {rc_rf} {err_rf.strip()[-200:]}")
             continue
@@ -362,7 +369,8 @@ def main():
     lines.append(f"Corpus: `{corpus}`; reference: xacrodoc (`{xacrodoc}`); ours: `{binary}`.\n")
     if not a.speed_only:
         lines.append(f"{len(report.rows)} expansions: {n_top} top-level (links), {n_macro} macro-only files; "
-                     f"`fill -i` round trip: {n_rt_written} link(s) written into the source and found again by xacrodoc, "
+                     f"`fill -i` round trip: {n_rt_written} link(s) written into the source and found again by xacrodoc "
+                     f"({n_rt_macro} of them into macro bodies with nothing computed inside the link), "
                      f"{n_rt_named} macro link(s) not written and named ({n_rt_literal} computed link(s) written literally in the sources, "
                      "outside macro bodies with a plain name, all of which must be written); "
                      f"on the reference expansions saved as xacro sources, {n_flat_written} link(s) written and found again.\n")

@@ -865,10 +865,115 @@ fn unwritten_summary(
     }
 }
 
+/// The places of the sources `fill -i` writes into, per file (span, update), and how many links
+/// they hold, of which how many from macro bodies; every computed link not written is named
+/// ([`write_into_sources`]).
+fn places_to_write(
+    input: &Input,
+    x: &Expansion,
+    report: &FillReport,
+    policy: &Policy,
+) -> (PerFile, usize, usize) {
+    let robot = &input.robot;
+    let not_written = |line: usize, name: &str, why: &str| {
+        let d = Diagnostic::new(
+            Code::OutputNotInSource,
+            format!(
+                "{}: not written into the xacro source: {why}; `urdf-inertia fill {} -o filled.urdf` writes the filled expansion",
+                input.link_at(line, name),
+                robot.path.display()
+            ),
+        );
+        print_one(policy, &d);
+    };
+    // Per place in the sources (file, span): the links expanded from it, with their updates and,
+    // in a macro body whose link name is computed, a `[links]` rule that gave a density by the
+    // name this call gave (another call, from another top-level file, gives another name, which
+    // the rule may not match). A link in a macro body called more than once is one place for
+    // several links.
+    let mut places = std::collections::BTreeMap::<
+        (usize, usize, usize),
+        Vec<(usize, LinkUpdate, Option<String>)>,
+    >::new();
+    for l in &report.links {
+        let link = &robot.links[l.index];
+        let Some(o) = x.origin(link.line) else {
+            continue;
+        };
+        let by_name = (!o.calls.is_empty() && !o.name_literal)
+            .then(|| l.parts.iter().find(|p| p.density_source.starts_with("[links]")))
+            .flatten()
+            .map(|p| {
+                let m = o.calls.last().map_or("a", |c| c.macro_name.as_str());
+                format!(
+                    "the density of `{}` comes from the density map's {}, matched by the name this call of macro {m} gives it, and another call may give it another name",
+                    link.name, p.density_source
+                )
+            });
+        match &o.literal {
+            Ok(()) => places.entry((o.file, o.start, o.end)).or_default().push((
+                l.index,
+                l.update(),
+                by_name,
+            )),
+            Err(why) => not_written(link.line, &link.name, why),
+        }
+    }
+    // A place written once, when every link expanded from it computes the same `<inertial>`.
+    let mut per_file = PerFile::new();
+    let (mut written, mut in_macros) = (0, 0);
+    for ((file, start, end), links) in places {
+        let first = links[0].1;
+        let names = || {
+            let n: Vec<String> = links
+                .iter()
+                .map(|(i, ..)| format!("`{}`", robot.links[*i].name))
+                .collect();
+            n.join(", ")
+        };
+        let why = links.iter().find_map(|(.., b)| b.clone()).or_else(|| {
+            (!links.iter().all(|(_, u, _)| same_values(u, &first))).then(|| {
+                format!(
+                    "its source expands to {} links ({}) whose computed <inertial> differ",
+                    links.len(),
+                    names()
+                )
+            })
+        });
+        if let Some(why) = why {
+            for (i, ..) in &links {
+                not_written(robot.links[*i].line, &robot.links[*i].name, &why);
+            }
+            continue;
+        }
+        written += links.len();
+        if x.origin(robot.links[links[0].0].line)
+            .is_some_and(|o| !o.calls.is_empty())
+        {
+            in_macros += links.len();
+        }
+        per_file.entry(file).or_default().push((start, end, first));
+    }
+    (per_file, written, in_macros)
+}
+
+/// Whether two updates write the same `<inertial>`: the same values, bit for bit.
+fn same_values(a: &LinkUpdate, b: &LinkUpdate) -> bool {
+    a.props == b.props
+        && a.error.to_bits() == b.error.to_bits()
+        && a.input_precision.to_bits() == b.input_precision.to_bits()
+        && a.size.to_bits() == b.size.to_bits()
+}
+
+/// Per source file: the places written there (span, update).
+type PerFile = std::collections::BTreeMap<usize, Vec<(usize, usize, LinkUpdate)>>;
+
 /// `fill -i` on a xacro source: each computed `<inertial>` spliced into the file where its link is
-/// written literally (an included file too), every other byte unchanged, each file replaced
-/// atomically. A link that comes from a macro (or is otherwise not written literally) is named with
-/// the reason and left alone: `-o FILE` writes the filled expansion instead.
+/// written (an included file too), every other byte unchanged, each file replaced atomically, where
+/// that place makes the same link for every expansion (`Origin::literal`) and every link made
+/// from it computes the same values; in a macro body whose link name is computed, not when a
+/// `[links]` rule gave the density (it matched this call's name). Any other link is named with the
+/// reason and left alone: `-o FILE` writes the filled expansion instead.
 fn write_into_sources(
     input: &Input,
     x: &Expansion,
@@ -880,32 +985,7 @@ fn write_into_sources(
     let mut options = WriteOptions::default();
     options.digits = w.digits;
     options.principal = w.principal;
-    // Per source file: the links written there (span, update).
-    let mut per_file = std::collections::BTreeMap::<usize, Vec<(usize, usize, LinkUpdate)>>::new();
-    for l in &report.links {
-        let link = &robot.links[l.index];
-        let Some(o) = x.origin(link.line) else {
-            continue;
-        };
-        match &o.literal {
-            Ok(()) => per_file
-                .entry(o.file)
-                .or_default()
-                .push((o.start, o.end, l.update())),
-            Err(why) => {
-                let d = Diagnostic::new(
-                    Code::OutputNotInSource,
-                    format!(
-                        "{}: not written into the xacro source: {why}; `urdf-inertia fill {} -o filled.urdf` writes the filled expansion",
-                        input.link_at(link.line, &link.name),
-                        robot.path.display()
-                    ),
-                );
-                print_one(policy, &d);
-            }
-        }
-    }
-    let written: usize = per_file.values().map(Vec::len).sum();
+    let (per_file, written, in_macros) = places_to_write(input, x, report, policy);
     let files = per_file.len();
     for (file, links) in per_file {
         let path = &x.files[file].path;
@@ -950,8 +1030,13 @@ fn write_into_sources(
             return Err(ExitStatus::Error);
         }
     }
+    let macros = if in_macros > 0 {
+        format!(" ({in_macros} of them from macro bodies with nothing computed inside the link, the same for every call)")
+    } else {
+        String::new()
+    };
     errln!(
-        "urdf-inertia: {}: wrote {written} of {} computed link(s) into {files} xacro source file(s)",
+        "urdf-inertia: {}: wrote {written} of {} computed link(s) into {files} xacro source file(s){macros}",
         robot.path.display(),
         report.links.len()
     );

@@ -18,6 +18,8 @@ pub struct Call {
 }
 
 /// Where an element was written.
+// Four independent facts about the place, each asked on its own (not states of one machine).
+#[allow(clippy::struct_excessive_bools)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Src {
     /// Index into the expansion's files.
@@ -32,6 +34,17 @@ pub struct Src {
     pub xacro_inside: bool,
     /// Its `name` attribute holds no `${…}` or `$(…)`.
     pub name_literal: bool,
+    /// Values xacro computes inside it: `${…}` or a `$(…)` other than `$(find …)` in one of its own
+    /// attributes other than `name`, or in an attribute or text of an element inside it.
+    pub computed_inside: bool,
+}
+
+/// Whether xacro computes something in `v`: a `${…}`, or a `$(…)` other than `$(find …)` (a
+/// package's directory, the same in every expansion).
+pub fn computed(v: &str) -> bool {
+    v.contains("${")
+        || v.match_indices("$(")
+            .any(|(i, _)| !v[i..].starts_with("$(find "))
 }
 
 /// An element: its tag, attributes in order, children, and origin.
@@ -155,17 +168,15 @@ pub fn parse(text: &str, file: usize) -> Result<Rc<Element>, ParseError> {
                     let s = t
                         .unescape()
                         .map_err(|e| err(&mut lines, pos, format!("malformed text: {e}")))?;
-                    push_text(&mut top.el.children, &s);
+                    push_text(top, &s);
                 } else if !t.iter().all(u8::is_ascii_whitespace) {
                     return Err(err(&mut lines, pos, "text outside the root element".into()));
                 }
                 continue;
             }
             Event::CData(c) => {
-                push_child(
-                    &mut stack,
-                    Node::CData(String::from_utf8_lossy(&c).into_owned()),
-                );
+                let s = String::from_utf8_lossy(&c).into_owned();
+                push_child(&mut stack, Node::CData(s));
                 continue;
             }
             Event::Comment(c) => {
@@ -233,6 +244,7 @@ fn open_element(
         .iter()
         .find(|(k, _)| k == "name")
         .is_some_and(|(_, v)| !v.contains("${") && !v.contains("$("));
+    let computed_inside = a.iter().any(|(k, v)| k != "name" && computed(v));
     let el = Element {
         name,
         attrs: a,
@@ -245,6 +257,7 @@ fn open_element(
             in_macro,
             xacro_inside: false,
             name_literal,
+            computed_inside,
         },
         calls: None,
     };
@@ -254,11 +267,19 @@ fn open_element(
 /// Adds a node to the open element (nothing outside the root is kept).
 fn push_child(stack: &mut [Open], node: Node) {
     if let Some(top) = stack.last_mut() {
+        // CDATA is text to xacro: `${…}` there is computed too.
+        if let Node::CData(s) = &node {
+            top.el.src.computed_inside |= computed(s);
+        }
         top.el.children.push(node);
     }
 }
 
-fn push_text(children: &mut Vec<Node>, s: &str) {
+/// Text into the open element (joined to text before it), which then computes something inside
+/// when the text holds `${…}`.
+fn push_text(open: &mut Open, s: &str) {
+    open.el.src.computed_inside |= computed(s);
+    let children = &mut open.el.children;
     if let Some(Node::Text(t)) = children.last_mut() {
         t.push_str(s);
     } else {
@@ -270,12 +291,15 @@ fn close(mut open: Open, end: usize, stack: &mut [Open], root: &mut Option<Rc<El
     open.el.src.end = end;
     let is_xacro = open.el.name.starts_with("xacro:");
     let inside = open.el.src.xacro_inside;
+    // Seen from its parent, an element's own name counts too.
+    let computed_inside = open.el.src.computed_inside || open.el.attr("name").is_some_and(computed);
     let el = Rc::new(open.el);
     match stack.last_mut() {
         Some(parent) => {
             if is_xacro || inside {
                 parent.el.src.xacro_inside = true;
             }
+            parent.el.src.computed_inside |= computed_inside;
             parent.el.children.push(Node::Element(el));
         }
         None => *root = Some(el),

@@ -135,10 +135,12 @@ pub struct Origin {
     /// The element's byte span in its file.
     pub start: usize,
     pub end: usize,
-    /// For a `<link>`: `Ok` when it is written literally in its file (outside any macro body, a
-    /// plain name, no xacro inside, expanded once), so a value can be written into it there; else
-    /// why not.
+    /// For a `<link>`: `Ok` when every expansion of the place makes the same link (no xacro
+    /// element inside; in a macro body, nothing computed inside but its name), so a value can be
+    /// written into it there; else why not.
     pub literal: Result<(), String>,
+    /// Its `name` attribute is written without `${…}` or `$(…)`: every expansion gives it that name.
+    pub name_literal: bool,
 }
 
 /// An expanded document and its source map.
@@ -296,12 +298,6 @@ pub fn expand_source(
         format!(" {} ", "=".repeat(83)),
     ];
     let printed = dom::print(&banner, &root);
-    let mut uses: HashMap<(usize, usize), usize> = HashMap::new();
-    for e in printed.line_elements.iter().flatten() {
-        if e.name == "link" {
-            *uses.entry((e.src.file, e.src.start)).or_default() += 1;
-        }
-    }
     let origins = printed
         .line_elements
         .iter()
@@ -309,7 +305,7 @@ pub fn expand_source(
             e.map(|e| {
                 let calls = e.calls.clone().unwrap_or_else(|| Rc::from(Vec::new()));
                 let literal = if e.name == "link" {
-                    literal(e, &calls, uses.get(&(e.src.file, e.src.start)).copied())
+                    literal(e, &calls)
                 } else {
                     Err("not a link".to_string())
                 };
@@ -320,6 +316,7 @@ pub fn expand_source(
                     start: e.src.start,
                     end: e.src.end,
                     literal,
+                    name_literal: e.src.name_literal,
                 }
             })
         })
@@ -333,21 +330,22 @@ pub fn expand_source(
     })
 }
 
-fn literal(e: &dom::Element, calls: &[Call], uses: Option<usize>) -> Result<(), String> {
-    if e.src.in_macro {
-        let m = calls.last().map_or("a", |c| c.macro_name.as_str());
-        return Err(format!("it is written in the body of macro {m}"));
-    }
-    if !e.src.name_literal {
-        return Err("its name is computed by xacro".into());
-    }
+/// Whether `fill -i` may write the link's `<inertial>` where the link is written: nothing inside
+/// it comes from xacro elements, and, in a macro body, nothing inside it is computed (`${…}`,
+/// `$(arg …)`; its name may be), so every call of the macro expands it to the same link. A link
+/// expanded several times (a macro called more than once) is written when every expansion computes
+/// the same `<inertial>` (the writer compares them).
+fn literal(e: &dom::Element, calls: &[Call]) -> Result<(), String> {
     if e.src.xacro_inside {
         return Err(
             "part of it comes from xacro (a macro call, condition or block inside it)".into(),
         );
     }
-    if uses.unwrap_or(0) > 1 {
-        return Err("it is expanded more than once".into());
+    if e.src.in_macro && e.src.computed_inside {
+        let m = calls.last().map_or("a", |c| c.macro_name.as_str());
+        return Err(format!(
+            "it is written in the body of macro {m} with values xacro computes inside it (`${{…}}` or `$(…)`), which may differ from call to call"
+        ));
     }
     Ok(())
 }
