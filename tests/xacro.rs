@@ -154,23 +154,37 @@ fn inertial_of(urdf: &str, name: &str) -> String {
     link[a..b].split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
+/// The reference for a write-back: `xacro ARGS` (the file and its `NAME:=VALUE`s) saved as
+/// `expanded.urdf` in `dir`, and the URDF `fill expanded.urdf FILL` prints.
+fn filled_expansion(dir: &Path, xacro: &[&str], fill: &[&str]) -> String {
+    let out = run_in(dir, &[&["xacro"], xacro].concat());
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    std::fs::write(dir.join("expanded.urdf"), &out.stdout).expect("write");
+    let out = run_in(dir, &[&["fill", "expanded.urdf"], fill].concat());
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    text(&out.stdout)
+}
+
+/// `fill -i ARGS`, which must succeed: its standard error.
+fn fill_in_place(dir: &Path, args: &[&str]) -> String {
+    let out = run_in(dir, &[&["fill", "-i"], args].concat());
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    stderr
+}
+
 #[test]
 fn fill_in_place_writes_literal_links_into_their_files() {
     let tmp = robot();
     let dir = tmp.path();
-    // The reference: fill of the expansion.
-    let out = run_in(dir, &["xacro", "robots/robot.urdf.xacro", "m:=2"]);
-    assert!(out.status.success());
-    std::fs::write(dir.join("expanded.urdf"), &out.stdout).expect("write");
-    let out = run_in(dir, &["fill", "expanded.urdf", "--density", "1000"]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    let filled = text(&out.stdout);
-
-    let out = run_in(
+    let filled = filled_expansion(
+        dir,
+        &["robots/robot.urdf.xacro", "m:=2"],
+        &["--density", "1000"],
+    );
+    let stderr = fill_in_place(
         dir,
         &[
-            "fill",
-            "-i",
             "robots/robot.urdf.xacro",
             "--arg",
             "m:=2",
@@ -178,8 +192,6 @@ fn fill_in_place_writes_literal_links_into_their_files() {
             "1000",
         ],
     );
-    let stderr = text(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
     assert!(
         stderr.contains("warning[UI502]: arms/arm_macro.xacro:4: link `left_shoulder_link` (macro arm called at robots/robot.urdf.xacro:11): not written into the xacro source: it is written in the body of macro arm with values xacro computes inside it (`${…}` or `$(…)`), which may differ from call to call; `urdf-inertia fill robots/robot.urdf.xacro -o filled.urdf` writes the filled expansion"),
         "{stderr}"
@@ -283,29 +295,9 @@ fn fill_in_place_writes_a_macro_body_that_computes_nothing() {
         "default = 1000\n[links]\nright_finger = 2000\n",
     )
     .expect("write");
-    // The reference: fill of the expansion.
-    let out = run_in(dir, &["xacro", "pads.urdf.xacro"]);
-    assert!(out.status.success());
-    std::fs::write(dir.join("expanded.urdf"), &out.stdout).expect("write");
-    let out = run_in(
-        dir,
-        &["fill", "expanded.urdf", "--density-map", "densities.toml"],
-    );
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    let filled = text(&out.stdout);
-
-    let out = run_in(
-        dir,
-        &[
-            "fill",
-            "-i",
-            "pads.urdf.xacro",
-            "--density-map",
-            "densities.toml",
-        ],
-    );
-    let stderr = text(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    let map = ["--density-map", "densities.toml"];
+    let filled = filled_expansion(dir, &["pads.urdf.xacro"], &map);
+    let stderr = fill_in_place(dir, &["pads.urdf.xacro", map[0], map[1]]);
     assert!(
         stderr.contains("wrote 2 of 5 computed link(s) into 1 xacro source file(s) (2 of them from macro bodies with nothing computed inside the link, the same for every call)"),
         "{stderr}"
