@@ -219,9 +219,15 @@ print(f"== fill hook: wrote the wheel's <inertial> (mass {got_m} kg, the cylinde
 EOF
 isolated git -C "$repo" diff --stat | sed 's/^/   /'
 
-# The fix (the solid cylinder's mass, 1000 * pi * 0.03^2 * 0.3 = 0.848 kg), staged with the filled URDF:
-# the whole repository, so this run is the one a clean commit gets.
-sed -i 's/<mass value="-1.5"\/>/<mass value="0.848"\/>/' "$repo/urdf/arm_macro.xacro"
+# The fill hook also fixed the macro: its link has nothing computed inside it but its name, so every
+# call makes the same link, and fill -i writes the solid cylinder's mass (1000 * pi * 0.03^2 * 0.3 =
+# 0.848 kg) into the macro body. Staged with the filled URDF: the whole repository, so this run is
+# the one a clean commit gets.
+if ! grep -qE '<mass value="0\.848[0-9]*"/>' "$repo/urdf/arm_macro.xacro"; then
+  cat "$repo/urdf/arm_macro.xacro"
+  fail "the fill hook did not write the cylinder's mass into the arm macro's body"
+fi
+echo "== fill hook: wrote the arm macro's <inertial> into its body ($(grep -oE '<mass value="[^"]*"/>' "$repo/urdf/arm_macro.xacro"))"
 isolated git -C "$repo" add -A
 hooks 0
 isolated git -C "$repo" commit --quiet -m "two arms and a cart"
@@ -256,7 +262,8 @@ run_config() {
 isolated git -C "$repo" add -A
 run_config 0 --all-files
 isolated git -C "$repo" commit --quiet -m "pre-commit configuration"
-sed -i 's/<mass value="0.848"\/>/<mass value="-0.848"\/>/' "$repo/urdf/arm_macro.xacro"
+sed -i -E 's/<mass value="0\.848[0-9]*"\/>/<mass value="-0.848"\/>/' "$repo/urdf/arm_macro.xacro"
+grep -qF '<mass value="-0.848"/>' "$repo/urdf/arm_macro.xacro" || fail "the macro's mass was not broken for the test"
 isolated git -C "$repo" add urdf/arm_macro.xacro
 run_config 1
 expect_in_log "arm_macro.xacro:$macro_line: link \`left_upper_arm\`"
